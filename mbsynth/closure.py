@@ -1,0 +1,158 @@
+"""Closing models with massless parts: the force balances of Result 3.
+
+When ``[M; A]`` has a null vector w, premultiplying (2.5) by wᵀ gives
+wᵀMq̈ = 0 = wᵀ(Q + C) (using (2.6), since Aw = 0): the applied forces along w
+must balance, or no motion exists. Such a balance is exactly what the paper adds
+by hand in example 3: (5.40) k1 x̄1 = k2 q̄2 when m1 = 0, (5.49) k2 q̄2 = 0 when
+m2 = 0. Where the balance vanishes identically (example 2's massless particle,
+(5.23)) the direction is simply free. ``balances`` derives them symbolically;
+``close`` appends the non-trivial ones as constraints (``closure: auto``).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from .connectors import ExpressionConstraint
+from .equations import rank_report
+from .errors import ModelError
+from .symbolic import T_SYMBOL
+from .system import Closure
+
+ZERO_TOL = 1e-9  # a sampled balance below this (relative to the force scale) is identically zero
+SAMPLES = 8
+
+
+@dataclass(frozen=True)
+class Balance:
+    """One indeterminate direction w and its balance wᵀ(Q + C) = 0.
+
+    ``direction``: {coordinate: component} at the diagnosed state, largest component +1.
+    ``expression``: wᵀ(Q + C) in the model's symbols (0 when identically zero: a free
+    direction). ``state_dependent``: w itself changes with the state, so the balance
+    holds along the motion only while the null space keeps its form.
+    """
+
+    direction: dict
+    expression: sp.Expr
+    state_dependent: bool
+
+    @property
+    def free(self):
+        return self.expression == 0
+
+    @property
+    def equation(self):
+        return f"{sp.sstr(self.expression)} = 0"
+
+
+def balances(system, t=0.0, q=None, qd=None):
+    """The balances of every indeterminate direction of ``system`` (none when unique).
+
+    The null space of [M; A] is found symbolically with the parameter values
+    substituted; where its dimension differs from the numeric one at (t, q, q̇)
+    (a special configuration) the numeric null vectors at that state are used and
+    the balances are marked state dependent.
+    """
+    q0, qd0 = system.initial_state()
+    q = q0 if q is None else np.asarray(q, dtype=float)
+    qd = qd0 if qd is None else np.asarray(qd, dtype=float)
+    values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in system.parameters.items()}
+    M, Q, A, _, C = system.symbolic()
+    force = Q + C
+    state = {s: v for s, v in zip(system.q_symbols + system.qd_symbols, np.concatenate([q, qd]))}
+    state[T_SYMBOL] = t
+    arrays = system.evaluate(t, q, qd)
+    numeric = rank_report(arrays.M, arrays.A).nullspace
+    if numeric.shape[1] == 0:
+        return []
+    symbolic_w = M.col_join(A).subs(values).nullspace(simplify=True)
+    if len(symbolic_w) == numeric.shape[1]:
+        W = sp.Matrix.hstack(*symbolic_w)
+    else:
+        W = sp.Matrix(numeric)
+    dynamic = set(system.q_symbols) | set(system.qd_symbols) | {T_SYMBOL}
+    state_dependent = len(symbolic_w) != numeric.shape[1] or bool(W.free_symbols & dynamic)
+    free, balanced = _separate(W.T * force, values, system, q, qd, t)
+    result = []
+    for combos, is_free in ((free, True), (balanced, False)):
+        for c in combos:
+            w = _normalized(W * sp.Matrix(c), dynamic)
+            expression = sp.S.Zero if is_free else sp.simplify((w.T * force)[0])
+            result.append(Balance(_direction(w, state, system.coordinates), expression, state_dependent))
+    return result
+
+
+def _separate(g, values, system, q, qd, t):
+    """Split the span of the balances g = Wᵀ(Q + C) into combinations that vanish
+    identically (free directions) and a basis of the rest, by sampling random states."""
+    rng = np.random.default_rng(0)
+    args = list(system.q_symbols) + list(system.qd_symbols) + [T_SYMBOL]
+    f = sp.lambdify(args, list(g.subs(values)), modules="numpy")
+    samples = []
+    for _ in range(SAMPLES):
+        x = np.concatenate([q + rng.normal(size=q.size), qd + rng.normal(size=qd.size), [t + rng.normal()]])
+        samples.append(np.asarray(f(*x), dtype=float))
+    G = np.array(samples)  # SAMPLES x r
+    scale = np.abs(G).max()
+    if scale == 0:
+        return _rational_rows(np.eye(G.shape[1])), []
+    _, s, vt = np.linalg.svd(G / scale)
+    rank = int(np.sum(s > ZERO_TOL))
+    return _rational_rows(vt[rank:]), _rational_rows(vt[:rank])
+
+
+def _rational_rows(rows):
+    return [[sp.nsimplify(x, rational=True, tolerance=1e-12) for x in row] for row in rows]
+
+
+def _normalized(w, dynamic):
+    """A constant w scaled so its largest entry is +1 (a state-dependent w is left as is)."""
+    if w.free_symbols & dynamic:
+        return w
+    return w / max(w, key=lambda x: (abs(float(x)), float(x)))
+
+
+def _direction(w, state, coordinates):
+    values = np.array([float(x) for x in w.subs(state).evalf()])
+    values /= values[np.argmax(np.abs(values))]
+    return {c: float(v) for c, v in zip(coordinates, values) if abs(v) > 1e-12}
+
+
+def close(system, max_rounds=None):
+    """Append every non-trivial balance as a constraint until the motion is unique or
+    only free directions are left (``closure: auto``). Returns a new System."""
+    for round_ in range(max_rounds or system.n):
+        needed = [bal for bal in balances(system) if not bal.free]
+        if not needed:
+            return system
+        extra, notes = [], []
+        for bal in needed:
+            name = f"closure_{len(system.closures) + len(extra) + 1}"
+            extra.append(_as_constraint(system, name, bal))
+            notes.append(Closure(name, bal.equation, bal.direction, bal.state_dependent))
+        before = rank_report(*_MA(system)).rank_Mhat
+        system = system.with_constraints(extra, notes)
+        if rank_report(*_MA(system)).rank_Mhat == before:
+            raise ModelError(f"model '{system.name}': closure balances {[b.equation for b in needed]} "
+                             "do not determine the indeterminate accelerations")
+    return system
+
+
+def _MA(system):
+    arrays = system.evaluate(0.0, *system.initial_state())
+    return arrays.M, arrays.A
+
+
+def _as_constraint(system, name, bal):
+    expression = bal.expression
+    dynamic = set(system.q_symbols) | set(system.qd_symbols)
+    if not expression.free_symbols & dynamic:
+        raise ModelError(f"model '{system.name}': the force along {bal.direction} is "
+                         f"{sp.sstr(expression)}, which involves no coordinate, and no mass resists "
+                         "that direction: the model admits no motion")
+    args = (system.q_symbols, system.qd_symbols, system.parameter_symbols)
+    if expression.free_symbols & set(system.qd_symbols):
+        return ExpressionConstraint.nonholonomic(name, expression, *args)
+    return ExpressionConstraint.holonomic(name, expression, *args)

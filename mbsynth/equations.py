@@ -1,0 +1,345 @@
+"""The explicit equation of motion of Udwadia & Phohomsiri (2006), and nothing else.
+
+Given the unconstrained equation M q̈ = Q (2.1) with symmetric positive semi-definite,
+possibly singular M, the constraints A q̈ = b (2.4) and the non-ideal constraint vector
+C (2.6), the constrained acceleration is (2.14) with η = 0,
+
+    q̈ = M̄⁺ [Q + C; b],     M̄ = [(I − A⁺A) M; A],                       (2.13)
+
+the minimum-norm solution of (2.12). It is unique iff M̂ = [M; A] has full column rank
+(Lemma 3.1, Result 3); otherwise any multiple of null(M̂) = null(M̄) may be added.
+
+Rank rule (scale-aware). Rows of A (and b) are divided by their 2-norms (zero rows stay
+zero and so contribute nothing); M is divided by its largest absolute entry μ (an all-zero
+M contributes nothing). A singular value of the equilibrated matrix counts as zero when
+it is below ``rtol`` times the largest one. Row scaling changes neither the null space nor
+the rank, nor, for consistent data, the minimum-norm solution of (2.12), so the equilibrated
+system is solved in place of the literal one. ``RANK_RTOL`` = 1e-12 lies far above the
+rounding noise of evaluated expressions (~n ε ≈ 1e-15) and below any physically meaningful
+mass ratio (after dividing by the largest entry of M). rank M and rank A use the same rule on
+their own blocks.
+
+Consistency rule. (2.12) has a solution iff (a) b ∈ range(A) and (b) wᵀ(Q + C) = 0 for
+every w ∈ null([M; A]) (proof in ``constrained_acceleration``). Either failure raises
+``SolveError``; no least-squares vector is ever returned. A violation counts when the
+offending component exceeds ``tol`` times a scale of the data, with
+tol = max(CONSISTENCY_RTOL, 8 k ε σ₁/σ_r): the second term is the rounding error of the
+computed null space (its angle error is about ε σ₁/σ_r, σ_r the smallest kept singular
+value), so a consistent problem is never rejected for the inaccuracy of its own basis.
+The scales: for (a), ‖b_e‖ + ‖q̈‖ (b_e the equilibrated b, whose rows of A have unit norm);
+for (b), ‖Q + C‖ + ‖M q̈‖ (the applied and the inertial forces). Both components are
+projections, so they never exceed their scale: the test is a pure ratio.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import SolveError
+
+RANK_RTOL = 1e-12  # singular values below RANK_RTOL · σ_max of the equilibrated matrix are zero
+CONSISTENCY_RTOL = 1e-9  # least relative size of b ∉ range(A) or of wᵀ(Q + C) that is an error
+SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
+NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
+
+_EPS = np.finfo(float).eps
+_TINY = np.finfo(float).tiny
+
+
+@dataclass(frozen=True, eq=False)
+class RankReport:
+    """Ranks behind Lemma 3.1 and Result 3 (equilibrated as in the module docstring).
+
+    ``nullspace``: n × (n − rank_Mhat) orthonormal basis of null([M; A]) = null(M̄).
+    """
+
+    rank_M: int
+    rank_A: int
+    rank_Mhat: int
+    n: int
+    m: int
+    nullspace: np.ndarray
+
+    @property
+    def unique(self) -> bool:
+        """Result 3: the acceleration is unique iff M̂ = [M; A] has full column rank n."""
+        return self.rank_Mhat == self.n
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """The constrained acceleration at one state.
+
+    ``qdd``: the minimum-norm solution of (2.12), (2.14) with η = 0; ``nullspace``: n × r
+    orthonormal basis of the directions it leaves free (n × 0 when ``unique``); ``Qc``:
+    the constraint force M q̈ − Q of (2.5); ``residual``: relative residual of the
+    row-equilibrated (2.12) at q̈; ``method``: the formula that produced q̈.
+    """
+
+    qdd: np.ndarray
+    unique: bool
+    nullspace: np.ndarray
+    Qc: np.ndarray
+    residual: float
+    method: str
+
+
+@dataclass(frozen=True, eq=False)
+class _Data:
+    """Validated float arrays of one problem and their equilibrated forms."""
+
+    M: np.ndarray
+    Q: np.ndarray
+    F: np.ndarray  # Q + C
+    A: np.ndarray
+    b: np.ndarray
+    Ae: np.ndarray  # rows of A divided by their 2-norms (zero rows stay zero)
+    be: np.ndarray  # b divided by the same norms
+    mu: float  # max |M|, 1 when M = 0
+    coordinates: tuple
+    constraints: tuple
+
+    @property
+    def n(self):
+        return self.M.shape[0]
+
+    @property
+    def m(self):
+        return self.A.shape[0]
+
+
+def rank_report(M, A, *, rtol=RANK_RTOL) -> RankReport:
+    """rank M, rank A, rank M̂ and null(M̂) of M̂ = [M; A] (Lemma 3.1, Result 3)."""
+    M, A = np.asarray(M, dtype=float), np.asarray(A, dtype=float)
+    if M.ndim != 2:
+        raise ValueError(f"M must be a square 2-d array, got shape {M.shape}")
+    d = _prepare(M, np.zeros(M.shape[0]), A, np.zeros(A.shape[0] if A.ndim == 2 else 0), None)
+    return _rank_report(d, rtol)[0]
+
+
+def constrained_acceleration(M, Q, A, b, C=None, *, rtol=RANK_RTOL,
+                             coordinates=None, constraints=None) -> Motion:
+    """The acceleration of (2.14) with η = 0: q̈ = M̄⁺ [Q + C; b], M̄ = [(I − A⁺A)M; A].
+
+    M may be singular (symmetric positive semi-definite). M̄⁺ keeps exactly rank M̂
+    singular values, since null(M̄) = null(M̂) (Lemma 3.1). The result is unique iff
+    rank M̂ = n (Result 3); otherwise ``nullspace`` spans the free directions and q̈ is
+    the solution orthogonal to them.
+
+    Solvability of (2.12), i.e. when some q̈ satisfies both (2.4) and (2.11): (2.4) needs
+    b ∈ range(A); then q̈ = A⁺b + P z with P = I − A⁺A and (2.11) reads
+    P M P z = P(Q + C − M A⁺b). P M P is symmetric, so this is solvable iff the right side
+    is orthogonal to null(P M P) = {z : M P z = 0} (M ⪰ 0: zᵀPMPz = ‖M^½ P z‖²). With
+    w = P z, which ranges over {w : A w = 0, M w = 0} = null([M; A]), the condition is
+    wᵀ(Q + C) − (M w)ᵀA⁺b = wᵀ(Q + C) = 0. Hence (a) b ∈ range(A) and (b) wᵀ(Q + C) = 0
+    for all w ∈ null([M; A]) are necessary and sufficient; a violation raises
+    ``SolveError`` naming the constraints (a) or coordinates (b) involved, as does
+    NaN/inf input. Shape errors raise ``ValueError``.
+    """
+    d = _prepare(M, Q, A, b, C, coordinates, constraints)
+    report, s_hat = _rank_report(d, rtol)
+    Ua, sa, Vk = _row_space(d.Ae, rtol)
+    r = report.rank_Mhat
+    Mbar = np.vstack([(d.M - Vk @ (Vk.T @ d.M)) / d.mu, d.Ae])  # (2.13), rows equilibrated
+    U, s, Vt = np.linalg.svd(Mbar, full_matrices=False)
+    rhs = np.concatenate([d.F / d.mu, d.be])
+    qdd = Vt[:r].T @ ((U[:, :r].T @ rhs) / s[:r])  # (2.14), η = 0
+    _check_constraints(d, Ua, sa, Vk.shape[1], qdd)
+    _check_forces(d, report.nullspace, s_hat, r, qdd)
+    return _motion(d, qdd, Vk, "pseudoinverse (2.14)", report.nullspace)
+
+
+def udwadia_kalaba(M, Q, A, b, C=None, *, coordinates=None, constraints=None) -> Motion:
+    """The Udwadia–Kalaba equation (4.24), valid for positive-definite M only:
+
+    q̈ = a + M^-½ B⁺ (b − A a) + M^-½ (I − B⁺B) M^-½ C,   a = M⁻¹Q,  B = A M^-½ (4.3).
+
+    M^-½ comes from the eigendecomposition of M. A singular or indefinite M (Cholesky
+    fails or λ_min ≤ n ε λ_max) raises ``SolveError`` pointing to (2.14),
+    ``constrained_acceleration``. B⁺ keeps the singular values of the row-equilibrated B
+    allowed by ``RANK_RTOL`` (dependent constraint rows are fine); contradictory
+    constraints raise ``SolveError`` as in ``constrained_acceleration``.
+    """
+    d = _prepare(M, Q, A, b, C, coordinates, constraints)
+    lam, V = np.linalg.eigh(d.M)
+    bad = lam <= d.n * _EPS * max(lam[-1], 0.0)
+    try:
+        np.linalg.cholesky(d.M)
+    except np.linalg.LinAlgError:
+        bad[0] = True
+    if bad.any():
+        names = [d.coordinates[i] for i in _named(np.linalg.norm(V[:, bad], axis=1))]
+        raise SolveError(
+            f"M is singular or not positive definite (eigenvalues from {lam[0]:.3g} to "
+            f"{lam[-1]:.3g}); M^-1/2 in (4.24) does not exist. The null/negative directions "
+            f"involve {', '.join(names)}. Use constrained_acceleration, eq. (2.14), which "
+            "handles singular mass matrices.", coordinates=names)
+    Mih = (V / np.sqrt(lam)) @ V.T  # M^-1/2
+    a = V @ ((V.T @ d.Q) / lam)  # M⁻¹Q
+    B = d.A @ Mih  # (4.3)
+    norms = np.linalg.norm(B, axis=1)
+    norms[norms == 0] = 1.0
+    Ub, sb, Vb = _row_space(B / norms[:, None], RANK_RTOL)
+    k = Vb.shape[1]
+    Bplus_e = Vb @ (Ub[:, :k].T / sb[:k, None])  # B⁺ of the row-equilibrated B
+    x = Mih @ (d.F - d.Q)  # M^-½ C
+    qdd = a + Mih @ (Bplus_e @ ((d.b - d.A @ a) / norms)) + Mih @ (x - Vb @ (Vb.T @ x))  # (4.24)
+    Ua, sa, Vk = _row_space(d.Ae, RANK_RTOL)
+    _check_constraints(d, Ua, sa, Vk.shape[1], qdd)
+    return _motion(d, qdd, Vk, "udwadia-kalaba (4.24)", np.zeros((d.n, 0)))
+
+
+# ---------------------------------------------------------------- shared helpers
+
+
+def _prepare(M, Q, A, b, C, coordinates=None, constraints=None) -> _Data:
+    """Check shapes (ValueError), finiteness and symmetry of M (SolveError); equilibrate."""
+    M, Q, A, b = (np.asarray(x, dtype=float) for x in (M, Q, A, b))
+    if Q.ndim != 1 or Q.shape[0] == 0:
+        raise ValueError(f"Q must be a 1-d array of n >= 1 entries, got shape {Q.shape}")
+    n = Q.shape[0]
+    if M.shape != (n, n):
+        raise ValueError(f"M must have shape ({n}, {n}) to match Q, got {M.shape}")
+    if A.size == 0 and b.size == 0:
+        A, b = A.reshape(0, n), b.reshape(0)
+    if A.ndim != 2 or A.shape[1] != n:
+        raise ValueError(f"A must have shape (m, {n}), got {A.shape}")
+    m = A.shape[0]
+    if b.shape != (m,):
+        raise ValueError(f"b must have shape ({m},) to match A, got {b.shape}")
+    C = np.zeros(n) if C is None else np.asarray(C, dtype=float)
+    if C.shape != (n,):
+        raise ValueError(f"C must have shape ({n},) to match Q, got {C.shape}")
+    coordinates = _names(coordinates, n, "coordinates", "q[{}]")
+    constraints = _names(constraints, m, "constraints", "row {}")
+    for label, x in (("M", M), ("Q", Q), ("C", C), ("A", A), ("b", b)):
+        _check_finite(label, x, coordinates, constraints)
+    mu = float(np.abs(M).max())
+    asym = np.abs(M - M.T)
+    if asym.max() > SYMMETRY_RTOL * mu:
+        i, j = np.unravel_index(np.argmax(asym), asym.shape)
+        raise SolveError(
+            f"M is not symmetric: M[{coordinates[i]}, {coordinates[j]}] = {M[i, j]:.6g} but "
+            f"M[{coordinates[j]}, {coordinates[i]}] = {M[j, i]:.6g}",
+            coordinates=(coordinates[i], coordinates[j]))
+    norms = np.linalg.norm(A, axis=1)
+    norms[norms == 0] = 1.0
+    return _Data(M=M, Q=Q, F=Q + C, A=A, b=b, Ae=A / norms[:, None], be=b / norms,
+                 mu=mu if mu > 0 else 1.0, coordinates=coordinates, constraints=constraints)
+
+
+def _names(names, count, label, pattern):
+    if names is None:
+        return tuple(pattern.format(i) for i in range(count))
+    names = tuple(str(x) for x in names)
+    if len(names) != count:
+        raise ValueError(f"{label} must name {count} entries, got {len(names)}")
+    return names
+
+
+def _check_finite(label, x, coordinates, constraints):
+    """SolveError naming the array, and the coordinate/constraint, of a NaN or inf entry."""
+    bad = ~np.isfinite(x)
+    if not bad.any():
+        return
+    index = tuple(int(i) for i in np.argwhere(bad)[0])
+    value = x[index]
+    if label in ("Q", "C"):
+        coords, cons, where = (coordinates[index[0]],), (), f" at {coordinates[index[0]]}"
+    elif label == "M":
+        coords = (coordinates[index[0]], coordinates[index[1]])
+        cons, where = (), f" at [{coords[0]}, {coords[1]}]"
+    elif label == "A":
+        coords, cons = (coordinates[index[1]],), (constraints[index[0]],)
+        where = f" in constraint {cons[0]}, coordinate {coords[0]}"
+    else:
+        coords, cons = (), (constraints[index[0]],)
+        where = f" in constraint {cons[0]}"
+    raise SolveError(f"{label} contains {value}{where}", constraints=cons, coordinates=coords)
+
+
+def _rank(s, rtol):
+    """Number of singular values s (descending) above rtol · s[0]."""
+    return int(np.count_nonzero(s > rtol * s[0])) if s.size and s[0] > 0 else 0
+
+
+def _rank_report(d: _Data, rtol):
+    """RankReport of M̂ = [M/μ; A_e] and the singular values of that matrix."""
+    _, s, Vt = np.linalg.svd(np.vstack([d.M / d.mu, d.Ae]), full_matrices=False)
+    r = _rank(s, rtol)
+    rank_M = _rank(np.linalg.svd(d.M / d.mu, compute_uv=False), rtol)
+    rank_A = _rank(np.linalg.svd(d.Ae, compute_uv=False), rtol) if d.m else 0
+    report = RankReport(rank_M=rank_M, rank_A=rank_A, rank_Mhat=r, n=d.n, m=d.m,
+                        nullspace=Vt[r:].T.copy())
+    return report, s
+
+
+def _row_space(X, rtol):
+    """SVD of X (m × n) as (U, s, V_k): V_k an orthonormal basis of the row space, so that
+    X⁺X = V_k V_kᵀ and I − X⁺X is the projector P of (2.8)."""
+    if X.shape[0] == 0:
+        return np.zeros((0, 0)), np.zeros(0), np.zeros((X.shape[1], 0))
+    U, s, Vt = np.linalg.svd(X, full_matrices=True)
+    return U, s, Vt[:_rank(s, rtol)].T
+
+
+def _tol(s, r, size):
+    """Relative tolerance for components along a computed null space (module docstring)."""
+    return max(CONSISTENCY_RTOL, 8 * size * _EPS * s[0] / s[r - 1]) if r else CONSISTENCY_RTOL
+
+
+def _named(weights):
+    """Indices whose weight is non-negligible relative to the largest."""
+    return [i for i, w in enumerate(weights) if w > NAME_RTOL * np.max(weights)]
+
+
+def _check_constraints(d: _Data, Ua, sa, k, qdd):
+    """(a): b ∈ range(A), tested on the left null space of the equilibrated A."""
+    if d.m == 0:
+        return
+    U0 = Ua[:, k:]
+    u = U0 @ (U0.T @ d.be)  # the part of b_e that no q̈ can produce
+    size = np.linalg.norm(u)
+    if size <= _tol(sa, k, d.m) * (np.linalg.norm(d.be) + np.linalg.norm(qdd) + _TINY):
+        return
+    names = [d.constraints[i] for i in _named(np.abs(u))]
+    raise SolveError(
+        f"contradictory constraints: {', '.join(names)} cannot hold together; A q̈ = b has no "
+        f"solution (b has a component of norm {size:.3g} outside the range of A, with each "
+        "row of A scaled to unit norm)", constraints=names)
+
+
+def _check_forces(d: _Data, N, s_hat, r, qdd):
+    """(b): wᵀ(Q + C) = 0 for every w in null([M; A])."""
+    if N.shape[1] == 0:
+        return
+    g = N.T @ d.F
+    imbalance = float(np.linalg.norm(g))
+    scale = np.linalg.norm(d.F) + np.linalg.norm(d.M @ qdd) + _TINY
+    if imbalance <= _tol(s_hat, r, d.n) * scale:
+        return
+    w = N @ g / imbalance
+    index = _named(np.abs(w))
+    names = [d.coordinates[i] for i in index]
+    direction = ", ".join(f"{d.coordinates[i]}: {w[i]:+.3g}" for i in index)
+    raise SolveError(
+        f"force on a direction no mass resists: wᵀ(Q + C) = {imbalance:.6g} ≠ 0 for w in "
+        f"null([M; A]) along ({direction}). No motion exists: these coordinates carry no "
+        "mass and no constraint fixes them; add the force balance wᵀ(Q + C) = 0 as a "
+        "constraint (as (5.40), (5.49) do) or give them mass.", coordinates=names)
+
+
+def _motion(d: _Data, qdd, Vk, method, nullspace) -> Motion:
+    """Motion with Qc = M q̈ − Q (2.5) and the relative residual of the equilibrated (2.12);
+    Vk spans the row space of A, so P x = x − V_k V_kᵀ x."""
+    def P(x):
+        return x - Vk @ (Vk.T @ x)
+    force = d.M @ qdd
+    res = np.concatenate([P(force - d.F) / d.mu, d.Ae @ qdd - d.be])
+    rhs = np.concatenate([P(d.F) / d.mu, d.be])
+    scale = ((np.linalg.norm(d.M) / d.mu + np.linalg.norm(d.Ae)) * np.linalg.norm(qdd)
+             + np.linalg.norm(rhs) + _TINY)
+    return Motion(qdd=qdd, unique=nullspace.shape[1] == 0, nullspace=nullspace,
+                  Qc=force - d.Q, residual=float(np.linalg.norm(res) / scale), method=method)

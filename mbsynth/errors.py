@@ -1,0 +1,21 @@
+"""The two kinds of error a user of mbsynth can cause."""
+
+
+class ModelError(ValueError):
+    """Bad model input: a file, key, name, expression or value that cannot be used.
+
+    The message names the file and line, the key path, the part or the coordinate.
+    """
+
+
+class SolveError(ArithmeticError):
+    """The data at a state admit no motion: contradictory constraints, a force on a
+    direction no mass resists (w^T (Q + C) != 0, w in null [M; A]), or NaN/inf input.
+
+    ``constraints`` and ``coordinates`` name the offenders where they are known.
+    """
+
+    def __init__(self, message, *, constraints=(), coordinates=()):
+        super().__init__(message)
+        self.constraints = tuple(constraints)
+        self.coordinates = tuple(coordinates)

@@ -1,0 +1,266 @@
+"""Model files (YAML) to Systems.
+
+Every mistake in a file raises ``ModelError`` reading ``file:line: at key.path: why``.
+Expressions are parsed by ``mbsynth.expressions`` (never evaluated as code).
+"""
+
+import difflib
+import keyword
+
+import numpy as np
+import sympy as sp
+
+from ..closure import close
+from ..connectors import ExpressionConstraint
+from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
+from ..subsystems import LagrangianSubsystem
+from ..symbolic import T_SYMBOL
+from ..system import System
+from .source import Document, LineDict, LineList, read_document
+
+TOP_KEYS = {"name", "description", "parameters", "subsystems", "constraints", "closure", "initial"}
+RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
+
+
+def load(path):
+    """Read the model file at ``path`` and return its ``System``."""
+    return build(read_document(path))
+
+
+def loads(text, name="<string>"):
+    """Build a ``System`` from model text (``name`` is used in error messages)."""
+    return build(Document(name, text))
+
+
+def build(doc):
+    """Build the System described by a parsed Document."""
+    return _Builder(doc).system()
+
+
+class _Builder:
+    def __init__(self, doc):
+        self.doc = doc
+        self.root = doc.root
+
+    # -- generic checks -------------------------------------------------------------
+    def fail(self, path, message):
+        raise self.doc.error(path, message)
+
+    def mapping(self, node, path, allowed, required=()):
+        if not isinstance(node, LineDict):
+            self.fail(path, f"expected a mapping, got {_kind(node)}")
+        for key in node:
+            if key not in allowed:
+                close_match = difflib.get_close_matches(str(key), sorted(allowed), n=1)
+                hint = f" (did you mean '{close_match[0]}'?)" if close_match else ""
+                self.fail(path + (key,), f"unknown key '{key}'{hint}; allowed: {', '.join(sorted(allowed))}")
+        for key in required:
+            if key not in node:
+                self.fail(path, f"missing required key '{key}'")
+        return node
+
+    def identifier(self, name, path, what):
+        if not isinstance(name, str) or not name.isidentifier() or keyword.iskeyword(name):
+            self.fail(path, f"{what} {name!r} must be a plain name (letters, digits, _)")
+        if name in RESERVED:
+            self.fail(path, f"{what} '{name}' is reserved (a function, constant or time)")
+        return name
+
+    def expression(self, text, path, symbols):
+        try:
+            return parse(text, symbols)
+        except ExpressionError as err:
+            self.fail(path, str(err))
+
+    # -- sections -------------------------------------------------------------------
+    def system(self):
+        root = self.mapping(self.root, (), TOP_KEYS, required=("subsystems",))
+        name = root.get("name", _stem(self.doc.name))
+        if not isinstance(name, str):
+            self.fail(("name",), f"expected a string, got {_kind(name)}")
+        self.parameters = self.read_parameters()
+        self.param_symbols = {p: sp.Symbol(p) for p in self.parameters}
+        parts = self.read_subsystems()
+        self.q = [sym for part in parts for sym in part.q]
+        self.qd = [sym for part in parts for sym in part.qd]
+        self.global_symbols = dict(self.param_symbols, t=T_SYMBOL)
+        for part in parts:
+            for c, qs, qds in zip(part.coordinates, part.q, part.qd):
+                self.global_symbols[f"{part.name}.{c}"] = qs
+                self.global_symbols[f"{part.name}.{c}_dot"] = qds
+        constraints = self.read_constraints()
+        system = System.build(name, parts, constraints, self.q, self.qd, self.parameters,
+                              self.read_initial())
+        self.check_parts(system)
+        closure = root.get("closure", "none")
+        if closure not in ("auto", "none"):
+            self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
+        return close(system) if closure == "auto" else system
+
+    def read_parameters(self):
+        node = self.root.get("parameters", LineDict())
+        node = self.mapping(node, ("parameters",), set(node) if isinstance(node, dict) else set())
+        values, symbols = {}, {}
+        for key, text in node.items():
+            path = ("parameters", key)
+            self.identifier(key, path, "parameter")
+            expr = self.expression(text, path, symbols)
+            value = complex(expr.subs(values).evalf())
+            if value.imag != 0 or not np.isfinite(value.real):
+                self.fail(path, f"parameter '{key}' = {text!r} is not a finite real number")
+            values[sp.Symbol(key)] = value.real
+            symbols[key] = sp.Symbol(key)
+        return {str(k): v for k, v in values.items()}
+
+    def read_subsystems(self):
+        node = self.root["subsystems"]
+        if not isinstance(node, LineDict) or not node:
+            self.fail(("subsystems",), "expected a mapping of named parts, e.g. 'wheel: {type: lagrangian, ...}'")
+        parts = []
+        for name, spec in node.items():
+            path = ("subsystems", name)
+            self.identifier(name, path, "subsystem name")
+            if name in self.parameters:
+                self.fail(path, f"subsystem '{name}' has the name of a parameter")
+            if not isinstance(spec, LineDict):
+                self.fail(path, f"expected a mapping with 'type' and the part's data, got {_kind(spec)}")
+            kind = spec.get("type")
+            if kind not in SUBSYSTEM_TYPES:
+                self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: {', '.join(SUBSYSTEM_TYPES)}")
+            parts.append(SUBSYSTEM_TYPES[kind](self, name, spec, path))
+        return parts
+
+    def read_lagrangian(self, name, spec, path):
+        self.mapping(spec, path, {"type", "coordinates", "T", "V", "forces", "description"},
+                     required=("coordinates", "T"))
+        coords = spec["coordinates"]
+        if not isinstance(coords, LineList) or not coords:
+            self.fail(path + ("coordinates",), "expected a non-empty list of coordinate names")
+        for i, c in enumerate(coords):
+            self.identifier(c, path + ("coordinates", i), "coordinate")
+            if c.endswith("_dot"):
+                self.fail(path + ("coordinates", i), f"coordinate '{c}' must not end in '_dot' (that names velocities)")
+            if c in self.parameters:
+                self.fail(path + ("coordinates", i), f"coordinate '{c}' has the name of a parameter")
+            if coords.index(c) != i:
+                self.fail(path + ("coordinates", i), f"coordinate '{c}' is listed twice")
+        q = [sp.Symbol(f"{name}.{c}") for c in coords]
+        qd = [sp.Symbol(f"{name}.{c}_dot") for c in coords]
+        symbols = dict(self.param_symbols, t=T_SYMBOL)
+        symbols.update(zip(coords, q))
+        symbols.update(zip((f"{c}_dot" for c in coords), qd))
+        T = self.expression(spec["T"], path + ("T",), symbols)
+        V = self.expression(spec.get("V", 0), path + ("V",), symbols)
+        if V.free_symbols & set(qd):
+            self.fail(path + ("V",), "potential energy V must not depend on velocities")
+        forces_node = self.mapping(spec.get("forces", LineDict()), path + ("forces",), set(coords))
+        forces = [self.expression(forces_node[c], path + ("forces", c), symbols) if c in forces_node
+                  else sp.S.Zero for c in coords]
+        return LagrangianSubsystem(name, coords, q, qd, T, V, forces, self.param_symbols.values())
+
+    def read_constraints(self):
+        node = self.root.get("constraints", LineList())
+        if not isinstance(node, LineList):
+            self.fail(("constraints",), f"expected a list of constraints, got {_kind(node)}")
+        kinds = ("holonomic", "nonholonomic", "acceleration")
+        constraints, names = [], set()
+        for i, spec in enumerate(node):
+            path = ("constraints", i)
+            self.mapping(spec, path, {"name", "description", "C", *kinds})
+            name = spec.get("name", f"constraint_{i + 1}")
+            if not isinstance(name, str) or not name.strip():
+                self.fail(path + ("name",), f"constraint name must be a string, got {_kind(name)}")
+            if name in names:
+                self.fail(path + ("name",), f"duplicate constraint name '{name}'")
+            names.add(name)
+            given = [k for k in kinds if k in spec]
+            if len(given) != 1:
+                self.fail(path, f"constraint '{name}' needs exactly one of {', '.join(kinds)}; got {given or 'none'}")
+            kind = given[0]
+            C = self.read_nonideal(spec, path) if "C" in spec else None
+            args = (self.q, self.qd, self.param_symbols.values())
+            kpath = path + (kind,)
+            if kind == "acceleration":
+                a, b = self.read_acceleration_row(spec[kind], kpath)
+                constraints.append(ExpressionConstraint.acceleration(name, a, b, *args, C=C))
+                continue
+            expr = self.expression(spec[kind], kpath, self.global_symbols)
+            has_q = expr.free_symbols & set(self.q)
+            has_qd = expr.free_symbols & set(self.qd)
+            if kind == "holonomic" and has_qd:
+                self.fail(kpath, f"constraint '{name}' uses velocities {sorted(map(str, has_qd))}; "
+                                 "write it as 'nonholonomic:'")
+            if kind == "holonomic" and not has_q:
+                self.fail(kpath, f"constraint '{name}' involves no coordinate")
+            if kind == "nonholonomic" and not has_qd:
+                self.fail(kpath, f"constraint '{name}' involves no velocity (name_dot); "
+                                 "a constraint on positions is 'holonomic:'")
+            make = getattr(ExpressionConstraint, kind)
+            constraints.append(make(name, expr, *args, C=C))
+        return constraints
+
+    def read_acceleration_row(self, node, path):
+        node = self.mapping(node, path, {"A", "b"}, required=("A",))
+        coords = list(self.coordinate_names())
+        row = node["A"]
+        if isinstance(row, LineList):
+            if len(row) != len(coords):
+                self.fail(path + ("A",), f"a row of A needs {len(coords)} entries (one per coordinate: "
+                                         f"{', '.join(coords)}), got {len(row)}")
+            a = [self.expression(x, path + ("A", i), self.global_symbols) for i, x in enumerate(row)]
+        else:
+            entries = self.mapping(row, path + ("A",), set(coords))
+            a = [self.expression(entries[c], path + ("A", c), self.global_symbols) if c in entries
+                 else sp.S.Zero for c in coords]
+        b = self.expression(node.get("b", 0), path + ("b",), self.global_symbols)
+        if all(x == 0 for x in a):
+            self.fail(path + ("A",), "the row of A is all zero")
+        return a, b
+
+    def read_nonideal(self, spec, path):
+        coords = list(self.coordinate_names())
+        node = self.mapping(spec["C"], path + ("C",), set(coords))
+        return [self.expression(node[c], path + ("C", c), self.global_symbols) if c in node
+                else sp.S.Zero for c in coords]
+
+    def coordinate_names(self):
+        return (str(s) for s in self.q)
+
+    def read_initial(self):
+        node = self.root.get("initial", LineDict())
+        coords = list(self.coordinate_names())
+        allowed = set(coords) | {c + "_dot" for c in coords}
+        node = self.mapping(node, ("initial",), allowed)
+        values = {}
+        for key, text in node.items():
+            expr = self.expression(text, ("initial", key), self.param_symbols)
+            values[key] = float(expr.subs({sp.Symbol(k): v for k, v in self.parameters.items()}))
+        return values
+
+    def check_parts(self, system):
+        """Each part's M must be finite, symmetric and positive semi-definite at the initial state."""
+        q, qd = system.initial_state()
+        start = 0
+        for part in system.subsystems:
+            stop = start + len(part.coordinates)
+            path = ("subsystems", part.name)
+            with np.errstate(all="ignore"):
+                M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], system.parameter_values)
+            if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
+                self.fail(path, f"subsystem '{part.name}': M or Q is not finite at the initial state")
+            scale = max(np.abs(M).max(), 1e-300)
+            if np.linalg.eigvalsh(M).min() < -1e-12 * scale:
+                self.fail(path + ("T",), f"subsystem '{part.name}': the mass matrix from T is not positive "
+                                         "semi-definite at the initial state (is T a kinetic energy?)")
+            start = stop
+
+
+SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian}
+
+
+def _kind(value):
+    return {LineDict: "a mapping", LineList: "a list", str: "a string"}.get(type(value), type(value).__name__)
+
+
+def _stem(name):
+    return name.rsplit("/", 1)[-1].rsplit(".", 1)[0]

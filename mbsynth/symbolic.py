@@ -1,0 +1,68 @@
+"""Symbolic derivations done once per model, and their compilation to numpy.
+
+- ``lagrange(T, V, F, q, qd, t)``: the unconstrained equation ``M q̈ = Q`` (2.1)
+  of a part given by its kinetic energy T, potential energy V and generalized
+  forces F, from Lagrange's equations.
+- ``differentiate(phi, q, qd, t)``: a constraint ``phi = 0`` differentiated to
+  the row ``A q̈ = b`` (2.4), once if phi contains velocities, twice if not.
+- ``compile_function(args, exprs)``: one fast numpy function for many expressions.
+"""
+
+import numpy as np
+import sympy as sp
+
+T_SYMBOL = sp.Symbol("t")
+
+
+def lagrange(T, V, F, q, qd, t=T_SYMBOL):
+    """M and Q of (2.1) from Lagrange's equations d/dt ∂T/∂q̇ − ∂T/∂q + ∂V/∂q = F.
+
+    Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
+    M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
+    """
+    q, qd = sp.Matrix(q), sp.Matrix(qd)
+    p = sp.Matrix([T]).jacobian(qd).T  # generalized momenta ∂T/∂q̇
+    M = p.jacobian(qd)
+    Q = (sp.Matrix(F) + sp.Matrix([T - V]).jacobian(q).T
+         - p.jacobian(q) * qd - p.diff(t))
+    return sp.simplify(M), sp.simplify(Q)
+
+
+def time_derivative(expr, q, qd, t=T_SYMBOL):
+    """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t."""
+    return (sp.Matrix([expr]).jacobian(sp.Matrix(q)) * sp.Matrix(qd))[0] + sp.diff(expr, t)
+
+
+def differentiate(phi, q, qd, t=T_SYMBOL):
+    """Row (a, b, phidot) of A q̈ = b (2.4) for the constraint phi(q, q̇, t) = 0.
+
+    A position-level phi(q, t) is differentiated twice (phidot = d phi/dt); a
+    velocity-level phi(q, q̇, t) once (phidot is phi itself). With ψ the
+    velocity-level form, ψ̇ = (∂ψ/∂q̇) q̈ + (∂ψ/∂q) q̇ + ∂ψ/∂t = 0, so
+    a = ∂ψ/∂q̇ and b = −(∂ψ/∂q) q̇ − ∂ψ/∂t.
+    """
+    velocity_level = bool(set(qd) & phi.free_symbols)
+    psi = phi if velocity_level else time_derivative(phi, q, qd, t)
+    a = sp.Matrix([psi]).jacobian(sp.Matrix(qd))
+    b = -(sp.Matrix([psi]).jacobian(sp.Matrix(q)) * sp.Matrix(qd))[0] - sp.diff(psi, t)
+    return a, sp.simplify(b), psi
+
+
+def compile_function(args, exprs):
+    """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
+    ``exprs`` (scalars, vectors or matrices), with common subexpressions shared."""
+    shapes = [sp.Matrix(e).shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
+    flat = [x for e in exprs for x in (e if isinstance(e, sp.MatrixBase) else [e])]
+    if not flat:
+        def empty(*_):
+            return tuple(np.zeros(s) for s in shapes)
+        return empty
+    raw = sp.lambdify(args, flat, modules="numpy", cse=True, dummify=True)
+    sizes = [int(np.prod(s)) for s in shapes]
+    splits = np.cumsum(sizes)[:-1]
+
+    def evaluate(*values):
+        out = np.asarray(raw(*values), dtype=float)
+        return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
+
+    return evaluate

@@ -1,0 +1,168 @@
+"""A System: parts, their coordinate layout, the constraints joining them, parameters.
+
+The System is built once and not changed afterwards. ``evaluate(t, q, qd)``
+assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
+``motion(t, q, qd)`` solves them with the singular-mass equation (2.14).
+"""
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import sympy as sp
+
+from . import equations, solvers
+from .errors import ModelError
+
+METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """The arrays of (2.1), (2.4) and (2.6) for the whole system at one state."""
+
+    M: np.ndarray
+    Q: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+
+
+@dataclass(frozen=True)
+class Closure:
+    """A force balance wᵀ(Q + C) = 0 appended by ``closure: auto`` (see closure.py)."""
+
+    constraint: str
+    equation: str
+    direction: dict
+    state_dependent: bool
+
+
+@dataclass(frozen=True)
+class System:
+    """An assembled model. Build it with ``mbsynth.load`` or ``System.build``."""
+
+    name: str
+    subsystems: tuple
+    constraints: tuple
+    coordinates: tuple
+    q_symbols: tuple
+    qd_symbols: tuple
+    parameters: dict
+    initial_q: np.ndarray
+    initial_qd: np.ndarray
+    closures: tuple = ()
+
+    @classmethod
+    def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None):
+        """Lay out the parts' coordinates in order, check names, set the initial state.
+
+        ``initial`` maps ``part.coordinate`` and ``part.coordinate_dot`` to values;
+        the rest start at zero.
+        """
+        coordinates = tuple(f"{s.name}.{c}" for s in subsystems for c in s.coordinates)
+        if len(set(coordinates)) != len(coordinates):
+            raise ModelError(f"model '{name}': duplicate coordinate names in {coordinates}")
+        names = [c.name for c in constraints]
+        duplicates = sorted({x for x in names if names.count(x) > 1})
+        if duplicates:
+            raise ModelError(f"model '{name}': duplicate constraint names {duplicates}")
+        q0, qd0 = np.zeros(len(coordinates)), np.zeros(len(coordinates))
+        index = {c: i for i, c in enumerate(coordinates)}
+        for key, value in (initial or {}).items():
+            if key in index:
+                q0[index[key]] = value
+            elif key.endswith("_dot") and key[:-4] in index:
+                qd0[index[key[:-4]]] = value
+            else:
+                raise ModelError(f"model '{name}': initial value for unknown coordinate '{key}'")
+        return cls(name, tuple(subsystems), tuple(constraints), coordinates, tuple(q_symbols),
+                   tuple(qd_symbols), dict(parameters), q0, qd0)
+
+    @property
+    def n(self):
+        return len(self.coordinates)
+
+    @property
+    def constraint_names(self):
+        return [c.name for c in self.constraints]
+
+    @property
+    def parameter_values(self):
+        return np.array(list(self.parameters.values()), dtype=float)
+
+    @property
+    def parameter_symbols(self):
+        return [sp.Symbol(p) for p in self.parameters]
+
+    def initial_state(self):
+        """(q, q̇) from the model's ``initial:`` mapping (copies)."""
+        return self.initial_q.copy(), self.initial_qd.copy()
+
+    def with_parameters(self, **values):
+        """A new System with some parameter values changed (the original is unchanged).
+
+        Closure balances appended at load time are kept as derived; they stay valid
+        while the masses that were zero stay zero."""
+        unknown = sorted(set(values) - set(self.parameters))
+        if unknown:
+            raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
+                             f"it has {sorted(self.parameters)}")
+        return replace(self, parameters={**self.parameters, **{k: float(v) for k, v in values.items()}})
+
+    def with_constraints(self, extra, closures=()):
+        """A new System with ``extra`` constraints appended (the original is unchanged)."""
+        return replace(self, constraints=self.constraints + tuple(extra),
+                       closures=self.closures + tuple(closures))
+
+    def _state(self, q, qd):
+        q, qd = np.asarray(q, dtype=float).ravel(), np.asarray(qd, dtype=float).ravel()
+        if q.shape != (self.n,) or qd.shape != (self.n,):
+            raise ValueError(f"model '{self.name}' has {self.n} coordinates; got q of shape "
+                             f"{q.shape} and qd of shape {qd.shape}")
+        return q, qd
+
+    def evaluate(self, t, q, qd):
+        """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
+        q, qd = self._state(q, qd)
+        p = self.parameter_values
+        n, m = self.n, len(self.constraints)
+        M, Q = np.zeros((n, n)), np.zeros(n)
+        start = 0
+        for part in self.subsystems:
+            stop = start + len(part.coordinates)
+            M[start:stop, start:stop], Q[start:stop] = part.evaluate(t, q[start:stop], qd[start:stop], p)
+            start = stop
+        A, b, C = np.zeros((m, n)), np.zeros(m), np.zeros(n)
+        for row, con in enumerate(self.constraints):
+            a, b[row], c = con.evaluate(t, q, qd, p)
+            A[row, con.indices] = a
+            C[con.indices] += c
+        return Assembly(M, Q, A, b, C)
+
+    def motion(self, t, q, qd, method="fast"):
+        """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
+        Qc, residual). ``method``: "fast" (KKT, falling back to the exact treatment when
+        it is not well posed) or "reference" (the literal pseudo-inverse of (2.14))."""
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
+        arrays = self.evaluate(t, q, qd)
+        return METHODS[method](arrays.M, arrays.Q, arrays.A, arrays.b, arrays.C,
+                               coordinates=self.coordinates, constraints=self.constraint_names)
+
+    def constraint_residuals(self, t, q, qd):
+        """(φ, φ̇) per constraint: position and velocity residuals (NaN where not defined)."""
+        q, qd = self._state(q, qd)
+        p = self.parameter_values
+        pairs = [con.residuals(t, q, qd, p) for con in self.constraints]
+        return np.array([r[0] for r in pairs]), np.array([r[1] for r in pairs])
+
+    def symbolic(self):
+        """(M, Q, A, b, C) as sympy matrices in the model's symbols."""
+        blocks = [part.symbolic() for part in self.subsystems]
+        M = sp.diag(*[blk[0] for blk in blocks]) if blocks else sp.zeros(0, 0)
+        Q = sp.Matrix.vstack(*[blk[1] for blk in blocks])
+        n = self.n
+        A = sp.Matrix.vstack(sp.zeros(0, n), *[con.a for con in self.constraints])
+        b = sp.Matrix([con.b for con in self.constraints])
+        C = sum((con.C for con in self.constraints), sp.zeros(n, 1))
+        return M, Q, A, b, C

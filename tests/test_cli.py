@@ -1,0 +1,85 @@
+"""`mbsynth check` on the paper's models: ranks, verdicts and balances (Result 3)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import sympy as sp
+
+from mbsynth.cli import main
+from mbsynth.expressions import parse
+
+MODELS = Path(__file__).resolve().parent.parent / "models" / "paper"
+
+
+def check_json(capsys, path):
+    code = main(["check", str(path), "--json"])
+    return code, json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("name, n, m, rank_M, rank_A", [
+    ("example1_wheel.yaml", 2, 1, 1, 1),                 # (5.6), (5.10)
+    ("example3_two_masses.yaml", 3, 1, 2, 1),            # (5.33), (5.35)
+    ("example3_m1_zero.yaml", 3, 2, 1, 2),               # (5.42), (5.46)
+    ("example3_m2_zero.yaml", 3, 2, 1, 2),               # (5.51), (5.55)
+    ("example3_m1_zero_auto.yaml", 3, 2, 1, 2),
+    ("example3_m2_zero_auto.yaml", 3, 2, 1, 2),
+])
+def test_unique_models(capsys, name, n, m, rank_M, rank_A):
+    code, report = check_json(capsys, MODELS / name)
+    assert code == 0
+    assert (report["n"], report["m"], report["rank_M"], report["rank_A"], report["rank_Mhat"]) == (
+        n, m, rank_M, rank_A, n)
+    assert report["unique"] and report["indeterminate"] == [] and report["suggested_constraints"] == []
+    assert report["consistent"]
+
+
+def test_massless_particle_is_a_free_direction(capsys):
+    code, report = check_json(capsys, MODELS / "example2_massless_particle.yaml")
+    assert code == 0
+    assert not report["unique"] and report["rank_Mhat"] == 2
+    assert report["indeterminate"] == [{"particle.x": 1.0}]        # (5.23): η on x
+    assert report["balances"] == [{"direction": {"particle.x": 1.0}, "free": True, "equation": None}]
+    assert report["suggested_constraints"] == []
+
+
+@pytest.mark.parametrize("mass, balance", [
+    ("m1", lambda k1, k2, x1, q2: k1 * (x1 - 1.0) - k2 * (q2 - 0.8)),   # (5.40)
+    ("m2", lambda k1, k2, x1, q2: k2 * (q2 - 0.8)),                     # (5.49)
+])
+def test_missing_balance_is_suggested(capsys, tmp_path, mass, balance):
+    text = (MODELS / "example3_two_masses.yaml").read_text()
+    text = text.replace(f"{mass}: {'1.5' if mass == 'm1' else '2.0'}", f"{mass}: 0.0")
+    model = tmp_path / "open.yaml"
+    model.write_text(text)
+    code, report = check_json(capsys, model)
+    assert code == 1 and not report["unique"] and report["rank_Mhat"] == 2
+    (equation,) = report["suggested_constraints"]
+    lhs, rhs = equation.split("=")
+    assert rhs.strip() == "0"
+    names = ["body1.x1", "body2.q1", "body2.q2", "k1", "k2", "l10", "l20", "d", "m1", "m2"]
+    symbols = {name: sp.Symbol(name) for name in names}
+    expr = parse(lhs, symbols).subs({symbols["k1"]: 100.0, symbols["k2"]: 60.0, symbols["l10"]: 1.0,
+                                     symbols["l20"]: 0.8})
+    x1, q2 = symbols["body1.x1"], symbols["body2.q2"]
+    ratio = sp.simplify(expr / balance(100.0, 60.0, x1, q2))
+    assert ratio.is_number and abs(float(ratio)) > 0
+
+
+def test_text_report_and_console_script(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "mbsynth.cli", "check", str(MODELS / "example1_wheel.yaml")],
+                            capture_output=True, text=True, check=True)
+    assert "rank M = 1, rank A = 1, rank [M; A] = 2 of 2" in result.stdout
+    assert "motion: unique" in result.stdout
+
+
+def test_model_error_is_one_line_and_exit_2(capsys, tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
+    assert main(["check", str(bad)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"error: {bad}:2:") and "\n" not in err
+    assert main(["check", str(bad), "--json"]) == 2
+    assert "error" in json.loads(capsys.readouterr().out)
