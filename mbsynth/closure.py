@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .connectors import ExpressionConstraint
+from .connectors import Connector
 from .equations import rank_report
 from .errors import ModelError
 from .symbolic import T_SYMBOL
@@ -50,10 +50,11 @@ class Balance:
 def balances(system, t=0.0, q=None, qd=None):
     """The balances of every indeterminate direction of ``system`` (none when unique).
 
-    The null space of [M; A] is found symbolically with the parameter values
-    substituted; where its dimension differs from the numeric one at (t, q, q̇)
-    (a special configuration) the numeric null vectors at that state are used and
-    the balances are marked state dependent.
+    Where [M; A] (with the parameter values substituted) does not depend on the state,
+    its null space is found exactly (sympy). Otherwise, or where the exact dimension
+    differs from the numeric one at (t, q, q̇), the numeric null vectors at that state
+    are used and the balances are marked state dependent: they hold at this state and
+    along the motion only while the null space keeps its form.
     """
     q0, qd0 = system.initial_state()
     q = q0 if q is None else np.asarray(q, dtype=float)
@@ -67,13 +68,13 @@ def balances(system, t=0.0, q=None, qd=None):
     numeric = rank_report(arrays.M, arrays.A).nullspace
     if numeric.shape[1] == 0:
         return []
-    symbolic_w = M.col_join(A).subs(values).nullspace(simplify=True)
-    if len(symbolic_w) == numeric.shape[1]:
-        W = sp.Matrix.hstack(*symbolic_w)
-    else:
-        W = sp.Matrix(numeric)
     dynamic = set(system.q_symbols) | set(system.qd_symbols) | {T_SYMBOL}
-    state_dependent = len(symbolic_w) != numeric.shape[1] or bool(W.free_symbols & dynamic)
+    Mhat = M.col_join(A).subs(values)
+    symbolic_w = [] if Mhat.free_symbols & dynamic else Mhat.nullspace(simplify=True)
+    if len(symbolic_w) == numeric.shape[1]:
+        W, state_dependent = sp.Matrix.hstack(*symbolic_w), False
+    else:
+        W, state_dependent = sp.Matrix(_rational_rows(numeric.T)).T, True
     free, balanced = _separate(W.T * force, values, system, q, qd, t)
     result = []
     for combos, is_free in ((free, True), (balanced, False)):
@@ -154,5 +155,5 @@ def _as_constraint(system, name, bal):
                          "that direction: the model admits no motion")
     args = (system.q_symbols, system.qd_symbols, system.parameter_symbols)
     if expression.free_symbols & set(system.qd_symbols):
-        return ExpressionConstraint.nonholonomic(name, expression, *args)
-    return ExpressionConstraint.holonomic(name, expression, *args)
+        return Connector.nonholonomic(name, [expression], *args)
+    return Connector.holonomic(name, [expression], *args)

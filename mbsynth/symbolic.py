@@ -45,7 +45,7 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     psi = phi if velocity_level else time_derivative(phi, q, qd, t)
     a = sp.Matrix([psi]).jacobian(sp.Matrix(qd))
     b = -(sp.Matrix([psi]).jacobian(sp.Matrix(q)) * sp.Matrix(qd))[0] - sp.diff(psi, t)
-    return a, sp.simplify(b), psi
+    return a, b, psi
 
 
 def compile_function(args, exprs):

@@ -50,10 +50,11 @@ class System:
     parameters: dict
     initial_q: np.ndarray
     initial_qd: np.ndarray
+    forces: tuple = ()
     closures: tuple = ()
 
     @classmethod
-    def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None):
+    def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=()):
         """Lay out the parts' coordinates in order, check names, set the initial state.
 
         ``initial`` maps ``part.coordinate`` and ``part.coordinate_dot`` to values;
@@ -76,7 +77,7 @@ class System:
             else:
                 raise ModelError(f"model '{name}': initial value for unknown coordinate '{key}'")
         return cls(name, tuple(subsystems), tuple(constraints), coordinates, tuple(q_symbols),
-                   tuple(qd_symbols), dict(parameters), q0, qd0)
+                   tuple(qd_symbols), dict(parameters), q0, qd0, tuple(forces))
 
     @property
     def n(self):
@@ -84,7 +85,8 @@ class System:
 
     @property
     def constraint_names(self):
-        return [c.name for c in self.constraints]
+        """One name per row of A (a joint with k rows names them ``joint[label]``)."""
+        return [row for c in self.constraints for row in c.row_names]
 
     @property
     def parameter_values(self):
@@ -125,18 +127,22 @@ class System:
         """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
         q, qd = self._state(q, qd)
         p = self.parameter_values
-        n, m = self.n, len(self.constraints)
+        n, m = self.n, sum(c.size for c in self.constraints)
         M, Q = np.zeros((n, n)), np.zeros(n)
         start = 0
         for part in self.subsystems:
             stop = start + len(part.coordinates)
             M[start:stop, start:stop], Q[start:stop] = part.evaluate(t, q[start:stop], qd[start:stop], p)
             start = stop
+        for element in self.forces:
+            Q[element.indices] += element.evaluate(t, q, qd, p)
         A, b, C = np.zeros((m, n)), np.zeros(m), np.zeros(n)
-        for row, con in enumerate(self.constraints):
-            a, b[row], c = con.evaluate(t, q, qd, p)
-            A[row, con.indices] = a
+        row = 0
+        for con in self.constraints:
+            a, b[row:row + con.size], c = con.evaluate(t, q, qd, p)
+            A[row:row + con.size, con.indices] = a
             C[con.indices] += c
+            row += con.size
         return Assembly(M, Q, A, b, C)
 
     def motion(self, t, q, qd, method="fast"):
@@ -150,19 +156,20 @@ class System:
                                coordinates=self.coordinates, constraints=self.constraint_names)
 
     def constraint_residuals(self, t, q, qd):
-        """(φ, φ̇) per constraint: position and velocity residuals (NaN where not defined)."""
+        """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
         q, qd = self._state(q, qd)
         p = self.parameter_values
         pairs = [con.residuals(t, q, qd, p) for con in self.constraints]
-        return np.array([r[0] for r in pairs]), np.array([r[1] for r in pairs])
+        return (np.concatenate([np.zeros(0)] + [r[0] for r in pairs]),
+                np.concatenate([np.zeros(0)] + [r[1] for r in pairs]))
 
     def symbolic(self):
         """(M, Q, A, b, C) as sympy matrices in the model's symbols."""
         blocks = [part.symbolic() for part in self.subsystems]
         M = sp.diag(*[blk[0] for blk in blocks]) if blocks else sp.zeros(0, 0)
-        Q = sp.Matrix.vstack(*[blk[1] for blk in blocks])
+        Q = sum((f.symbolic() for f in self.forces), sp.Matrix.vstack(*[blk[1] for blk in blocks]))
         n = self.n
         A = sp.Matrix.vstack(sp.zeros(0, n), *[con.a for con in self.constraints])
-        b = sp.Matrix([con.b for con in self.constraints])
+        b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.constraints])
         C = sum((con.C for con in self.constraints), sp.zeros(n, 1))
         return M, Q, A, b, C

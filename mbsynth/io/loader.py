@@ -11,14 +11,17 @@ import numpy as np
 import sympy as sp
 
 from ..closure import close
-from ..connectors import ExpressionConstraint
+from ..connectors import Connector
 from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
 from ..symbolic import T_SYMBOL
 from ..system import System
+from .joints import read_joints, read_world
+from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body
 from .source import Document, LineDict, LineList, read_document
 
-TOP_KEYS = {"name", "description", "parameters", "subsystems", "constraints", "closure", "initial"}
+TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
+            "closure", "initial"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 
 
@@ -47,7 +50,9 @@ class _Builder:
         raise self.doc.error(path, message)
 
     def mapping(self, node, path, allowed, required=()):
-        if not isinstance(node, LineDict):
+        if node is None:
+            node = LineDict()
+        if not isinstance(node, dict):
             self.fail(path, f"expected a mapping, got {_kind(node)}")
         for key in node:
             if key not in allowed:
@@ -72,6 +77,39 @@ class _Builder:
         except ExpressionError as err:
             self.fail(path, str(err))
 
+    def constant(self, text, path):
+        """An expression of parameters only (a mass, a length), checked finite and real."""
+        expr = self.expression(text, path, self.param_symbols)
+        value = complex(expr.subs(self.param_values).evalf())
+        if value.imag != 0 or not np.isfinite(value.real):
+            self.fail(path, f"{text!r} is not a finite real number")
+        return expr
+
+    def value(self, expr):
+        """The float value of an expression of parameters."""
+        return float(sp.sympify(expr).subs(self.param_values))
+
+    def sized_list(self, node, path, size):
+        if not isinstance(node, list) or len(node) != size:
+            self.fail(path, f"expected a list of {size} numbers or expressions, got {_kind(node)}"
+                            + (f" of {len(node)}" if isinstance(node, list) else ""))
+        return node
+
+    def vector(self, node, path, size, symbols):
+        """A sympy column of ``size`` expressions."""
+        node = self.sized_list(node, path, size)
+        return sp.Matrix([self.expression(x, path + (i,), symbols) for i, x in enumerate(node)])
+
+    def numbers(self, node, path, size):
+        """A list of ``size`` floats (expressions of parameters allowed)."""
+        node = self.sized_list(node, path, size)
+        return [self.value(self.constant(x, path + (i,))) for i, x in enumerate(node)]
+
+    def part_symbols(self, name, coordinates):
+        """The model's symbols of a part's coordinates and velocities."""
+        return ([sp.Symbol(f"{name}.{c}") for c in coordinates],
+                [sp.Symbol(f"{name}.{c}_dot") for c in coordinates])
+
     # -- sections -------------------------------------------------------------------
     def system(self):
         root = self.mapping(self.root, (), TOP_KEYS, required=("subsystems",))
@@ -80,7 +118,11 @@ class _Builder:
             self.fail(("name",), f"expected a string, got {_kind(name)}")
         self.parameters = self.read_parameters()
         self.param_symbols = {p: sp.Symbol(p) for p in self.parameters}
+        self.param_values = {sp.Symbol(k): v for k, v in self.parameters.items()}
+        self.gravity = self.vector(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3, self.param_symbols)
+        self.world_frames = {f.name: f for f in read_world(self)}
         parts = self.read_subsystems()
+        self.parts = {part.name: part for part in parts}
         self.q = [sym for part in parts for sym in part.q]
         self.qd = [sym for part in parts for sym in part.qd]
         self.global_symbols = dict(self.param_symbols, t=T_SYMBOL)
@@ -88,9 +130,11 @@ class _Builder:
             for c, qs, qds in zip(part.coordinates, part.q, part.qd):
                 self.global_symbols[f"{part.name}.{c}"] = qs
                 self.global_symbols[f"{part.name}.{c}_dot"] = qds
-        constraints = self.read_constraints()
+        args = (self.q, self.qd, self.param_symbols.values())
+        constraints = [c for part in parts for c in part.own_constraints(*args)]
+        constraints += self.read_constraints() + read_joints(self)
         system = System.build(name, parts, constraints, self.q, self.qd, self.parameters,
-                              self.read_initial())
+                              self.read_initial(parts))
         self.check_parts(system)
         closure = root.get("closure", "none")
         if closure not in ("auto", "none"):
@@ -120,18 +164,19 @@ class _Builder:
         for name, spec in node.items():
             path = ("subsystems", name)
             self.identifier(name, path, "subsystem name")
-            if name in self.parameters:
-                self.fail(path, f"subsystem '{name}' has the name of a parameter")
+            if name in self.parameters or name == "world":
+                self.fail(path, f"subsystem '{name}' has the name of a parameter or of the world")
             if not isinstance(spec, LineDict):
                 self.fail(path, f"expected a mapping with 'type' and the part's data, got {_kind(spec)}")
             kind = spec.get("type")
             if kind not in SUBSYSTEM_TYPES:
                 self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: {', '.join(SUBSYSTEM_TYPES)}")
-            parts.append(SUBSYSTEM_TYPES[kind](self, name, spec, path))
+            reader = SUBSYSTEM_TYPES[kind]
+            parts.append(reader(self, name, spec, path))
         return parts
 
     def read_lagrangian(self, name, spec, path):
-        self.mapping(spec, path, {"type", "coordinates", "T", "V", "forces", "description"},
+        self.mapping(spec, path, {"type", "coordinates", "T", "V", "forces", "frames", "geometry", "description"},
                      required=("coordinates", "T"))
         coords = spec["coordinates"]
         if not isinstance(coords, LineList) or not coords:
@@ -144,8 +189,7 @@ class _Builder:
                 self.fail(path + ("coordinates", i), f"coordinate '{c}' has the name of a parameter")
             if coords.index(c) != i:
                 self.fail(path + ("coordinates", i), f"coordinate '{c}' is listed twice")
-        q = [sp.Symbol(f"{name}.{c}") for c in coords]
-        qd = [sp.Symbol(f"{name}.{c}_dot") for c in coords]
+        q, qd = self.part_symbols(name, coords)
         symbols = dict(self.param_symbols, t=T_SYMBOL)
         symbols.update(zip(coords, q))
         symbols.update(zip((f"{c}_dot" for c in coords), qd))
@@ -156,7 +200,9 @@ class _Builder:
         forces_node = self.mapping(spec.get("forces", LineDict()), path + ("forces",), set(coords))
         forces = [self.expression(forces_node[c], path + ("forces", c), symbols) if c in forces_node
                   else sp.S.Zero for c in coords]
-        return LagrangianSubsystem(name, coords, q, qd, T, V, forces, self.param_symbols.values())
+        frames = read_frames(self, name, spec.get("frames"), path + ("frames",), True, symbols)
+        return LagrangianSubsystem(name, coords, q, qd, T, V, forces, self.param_symbols.values(), frames,
+                                   read_geometry(self, spec.get("geometry"), path + ("geometry",)))
 
     def read_constraints(self):
         node = self.root.get("constraints", LineList())
@@ -182,7 +228,7 @@ class _Builder:
             kpath = path + (kind,)
             if kind == "acceleration":
                 a, b = self.read_acceleration_row(spec[kind], kpath)
-                constraints.append(ExpressionConstraint.acceleration(name, a, b, *args, C=C))
+                constraints.append(Connector.acceleration(name, a, b, *args, C=C))
                 continue
             expr = self.expression(spec[kind], kpath, self.global_symbols)
             has_q = expr.free_symbols & set(self.q)
@@ -195,8 +241,8 @@ class _Builder:
             if kind == "nonholonomic" and not has_qd:
                 self.fail(kpath, f"constraint '{name}' involves no velocity (name_dot); "
                                  "a constraint on positions is 'holonomic:'")
-            make = getattr(ExpressionConstraint, kind)
-            constraints.append(make(name, expr, *args, C=C))
+            make = getattr(Connector, kind)
+            constraints.append(make(name, [expr], *args, C=C))
         return constraints
 
     def read_acceleration_row(self, node, path):
@@ -226,15 +272,17 @@ class _Builder:
     def coordinate_names(self):
         return (str(s) for s in self.q)
 
-    def read_initial(self):
-        node = self.root.get("initial", LineDict())
+    def read_initial(self, parts):
+        """Initial values: each part's own ``initial:``, then the model's ``initial:``
+        mapping by coordinate name (one place per coordinate)."""
+        values = {f"{part.name}.{k}": v for part in parts for k, v in part.initial.items()}
         coords = list(self.coordinate_names())
         allowed = set(coords) | {c + "_dot" for c in coords}
-        node = self.mapping(node, ("initial",), allowed)
-        values = {}
+        node = self.mapping(self.root.get("initial", LineDict()), ("initial",), allowed)
         for key, text in node.items():
-            expr = self.expression(text, ("initial", key), self.param_symbols)
-            values[key] = float(expr.subs({sp.Symbol(k): v for k, v in self.parameters.items()}))
+            if key in values:
+                self.fail(("initial", key), f"'{key}' is already set by the part's own initial: mapping")
+            values[key] = self.value(self.constant(text, ("initial", key)))
         return values
 
     def check_parts(self, system):
@@ -255,7 +303,8 @@ class _Builder:
             start = stop
 
 
-SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian}
+SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,
+                   "particle": read_particle, "planar_body": read_planar_body}
 
 
 def _kind(value):

@@ -2,10 +2,15 @@
 
 A subsystem knows only its own coordinates. It offers
 ``evaluate(t, q, qd, p) -> (M, Q)`` on its own slice of the state (``p``: the
-model's parameter values in the model's order) and ``symbolic()`` returning the
-same M and Q as sympy matrices, used to derive closure balances.
+model's parameter values in the model's order), ``symbolic()`` returning the same
+M and Q as sympy matrices (used to derive closure balances), its energies, and the
+world pose of its named frames for connectors and force elements.
 """
 
+from .base import Frame, Part
 from .lagrangian import LagrangianSubsystem
+from .particle import Particle
+from .planar_body import PlanarBody
+from .rigid_body import RigidBody
 
-__all__ = ["LagrangianSubsystem"]
+__all__ = ["Frame", "Part", "LagrangianSubsystem", "Particle", "PlanarBody", "RigidBody"]

@@ -1,0 +1,108 @@
+"""Joints between two frames: holonomic constraints φ(q) = 0 on their world poses.
+
+Frame A belongs to the parent (a part or the world), frame B to the child. With p the
+frame origins and x, y, z their axes in the world:
+
+    spherical    p_B − p_A = 0                                   3 rows
+    revolute     spherical, and z_B ⟂ x_A, z_B ⟂ y_A             5 rows (turns about z)
+    universal    spherical, and z_A ⟂ z_B                        4 rows (cross axes z_A, z_B)
+    cylindrical  z_B ⟂ x_A, z_B ⟂ y_A, (p_B − p_A) ⟂ x_A, y_A     4 rows (turns and slides along z)
+    prismatic    orientation locked, (p_B − p_A) ⟂ x_A, y_A      5 rows (slides along z)
+    fixed        spherical, orientation locked                   6 rows
+    distance     (|p_B − p_A|² − L²) / 2L = 0                    1 row  (a massless rod)
+
+The orientation lock is x_A·y_B = y_A·z_B = z_A·x_B = 0: independent near aligned
+frames, so assemble the frames aligned. Rows of A and b follow by differentiating φ
+twice (symbolic.differentiate), exactly.
+"""
+
+import sympy as sp
+
+from ..symbolic import time_derivative
+from .constraint import Connector, differentiated
+
+ROTATING = {"revolute", "cylindrical"}
+SLIDING = {"prismatic", "cylindrical"}
+
+
+def _axes(R):
+    return R[:, 0], R[:, 1], R[:, 2]
+
+
+def _orientation_lock(RA, RB):
+    xa, ya, za = _axes(RA)
+    xb, yb, zb = _axes(RB)
+    return [xa.dot(yb), ya.dot(zb), za.dot(xb)], ["rx", "ry", "rz"]
+
+
+def _aligned_axis(RA, RB):
+    xa, ya, _ = _axes(RA)
+    zb = RB[:, 2]
+    return [zb.dot(xa), zb.dot(ya)], ["axis_x", "axis_y"]
+
+
+def _on_axis(pA, RA, pB):
+    xa, ya, _ = _axes(RA)
+    d = pB - pA
+    return [d.dot(xa), d.dot(ya)], ["slide_x", "slide_y"]
+
+
+def _coincident(pA, pB):
+    return list(pB - pA), ["x", "y", "z"]
+
+
+def joint_equations(kind, pA, RA, pB, RB, length=None):
+    """(φ rows, row labels) of a joint of ``kind`` between poses (pA, RA) and (pB, RB)."""
+    if kind == "spherical":
+        parts = [_coincident(pA, pB)]
+    elif kind == "revolute":
+        parts = [_coincident(pA, pB), _aligned_axis(RA, RB)]
+    elif kind == "universal":
+        parts = [_coincident(pA, pB), ([RA[:, 2].dot(RB[:, 2])], ["cross"])]
+    elif kind == "cylindrical":
+        parts = [_aligned_axis(RA, RB), _on_axis(pA, RA, pB)]
+    elif kind == "prismatic":
+        parts = [_orientation_lock(RA, RB), _on_axis(pA, RA, pB)]
+    elif kind == "fixed":
+        parts = [_coincident(pA, pB), _orientation_lock(RA, RB)]
+    elif kind == "distance":
+        d = pB - pA
+        parts = [([(d.dot(d) - length**2) / (2 * length)], ["length"])]
+    else:
+        raise ValueError(f"unknown joint kind {kind!r}; known: {', '.join(JOINT_KINDS)}")
+    return [e for p in parts for e in p[0]], [label for p in parts for label in p[1]]
+
+
+JOINT_KINDS = ("fixed", "revolute", "prismatic", "cylindrical", "spherical", "universal", "distance")
+
+
+class Joint(Connector):
+    """A holonomic joint between frame A (on ``parent``, or the world when None) and
+    frame B (on ``child``). Besides its rows it knows, where it has them, its free
+    motions: ``angle`` about z_A with rate ``angle_rate`` = z_A·(ω_B − ω_A) (revolute,
+    cylindrical), and ``displacement`` z_A·(p_B − p_A) along z_A with its rate
+    (prismatic, cylindrical) — what actuation, joint springs and friction act on."""
+
+    def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None):
+        pA, RA = _pose(parent, frame_a)
+        pB, RB = _pose(child, frame_b)
+        phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
+        a, b, psi = differentiated(phis, q, qd)
+        super().__init__(name, "holonomic", a, b, sp.zeros(len(q), 1), phis, psi, q, qd, params, labels)
+        self.joint_kind, self.frames = kind, (frame_a, frame_b)
+        xa, ya, za = _axes(RA)
+        self.angle = self.angle_rate = self.displacement = self.displacement_rate = None
+        if kind in ROTATING:
+            xb = RB[:, 0]
+            self.angle = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
+            omega_a = parent.angular_velocity() if parent else sp.zeros(3, 1)
+            self.angle_rate = za.dot(child.angular_velocity() - omega_a)
+        if kind in SLIDING:
+            self.displacement = za.dot(pB - pA)
+            self.displacement_rate = time_derivative(self.displacement, q, qd)
+
+
+def _pose(part, frame):
+    if part is None:
+        return sp.Matrix(frame.position), sp.Matrix(frame.rotation)
+    return part.pose(frame)

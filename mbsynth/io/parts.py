@@ -1,0 +1,206 @@
+"""Reading three-dimensional parts, their frames, drawing geometry and initial states.
+
+Each ``read_*`` takes the loader's builder (for error reporting, expressions and the
+model's symbols), the part's name, its mapping and key path, and returns a Part.
+"""
+
+import numpy as np
+import sympy as sp
+
+from ..kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
+from ..subsystems import Frame, Particle, PlanarBody, RigidBody
+
+ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
+SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None}
+COLORS = {"red": (0.85, 0.2, 0.2), "green": (0.2, 0.7, 0.3), "blue": (0.2, 0.4, 0.85), "grey": (0.6, 0.6, 0.6),
+          "gray": (0.6, 0.6, 0.6), "black": (0.1, 0.1, 0.1), "white": (0.95, 0.95, 0.95),
+          "orange": (0.95, 0.55, 0.1), "yellow": (0.95, 0.85, 0.2), "purple": (0.55, 0.3, 0.75)}
+
+
+def read_rigid_body(builder, name, spec, path):
+    builder.mapping(spec, path, {"type", "mass", "inertia", "frames", "geometry", "initial", "description"},
+                    required=("mass", "inertia"))
+    mass = read_mass(builder, spec, path)
+    inertia = read_inertia(builder, spec["inertia"], path + ("inertia",))
+    q, qd = builder.part_symbols(name, RigidBody.COORDINATES)
+    frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=True)
+    initial = read_body_initial(builder, spec.get("initial"), path + ("initial",), planar=False)
+    return RigidBody(name, q, qd, mass, inertia, builder.gravity, builder.param_symbols.values(), frames,
+                     read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
+
+
+def read_particle(builder, name, spec, path):
+    builder.mapping(spec, path, {"type", "mass", "frames", "geometry", "initial", "description"}, required=("mass",))
+    q, qd = builder.part_symbols(name, ("x", "y", "z"))
+    frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=False)
+    initial = {}
+    node = builder.mapping(spec.get("initial"), path + ("initial",), {"position", "velocity"})
+    for key, suffix in (("position", ""), ("velocity", "_dot")):
+        if key in node:
+            values = builder.numbers(node[key], path + ("initial", key), 3)
+            initial.update({f"{c}{suffix}": v for c, v in zip("xyz", values)})
+    return Particle(name, q, qd, read_mass(builder, spec, path), builder.gravity, builder.param_symbols.values(),
+                    frames, read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
+
+
+def read_planar_body(builder, name, spec, path):
+    builder.mapping(spec, path, {"type", "mass", "inertia", "frames", "geometry", "initial", "description"},
+                    required=("mass", "inertia"))
+    inertia = builder.constant(spec["inertia"], path + ("inertia",))
+    if builder.value(inertia) < 0:
+        builder.fail(path + ("inertia",), "the moment of inertia I_zz must be ≥ 0")
+    q, qd = builder.part_symbols(name, ("x", "y", "theta"))
+    frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=True)
+    initial = read_body_initial(builder, spec.get("initial"), path + ("initial",), planar=True)
+    return PlanarBody(name, q, qd, read_mass(builder, spec, path), inertia, builder.gravity,
+                      builder.param_symbols.values(), frames,
+                      read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
+
+
+def read_mass(builder, spec, path):
+    mass = builder.constant(spec["mass"], path + ("mass",))
+    if builder.value(mass) < 0:
+        builder.fail(path + ("mass",), f"mass must be ≥ 0, got {builder.value(mass)}")
+    return mass
+
+
+def read_inertia(builder, node, path):
+    """Principal moments [Ixx, Iyy, Izz] or a full symmetric 3 × 3 matrix about the centre
+    of mass; positive semi-definite and obeying the triangle inequality."""
+    if isinstance(node, list) and len(node) == 3 and not any(isinstance(x, list) for x in node):
+        J = sp.diag(*[builder.constant(x, path + (i,)) for i, x in enumerate(node)])
+    elif isinstance(node, list) and len(node) == 3 and all(isinstance(r, list) and len(r) == 3 for r in node):
+        J = sp.Matrix([[builder.constant(x, path + (i, j)) for j, x in enumerate(r)] for i, r in enumerate(node)])
+    else:
+        builder.fail(path, "inertia must be [Ixx, Iyy, Izz] or a 3 × 3 matrix [[...], [...], [...]]")
+    values = np.array([[builder.value(x) for x in row] for row in J.tolist()])
+    scale = max(np.abs(values).max(), 1e-300)
+    if np.abs(values - values.T).max() > 1e-12 * scale:
+        builder.fail(path, "the inertia matrix is not symmetric")
+    moments = np.linalg.eigvalsh(values)
+    if moments.min() < -1e-12 * scale:
+        builder.fail(path, f"the inertia matrix is not positive semi-definite (principal moments {moments})")
+    a, b, c = moments
+    if a + b < c * (1 - 1e-9) - 1e-12 * scale:
+        builder.fail(path, f"principal moments {moments} violate the triangle inequality I1 + I2 ≥ I3: "
+                           "no mass distribution has them")
+    return J
+
+
+def read_rotation(builder, node, path):
+    """A numeric 3 × 3 rotation from ``rpy`` (URDF: Rz(yaw) Ry(pitch) Rx(roll)), ``axis``
+    (z along the vector) or ``quaternion`` (w, x, y, z); identity when none is given."""
+    given = [k for k in ORIENTATION_KEYS if k in node]
+    if len(given) > 1:
+        builder.fail(path, f"give at most one of {', '.join(ORIENTATION_KEYS)}, got {', '.join(given)}")
+    if not given:
+        return np.eye(3)
+    key = given[0]
+    values = builder.numbers(node[key], path + (key,), 4 if key == "quaternion" else 3)
+    if key == "rpy":
+        return rpy_matrix(*values)
+    if np.linalg.norm(values) == 0:
+        builder.fail(path + (key,), f"{key} must not be zero")
+    if key == "axis":
+        return axis_matrix(values)
+    if abs(np.linalg.norm(values) - 1) > 1e-6:
+        builder.fail(path + (key,), f"quaternion {values} is not of unit norm (norm {np.linalg.norm(values):.6g})")
+    return quaternion_matrix(values)
+
+
+def read_frames(builder, part, node, path, offsets, symbols=None):
+    """Named frames: ``position`` (expressions of parameters, or of ``symbols``) and an
+    orientation."""
+    frames = []
+    node = builder.mapping(node, path, set(node) if isinstance(node, dict) else set())
+    for name, spec in node.items():
+        fpath = path + (name,)
+        builder.identifier(name, fpath, "frame name")
+        spec = builder.mapping(spec, fpath,
+                               {"position", "geometry", *ORIENTATION_KEYS})
+        position = builder.vector(spec.get("position", [0, 0, 0]), fpath + ("position",), 3,
+                                  symbols or builder.param_symbols)
+        if not offsets and any(x != 0 for x in position):
+            builder.fail(fpath + ("position",), "a particle is a point: its frames cannot be offset")
+        rotation = sp.Matrix(read_rotation(builder, spec, fpath))
+        frames.append(Frame(part, name, position, rotation,
+                            read_geometry(builder, spec.get("geometry"), fpath + ("geometry",))))
+    return frames
+
+
+def read_body_initial(builder, node, path, planar):
+    """Coordinate values from ``position``, an orientation (``theta`` when planar),
+    ``velocity`` and ``angular_velocity`` (world axes)."""
+    if planar:
+        keys = {"position", "theta", "velocity", "angular_velocity"}
+    else:
+        keys = {"position", "velocity", "angular_velocity", *ORIENTATION_KEYS}
+    node = builder.mapping(node, path, keys)
+    size = 2 if planar else 3
+    names = ("x", "y", "z")[:size]
+    values = {}
+    if "position" in node:
+        values.update(zip(names, builder.numbers(node["position"], path + ("position",), size)))
+    if "velocity" in node:
+        values.update(zip((c + "_dot" for c in names), builder.numbers(node["velocity"], path + ("velocity",), size)))
+    if planar:
+        if "theta" in node:
+            values["theta"] = builder.numbers([node["theta"]], path + ("theta",), 1)[0]
+        if "angular_velocity" in node:
+            values["theta_dot"] = builder.numbers([node["angular_velocity"]], path + ("angular_velocity",), 1)[0]
+        return values
+    u = matrix_quaternion(read_rotation(builder, node, path))
+    values.update(zip(("qw", "qx", "qy", "qz"), u))
+    omega = builder.numbers(node.get("angular_velocity", [0, 0, 0]), path + ("angular_velocity",), 3)
+    w, v = u[0], u[1:]
+    G = np.column_stack([-v, w * np.eye(3) + np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])])
+    values.update(zip(("qw_dot", "qx_dot", "qy_dot", "qz_dot"), G.T @ np.asarray(omega) / 2))  # ω = 2 G u̇
+    return values
+
+
+def read_geometry(builder, node, path):
+    """Drawing shapes: a mapping or a list of them, each with one of box [x, y, z],
+    sphere r, cylinder [r, length], capsule [r, length] or mesh: file (with ``scale``),
+    and optional ``color`` (name or [r, g, b(, a)] in 0..1) and an ``origin`` pose."""
+    if node is None:
+        return ()
+    items = node if isinstance(node, list) else [node]
+    shapes = []
+    for i, item in enumerate(items):
+        ipath = path + (i,) if isinstance(node, list) else path
+        item = builder.mapping(item, ipath, {*SHAPES, "color", "origin", "scale"})
+        kinds = [k for k in SHAPES if k in item]
+        if len(kinds) != 1:
+            builder.fail(ipath, f"a shape needs exactly one of {', '.join(SHAPES)}; got {kinds or 'none'}")
+        kind = kinds[0]
+        shape = {"shape": kind}
+        if kind == "mesh":
+            if not isinstance(item["mesh"], str):
+                builder.fail(ipath + ("mesh",), "mesh must be a file path")
+            shape["file"] = item["mesh"]
+            shape["scale"] = builder.numbers(item.get("scale", [1, 1, 1]), ipath + ("scale",), 3)
+        else:
+            size = builder.numbers(item[kind] if isinstance(item[kind], list) else [item[kind]],
+                                   ipath + (kind,), SHAPES[kind])
+            if min(size) <= 0:
+                builder.fail(ipath + (kind,), f"{kind} dimensions must be positive, got {size}")
+            shape["size"] = size
+        shape["color"] = read_color(builder, item.get("color", "grey"), ipath + ("color",))
+        origin = builder.mapping(item.get("origin"), ipath + ("origin",), {"position", *ORIENTATION_KEYS})
+        shape["position"] = builder.numbers(origin.get("position", [0, 0, 0]), ipath + ("origin", "position"), 3)
+        shape["rotation"] = read_rotation(builder, origin, ipath + ("origin",)).tolist()
+        shapes.append(shape)
+    return tuple(shapes)
+
+
+def read_color(builder, node, path):
+    if isinstance(node, str):
+        if node not in COLORS:
+            builder.fail(path, f"unknown colour '{node}'; known: {', '.join(COLORS)} or [r, g, b(, a)]")
+        return [*COLORS[node], 1.0]
+    if not isinstance(node, list) or len(node) not in (3, 4):
+        builder.fail(path, "colour must be a name or [r, g, b] / [r, g, b, a] in 0..1")
+    values = builder.numbers(node, path, len(node))
+    if min(values) < 0 or max(values) > 1:
+        builder.fail(path, f"colour components must lie in 0..1, got {values}")
+    return values + [1.0] * (4 - len(values))

@@ -1,0 +1,81 @@
+"""What every part shares: its unconstrained M q̈ = Q (2.1) as sympy expressions of its
+own coordinates, compiled once; its energies; its named frames."""
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ..symbolic import T_SYMBOL, compile_function
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A named frame on a part: ``position`` (sympy 3-vector) and ``rotation`` (3 × 3,
+    frame → part axes) relative to the part's own reference, and drawing ``geometry``."""
+
+    part: str
+    name: str
+    position: sp.Matrix
+    rotation: sp.Matrix
+    geometry: tuple = field(default=(), compare=False)
+
+    @property
+    def label(self):
+        return f"{self.part}.{self.name}"
+
+
+class Part:
+    """A subsystem given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
+    and the model's parameter symbols ``params``.
+
+    Subclasses describe the kind of part; they provide ``pose(frame)`` (world position
+    and rotation of a frame), ``angular_velocity()`` (world) and may add constraints of
+    their own (``own_constraints``) and initial values (``initial``).
+    """
+
+    kind = "part"
+
+    def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None):
+        self.name = name
+        self.coordinates = tuple(coordinates)
+        self.q, self.qd = list(q), list(qd)
+        self.M, self.Q = sp.Matrix(M), sp.Matrix(Q)
+        self.T, self.V = sp.sympify(T), sp.sympify(V)
+        self.frames = {f.name: f for f in frames}
+        self.geometry = tuple(geometry)
+        self.initial = dict(initial or {})
+        args = (T_SYMBOL, self.q, self.qd, list(params))
+        self._evaluate = compile_function(args, [self.M, self.Q])
+        self._energy = compile_function(args, [self.T, self.V])
+
+    def evaluate(self, t, q, qd, p):
+        """(M, Q) of this part at its own coordinates q, velocities qd (2.1)."""
+        M, Q = self._evaluate(t, q, qd, p)
+        return M, Q.ravel()
+
+    def energy(self, t, q, qd, p):
+        """(kinetic, potential) energy of this part."""
+        T, V = self._energy(t, q, qd, p)
+        return float(T), float(V)
+
+    def symbolic(self):
+        """(M, Q) as sympy matrices of the model's symbols."""
+        return self.M, self.Q
+
+    def own_constraints(self, q, qd, params):
+        """Constraints the part's coordinates always obey (a quaternion's unit norm)."""
+        return []
+
+    def pose(self, frame):
+        """(position, rotation) of ``frame`` in the world, as sympy expressions."""
+        raise NotImplementedError(f"a {self.kind} part has no frames")
+
+    def angular_velocity(self):
+        """The part's angular velocity in world axes (zero for point-like parts)."""
+        return sp.zeros(3, 1)
+
+
+def frame_velocity(position, q, qd):
+    """d/dt of a world position that depends on q only."""
+    return sp.Matrix(position).jacobian(sp.Matrix(q)) * sp.Matrix(qd)
+

@@ -1,0 +1,20 @@
+"""A point mass in 3 coordinates."""
+
+import sympy as sp
+
+from .base import Part
+
+
+class Particle(Part):
+    """M = m I₃ (m ≥ 0; a massless particle is legal), Q = m g. Its frames are the point."""
+
+    kind = "particle"
+
+    def __init__(self, name, q, qd, mass, gravity, params, frames=(), geometry=(), initial=None):
+        r, rd = sp.Matrix(q), sp.Matrix(qd)
+        g = sp.Matrix(gravity)
+        super().__init__(name, ("x", "y", "z"), q, qd, mass * sp.eye(3), mass * g,
+                         mass * (rd.T * rd)[0] / 2, -mass * (g.T * r)[0], params, frames, geometry, initial)
+
+    def pose(self, frame):
+        return sp.Matrix(self.q), frame.rotation

@@ -1,0 +1,48 @@
+"""A rigid body in 7 coordinates: its centre of mass r in the world and a unit
+quaternion u (scalar-first) for its orientation."""
+
+import sympy as sp
+
+from ..kinematics import body_rate_matrix, rotation, world_rate_matrix
+from ..connectors import Connector
+from .base import Part
+
+COORDINATES = ("x", "y", "z", "qw", "qx", "qy", "qz")
+
+
+class RigidBody(Part):
+    """M = blockdiag(m I₃, 4 EᵀJE): the rotational block has rank 3 — singular by design,
+    closed by the unit-norm constraint uᵀu = 1 that the body adds itself.
+
+    Q = [m g + F;  2 EᵀΓ_body − 8 E(u̇)ᵀ J E(u) u̇], the last term from Lagrange's equations
+    with T = ½ m ṙᵀṙ + 2 u̇ᵀ Eᵀ J E u̇ (ω_body = 2 E u̇). ``mass`` (≥ 0) and ``inertia``
+    (3 × 3, about the centre of mass, body axes) are sympy expressions of parameters.
+    """
+
+    kind = "rigid_body"
+    COORDINATES = COORDINATES
+
+    def __init__(self, name, q, qd, mass, inertia, gravity, params, frames=(), geometry=(), initial=None):
+        r, u = sp.Matrix(q[:3]), sp.Matrix(q[3:])
+        rd, ud = sp.Matrix(qd[:3]), sp.Matrix(qd[3:])
+        J = sp.Matrix(inertia)
+        E, Ed = body_rate_matrix(u), body_rate_matrix(ud)
+        M = sp.diag(mass * sp.eye(3), 4 * E.T * J * E)
+        Q = sp.Matrix.vstack(mass * sp.Matrix(gravity), -8 * Ed.T * J * E * ud)
+        T = mass * (rd.T * rd)[0] / 2 + 2 * (ud.T * E.T * J * E * ud)[0]
+        V = -mass * (sp.Matrix(gravity).T * r)[0]
+        self.mass, self.inertia = mass, J
+        super().__init__(name, COORDINATES, q, qd, M, Q, T, V, params, frames, geometry, initial)
+
+    def own_constraints(self, q, qd, params):
+        """uᵀu = 1, differentiated: uᵀü = −u̇ᵀu̇."""
+        u = sp.Matrix(self.q[3:])
+        return [Connector.holonomic(f"{self.name}.unit_quaternion", [((u.T * u)[0] - 1) / 2], q, qd, params)]
+
+    def pose(self, frame):
+        R = rotation(self.q[3:])
+        return sp.Matrix(self.q[:3]) + R * frame.position, R * frame.rotation
+
+    def angular_velocity(self):
+        return 2 * world_rate_matrix(self.q[3:]) * sp.Matrix(self.qd[3:])
+
