@@ -7,13 +7,16 @@ Result 3 (full column rank of [M; A]) as the exact test of uniqueness.
 """
 
 from .equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
-from .errors import ModelError, SolveError
+from .errors import ModelError, SimulationError, SolveError
 from .io import load, loads
+from .simulate import simulate
 from .system import System
+from .trajectory import Trajectory, load_trajectory
 
 __version__ = "0.1.0"
 
 __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
-    "ModelError", "SolveError", "load", "loads", "System",
+    "ModelError", "SolveError", "SimulationError", "load", "loads", "System",
+    "simulate", "Trajectory", "load_trajectory",
 ]

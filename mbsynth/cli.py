@@ -8,11 +8,14 @@ model error (one readable line on stderr, or ``{"error": ...}`` with ``--json``)
 import argparse
 import json
 import sys
+import time
 import traceback
 
 from .diagnose import diagnose
-from .errors import ModelError, SolveError
+from .errors import ModelError, SimulationError, SolveError
 from .io import load
+from .plot import plot_trajectory
+from .simulate import STABILIZATIONS, simulate
 
 
 def main(argv=None):
@@ -44,6 +47,24 @@ def _parser():
     check.add_argument("--json", action="store_true", help="print one JSON object")
     check.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     check.set_defaults(run=run_check)
+
+    sim = commands.add_parser(
+        "simulate", help="integrate a model over time",
+        description="Integrate the model from its initial state (made consistent with the constraints) "
+                    "to --t-end, keeping the constraints by projection; print a summary.")
+    sim.add_argument("model", help="model file (YAML)")
+    sim.add_argument("--t-end", type=float, required=True, help="end time [s]")
+    sim.add_argument("--dt", type=float, help="output interval [s] (default t_end/500)")
+    sim.add_argument("--out", help="trajectory file (.npz or .csv), written as the run goes")
+    sim.add_argument("--plot", help="figure of coordinates, energy drift and residuals (.png, .pdf, .svg)")
+    sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
+    sim.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
+    sim.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance (default 1e-10)")
+    sim.add_argument("--stabilization", choices=STABILIZATIONS, default="projection",
+                     help="drift control (default projection)")
+    sim.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    sim.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    sim.set_defaults(run=run_simulate)
     return parser
 
 
@@ -55,6 +76,69 @@ def run_check(args):
     else:
         print(format_check(report, args.model))
     return 0 if report.consistent and not report.suggested_constraints else 1
+
+
+def run_simulate(args):
+    system = load(args.model)
+    bar = ProgressBar(args.t_end) if sys.stderr.isatty() and not args.json else None
+    started = time.perf_counter()
+    try:
+        traj = simulate(system, args.t_end, dt=args.dt, method=args.method, rtol=args.rtol, atol=args.atol,
+                        stabilization=args.stabilization, out=args.out, progress=bar)
+        error = None
+    except SimulationError as err:
+        traj, error = err.trajectory, str(err)
+    finally:
+        if bar:
+            bar.close()
+    summary = {"model": system.name, "t_end": float(traj.t[-1]) if traj.t.size else 0.0, "outputs": int(traj.t.size),
+               "steps": traj.stats.get("steps"), "evaluations": traj.stats.get("evaluations"),
+               "wall_time_s": round(time.perf_counter() - started, 3), "max_residual": traj.max_residual,
+               "energy_drift": traj.energy_drift, "initial_changes": traj.stats.get("initial_changes", {}),
+               "out": args.out, "plot": args.plot, "status": "completed" if error is None else "failed"}
+    if error:
+        summary["error"] = error
+    if args.plot and traj.t.size:
+        plot_trajectory(traj, args.plot, title=f"{system.name}")
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(format_summary(summary))
+    if error and not args.json:
+        print(f"error: {error}", file=sys.stderr)
+    return 0 if error is None else 1
+
+
+def format_summary(s):
+    lines = [f"model {s['model']}: simulated to t = {s['t_end']:.6g} s ({s['status']})",
+             f"  {s['steps']} steps, {s['evaluations']} evaluations of (2.14), {s['wall_time_s']:.3g} s wall time",
+             f"  max constraint residual {s['max_residual']:.3g}, relative energy drift {s['energy_drift']:.3g}"]
+    for name, (given, new) in s["initial_changes"].items():
+        lines.append(f"  initial {name}: {given:.9g} -> {new:.9g} (made consistent)")
+    for key in ("out", "plot"):
+        if s[key]:
+            lines.append(f"  wrote {s[key]}")
+    return "\n".join(lines)
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr (only on a terminal)."""
+
+    def __init__(self, t_end, width=40):
+        self.t_end, self.width = t_end, width
+        self.started = time.perf_counter()
+
+    def __call__(self, t):
+        done = min(max(t / self.t_end, 0.0), 1.0)
+        filled = int(done * self.width)
+        elapsed = time.perf_counter() - self.started
+        left = elapsed * (1 - done) / done if done > 0 else float("nan")
+        sys.stderr.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] t = {t:.4g} s, "
+                         f"{elapsed:.1f} s elapsed, ~{left:.0f} s left ")
+        sys.stderr.flush()
+
+    def close(self):
+        sys.stderr.write("\n")
 
 
 def format_check(report, path):

@@ -19,3 +19,15 @@ class SolveError(ArithmeticError):
         super().__init__(message)
         self.constraints = tuple(constraints)
         self.coordinates = tuple(coordinates)
+
+
+class SimulationError(SolveError):
+    """A run that had to stop (no motion at a state, a NaN/inf or exploding state, a
+    step-size collapse). ``time`` is where it stopped and ``trajectory`` holds every
+    output row computed before, the last good state included (saved when an output
+    file was asked for)."""
+
+    def __init__(self, message, *, time, trajectory, constraints=(), coordinates=()):
+        super().__init__(message, constraints=constraints, coordinates=coordinates)
+        self.time = time
+        self.trajectory = trajectory

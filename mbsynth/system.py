@@ -52,13 +52,18 @@ class System:
     initial_qd: np.ndarray
     forces: tuple = ()
     closures: tuple = ()
+    initial_given: frozenset = frozenset()
+    initial_fixed: frozenset = frozenset()
 
     @classmethod
-    def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=()):
+    def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
+              initial_fixed=()):
         """Lay out the parts' coordinates in order, check names, set the initial state.
 
         ``initial`` maps ``part.coordinate`` and ``part.coordinate_dot`` to values;
-        the rest start at zero.
+        the rest start at the parts' defaults (zero, or the identity orientation).
+        ``initial_given`` records the names the model set, ``initial_fixed`` those that
+        must not change when the initial state is made consistent (projection.py).
         """
         coordinates = tuple(f"{s.name}.{c}" for s in subsystems for c in s.coordinates)
         if len(set(coordinates)) != len(coordinates):
@@ -67,7 +72,8 @@ class System:
         duplicates = sorted({x for x in names if names.count(x) > 1})
         if duplicates:
             raise ModelError(f"model '{name}': duplicate constraint names {duplicates}")
-        q0, qd0 = np.zeros(len(coordinates)), np.zeros(len(coordinates))
+        q0 = np.array([float(s.defaults.get(c, 0.0)) for s in subsystems for c in s.coordinates])
+        qd0 = np.zeros(len(coordinates))
         index = {c: i for i, c in enumerate(coordinates)}
         for key, value in (initial or {}).items():
             if key in index:
@@ -77,7 +83,8 @@ class System:
             else:
                 raise ModelError(f"model '{name}': initial value for unknown coordinate '{key}'")
         return cls(name, tuple(subsystems), tuple(constraints), coordinates, tuple(q_symbols),
-                   tuple(qd_symbols), dict(parameters), q0, qd0, tuple(forces))
+                   tuple(qd_symbols), dict(parameters), q0, qd0, tuple(forces),
+                   initial_given=frozenset(initial or ()), initial_fixed=frozenset(initial_fixed))
 
     @property
     def n(self):
@@ -145,15 +152,35 @@ class System:
             row += con.size
         return Assembly(M, Q, A, b, C)
 
-    def motion(self, t, q, qd, method="fast"):
+    def motion(self, t, q, qd, method="fast", baumgarte=None):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
         Qc, residual). ``method``: "fast" (KKT, falling back to the exact treatment when
-        it is not well posed) or "reference" (the literal pseudo-inverse of (2.14))."""
+        it is not well posed) or "reference" (the literal pseudo-inverse of (2.14)).
+        ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
+        residuals (drift control during integration; b itself when they are zero)."""
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         arrays = self.evaluate(t, q, qd)
-        return METHODS[method](arrays.M, arrays.Q, arrays.A, arrays.b, arrays.C,
+        b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
+        return METHODS[method](arrays.M, arrays.Q, arrays.A, b, arrays.C,
                                coordinates=self.coordinates, constraints=self.constraint_names)
+
+    def _stabilized(self, t, q, qd, b, alpha, beta):
+        phi, psi = self.constraint_residuals(t, q, qd)
+        return b - 2 * alpha * np.nan_to_num(psi) - beta**2 * np.nan_to_num(phi)
+
+    def energy(self, t, q, qd):
+        """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
+        q, qd = self._state(q, qd)
+        p = self.parameter_values
+        kinetic = potential = 0.0
+        start = 0
+        for part in self.subsystems:
+            stop = start + len(part.coordinates)
+            T, V = part.energy(t, q[start:stop], qd[start:stop], p)
+            kinetic, potential, start = kinetic + T, potential + V, stop
+        potential += sum(element.potential(t, q, qd, p) for element in self.forces)
+        return kinetic, potential
 
     def constraint_residuals(self, t, q, qd):
         """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""

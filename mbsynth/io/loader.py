@@ -21,7 +21,7 @@ from .parts import read_frames, read_geometry, read_particle, read_planar_body, 
 from .source import Document, LineDict, LineList, read_document
 
 TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
-            "closure", "initial"}
+            "closure", "initial", "initial_fixed"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 
 
@@ -133,8 +133,9 @@ class _Builder:
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
         constraints += self.read_constraints() + read_joints(self)
-        system = System.build(name, parts, constraints, self.q, self.qd, self.parameters,
-                              self.read_initial(parts))
+        initial = self.read_initial(parts)
+        system = System.build(name, parts, constraints, self.q, self.qd, self.parameters, initial,
+                              initial_fixed=self.read_initial_fixed(initial))
         self.check_parts(system)
         closure = root.get("closure", "none")
         if closure not in ("auto", "none"):
@@ -284,6 +285,16 @@ class _Builder:
                 self.fail(("initial", key), f"'{key}' is already set by the part's own initial: mapping")
             values[key] = self.value(self.constant(text, ("initial", key)))
         return values
+
+    def read_initial_fixed(self, initial):
+        """Names whose initial values must be kept exactly (a list; each must be set)."""
+        node = self.root.get("initial_fixed", LineList())
+        if not isinstance(node, list):
+            self.fail(("initial_fixed",), f"expected a list of names from 'initial:', got {_kind(node)}")
+        for i, key in enumerate(node):
+            if key not in initial:
+                self.fail(("initial_fixed", i), f"'{key}' has no initial value to keep")
+        return set(node)
 
     def check_parts(self, system):
         """Each part's M must be finite, symmetric and positive semi-definite at the initial state."""

@@ -150,8 +150,11 @@ def read_body_initial(builder, node, path, planar):
             values["theta_dot"] = builder.numbers([node["angular_velocity"]], path + ("angular_velocity",), 1)[0]
         return values
     u = matrix_quaternion(read_rotation(builder, node, path))
-    values.update(zip(("qw", "qx", "qy", "qz"), u))
-    omega = builder.numbers(node.get("angular_velocity", [0, 0, 0]), path + ("angular_velocity",), 3)
+    if any(k in node for k in ORIENTATION_KEYS):
+        values.update(zip(("qw", "qx", "qy", "qz"), u))
+    if "angular_velocity" not in node:
+        return values
+    omega = builder.numbers(node["angular_velocity"], path + ("angular_velocity",), 3)
     w, v = u[0], u[1:]
     G = np.column_stack([-v, w * np.eye(3) + np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])])
     values.update(zip(("qw_dot", "qx_dot", "qy_dot", "qz_dot"), G.T @ np.asarray(omega) / 2))  # ω = 2 G u̇

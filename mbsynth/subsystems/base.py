@@ -34,6 +34,7 @@ class Part:
     """
 
     kind = "part"
+    defaults = {}  # initial coordinate values that are not zero unless the model says otherwise
 
     def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None):
         self.name = name

@@ -21,6 +21,7 @@ class RigidBody(Part):
 
     kind = "rigid_body"
     COORDINATES = COORDINATES
+    defaults = {"qw": 1.0}  # the identity orientation
 
     def __init__(self, name, q, qd, mass, inertia, gravity, params, frames=(), geometry=(), initial=None):
         r, u = sp.Matrix(q[:3]), sp.Matrix(q[3:])

@@ -1,0 +1,112 @@
+"""Putting a state back on the constraint manifold.
+
+(2.14) enforces the constraints only at the acceleration level (2.4): an integrated
+state drifts off φ(q, t) = 0 and φ̇ = 0. These functions move it back with the least
+change: positions by Gauss–Newton on the position-level rows, q ← q − Φ_q⁺ φ
+(Φ_q = the rows of A of the holonomic constraints), then velocities on every
+velocity-level row (holonomic and non-holonomic, both linear in q̇),
+q̇ ← q̇ − A_v⁺ ψ. Coordinates marked fixed are not changed. Unit quaternions are
+holonomic rows of their bodies, so they are restored like any other constraint.
+"""
+
+import numpy as np
+
+from .errors import SolveError
+
+TOLERANCE = 1e-12  # largest residual accepted after projection (in each row's own units)
+MAX_ITERATIONS = 50
+
+
+def _free_columns(n, fixed):
+    free = np.ones(n, dtype=bool)
+    if fixed is not None:
+        free[np.asarray(fixed, dtype=int)] = False
+    return free
+
+
+def _correction(J, r):
+    """Least-norm Δ with J Δ = r (dependent rows allowed)."""
+    return np.linalg.lstsq(J, r, rcond=1e-12)[0]
+
+
+def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
+    """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices)."""
+    q = np.array(q, dtype=float)
+    qd = np.zeros_like(q)
+    free = _free_columns(q.size, fixed)
+    for _ in range(MAX_ITERATIONS):
+        phi, _ = system.constraint_residuals(t, q, qd)
+        rows = np.isfinite(phi)
+        if not rows.any() or np.abs(phi[rows]).max() <= tolerance:
+            return q
+        A = system.evaluate(t, q, qd).A[rows][:, free]
+        q[free] -= _correction(A, phi[rows])
+        if not np.all(np.isfinite(q)):
+            break
+    phi, _ = system.constraint_residuals(t, q, qd)
+    raise SolveError(_unmet(system, phi, "positions", free),
+                     constraints=[n for n, r in zip(system.constraint_names, phi) if abs(r) > tolerance])
+
+
+def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
+    """q̇ on the velocity-level rows (φ̇ = 0, ψ = 0), changing only free velocities."""
+    qd = np.array(qd, dtype=float)
+    free = _free_columns(qd.size, fixed)
+    _, psi = system.constraint_residuals(t, q, qd)
+    rows = np.isfinite(psi)
+    if not rows.any() or np.abs(psi[rows]).max() <= tolerance:
+        return qd
+    A = system.evaluate(t, q, qd).A[rows][:, free]
+    qd[free] -= _correction(A, psi[rows])  # ψ is affine in q̇ with slope A
+    _, psi = system.constraint_residuals(t, q, qd)
+    if np.abs(psi[rows]).max() > max(tolerance, 1e-9 * (1 + np.abs(qd).max())):
+        raise SolveError(_unmet(system, psi, "velocities", free),
+                         constraints=[n for n, r in zip(system.constraint_names, psi) if abs(r) > tolerance])
+    return qd
+
+
+def project(system, t, q, qd, fixed_q=None, fixed_qd=None):
+    """(q, q̇) on the constraint manifold: positions first, then velocities."""
+    q = project_positions(system, t, q, fixed_q)
+    return q, project_velocities(system, t, q, qd, fixed_qd)
+
+
+def consistent_initial_state(system, t=0.0):
+    """The model's initial state made consistent with the constraints.
+
+    First every value the model sets is kept and only the others are completed (a
+    partial state). If that is impossible (a state slightly off), only the values
+    listed in ``initial_fixed`` are kept and the rest change as little as possible.
+    Returns (q, q̇, changes) with changes = {name: (given, new)} for the values that
+    moved. Raises SolveError when no consistent state keeps the fixed values."""
+    q0, qd0 = system.initial_state()
+    try:
+        q, qd = _project_keeping(system, t, q0, qd0, system.initial_given)
+    except SolveError:
+        try:
+            q, qd = _project_keeping(system, t, q0, qd0, system.initial_fixed)
+        except SolveError as err:
+            kept = ", ".join(sorted(system.initial_fixed)) or "nothing"
+            raise SolveError(f"no consistent initial state exists (keeping {kept}): {err}",
+                             constraints=err.constraints) from None
+    names = list(system.coordinates)
+    changes = {}
+    for i, c in enumerate(names):
+        if abs(q[i] - q0[i]) > 1e-12:
+            changes[c] = (float(q0[i]), float(q[i]))
+        if abs(qd[i] - qd0[i]) > 1e-12:
+            changes[c + "_dot"] = (float(qd0[i]), float(qd[i]))
+    return q, qd, changes
+
+
+def _project_keeping(system, t, q, qd, keep):
+    names = list(system.coordinates)
+    return project(system, t, q, qd, [i for i, c in enumerate(names) if c in keep],
+                   [i for i, c in enumerate(names) if c + "_dot" in keep])
+
+
+def _unmet(system, residual, level, free):
+    worst = np.nanargmax(np.abs(residual))
+    return (f"the constraints cannot be met by adjusting the {level} of "
+            f"{', '.join(c for c, f in zip(system.coordinates, free) if f) or 'no coordinate (all are fixed)'}; "
+            f"largest residual {abs(residual[worst]):.3g} in {system.constraint_names[worst]}")

@@ -1,0 +1,176 @@
+"""Motion over time: integrate (q, q̇) with q̈ from (2.14), keeping the constraints.
+
+The accelerations satisfy the constraints only at the acceleration level (2.4), so
+positions and velocities drift. ``simulate`` integrates with scipy's adaptive
+integrators between output times and, with the default ``stabilization="projection"``,
+projects (q, q̇) back onto the constraints at every output time (projection.py); the
+integrator restarts there with its last step size. ``"baumgarte"`` instead replaces
+b by b − 2α φ̇ − β² φ (Baumgarte 1972) with no restart; ``"none"`` does neither.
+"""
+
+import logging
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .errors import SimulationError, SolveError
+from .projection import consistent_initial_state, project
+from .trajectory import Trajectory, TrajectoryWriter
+
+log = logging.getLogger(__name__)
+
+STABILIZATIONS = ("projection", "baumgarte", "none")
+DEFAULT_OUTPUTS = 500
+MAX_STATE = 1e12  # a coordinate or velocity beyond this counts as an exploding state
+
+
+def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
+             stabilization="projection", baumgarte=(10.0, 10.0), out=None, progress=None):
+    """Integrate ``system`` from t0 to t_end; returns a Trajectory with one row per output time.
+
+    q0, qd0: the initial state (default: the model's, made consistent by projection
+    keeping every value the model sets; the changes are logged and kept in
+    ``stats["initial_changes"]``). dt: output interval (default (t_end − t0)/500).
+    method, rtol, atol: scipy ``solve_ivp`` settings. out: a .npz or .csv path written as
+    the run goes. progress: a callable(t) called at every output time.
+    Raises SimulationError (with the partial trajectory) when the run cannot go on.
+    """
+    if stabilization not in STABILIZATIONS:
+        raise ValueError(f"stabilization must be one of {STABILIZATIONS}, got {stabilization!r}")
+    if not t_end > t0:
+        raise ValueError(f"t_end ({t_end}) must be after t0 ({t0})")
+    run = _Run(system, method, rtol, atol, stabilization, baumgarte)
+    if q0 is None and qd0 is None:
+        q, qd, changes = consistent_initial_state(system, t0)
+        for name, (given, new) in changes.items():
+            log.info("initial %s: %.12g -> %.12g (made consistent with the constraints)", name, given, new)
+    else:
+        start_q, start_qd = system.initial_state()
+        q = start_q if q0 is None else np.asarray(q0, dtype=float)
+        qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
+        changes = {}
+    times = _output_times(t0, t_end, dt)
+    writer = TrajectoryWriter(out, system.coordinates) if out is not None else None
+    started = time.perf_counter()
+    status = "stopped"
+    try:
+        run.record(t0, q, qd, writer)
+        for t_next in times[1:]:
+            q, qd = run.advance(t_next, q, qd)
+            run.record(t_next, q, qd, writer)
+            if progress is not None:
+                progress(t_next)
+        status = "completed"
+    except SolveError as err:
+        status = f"failed at t = {run.t_failed:.9g}: {err}"
+        raise SimulationError(f"run stopped at t = {run.t_failed:.9g} (last good state saved at "
+                              f"t = {run.t[-1]:.9g}): {err}", time=run.t_failed, trajectory=run.trajectory(status),
+                              constraints=err.constraints, coordinates=err.coordinates) from None
+    except KeyboardInterrupt:
+        status = f"interrupted at t = {run.t[-1]:.9g}"
+        raise
+    finally:
+        if writer is not None:
+            writer.status = status
+            writer.close()
+    traj = run.trajectory(status)
+    traj.stats.update(wall_time=time.perf_counter() - started, initial_changes=changes)
+    return traj
+
+
+def _output_times(t0, t_end, dt):
+    if dt is None:
+        return np.linspace(t0, t_end, DEFAULT_OUTPUTS + 1)
+    if not dt > 0:
+        raise ValueError(f"dt must be positive, got {dt}")
+    times = np.arange(t0, t_end, dt)
+    return np.append(times, t_end) if t_end - times[-1] > 1e-12 * dt else np.append(times[:-1], t_end)
+
+
+class _Run:
+    """The state of one integration: settings, output rows and counters."""
+
+    def __init__(self, system, method, rtol, atol, stabilization, baumgarte):
+        self.system, self.method, self.rtol, self.atol = system, method, rtol, atol
+        self.stabilization = stabilization
+        self.baumgarte = baumgarte if stabilization == "baumgarte" else None
+        self.n = system.n
+        self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity")}
+        self.steps = self.evaluations = 0
+        self.first_step = None
+        self.t_failed = float("nan")
+        self.non_unique = False
+
+    @property
+    def t(self):
+        return self.rows["t"]
+
+    def rhs(self, t, y):
+        self.t_failed = t
+        q, qd = y[:self.n], y[self.n:]
+        motion = self.system.motion(t, q, qd, baumgarte=self.baumgarte)
+        self.non_unique |= not motion.unique
+        return np.concatenate([qd, motion.qdd])
+
+    def advance(self, t_next, q, qd):
+        """Integrate to t_next, check the state, project it if asked."""
+        t = self.t[-1]
+        first_step = min(self.first_step, t_next - t) if self.first_step else None
+        sol = solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=self.rtol,
+                        atol=self.atol, first_step=first_step)
+        self.evaluations += sol.nfev
+        self.steps += len(sol.t) - 1
+        if sol.status != 0:
+            self.t_failed = sol.t[-1]
+            raise SolveError(f"the integrator gave up: {sol.message}")
+        steps = np.diff(sol.t)
+        self.first_step = steps[-2] if steps.size > 1 else self.first_step  # the last step was cut short
+        y = sol.y[:, -1]
+        self._check(t_next, y)
+        q, qd = y[:self.n], y[self.n:]
+        if self.stabilization == "projection":
+            self.t_failed = t_next
+            q, qd = project(self.system, t_next, q, qd)
+        return q, qd
+
+    def _check(self, t, y):
+        bad = ~np.isfinite(y) | (np.abs(y) > MAX_STATE)
+        if bad.any():
+            self.t_failed = t
+            names = [c for c in self.system.coordinates] + [c + "_dot" for c in self.system.coordinates]
+            culprits = [names[i] for i in np.flatnonzero(bad)]
+            raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
+                             f"{', '.join(culprits[:6])}", coordinates=culprits)
+
+    def record(self, t, q, qd, writer):
+        kinetic, potential = self.system.energy(t, q, qd)
+        phi, psi = self.system.constraint_residuals(t, q, qd)
+        row = dict(t=t, q=np.array(q), qd=np.array(qd), energy=kinetic + potential, kinetic=kinetic,
+                   residual_position=_max_abs(phi), residual_velocity=_max_abs(psi))
+        for k, v in row.items():
+            self.rows[k].append(v)
+        if writer is not None:
+            writer.append(_chunk(self.system.coordinates, row))
+
+    def trajectory(self, status):
+        r = self.rows
+        traj = Trajectory(tuple(self.system.coordinates), np.array(r["t"]), np.array(r["q"]).reshape(-1, self.n),
+                          np.array(r["qd"]).reshape(-1, self.n), np.array(r["energy"]), np.array(r["kinetic"]),
+                          np.array(r["residual_position"]), np.array(r["residual_velocity"]), status)
+        traj.stats.update(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique)
+        if self.non_unique:
+            log.warning("the motion was not unique somewhere on this run; the free directions got zero "
+                        "acceleration (η = 0 in (2.14))")
+        return traj
+
+
+def _max_abs(values):
+    finite = values[np.isfinite(values)]
+    return float(np.abs(finite).max()) if finite.size else 0.0
+
+
+def _chunk(coordinates, row):
+    return Trajectory(tuple(coordinates), np.array([row["t"]]), row["q"][None, :], row["qd"][None, :],
+                      np.array([row["energy"]]), np.array([row["kinetic"]]), np.array([row["residual_position"]]),
+                      np.array([row["residual_velocity"]]))

@@ -1,0 +1,157 @@
+"""Trajectories and their files.
+
+A ``Trajectory`` holds one row per output time: ``t``, ``q``, ``qd``, the largest
+position and velocity constraint residuals, and the total energy. Files:
+
+- ``.npz``: arrays ``t``, ``q``, ``qd``, ``coordinates`` (plus ``energy``,
+  ``residual_position``, ``residual_velocity``, ``status``);
+- ``.csv``: a header ``t, <coordinate>..., <coordinate>_dot..., energy`` and one row per time.
+
+``TrajectoryWriter`` writes while a run goes on, so an interrupted or failed run keeps
+everything computed so far, and never leaves half a file under the final name: CSV
+rows are appended to ``FILE.partial`` (renamed to FILE when the run ends, however it
+ends); NPZ is checkpointed to a temporary file that replaces FILE atomically.
+"""
+
+import csv
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ModelError
+
+FORMATS = (".npz", ".csv")
+
+
+@dataclass
+class Trajectory:
+    coordinates: tuple
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    energy: np.ndarray
+    kinetic: np.ndarray
+    residual_position: np.ndarray
+    residual_velocity: np.ndarray
+    status: str = "completed"
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def energy_drift(self):
+        """max |E(t) − E(0)| relative to max(|E(0)|, the largest kinetic energy): a
+        pendulum whose energy is zero at the start still gets a meaningful scale."""
+        E = self.energy
+        if E.size == 0 or not np.all(np.isfinite(E)):
+            return float("nan")
+        scale = max(abs(E[0]), float(np.nanmax(np.abs(self.kinetic))) if self.kinetic.size else 0.0)
+        return 0.0 if scale == 0 else float(np.abs(E - E[0]).max() / scale)
+
+    @property
+    def max_residual(self):
+        values = np.concatenate([self.residual_position, self.residual_velocity])
+        values = values[np.isfinite(values)]
+        return float(values.max()) if values.size else 0.0
+
+    def column(self, name):
+        """The history of one coordinate (``part.coord``) or velocity (``part.coord_dot``)."""
+        if name in self.coordinates:
+            return self.q[:, self.coordinates.index(name)]
+        if name.endswith("_dot") and name[:-4] in self.coordinates:
+            return self.qd[:, self.coordinates.index(name[:-4])]
+        raise KeyError(f"no coordinate '{name}'; coordinates: {', '.join(self.coordinates)}")
+
+    def save(self, path):
+        """Write the whole trajectory to ``path`` (.npz or .csv), atomically."""
+        with TrajectoryWriter(path, self.coordinates) as writer:
+            writer.append(self)
+            writer.status = self.status
+
+
+def load_trajectory(path):
+    """Read a trajectory written by ``Trajectory.save`` or a run (.npz or .csv)."""
+    path = Path(path)
+    if path.suffix == ".npz":
+        with np.load(path, allow_pickle=False) as data:
+            coordinates = tuple(str(c) for c in data["coordinates"])
+            get = {k: data[k] for k in data.files}
+        n_rows = get["t"].size
+        nan = np.full(n_rows, np.nan)
+        return Trajectory(coordinates, get["t"], get["q"], get["qd"], get.get("energy", nan),
+                          get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
+                          str(get.get("status", "completed")))
+    if path.suffix == ".csv":
+        with path.open(newline="") as f:
+            header = next(csv.reader(f))
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        n = (len(header) - 2) // 2
+        nan = np.full(data.shape[0], np.nan)
+        return Trajectory(tuple(header[1:1 + n]), data[:, 0], data[:, 1:1 + n], data[:, 1 + n:1 + 2 * n],
+                          data[:, -1], nan, nan, nan)
+    raise ModelError(f"{path}: unknown trajectory format (use {' or '.join(FORMATS)})")
+
+
+class TrajectoryWriter:
+    """Writes trajectory rows as they come (see the module docstring)."""
+
+    def __init__(self, path, coordinates, checkpoint_seconds=2.0):
+        self.path = Path(path)
+        if self.path.suffix not in FORMATS:
+            raise ModelError(f"{self.path}: output must end in {' or '.join(FORMATS)}")
+        if not self.path.parent.exists():
+            raise ModelError(f"{self.path}: the folder {self.path.parent} does not exist")
+        self.coordinates = tuple(coordinates)
+        self.checkpoint_seconds = checkpoint_seconds
+        self.status = "running"
+        self._chunks = []
+        self._last_checkpoint = time.monotonic()
+        if self.path.suffix == ".csv":
+            self._partial = self.path.with_name(self.path.name + ".partial")
+            self._csv_file = self._partial.open("w", newline="")
+            self._csv = csv.writer(self._csv_file)
+            self._csv.writerow(["t", *self.coordinates, *(c + "_dot" for c in self.coordinates), "energy"])
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def append(self, traj):
+        """Add the rows of a Trajectory (or a chunk of one)."""
+        if self.path.suffix == ".csv":
+            for row in zip(traj.t, traj.q, traj.qd, traj.energy):
+                self._csv.writerow([repr(float(row[0])), *map(repr, map(float, row[1])),
+                                    *map(repr, map(float, row[2])), repr(float(row[3]))])
+            self._csv_file.flush()
+        else:
+            self._chunks.append(traj)
+            if time.monotonic() - self._last_checkpoint > self.checkpoint_seconds:
+                self._write_npz()
+
+    def close(self):
+        """Finish the file under its final name, whatever the state of the run."""
+        if self.path.suffix == ".csv":
+            self._csv_file.close()
+            os.replace(self._partial, self.path)
+        else:
+            self._write_npz()
+
+    def _write_npz(self):
+        self._last_checkpoint = time.monotonic()
+        chunks = self._chunks
+        n = len(self.coordinates)
+
+        def stack(name, width=None):
+            parts = [getattr(c, name) for c in chunks]
+            if not parts:
+                return np.zeros((0, n) if width else 0)
+            return np.concatenate(parts)
+
+        tmp = self.path.with_name(self.path.name + ".tmp.npz")
+        np.savez(tmp, t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
+                 energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
+                 residual_velocity=stack("residual_velocity"), status=np.array(self.status))
+        os.replace(tmp, self.path)
