@@ -65,6 +65,28 @@ def _parser():
     sim.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     sim.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     sim.set_defaults(run=run_simulate)
+
+    sw = commands.add_parser(
+        "sweep", help="a parameter study: many simulations on Dask",
+        description="Simulate the model for every combination of the --param ranges (or every row of "
+                    "--samples) on a Dask cluster (a local one by default, or --scheduler), one result "
+                    "row per run. Restarting with the same --out skips the runs already done.")
+    sw.add_argument("model", help="model file (YAML)")
+    grid = sw.add_mutually_exclusive_group(required=True)
+    grid.add_argument("--param", action="append", metavar="NAME=START:STOP:COUNT", help="a swept parameter")
+    grid.add_argument("--samples", metavar="FILE.csv", help="one run per row; columns are parameter names")
+    sw.add_argument("--t-end", type=float, required=True, help="end time of every run [s]")
+    sw.add_argument("--out", required=True, help="results table (.parquet or .csv)")
+    sw.add_argument("--metric", action="append", metavar="M",
+                    help="energy_drift, max_residual, or AGG:expression with AGG final|max|min|mean "
+                         "(repeatable; default energy_drift and max_residual)")
+    sw.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (default: a local cluster)")
+    sw.add_argument("--workers", type=int, help="local workers (default: one per core)")
+    sw.add_argument("--trajectories", metavar="DIR", help="also save each run's trajectory as DIR/<run_id>.npz")
+    sw.add_argument("--dt", type=float, help="output interval of each run [s]")
+    sw.add_argument("--json", action="store_true", help="print a summary as one JSON object")
+    sw.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    sw.set_defaults(run=run_sweep)
     return parser
 
 
@@ -107,6 +129,36 @@ def run_simulate(args):
     if error and not args.json:
         print(f"error: {error}", file=sys.stderr)
     return 0 if error is None else 1
+
+
+def run_sweep(args):
+    from .sweep import parse_range, sweep
+
+    params = dict(parse_range(p) for p in args.param) if args.param else None
+    metrics = args.metric or ["energy_drift", "max_residual"]
+    options = {} if args.dt is None else {"dt": args.dt}
+    bar = _sweep_progress if sys.stderr.isatty() and not args.json else None
+    started = time.perf_counter()
+    table = sweep(args.model, params, args.t_end, samples=args.samples, metrics=metrics, out=args.out,
+                  scheduler=args.scheduler, workers=args.workers, trajectories=args.trajectories,
+                  progress=bar, **options)
+    if bar:
+        sys.stderr.write("\n")
+    failed = int((table["status"] != "ok").sum())
+    summary = {"runs": len(table), "failed": failed, "out": args.out,
+               "wall_time_s": round(time.perf_counter() - started, 3)}
+    if args.json:
+        print(json.dumps(summary))
+    else:
+        print(f"{summary['runs']} runs ({failed} failed) in {summary['wall_time_s']:.3g} s; results in {args.out}")
+        for row in table[table["status"] != "ok"].head(5).itertuples():
+            print(f"  failed {row.run_id}: {row.error}")
+    return 0 if failed == 0 else 1
+
+
+def _sweep_progress(done, failed, total, eta):
+    sys.stderr.write(f"\r{done}/{total} runs done, {failed} failed, ~{eta:.0f} s left ")
+    sys.stderr.flush()
 
 
 def format_summary(s):

@@ -9,12 +9,19 @@ generalized force is
 
 added to the parts' Q of (2.1). Dampers use effort = −c·rate; actuators an effort of t.
 Gravity is part of each massive part's own Q.
+
+Builders: ``point_spring`` (a linear spring and damper between two points),
+``applied_force`` (a force at a point), ``applied_torque`` (a torque on a body).
 """
 
 import numpy as np
 import sympy as sp
 
-from .symbolic import T_SYMBOL, compile_function
+from .subsystems.base import Frame, frame_velocity
+from .subsystems.spring import quiet_at_zero_length, spring_damper
+from .symbolic import T_SYMBOL, compile_function, generalized_force
+
+AXES = ("world", "body")
 
 
 class ForceElement:
@@ -24,10 +31,7 @@ class ForceElement:
     def __init__(self, name, V, efforts, q, qd, params):
         self.name = name
         self.V = sp.sympify(V)
-        Q = -sp.Matrix([self.V]).jacobian(sp.Matrix(q)).T
-        for effort, rate in efforts:
-            Q += sp.sympify(effort) * sp.Matrix([rate]).jacobian(sp.Matrix(qd)).T
-        self.Q = Q
+        self.Q = Q = generalized_force(self.V, efforts, q, qd)
         used = Q.free_symbols | self.V.free_symbols
         self.indices = np.array([i for i in range(len(q)) if q[i] in used or qd[i] in used or Q[i] != 0], dtype=int)
         local = [int(i) for i in self.indices]
@@ -37,10 +41,36 @@ class ForceElement:
 
     def evaluate(self, t, q, qd, p):
         """Q_e on ``indices`` at the full state (q, qd)."""
-        return self._evaluate(t, q[self.indices], qd[self.indices], p)[0].ravel()
+        with quiet_at_zero_length():
+            return self._evaluate(t, q[self.indices], qd[self.indices], p)[0].ravel()
 
     def potential(self, t, q, qd, p):
         return float(self._evaluate(t, q[self.indices], qd[self.indices], p)[1])
 
     def symbolic(self):
         return self.Q
+
+
+def point_spring(name, pA, pB, stiffness, rest_length, damping, q, qd, params):
+    """A spring (k, ℓ0) and damper (c) between two world points (sympy 3-vectors of q)."""
+    V, efforts = spring_damper(pA, pB, stiffness, rest_length, damping, q, qd)
+    return ForceElement(name, V, efforts, q, qd, params)
+
+
+def applied_force(name, point, force_world, q, qd, params):
+    """A force (world axes; expressions of q, q̇, t) at a world point: Q = (∂v/∂q̇)ᵀ F
+    with v = (∂p/∂q) q̇ the point's velocity."""
+    velocity = frame_velocity(point, q, qd)
+    return ForceElement(name, 0, list(zip(sp.Matrix(force_world), velocity)), q, qd, params)
+
+
+def applied_torque(name, part, torque, axes, q, qd, params):
+    """A torque on ``part`` (a body with a rotation and ``angular_velocity``), in world
+    axes or in the part's own axes (then turned to the world by its rotation R):
+    Q = (∂ω/∂q̇)ᵀ Γ_world with ω the part's angular velocity in the world."""
+    if axes not in AXES:
+        raise ValueError(f"axes must be one of {AXES}, got {axes!r}")
+    torque = sp.Matrix(torque)
+    if axes == "body":
+        torque = part.pose(Frame(part.name, "origin", sp.zeros(3, 1), sp.eye(3)))[1] * torque
+    return ForceElement(name, 0, list(zip(torque, part.angular_velocity())), q, qd, params)

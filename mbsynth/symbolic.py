@@ -5,6 +5,7 @@
   forces F, from Lagrange's equations.
 - ``differentiate(phi, q, qd, t)``: a constraint ``phi = 0`` differentiated to
   the row ``A q̈ = b`` (2.4), once if phi contains velocities, twice if not.
+- ``generalized_force(V, efforts, q, qd)``: Q of a potential and (effort, rate) pairs.
 - ``compile_function(args, exprs)``: one fast numpy function for many expressions.
 """
 
@@ -31,6 +32,14 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
 def time_derivative(expr, q, qd, t=T_SYMBOL):
     """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t."""
     return (sp.Matrix([expr]).jacobian(sp.Matrix(q)) * sp.Matrix(qd))[0] + sp.diff(expr, t)
+
+
+def generalized_force(V, efforts, q, qd):
+    """Q = −∂V/∂q + Σ effort ∂rate/∂q̇ (virtual power; each rate linear in q̇), a column over q."""
+    Q = -sp.Matrix([sp.sympify(V)]).jacobian(sp.Matrix(q)).T
+    for effort, rate in efforts:
+        Q += sp.sympify(effort) * sp.Matrix([rate]).jacobian(sp.Matrix(qd)).T
+    return Q
 
 
 def differentiate(phi, q, qd, t=T_SYMBOL):

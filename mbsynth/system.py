@@ -54,6 +54,9 @@ class System:
     closures: tuple = ()
     initial_given: frozenset = frozenset()
     initial_fixed: frozenset = frozenset()
+    definitions: dict = None  # parameter name -> sympy expression of earlier parameters
+    initial_definitions: dict = None  # initial value name -> sympy expression of parameters
+    source: str = ""  # the model file's text, for workers that rebuild the System
 
     @classmethod
     def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
@@ -110,13 +113,52 @@ class System:
     def with_parameters(self, **values):
         """A new System with some parameter values changed (the original is unchanged).
 
-        Closure balances appended at load time are kept as derived; they stay valid
-        while the masses that were zero stay zero."""
+        Parameters defined by expressions of others, and initial values written as
+        expressions of parameters, follow the new values. Closure balances appended at
+        load time are kept as derived; they stay valid while the masses that were zero
+        stay zero."""
         unknown = sorted(set(values) - set(self.parameters))
         if unknown:
             raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
                              f"it has {sorted(self.parameters)}")
-        return replace(self, parameters={**self.parameters, **{k: float(v) for k, v in values.items()}})
+        definitions = self.definitions or {}
+        new, subs = {}, {}
+        for name, old in self.parameters.items():
+            if name in values:
+                new[name] = float(values[name])
+            elif name in definitions:
+                new[name] = float(definitions[name].subs(subs))
+            else:
+                new[name] = old
+            subs[sp.Symbol(name)] = new[name]
+        q0, qd0 = self.initial_state()
+        index = {c: i for i, c in enumerate(self.coordinates)}
+        for key, expr in (self.initial_definitions or {}).items():
+            target, i = (qd0, index[key[:-4]]) if key not in index else (q0, index[key])
+            target[i] = float(expr.subs(subs))
+        changed = replace(self, parameters=new, initial_q=q0, initial_qd=qd0)
+        problems = changed.part_problems()
+        if problems:
+            raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")
+        return changed
+
+    def part_problems(self):
+        """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
+        positive semi-definite, at the initial state — a model no equation of motion fits."""
+        q, qd = self.initial_state()
+        problems, start = [], 0
+        for part in self.subsystems:
+            stop = start + len(part.coordinates)
+            with np.errstate(all="ignore"):
+                M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], self.parameter_values)
+            if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
+                problems.append((part.name, f"subsystem '{part.name}': M or Q is not finite at the initial state"))
+            elif np.linalg.eigvalsh(M).min() < -1e-12 * max(np.abs(M).max(), 1e-300):
+                problems.append((part.name, f"subsystem '{part.name}': the mass matrix is not positive "
+                                            "semi-definite at the initial state (a negative mass or inertia, "
+                                            "or a T that is no kinetic energy)"))
+            start = stop
+        return problems
 
     def with_constraints(self, extra, closures=()):
         """A new System with ``extra`` constraints appended (the original is unchanged)."""

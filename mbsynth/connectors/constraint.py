@@ -74,5 +74,13 @@ def differentiated(exprs, q, qd):
     return sp.Matrix.vstack(*[r[0] for r in rows]), [r[1] for r in rows], [r[2] for r in rows]
 
 
+def mixed(holonomic, nonholonomic, q, qd):
+    """(a, b, φ, ψ) of position-level rows φ(q, t) = 0 followed by velocity-level rows
+    ψ(q, q̇, t) = 0 in one connector (2.4): φ is NaN on the velocity-level rows, which
+    have no position form."""
+    a, b, psi = differentiated(list(holonomic) + list(nonholonomic), q, qd)
+    return a, b, list(holonomic) + [sp.nan] * len(nonholonomic), psi
+
+
 def _vector(C, n):
     return sp.zeros(n, 1) if C is None else sp.Matrix(C)

@@ -1,12 +1,16 @@
-"""Reading the world's frames and the joints between frames."""
+"""Reading the world's frames, the joints between frames and the ground contacts."""
 
 import sympy as sp
 
 from ..connectors import JOINT_KINDS, Joint
+from ..connectors.rolling import KnifeEdge, RollingDisk
 from ..subsystems import Frame
 from .parts import read_frames
 
 JOINT_KEYS = {"name", "type", "parent", "child", "length", "description"}
+# ground contacts: extra keys, required keys, the part kinds they may sit on
+CONTACT_TYPES = {"rolling_disk": ({"radius", "ground"}, ("radius",), ("rigid_body",)),
+                 "knife_edge": (set(), (), ("rigid_body", "planar_body"))}
 
 
 def read_world(builder):
@@ -26,8 +30,8 @@ def frame_reference(builder, text, path):
     elif part_name in builder.parts:
         part = builder.parts[part_name]
         frames = part.frames
-        if part.kind == "lagrangian" and not frame_name:
-            builder.fail(path, f"a lagrangian part has no frame of its own: name one of its frames "
+        if part.kind in ("lagrangian", "spring") and not frame_name:
+            builder.fail(path, f"a {part.kind} part has no frame of its own: name one of its frames "
                                f"({', '.join(frames) or 'it declares none'})")
     else:
         builder.fail(path, f"unknown part '{part_name}' in frame '{text}'; parts: "
@@ -48,15 +52,15 @@ def read_joints(builder):
     joints, names = [], set()
     for i, spec in enumerate(node):
         path = ("joints", i)
+        if isinstance(spec, dict) and spec.get("type") in CONTACT_TYPES:
+            joints.append(read_contact(builder, spec, path, names))
+            continue
         spec = builder.mapping(spec, path, JOINT_KEYS, required=("name", "type", "parent", "child"))
-        name = spec["name"]
-        builder.identifier(name, path + ("name",), "joint name")
-        if name in names:
-            builder.fail(path + ("name",), f"duplicate joint name '{name}'")
-        names.add(name)
+        name = _joint_name(builder, spec, path, names)
         kind = spec["type"]
         if kind not in JOINT_KINDS:
-            builder.fail(path + ("type",), f"unknown joint type {kind!r}; known: {', '.join(JOINT_KINDS)}")
+            builder.fail(path + ("type",), f"unknown joint type {kind!r}; known: "
+                                           f"{', '.join((*JOINT_KINDS, *CONTACT_TYPES))}")
         parent, frame_a = frame_reference(builder, spec["parent"], path + ("parent",))
         child, frame_b = frame_reference(builder, spec["child"], path + ("child",))
         if child is None or child is parent:
@@ -73,3 +77,35 @@ def read_joints(builder):
         joints.append(Joint(name, kind, parent, frame_a, child, frame_b, builder.q, builder.qd,
                             builder.param_symbols.values(), length))
     return joints
+
+
+def read_contact(builder, spec, path, names):
+    """A ground contact: ``rolling_disk`` (``child`` the disk's centre frame, z along its
+    axis; ``radius``; ``ground`` the height of the plane, 0 by default) or ``knife_edge``
+    (``child`` a frame whose x axis is the blade)."""
+    kind = spec["type"]
+    extra, required, hosts = CONTACT_TYPES[kind]
+    spec = builder.mapping(spec, path, {"name", "type", "child", "description", *extra},
+                           required=("name", "type", "child", *required))
+    name = _joint_name(builder, spec, path, names)
+    part, frame = frame_reference(builder, spec["child"], path + ("child",))
+    if part is None or part.kind not in hosts:
+        builder.fail(path + ("child",), f"a {kind} is a frame on a {' or '.join(hosts)}, not on "
+                                        f"{'the world' if part is None else 'a ' + part.kind}")
+    args = (builder.q, builder.qd, builder.param_symbols.values())
+    if kind == "knife_edge":
+        return KnifeEdge(name, part, frame, *args)
+    radius = builder.constant(spec["radius"], path + ("radius",))
+    if builder.value(radius) <= 0:
+        builder.fail(path + ("radius",), "radius must be positive")
+    return RollingDisk(name, part, frame, radius, builder.constant(spec.get("ground", 0), path + ("ground",)),
+                       *args)
+
+
+def _joint_name(builder, spec, path, names):
+    name = spec["name"]
+    builder.identifier(name, path + ("name",), "joint name")
+    if name in names:
+        builder.fail(path + ("name",), f"duplicate joint name '{name}'")
+    names.add(name)
+    return name

@@ -6,6 +6,7 @@ Expressions are parsed by ``mbsynth.expressions`` (never evaluated as code).
 
 import difflib
 import keyword
+from dataclasses import replace
 
 import numpy as np
 import sympy as sp
@@ -16,12 +17,13 @@ from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
 from ..symbolic import T_SYMBOL
 from ..system import System
+from .forces import read_forces
 from .joints import read_joints, read_world
-from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body
+from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
 from .source import Document, LineDict, LineList, read_document
 
 TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
-            "closure", "initial", "initial_fixed"}
+            "closure", "initial", "initial_fixed", "forces"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 
 
@@ -135,7 +137,9 @@ class _Builder:
         constraints += self.read_constraints() + read_joints(self)
         initial = self.read_initial(parts)
         system = System.build(name, parts, constraints, self.q, self.qd, self.parameters, initial,
-                              initial_fixed=self.read_initial_fixed(initial))
+                              initial_fixed=self.read_initial_fixed(initial), forces=read_forces(self))
+        system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
+                         source=self.doc.text)
         self.check_parts(system)
         closure = root.get("closure", "none")
         if closure not in ("auto", "none"):
@@ -143,6 +147,8 @@ class _Builder:
         return close(system) if closure == "auto" else system
 
     def read_parameters(self):
+        """Parameter values in order; ``self.definitions`` keeps each one's expression."""
+        self.definitions = {}
         node = self.root.get("parameters", LineDict())
         node = self.mapping(node, ("parameters",), set(node) if isinstance(node, dict) else set())
         values, symbols = {}, {}
@@ -155,6 +161,7 @@ class _Builder:
                 self.fail(path, f"parameter '{key}' = {text!r} is not a finite real number")
             values[sp.Symbol(key)] = value.real
             symbols[key] = sp.Symbol(key)
+            self.definitions[key] = expr
         return {str(k): v for k, v in values.items()}
 
     def read_subsystems(self):
@@ -277,13 +284,15 @@ class _Builder:
         """Initial values: each part's own ``initial:``, then the model's ``initial:``
         mapping by coordinate name (one place per coordinate)."""
         values = {f"{part.name}.{k}": v for part in parts for k, v in part.initial.items()}
+        self.initial_definitions = {}
         coords = list(self.coordinate_names())
         allowed = set(coords) | {c + "_dot" for c in coords}
         node = self.mapping(self.root.get("initial", LineDict()), ("initial",), allowed)
         for key, text in node.items():
             if key in values:
                 self.fail(("initial", key), f"'{key}' is already set by the part's own initial: mapping")
-            values[key] = self.value(self.constant(text, ("initial", key)))
+            self.initial_definitions[key] = self.constant(text, ("initial", key))
+            values[key] = self.value(self.initial_definitions[key])
         return values
 
     def read_initial_fixed(self, initial):
@@ -297,25 +306,13 @@ class _Builder:
         return set(node)
 
     def check_parts(self, system):
-        """Each part's M must be finite, symmetric and positive semi-definite at the initial state."""
-        q, qd = system.initial_state()
-        start = 0
-        for part in system.subsystems:
-            stop = start + len(part.coordinates)
-            path = ("subsystems", part.name)
-            with np.errstate(all="ignore"):
-                M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], system.parameter_values)
-            if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
-                self.fail(path, f"subsystem '{part.name}': M or Q is not finite at the initial state")
-            scale = max(np.abs(M).max(), 1e-300)
-            if np.linalg.eigvalsh(M).min() < -1e-12 * scale:
-                self.fail(path + ("T",), f"subsystem '{part.name}': the mass matrix from T is not positive "
-                                         "semi-definite at the initial state (is T a kinetic energy?)")
-            start = stop
+        """Each part's M must be finite and positive semi-definite at the initial state."""
+        for part, problem in system.part_problems():
+            self.fail(("subsystems", part) + (("T",) if "semi-definite" in problem else ()), problem)
 
 
 SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,
-                   "particle": read_particle, "planar_body": read_planar_body}
+                   "particle": read_particle, "planar_body": read_planar_body, "spring": read_spring}
 
 
 def _kind(value):

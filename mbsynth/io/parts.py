@@ -8,7 +8,7 @@ import numpy as np
 import sympy as sp
 
 from ..kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
-from ..subsystems import Frame, Particle, PlanarBody, RigidBody
+from ..subsystems import Frame, Particle, PlanarBody, RigidBody, Spring
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
 SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None}
@@ -57,11 +57,38 @@ def read_planar_body(builder, name, spec, path):
                       read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
 
 
+def read_spring(builder, name, spec, path):
+    """A spring part: ends ``end1``, ``end2``; ``initial: {end1: [x, y, z], end2: ...,
+    end1_velocity: ..., end2_velocity: ...}``."""
+    builder.mapping(spec, path, {"type", "stiffness", "rest_length", "damping", "mass", "initial", "description"},
+                    required=("stiffness", "rest_length"))
+    stiffness, rest_length, damping, mass = (read_nonnegative(builder, spec, key, path, default=0)
+                                             for key in ("stiffness", "rest_length", "damping", "mass"))
+    q, qd = builder.part_symbols(name, Spring.COORDINATES)
+    node = builder.mapping(spec.get("initial"), path + ("initial",),
+                           {"end1", "end2", "end1_velocity", "end2_velocity"})
+    initial = {}
+    for key, values in node.items():
+        end, _, velocity = key.partition("_")
+        names = Spring.COORDINATES[:3] if end == "end1" else Spring.COORDINATES[3:]
+        suffix = "_dot" if velocity else ""
+        initial.update({c + suffix: v for c, v in zip(names, builder.numbers(values, path + ("initial", key), 3))})
+    return Spring(name, q, qd, stiffness, rest_length, damping, mass, builder.gravity,
+                  builder.param_symbols.values(), initial)
+
+
 def read_mass(builder, spec, path):
-    mass = builder.constant(spec["mass"], path + ("mass",))
-    if builder.value(mass) < 0:
-        builder.fail(path + ("mass",), f"mass must be ≥ 0, got {builder.value(mass)}")
-    return mass
+    return read_nonnegative(builder, spec, "mass", path)
+
+
+def read_nonnegative(builder, spec, key, path, default=None):
+    """``spec[key]`` (or ``default`` when absent and not None): an expression of parameters ≥ 0."""
+    if key not in spec and default is not None:
+        return sp.sympify(default)
+    value = builder.constant(spec[key], path + (key,))
+    if builder.value(value) < 0:
+        builder.fail(path + (key,), f"{key} must be ≥ 0, got {builder.value(value)}")
+    return value
 
 
 def read_inertia(builder, node, path):

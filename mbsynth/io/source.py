@@ -64,6 +64,7 @@ class Document:
 
     def __init__(self, name, text):
         self.name = str(name)
+        self.text = text
         loader = _Loader(text)
         loader.name = self.name
         try:

@@ -12,5 +12,6 @@ from .lagrangian import LagrangianSubsystem
 from .particle import Particle
 from .planar_body import PlanarBody
 from .rigid_body import RigidBody
+from .spring import Spring
 
-__all__ = ["Frame", "Part", "LagrangianSubsystem", "Particle", "PlanarBody", "RigidBody"]
+__all__ = ["Frame", "Part", "LagrangianSubsystem", "Particle", "PlanarBody", "RigidBody", "Spring"]

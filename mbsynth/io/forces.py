@@ -1,0 +1,95 @@
+"""Reading the top-level ``forces:`` list into force elements (mbsynth.forces).
+
+    - {name: s, type: spring, between: [a.frame, b.frame], stiffness: k, rest_length: l0, damping: c}
+    - {name: d, type: damper, between: [a.frame, world.anchor], damping: c}
+    - {name: f, type: force, at: body.tip, value: [fx, fy, fz]}           world axes
+    - {name: m, type: torque, part: body, value: [tx, ty, tz], axes: body}  world (default) or body
+
+Values are expressions of parameters, ``t`` and the coordinates (``part.x``); stiffness,
+rest length and damping are expressions of parameters, ≥ 0. ``name`` defaults to
+``<type>_<index>``. (A torque names its body with ``part:``: YAML 1.1 reads ``on`` as true.)
+"""
+
+from ..forces import AXES, applied_force, applied_torque, point_spring
+from .joints import frame_reference
+from .parts import read_nonnegative
+
+KEYS = {"spring": {"between", "stiffness", "rest_length", "damping"},
+        "damper": {"between", "damping"},
+        "force": {"at", "value"},
+        "torque": {"part", "value", "axes"}}
+REQUIRED = {"spring": ("between", "stiffness", "rest_length"), "damper": ("between", "damping"),
+            "force": ("at", "value"), "torque": ("part", "value")}
+TURNING = ("rigid_body", "planar_body")  # parts with an orientation a torque can act on
+
+
+def read_forces(builder):
+    """The force elements of the model's ``forces:`` list (empty when absent)."""
+    node = builder.root.get("forces")
+    if node is None:
+        return []
+    if not isinstance(node, list):
+        builder.fail(("forces",), "expected a list of force elements")
+    elements, names = [], set()
+    for i, spec in enumerate(node):
+        path = ("forces", i)
+        if not isinstance(spec, dict) or "type" not in spec:
+            builder.fail(path, f"expected a mapping with 'type' (one of {', '.join(KEYS)}) and its data")
+        if True in spec:
+            builder.fail(path, "YAML reads the key 'on' as true: name the body with 'part:'")
+        kind = spec["type"]
+        if kind not in KEYS:
+            builder.fail(path + ("type",), f"unknown force type {kind!r}; known: {', '.join(KEYS)}")
+        builder.mapping(spec, path, {"name", "type", "description", *KEYS[kind]}, required=REQUIRED[kind])
+        name = builder.identifier(spec.get("name", f"{kind}_{i + 1}"), path + ("name",), "force name")
+        if name in names:
+            builder.fail(path + ("name",), f"duplicate force name '{name}'")
+        names.add(name)
+        elements.append(READERS[kind](builder, name, spec, path))
+    return elements
+
+
+def _args(builder):
+    return builder.q, builder.qd, builder.param_symbols.values()
+
+
+def _spring(builder, name, spec, path):
+    pA, pB = _between(builder, spec["between"], path + ("between",))
+    stiffness, rest_length, damping = (read_nonnegative(builder, spec, key, path, default=0)
+                                       for key in ("stiffness", "rest_length", "damping"))
+    return point_spring(name, pA, pB, stiffness, rest_length, damping, *_args(builder))
+
+
+def _between(builder, node, path):
+    """World positions of the two frames a spring or damper joins (at most one on the world)."""
+    if not isinstance(node, list) or len(node) != 2:
+        builder.fail(path, "expected two frames, e.g. [body.tip, world.anchor]")
+    ends = [frame_reference(builder, text, path + (i,)) for i, text in enumerate(node)]
+    if ends[0][0] is None and ends[1][0] is None:
+        builder.fail(path, "both ends are on the world: at least one must be on a part")
+    return [frame.position if part is None else part.pose(frame)[0] for part, frame in ends]
+
+
+def _force(builder, name, spec, path):
+    part, frame = frame_reference(builder, spec["at"], path + ("at",))
+    if part is None:
+        builder.fail(path + ("at",), "a force must act on a part, not on the world")
+    value = builder.vector(spec["value"], path + ("value",), 3, builder.global_symbols)
+    return applied_force(name, part.pose(frame)[0], value, *_args(builder))
+
+
+def _torque(builder, name, spec, path):
+    part_name = spec["part"]
+    if not isinstance(part_name, str) or part_name not in builder.parts:
+        builder.fail(path + ("part",), f"unknown part {part_name!r}; parts: {', '.join(builder.parts)}")
+    part = builder.parts[part_name]
+    if part.kind not in TURNING:
+        builder.fail(path + ("part",), f"a torque acts on a {' or '.join(TURNING)}; '{part_name}' is a {part.kind}")
+    axes = spec.get("axes", "world")
+    if axes not in AXES:
+        builder.fail(path + ("axes",), f"axes must be one of {', '.join(AXES)}, got {axes!r}")
+    value = builder.vector(spec["value"], path + ("value",), 3, builder.global_symbols)
+    return applied_torque(name, part, value, axes, *_args(builder))
+
+
+READERS = {"spring": _spring, "damper": _spring, "force": _force, "torque": _torque}
