@@ -10,6 +10,7 @@ from .equations import Motion, RankReport, constrained_acceleration, rank_report
 from .errors import ModelError, SimulationError, SolveError
 from .io import load, loads
 from .simulate import simulate
+from .sweep import sweep
 from .system import System
 from .trajectory import Trajectory, load_trajectory
 
@@ -18,5 +19,5 @@ __version__ = "0.1.0"
 __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
     "ModelError", "SolveError", "SimulationError", "load", "loads", "System",
-    "simulate", "Trajectory", "load_trajectory",
+    "simulate", "sweep", "Trajectory", "load_trajectory",
 ]

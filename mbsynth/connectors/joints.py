@@ -89,7 +89,7 @@ class Joint(Connector):
         phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
         a, b, psi = differentiated(phis, q, qd)
         super().__init__(name, "holonomic", a, b, sp.zeros(len(q), 1), phis, psi, q, qd, params, labels)
-        self.joint_kind, self.frames = kind, (frame_a, frame_b)
+        self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         xa, ya, za = _axes(RA)
         self.angle = self.angle_rate = self.displacement = self.displacement_rate = None
         if kind in ROTATING:
