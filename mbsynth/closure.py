@@ -12,6 +12,7 @@ m2 = 0. Where the balance vanishes identically (example 2's massless particle,
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 import sympy as sp
 
 from .connectors import Connector
@@ -22,6 +23,7 @@ from .system import Closure
 
 ZERO_TOL = 1e-9  # a sampled balance below this (relative to the force scale) is identically zero
 SAMPLES = 8
+SIMPLIFY_MAX_OPS = 60  # balances longer than this are printed as derived, unsimplified
 
 
 @dataclass(frozen=True)
@@ -78,9 +80,10 @@ def balances(system, t=0.0, q=None, qd=None):
     free, balanced = _separate(W.T * force, values, system, q, qd, t)
     result = []
     for combos, is_free in ((free, True), (balanced, False)):
-        for c in combos:
-            w = _normalized(W * sp.Matrix(c), dynamic)
-            expression = sp.S.Zero if is_free else sp.simplify((w.T * force)[0])
+        if not combos:
+            continue
+        for w in _canonical(W * sp.Matrix(combos).T, state, dynamic):
+            expression = sp.S.Zero if is_free else _tidy((w.T * force)[0])
             result.append(Balance(_direction(w, state, system.coordinates), expression, state_dependent))
     return result
 
@@ -108,11 +111,23 @@ def _rational_rows(rows):
     return [[sp.nsimplify(x, rational=True, tolerance=1e-12) for x in row] for row in rows]
 
 
-def _normalized(w, dynamic):
-    """A constant w scaled so its largest entry is +1 (a state-dependent w is left as is)."""
-    if w.free_symbols & dynamic:
-        return w
-    return w / max(w, key=lambda x: (abs(float(x)), float(x)))
+def _tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
+    """sympy.simplify for expressions small enough to be worth it (it is slow on big ones)."""
+    return sp.simplify(expr) if sp.count_ops(expr) <= max_ops else expr
+
+
+def _canonical(D, state, dynamic):
+    """The columns of D recombined so that each is +1 at a coordinate of its own where the
+    others are 0 (a reduced echelon form, pivots chosen by QR with column pivoting at the
+    state): a direction of three free coordinates comes out as the three unit vectors, not
+    as an arbitrary orthonormal mixture. Exact when D is constant."""
+    numeric = np.array(D.subs(state).evalf(), dtype=float)
+    pivots = sorted(scipy.linalg.qr(numeric.T, pivoting=True)[2][:D.shape[1]])
+    if D.free_symbols & dynamic:
+        D = sp.Matrix(_rational_rows((numeric @ np.linalg.inv(numeric[pivots, :])).T)).T
+    else:
+        D = D * D.extract(pivots, list(range(D.shape[1]))).inv()
+    return [D[:, j] for j in range(D.shape[1])]
 
 
 def _direction(w, state, coordinates):

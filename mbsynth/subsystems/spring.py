@@ -52,7 +52,6 @@ class Spring(Part):
         M = mass / 6 * sp.Matrix(sp.BlockMatrix([[2 * I3, I3], [I3, 2 * I3]]))
         T = (sp.Matrix(qd).T * M * sp.Matrix(qd))[0] / 2
         frames = (Frame(name, "end1", p1, I3), Frame(name, "end2", p2, I3))
-        self.mass = mass
         super().__init__(name, COORDINATES, q, qd, M, generalized_force(V, efforts, q, qd), T, V, params,
                          frames, (), initial)
 
