@@ -11,6 +11,7 @@ run: $(STAMP)
 	$(PY) examples/paper_example3.py
 
 test: $(TEST_STAMP)
+	bash scripts/install-chromium.sh
 	$(PY) -m pytest -q
 
 install: $(STAMP)

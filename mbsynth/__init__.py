@@ -13,6 +13,7 @@ from .simulate import simulate
 from .sweep import sweep
 from .system import System
 from .trajectory import Trajectory, load_trajectory
+from . import viewer  # mb.viewer.show, mb.viewer.to_html (meshcat is imported on first use)
 
 __version__ = "0.1.0"
 

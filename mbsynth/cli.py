@@ -16,6 +16,7 @@ from .errors import ModelError, SimulationError, SolveError
 from .io import load
 from .plot import plot_trajectory
 from .simulate import STABILIZATIONS, simulate
+from .trajectory import load_trajectory
 
 
 def main(argv=None):
@@ -87,6 +88,20 @@ def _parser():
     sw.add_argument("--json", action="store_true", help="print a summary as one JSON object")
     sw.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     sw.set_defaults(run=run_sweep)
+
+    view = commands.add_parser(
+        "view", help="see the motion: a live meshcat viewer or a self-contained HTML animation",
+        description="Simulate the model (or read --trajectory) and draw its motion in meshcat: served live "
+                    "on this machine (the URL is printed; Ctrl-C stops it), or with --html written as one "
+                    "HTML file that plays offline in any browser.")
+    view.add_argument("model", help="model file (YAML)")
+    view.add_argument("--t-end", type=float, default=5.0, help="end time of the simulation [s] (default 5)")
+    view.add_argument("--trajectory", metavar="FILE.npz", help="draw this saved trajectory instead of simulating")
+    view.add_argument("--html", metavar="FILE.html", help="write the animation to this file instead of serving it")
+    view.add_argument("--axes", action="store_true", help="draw a triad at every body and frame")
+    view.add_argument("--joints", action="store_true", help="mark the frames of every joint")
+    view.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    view.set_defaults(run=run_view)
     return parser
 
 
@@ -154,6 +169,28 @@ def run_sweep(args):
         for row in table[table["status"] != "ok"].head(5).itertuples():
             print(f"  failed {row.run_id}: {row.error}")
     return 0 if failed == 0 else 1
+
+
+def run_view(args):
+    from . import viewer
+
+    system = load(args.model)
+    status = 0
+    if args.trajectory:
+        traj = load_trajectory(args.trajectory)
+    else:
+        try:
+            traj = simulate(system, args.t_end, dt=1 / viewer.FPS)
+        except SimulationError as err:
+            traj, status = err.trajectory, 1
+            print(f"error: {err}; drawing the motion up to there", file=sys.stderr)
+    options = {"axes": args.axes, "joints": args.joints}
+    if args.html:
+        path = viewer.to_html(system, traj, args.html, **options)
+        print(f"wrote {path}: {system.name}, t = {traj.t[0]:.6g} to {traj.t[-1]:.6g} s")
+    else:
+        viewer.show(system, traj, **options)
+    return status
 
 
 def _sweep_progress(done, failed, total, eta):

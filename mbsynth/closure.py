@@ -18,12 +18,11 @@ import sympy as sp
 from .connectors import Connector
 from .equations import rank_report
 from .errors import ModelError
-from .symbolic import T_SYMBOL
+from .symbolic import T_SYMBOL, tidy
 from .system import Closure
 
 ZERO_TOL = 1e-9  # a sampled balance below this (relative to the force scale) is identically zero
 SAMPLES = 8
-SIMPLIFY_MAX_OPS = 60  # balances longer than this are printed as derived, unsimplified
 
 
 @dataclass(frozen=True)
@@ -83,7 +82,7 @@ def balances(system, t=0.0, q=None, qd=None):
         if not combos:
             continue
         for w in _canonical(W * sp.Matrix(combos).T, state, dynamic):
-            expression = sp.S.Zero if is_free else _tidy((w.T * force)[0])
+            expression = sp.S.Zero if is_free else tidy((w.T * force)[0])
             result.append(Balance(_direction(w, state, system.coordinates), expression, state_dependent))
     return result
 
@@ -109,11 +108,6 @@ def _separate(g, values, system, q, qd, t):
 
 def _rational_rows(rows):
     return [[sp.nsimplify(x, rational=True, tolerance=1e-12) for x in row] for row in rows]
-
-
-def _tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
-    """sympy.simplify for expressions small enough to be worth it (it is slow on big ones)."""
-    return sp.simplify(expr) if sp.count_ops(expr) <= max_ops else expr
 
 
 def _canonical(D, state, dynamic):

@@ -5,6 +5,12 @@ A model file holds expressions such as ``0.5*m*(R*theta_dot)**2`` or
 module (which never executes anything) and translated node by node into sympy;
 only numbers, names the caller allows, arithmetic and the functions in
 ``FUNCTIONS`` are accepted. ``sympy.sympify`` is never used: it calls ``eval``.
+
+Bounds keep every expression cheap and its numbers usable in double precision:
+at most ``MAX_LENGTH`` characters and ``MAX_DEPTH`` levels of nesting (a chain
+``a + b - c + ...`` counts as one level); no exact power of numbers beyond
+``MAX_POWER_BITS`` bits (``2**2**2**2**2**2`` would never finish); and the result
+holds no number beyond the double range, no division by zero and nothing complex.
 """
 
 import ast
@@ -21,6 +27,10 @@ FUNCTIONS = {
 }
 CONSTANTS = {"pi": sp.pi}
 MAX_LENGTH = 10_000
+MAX_DEPTH = 50
+MAX_POWER_BITS = 10_000  # largest exact numeric power computed while parsing
+MAX_EXPONENT = 1024  # largest exponent of a number that is not rational (sqrt(2)**e)
+LARGEST = sp.Float(np.finfo(float).max)
 
 _BINARY = {
     ast.Add: lambda a, b: a + b,
@@ -54,26 +64,61 @@ def parse(text, symbols):
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as err:
-        raise ExpressionError(f"malformed expression {text!r}: {err.msg} at column {err.offset}") from None
-    return _Translator(symbols, text).visit(tree.body)
+        where = f" at column {err.offset}" if err.offset else ""
+        raise ExpressionError(f"malformed expression {_short(text)}: {err.msg}{where}") from None
+    except (ValueError, RecursionError, MemoryError) as err:  # null bytes; nesting Python cannot parse
+        raise ExpressionError(f"malformed expression {_short(text)}: "
+                              f"{'nested too deeply' if not isinstance(err, ValueError) else err}") from None
+    return _check_value(_Translator(symbols, text.strip()).visit(tree.body), text)
+
+
+def _check_value(expr, text):
+    """``expr`` unless it holds an infinity or NaN, a number beyond the double range, or
+    a complex constant (sqrt(-1), (-8)**(1/3), log(-1))."""
+    if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
+        raise ExpressionError(f"{_short(text)} divides by zero or is not finite")
+    if any(abs(x) > LARGEST for x in expr.atoms(sp.Number)):
+        raise ExpressionError(f"{_short(text)} holds a number beyond the double range (±{float(LARGEST):.3g})")
+    if expr.has(sp.I) or any(x.base.is_negative and not x.exp.is_integer
+                             for x in expr.atoms(sp.Pow) if x.base.is_number and x.exp.is_number):
+        raise ExpressionError(f"{_short(text)} is not real (a root or logarithm of a negative number)")
+    return expr
+
+
+def _short(text, size=80):
+    """repr of ``text`` cut to about ``size`` characters, for messages."""
+    text = repr(text)
+    return text if len(text) <= size else text[:size - 5] + "...'"
 
 
 class _Translator:
     def __init__(self, symbols, text):
         self.symbols = symbols
         self.text = text
+        self.depth = 0
 
     def fail(self, node, why):
         col = getattr(node, "col_offset", None)
         where = f" at column {col + 1}" if col is not None else ""
-        raise ExpressionError(f"{why}{where} in {self.text!r}")
+        raise ExpressionError(f"{why}{where} in {_short(self.text)}")
+
+    def source(self, node):
+        """The text of ``node`` (cut short), without ast.unparse's recursion."""
+        segment = ast.get_source_segment(self.text, node) or type(node).__name__
+        return segment if len(segment) <= 40 else segment[:37] + "..."
 
     def visit(self, node):
         method = getattr(self, "visit_" + type(node).__name__, None)
         if method is None:
-            self.fail(node, f"'{ast.unparse(node)}' is not allowed (only arithmetic, numbers, names and "
+            self.fail(node, f"'{self.source(node)}' is not allowed (only arithmetic, numbers, names and "
                             f"the functions {', '.join(sorted(FUNCTIONS))})")
-        return method(node)
+        if self.depth >= MAX_DEPTH:
+            self.fail(node, f"expression nested more than {MAX_DEPTH} levels deep")
+        self.depth += 1
+        try:
+            return method(node)
+        finally:
+            self.depth -= 1
 
     def visit_Constant(self, node):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
@@ -81,24 +126,37 @@ class _Translator:
         return _number(node.value)
 
     def visit_BinOp(self, node):
-        op = _BINARY.get(type(node.op))
-        if op is None:
+        chain = []  # a + b - c ... is nested to the left: walk it as one level
+        while isinstance(node, ast.BinOp) and type(node.op) in _BINARY and not isinstance(node.op, ast.Pow):
+            chain.append(node)
+            node = node.left
+        value = self.binary(node) if isinstance(node, ast.BinOp) else self.visit(node)
+        for link in reversed(chain):
+            value = _BINARY[type(link.op)](value, self.visit(link.right))
+        return value
+
+    def binary(self, node):
+        """A power, or an operator that is not allowed."""
+        if not isinstance(node.op, ast.Pow):
             hint = " (use ** for powers)" if isinstance(node.op, ast.BitXor) else ""
-            self.fail(node, f"operator '{ast.unparse(node)}' is not allowed{hint}")
-        return op(self.visit(node.left), self.visit(node.right))
+            self.fail(node, f"operator '{self.source(node)}' is not allowed{hint}")
+        base, exponent = self.visit(node.left), self.visit(node.right)
+        if _huge_power(base, exponent) or not _in_range(exponent):
+            self.fail(node, f"the power '{self.source(node)}' is too large to compute")
+        return base**exponent
 
     def visit_UnaryOp(self, node):
         if isinstance(node.op, ast.USub):
             return -self.visit(node.operand)
         if isinstance(node.op, ast.UAdd):
             return self.visit(node.operand)
-        self.fail(node, f"operator '{ast.unparse(node)}' is not allowed")
+        self.fail(node, f"operator '{self.source(node)}' is not allowed")
 
     def visit_Name(self, node):
         return self.lookup(node, node.id)
 
     def visit_Attribute(self, node):
-        return self.lookup(node, _dotted_name(node) or self.fail(node, f"'{ast.unparse(node)}' is not a name"))
+        return self.lookup(node, _dotted_name(node) or self.fail(node, f"'{self.source(node)}' is not a name"))
 
     def lookup(self, node, name):
         if name in self.symbols:
@@ -112,13 +170,39 @@ class _Translator:
     def visit_Call(self, node):
         name = node.func.id if isinstance(node.func, ast.Name) else None
         if name not in FUNCTIONS:
-            self.fail(node, f"unknown function '{ast.unparse(node.func)}' (allowed: {', '.join(sorted(FUNCTIONS))})")
+            self.fail(node, f"unknown function '{self.source(node.func)}' (allowed: {', '.join(sorted(FUNCTIONS))})")
         if node.keywords:
             self.fail(node, f"keyword arguments are not allowed in {name}()")
+        args = [self.visit(arg) for arg in node.args]
+        if not all(map(_in_range, args)):
+            self.fail(node, f"an argument of '{self.source(node)}' is not finite in double precision")
         try:
-            return FUNCTIONS[name](*[self.visit(arg) for arg in node.args])
+            return FUNCTIONS[name](*args)
         except (TypeError, ValueError) as err:
-            self.fail(node, f"bad call {ast.unparse(node)}: {err}")
+            self.fail(node, f"bad call {self.source(node)}: {err}")
+
+
+def _in_range(expr):
+    """Whether ``expr`` is not a number, or a number of the double range (evaluating, say,
+    exp(exp(exp(100))) would need mpmath to reduce an argument of 10^(10^43))."""
+    if not expr.is_number:
+        return True
+    try:
+        value = complex(expr.evalf(15))
+    except (TypeError, ValueError, OverflowError):
+        return False
+    return bool(np.isfinite(value))
+
+
+def _huge_power(base, exponent):
+    """Whether sympy would compute base**exponent exactly as a number of more than
+    MAX_POWER_BITS bits (or with an exponent above MAX_EXPONENT for other numbers)."""
+    if not (base.is_number and exponent.is_Rational) or base in (0, 1, -1):
+        return False
+    if not base.is_Rational:
+        return abs(exponent) > MAX_EXPONENT
+    bits = max(abs(base.p).bit_length(), base.q.bit_length())
+    return abs(exponent.p) * bits > MAX_POWER_BITS * exponent.q
 
 
 def _number(value):

@@ -13,6 +13,8 @@ import numpy as np
 import sympy as sp
 
 T_SYMBOL = sp.Symbol("t")
+_LARGEST = sp.Float(np.finfo(float).max)
+SIMPLIFY_MAX_OPS = 60  # sympy.simplify takes seconds beyond this, growing fast (nested sin, exp)
 
 
 def lagrange(T, V, F, q, qd, t=T_SYMBOL):
@@ -20,25 +22,45 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
 
     Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
     M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
+    Each entry is simplified when it is small (``tidy``).
     """
     q, qd = sp.Matrix(q), sp.Matrix(qd)
     p = sp.Matrix([T]).jacobian(qd).T  # generalized momenta ∂T/∂q̇
     M = p.jacobian(qd)
     Q = (sp.Matrix(F) + sp.Matrix([T - V]).jacobian(q).T
          - p.jacobian(q) * qd - p.diff(t))
-    return sp.simplify(M), sp.simplify(Q)
+    return M.applyfunc(tidy), Q.applyfunc(tidy)
+
+
+def tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
+    """sympy.simplify for expressions small enough to be worth it (it is slow on big ones)."""
+    return sp.simplify(expr) if sp.count_ops(expr) <= max_ops else expr
+
+
+def jacobian(exprs, symbols):
+    """∂exprs/∂symbols (a len(exprs) × len(symbols) matrix), differentiating each
+    expression only by the symbols it contains: a model has hundreds of coordinates and
+    a joint's rows involve fourteen."""
+    exprs, symbols = [sp.sympify(e) for e in exprs], list(symbols)
+    out = sp.zeros(len(exprs), len(symbols))
+    for i, e in enumerate(exprs):
+        free = e.free_symbols
+        for j, s in enumerate(symbols):
+            if s in free:
+                out[i, j] = e.diff(s)
+    return out
 
 
 def time_derivative(expr, q, qd, t=T_SYMBOL):
     """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t."""
-    return (sp.Matrix([expr]).jacobian(sp.Matrix(q)) * sp.Matrix(qd))[0] + sp.diff(expr, t)
+    return (jacobian([expr], q) * sp.Matrix(qd))[0] + sp.diff(expr, t)
 
 
 def generalized_force(V, efforts, q, qd):
     """Q = −∂V/∂q + Σ effort ∂rate/∂q̇ (virtual power; each rate linear in q̇), a column over q."""
-    Q = -sp.Matrix([sp.sympify(V)]).jacobian(sp.Matrix(q)).T
+    Q = -jacobian([V], q).T
     for effort, rate in efforts:
-        Q += sp.sympify(effort) * sp.Matrix([rate]).jacobian(sp.Matrix(qd)).T
+        Q += sp.sympify(effort) * jacobian([rate], qd).T
     return Q
 
 
@@ -52,8 +74,8 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     """
     velocity_level = bool(set(qd) & phi.free_symbols)
     psi = phi if velocity_level else time_derivative(phi, q, qd, t)
-    a = sp.Matrix([psi]).jacobian(sp.Matrix(qd))
-    b = -(sp.Matrix([psi]).jacobian(sp.Matrix(q)) * sp.Matrix(qd))[0] - sp.diff(psi, t)
+    a = jacobian([psi], qd)
+    b = -(jacobian([psi], q) * sp.Matrix(qd))[0] - sp.diff(psi, t)
     return a, b, psi
 
 
@@ -66,7 +88,7 @@ def compile_function(args, exprs):
         def empty(*_):
             return tuple(np.zeros(s) for s in shapes)
         return empty
-    raw = sp.lambdify(args, flat, modules="numpy", cse=True, dummify=True)
+    raw = sp.lambdify(args, [_beyond_double_as_inf(x) for x in flat], modules="numpy", cse=True, dummify=True)
     sizes = [int(np.prod(s)) for s in shapes]
     splits = np.cumsum(sizes)[:-1]
 
@@ -75,3 +97,11 @@ def compile_function(args, exprs):
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
 
     return evaluate
+
+
+def _beyond_double_as_inf(expr):
+    """``expr`` with exact numbers beyond the double range (a mass of 1e308 times g = 1e308)
+    replaced by ±inf, as float arithmetic would give, instead of an OverflowError when
+    evaluated; the non-finite result is then reported by the checks of M, Q, A, b."""
+    huge = {x: sp.sign(x) * sp.oo for x in sp.sympify(expr).atoms(sp.Rational) if abs(x) > _LARGEST}
+    return sp.sympify(expr).xreplace(huge) if huge else expr

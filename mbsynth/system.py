@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
-from . import equations, solvers
+from . import equations, friction, solvers
 from .errors import ModelError
 
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
@@ -57,6 +57,7 @@ class System:
     definitions: dict = None  # parameter name -> sympy expression of earlier parameters
     initial_definitions: dict = None  # initial value name -> sympy expression of parameters
     source: str = ""  # the model file's text, for workers that rebuild the System
+    robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
 
     @classmethod
     def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
@@ -199,13 +200,21 @@ class System:
         Qc, residual). ``method``: "fast" (KKT, falling back to the exact treatment when
         it is not well posed) or "reference" (the literal pseudo-inverse of (2.14)).
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
-        residuals (drift control during integration; b itself when they are zero)."""
+        residuals (drift control during integration; b itself when they are zero).
+        Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``
+        iterates, and Qc includes the friction."""
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
+        q, qd = self._state(q, qd)
         arrays = self.evaluate(t, q, qd)
         b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
-        return METHODS[method](arrays.M, arrays.Q, arrays.A, b, arrays.C,
-                               coordinates=self.coordinates, constraints=self.constraint_names)
+
+        def solve(C):
+            return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C,
+                                   coordinates=self.coordinates, constraints=self.constraint_names)
+        if any(getattr(con, "coulomb", None) for con in self.constraints):  # C depends on q̈ (friction.py)
+            return friction.coulomb_motion(self.constraints, arrays, solve, t, q, qd, self.parameter_values)
+        return solve(arrays.C)
 
     def _stabilized(self, t, q, qd, b, alpha, beta):
         phi, psi = self.constraint_residuals(t, q, qd)

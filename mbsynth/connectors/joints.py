@@ -83,13 +83,15 @@ class Joint(Connector):
     cylindrical), and ``displacement`` z_A·(p_B − p_A) along z_A with its rate
     (prismatic, cylindrical) — what actuation, joint springs and friction act on."""
 
-    def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None):
+    def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None, friction=None):
+        """``friction`` (a ``friction.Friction``) puts viscous friction into the joint's C
+        (2.6) and keeps Coulomb friction, which needs the joint's load, in ``coulomb``."""
         pA, RA = _pose(parent, frame_a)
         pB, RB = _pose(child, frame_b)
         phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
         a, b, psi = differentiated(phis, q, qd)
-        super().__init__(name, "holonomic", a, b, sp.zeros(len(q), 1), phis, psi, q, qd, params, labels)
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
+        self.length = length  # a distance joint's L (sympy), None for the other kinds
         xa, ya, za = _axes(RA)
         self.angle = self.angle_rate = self.displacement = self.displacement_rate = None
         if kind in ROTATING:
@@ -100,6 +102,9 @@ class Joint(Connector):
         if kind in SLIDING:
             self.displacement = za.dot(pB - pA)
             self.displacement_rate = time_derivative(self.displacement, q, qd)
+        C = sp.zeros(len(q), 1) if friction is None else friction.viscous_force(self, qd)
+        super().__init__(name, "holonomic", a, b, C, phis, psi, q, qd, params, labels)
+        self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
 
 
 def _pose(part, frame):

@@ -1,13 +1,17 @@
-"""Reading the world's frames, the joints between frames and the ground contacts."""
+"""Reading the world's frames, the joints between frames and the ground contacts.
+
+A joint's ``actuation``, ``spring`` and ``friction`` keys are read by ``joint_forces``."""
 
 import sympy as sp
 
 from ..connectors import JOINT_KINDS, Joint
 from ..connectors.rolling import KnifeEdge, RollingDisk
 from ..subsystems import Frame
+from .joint_forces import KEYS as FORCE_KEYS
+from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
 
-JOINT_KEYS = {"name", "type", "parent", "child", "length", "description"}
+JOINT_KEYS = {"name", "type", "parent", "child", "length", "description", *FORCE_KEYS}
 # ground contacts: extra keys, required keys, the part kinds they may sit on
 CONTACT_TYPES = {"rolling_disk": ({"radius", "ground"}, ("radius",), ("rigid_body",)),
                  "knife_edge": (set(), (), ("rigid_body", "planar_body"))}
@@ -44,12 +48,13 @@ def frame_reference(builder, text, path):
 
 
 def read_joints(builder):
+    """(joints and ground contacts, the force elements of the joints' actuation and springs)."""
     node = builder.root.get("joints")
     if node is None:
-        return []
+        return [], []
     if not isinstance(node, list):
         builder.fail(("joints",), "expected a list of joints")
-    joints, names = [], set()
+    joints, elements, names = [], [], set()
     for i, spec in enumerate(node):
         path = ("joints", i)
         if isinstance(spec, dict) and spec.get("type") in CONTACT_TYPES:
@@ -74,9 +79,12 @@ def read_joints(builder):
                 builder.fail(path + ("length",), "length must be positive")
         elif "length" in spec:
             builder.fail(path + ("length",), f"only a distance joint has a length, not a {kind} joint")
-        joints.append(Joint(name, kind, parent, frame_a, child, frame_b, builder.q, builder.qd,
-                            builder.param_symbols.values(), length))
-    return joints
+        friction = read_friction(builder, spec, path, kind)
+        joint = Joint(name, kind, parent, frame_a, child, frame_b, builder.q, builder.qd,
+                      builder.param_symbols.values(), length, friction)
+        joints.append(joint)
+        elements += read_joint_forces(builder, spec, path, joint)
+    return joints, elements
 
 
 def read_contact(builder, spec, path, names):

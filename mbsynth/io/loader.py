@@ -134,10 +134,13 @@ class _Builder:
                 self.global_symbols[f"{part.name}.{c}_dot"] = qds
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
-        constraints += self.read_constraints() + read_joints(self)
+        joints, joint_forces = read_joints(self)
+        constraints += self.read_constraints() + joints
+        self.check_names(constraints)
         initial = self.read_initial(parts)
         system = System.build(name, parts, constraints, self.q, self.qd, self.parameters, initial,
-                              initial_fixed=self.read_initial_fixed(initial), forces=read_forces(self))
+                              initial_fixed=self.read_initial_fixed(initial),
+                              forces=[*read_forces(self), *joint_forces])
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
                          source=self.doc.text)
         self.check_parts(system)
@@ -304,6 +307,19 @@ class _Builder:
             if key not in initial:
                 self.fail(("initial_fixed", i), f"'{key}' has no initial value to keep")
         return set(node)
+
+    def check_names(self, constraints):
+        """A name given to a constraint or joint must not be another one's (nor a part's own
+        constraint's, such as ``body.unit_quaternion``)."""
+        seen = set()
+        for con in constraints:
+            if con.name in seen:
+                places = [(key, i) for key in ("constraints", "joints")
+                          for i, spec in enumerate(self.root.get(key) or ())
+                          if isinstance(spec, dict) and spec.get("name") == con.name]
+                self.fail(places[-1] + ("name",) if places else ("constraints",),
+                          f"the name '{con.name}' is given to two constraints or joints")
+            seen.add(con.name)
 
     def check_parts(self, system):
         """Each part's M must be finite and positive semi-definite at the initial state."""

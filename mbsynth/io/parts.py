@@ -4,6 +4,8 @@ Each ``read_*`` takes the loader's builder (for error reporting, expressions and
 model's symbols), the part's name, its mapping and key path, and returns a Part.
 """
 
+from pathlib import Path
+
 import numpy as np
 import sympy as sp
 
@@ -11,7 +13,8 @@ from ..kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody, Spring
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
-SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None}
+SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None, "line": None}
+MESH_FORMATS = (".stl", ".obj", ".dae")
 COLORS = {"red": (0.85, 0.2, 0.2), "green": (0.2, 0.7, 0.3), "blue": (0.2, 0.4, 0.85), "grey": (0.6, 0.6, 0.6),
           "gray": (0.6, 0.6, 0.6), "black": (0.1, 0.1, 0.1), "white": (0.95, 0.95, 0.95),
           "orange": (0.95, 0.55, 0.1), "yellow": (0.95, 0.85, 0.2), "purple": (0.55, 0.3, 0.75)}
@@ -151,7 +154,7 @@ def read_frames(builder, part, node, path, offsets, symbols=None):
             builder.fail(fpath + ("position",), "a particle is a point: its frames cannot be offset")
         rotation = sp.Matrix(read_rotation(builder, spec, fpath))
         frames.append(Frame(part, name, position, rotation,
-                            read_geometry(builder, spec.get("geometry"), fpath + ("geometry",))))
+                            read_geometry(builder, spec.get("geometry"), fpath + ("geometry",), set(node) - {name})))
     return frames
 
 
@@ -188,10 +191,12 @@ def read_body_initial(builder, node, path, planar):
     return values
 
 
-def read_geometry(builder, node, path):
+def read_geometry(builder, node, path, frames=()):
     """Drawing shapes: a mapping or a list of them, each with one of box [x, y, z],
-    sphere r, cylinder [r, length], capsule [r, length] or mesh: file (with ``scale``),
-    and optional ``color`` (name or [r, g, b(, a)] in 0..1) and an ``origin`` pose."""
+    sphere r, cylinder [r, length] (along z), capsule [r, length], mesh: file (.stl, .obj
+    or .dae, relative to the model file's folder; stored absolute; with ``scale``) or, on
+    a frame, line: another of the part's ``frames`` (drawn between the two), and optional
+    ``color`` (name or [r, g, b(, a)] in 0..1) and an ``origin`` pose."""
     if node is None:
         return ()
     items = node if isinstance(node, list) else [node]
@@ -204,10 +209,13 @@ def read_geometry(builder, node, path):
             builder.fail(ipath, f"a shape needs exactly one of {', '.join(SHAPES)}; got {kinds or 'none'}")
         kind = kinds[0]
         shape = {"shape": kind}
+        if kind == "line":
+            shape["to"] = read_line_end(builder, item, frames, ipath)
+            shape["color"] = read_color(builder, item.get("color", "grey"), ipath + ("color",))
+            shapes.append(shape)
+            continue
         if kind == "mesh":
-            if not isinstance(item["mesh"], str):
-                builder.fail(ipath + ("mesh",), "mesh must be a file path")
-            shape["file"] = item["mesh"]
+            shape["file"] = read_mesh_file(builder, item["mesh"], ipath + ("mesh",))
             shape["scale"] = builder.numbers(item.get("scale", [1, 1, 1]), ipath + ("scale",), 3)
         else:
             size = builder.numbers(item[kind] if isinstance(item[kind], list) else [item[kind]],
@@ -221,6 +229,33 @@ def read_geometry(builder, node, path):
         shape["rotation"] = read_rotation(builder, origin, ipath + ("origin",)).tolist()
         shapes.append(shape)
     return tuple(shapes)
+
+
+def read_line_end(builder, item, frames, path):
+    """The frame a ``line:`` shape runs to: another frame of the same part."""
+    extra = set(item) - {"line", "color"}
+    if extra:
+        builder.fail(path + (sorted(extra)[0],), "a line takes only 'color'")
+    if item["line"] not in frames:
+        builder.fail(path + ("line",), f"a line runs from a frame to another frame of the same part "
+                                       f"({', '.join(sorted(frames)) or 'none here'}), got {item['line']!r}")
+    return item["line"]
+
+
+def read_mesh_file(builder, text, path):
+    """The absolute path of a mesh file named relative to the model file's folder (the
+    working folder for a model given as text)."""
+    if not isinstance(text, str) or not text:
+        builder.fail(path, "mesh must be a file path")
+    file = Path(text).expanduser()
+    if not file.is_absolute():
+        model = Path(builder.doc.name)
+        file = (model.parent if model.is_file() else Path.cwd()) / file
+    if file.suffix.lower() not in MESH_FORMATS:
+        builder.fail(path, f"mesh {text!r}: the viewer reads {', '.join(MESH_FORMATS)} files")
+    if not file.is_file():
+        builder.fail(path, f"mesh file {text!r} not found (looked for {file})")
+    return str(file.resolve())
 
 
 def read_color(builder, node, path):

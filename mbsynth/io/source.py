@@ -3,6 +3,11 @@
 ``read_document(path)`` parses a model file with PyYAML's safe loader (no tags,
 no code) into ordinary dicts and lists that also carry line numbers, so that a
 mistake found later can be reported as ``file:line: at key.path: message``.
+
+Hostile files are refused with a line too: text that is not UTF-8 or holds control
+characters, nesting deeper than ``MAX_DEPTH``, more than ``MAX_NODES`` nodes once every
+alias is expanded (a "billion laughs" file: each alias repeats its anchor), and scalars
+that cannot be read (an integer of thousands of digits, a date that does not exist).
 """
 
 from pathlib import Path
@@ -11,12 +16,19 @@ import yaml
 
 from ..errors import ModelError
 
+MAX_DEPTH = 64  # levels of nested mappings and lists
+MAX_NODES = 100_000  # nodes of a document with every alias expanded
+
 
 class LineDict(dict):
-    """A mapping with ``line`` (its own) and ``key_lines`` (one per key), 1-based."""
+    """A mapping with ``line`` (its own) and ``key_lines`` (one per key), 1-based.
+
+    Hashable by identity, like LineList: a model reader may ask ``value in KINDS`` of
+    any value it finds (a mapping or list is no name, and the answer is simply no)."""
 
     line = 0
     key_lines: dict
+    __hash__ = object.__hash__
 
 
 class LineList(list):
@@ -24,10 +36,45 @@ class LineList(list):
 
     line = 0
     item_lines: list
+    __hash__ = object.__hash__
 
 
 class _Loader(yaml.SafeLoader):
-    pass
+    """SafeLoader that bounds the nesting depth and the expanded size of a document."""
+
+    def __init__(self, text, name):
+        super().__init__(text)
+        self.name = name
+        self.depth = 0
+        self.sizes = {}  # id(node) -> its number of nodes with aliases expanded
+
+    def compose_node(self, parent, index):
+        alias = self.check_event(yaml.AliasEvent)
+        line = self.peek_event().start_mark.line + 1
+        if self.depth >= MAX_DEPTH:
+            raise ModelError(f"{self.name}:{line}: nested more than {MAX_DEPTH} levels deep")
+        self.depth += 1
+        node = super().compose_node(parent, index)
+        self.depth -= 1
+        if not alias:
+            children = (node.value if isinstance(node, yaml.SequenceNode) else
+                        [x for pair in node.value for x in pair] if isinstance(node, yaml.MappingNode) else [])
+            self.sizes[id(node)] = 1 + sum(self.sizes.get(id(child), 1) for child in children)
+        if self.sizes.get(id(node), 1) > MAX_NODES:
+            raise ModelError(f"{self.name}:{line}: more than {MAX_NODES} values once the aliases (*name) "
+                             "are expanded; refusing a file that repeats its anchors this much")
+        return node
+
+    def construct_object(self, node, deep=False):
+        try:
+            return super().construct_object(node, deep)
+        except ModelError:
+            raise
+        except (ValueError, OverflowError) as err:  # int("9" * 5000), date 2001-02-30
+            value = str(node.value)
+            value = value if len(value) <= 40 else value[:37] + "..."
+            raise ModelError(f"{self.name}:{node.start_mark.line + 1}: cannot read the value "
+                             f"{value!r}: {err}") from None
 
 
 def _construct_mapping(loader, node):
@@ -65,10 +112,14 @@ class Document:
     def __init__(self, name, text):
         self.name = str(name)
         self.text = text
-        loader = _Loader(text)
-        loader.name = self.name
+        loader = None
         try:
+            loader = _Loader(text, self.name)
             root = loader.get_single_data()
+        except yaml.reader.ReaderError as err:
+            line = text.count("\n", 0, err.position) + 1
+            raise ModelError(f"{self.name}:{line}: not valid YAML: character U+{err.character:04X} is not "
+                             "allowed in a model file (binary data?)") from None
         except yaml.MarkedYAMLError as err:
             mark = err.problem_mark or err.context_mark
             line = f":{mark.line + 1}" if mark else ""
@@ -76,7 +127,8 @@ class Document:
         except yaml.YAMLError as err:
             raise ModelError(f"{self.name}: not valid YAML: {err}") from None
         finally:
-            loader.dispose()
+            if loader is not None:
+                loader.dispose()
         if not isinstance(root, LineDict):
             raise ModelError(f"{self.name}:1: a model file must be a mapping of keys "
                              f"(name, parameters, subsystems, ...), got {type(root).__name__}")
@@ -105,9 +157,17 @@ def read_document(path):
     """Read and parse the model file at ``path``."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except FileNotFoundError:
         raise ModelError(f"{path}: no such model file") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise ModelError(f"{path}: cannot read model file: {err}") from None
+    except IsADirectoryError:
+        raise ModelError(f"{path}: is a folder, not a model file") from None
+    except OSError as err:
+        raise ModelError(f"{path}: cannot read model file: {err.strerror or err}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data.count(b"\n", 0, err.start) + 1
+        raise ModelError(f"{path}:{line}: not UTF-8 text (byte {data[err.start]:#04x}); "
+                         "a model file is YAML") from None
     return Document(path, text)

@@ -1,0 +1,108 @@
+"""Rigid bodies in numba: rotations, the blocks of (2.1), and the change of variables that
+takes a quaternion's norm direction out of the body's block.
+
+A rigid body (rigid_body.py) has M = blockdiag(m I₃, 4 EᵀJE), Q = [m g; −8 E(u̇)ᵀ J E(u) u̇]
+with the homogeneous forms of kinematics.py (exact for any u, unit or not):
+
+    R(u) = (w² − vᵀv) I + 2 v vᵀ + 2 w [v]×,      E(u) = [−v, w I − [v]×].
+
+With ν = |u|, U = [uᵀ; E(u)]/ν is orthogonal (E u = 0, E Eᵀ = ν² I), so
+
+    ü = Uᵀ [s; a] = (u s + Eᵀ a)/ν,     U (4 EᵀJE) Uᵀ = blockdiag(0, 4 ν² J),
+
+and the unit-norm row uᵀü = −u̇ᵀu̇ fixes s = −u̇ᵀu̇/ν before any solve. The body's unknowns
+become y = (r̈, a) ∈ R⁶ with mass H = blockdiag(m I₃, 4 ν² J) and force (Q_r, E Q_u/ν); a
+row c = (c_r, c_u) of A becomes (c_r, E c_u/ν), with (c_u·u) s/ν moved to its right side.
+The norm row's multiplier only balances the s component, which no other unknown sees, so
+the row and its multiplier leave the system exactly (an orthogonal change of variables).
+"""
+
+import numpy as np
+from numba import njit
+
+OPTIONS = dict(cache=True, error_model="numpy")
+
+
+@njit(**OPTIONS)
+def rotation(u, R):
+    """R(u) into R (3 × 3)."""
+    w, x, y, z = u[0], u[1], u[2], u[3]
+    d = w * w - x * x - y * y - z * z
+    R[0, 0] = d + 2 * x * x
+    R[1, 1] = d + 2 * y * y
+    R[2, 2] = d + 2 * z * z
+    R[0, 1] = 2 * (x * y - w * z)
+    R[1, 0] = 2 * (x * y + w * z)
+    R[0, 2] = 2 * (x * z + w * y)
+    R[2, 0] = 2 * (x * z - w * y)
+    R[1, 2] = 2 * (y * z - w * x)
+    R[2, 1] = 2 * (y * z + w * x)
+
+
+@njit(**OPTIONS)
+def rotation_jacobian(u, c, J):
+    """J = ∂(R(u) c)/∂u (3 × 4) for a constant c. R(u)c is quadratic in u, so
+    d²/dt² R(u)c = J ü + 2 R(u̇) c."""
+    w, vx, vy, vz = u[0], u[1], u[2], u[3]
+    cx, cy, cz = c[0], c[1], c[2]
+    vc = vx * cx + vy * cy + vz * cz
+    # ∂/∂w = 2 (w c + v × c)
+    J[0, 0] = 2 * (w * cx + vy * cz - vz * cy)
+    J[1, 0] = 2 * (w * cy + vz * cx - vx * cz)
+    J[2, 0] = 2 * (w * cz + vx * cy - vy * cx)
+    # ∂/∂v = 2 ((vᵀc) I + v cᵀ − c vᵀ − w [c]×)
+    v = (vx, vy, vz)
+    for i in range(3):
+        for j in range(3):
+            J[i, 1 + j] = 2 * (v[i] * c[j] - c[i] * v[j])
+        J[i, 1 + i] += 2 * vc
+    J[0, 2] += 2 * w * cz
+    J[0, 3] -= 2 * w * cy
+    J[1, 1] -= 2 * w * cz
+    J[1, 3] += 2 * w * cx
+    J[2, 1] += 2 * w * cy
+    J[2, 2] -= 2 * w * cx
+
+
+@njit(**OPTIONS)
+def rate(u, x):
+    """E(u) x for a 4-vector x: −x_w v + w x_v − v × x_v (a 3-tuple)."""
+    w, a, b, c = u[0], u[1], u[2], u[3]
+    return (-x[0] * a + w * x[1] - (b * x[3] - c * x[2]),
+            -x[0] * b + w * x[2] - (c * x[1] - a * x[3]),
+            -x[0] * c + w * x[3] - (a * x[2] - b * x[1]))
+
+
+@njit(**OPTIONS)
+def rate_transpose(u, g):
+    """E(u)ᵀ g for a 3-vector g: (−v·g, w g + v × g) (a 4-tuple)."""
+    w, a, b, c = u[0], u[1], u[2], u[3]
+    return (-(a * g[0] + b * g[1] + c * g[2]),
+            w * g[0] + b * g[2] - c * g[1],
+            w * g[1] + c * g[0] - a * g[2],
+            w * g[2] + a * g[1] - b * g[0])
+
+
+@njit(**OPTIONS)
+def body_force(mg, J, u, ud, Q):
+    """Q of a rigid body into Q (7): [m g; −8 E(u̇)ᵀ J E(u) u̇]."""
+    o = rate(u, ud)
+    g = (J[0, 0] * o[0] + J[0, 1] * o[1] + J[0, 2] * o[2],
+         J[1, 0] * o[0] + J[1, 1] * o[1] + J[1, 2] * o[2],
+         J[2, 0] * o[0] + J[2, 1] * o[1] + J[2, 2] * o[2])
+    f = rate_transpose(ud, g)
+    for i in range(3):
+        Q[i] = mg[i]
+    for k in range(4):
+        Q[3 + k] = -8 * f[k]
+
+
+@njit(**OPTIONS)
+def reduce_row(c, u, nu, s, out):
+    """(c_r, E c_u/ν) of a 7-coefficient row segment c into out (6); returns the right-side
+    shift −(c_u·u) s/ν (module docstring)."""
+    e = rate(u, c[3:])
+    for i in range(3):
+        out[i] = c[i]
+        out[3 + i] = e[i] / nu
+    return -(c[3] * u[0] + c[4] * u[1] + c[5] * u[2] + c[6] * u[3]) * s / nu

@@ -1,0 +1,71 @@
+"""The compiled fast path of one System: layout, generated function, work buffers.
+
+``Engine.build(system)`` returns None when the kernels cover no part of the System
+(layout.build). ``motion`` returns a ``Motion`` equal to (2.14)'s, or None when the
+kernel's checks send the problem to the exact treatment (kernel.py's status);
+``motion_batch`` evaluates many states in parallel.
+"""
+
+import os
+import threading
+
+import numpy as np
+
+from . import cache
+
+cache.configure()
+
+from ..equations import Motion  # noqa: E402  (numba must see the cache directory first)
+from . import codegen, kernel, layout  # noqa: E402
+from .assembly import make_work  # noqa: E402
+
+EMPTY = np.zeros(0)
+
+
+class Engine:
+    """The fast path for ``system`` at its parameter values."""
+
+    def __init__(self, system, L, exprs):
+        self.system, self.L = system, L
+        self.n = system.n
+        self.p = system.parameter_values
+        self.outputs = len(exprs)
+        self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
+                                                  system.parameter_symbols) if exprs else None
+        self.gen = np.zeros(self.outputs)
+        self.W = make_work(L)
+        self.lock = threading.Lock()
+
+    @classmethod
+    def build(cls, system):
+        found = layout.build(system)
+        return None if found is None else cls(system, *found)
+
+    def warm(self):
+        """Compile (or load from the cache) everything ``motion`` calls, at the initial state."""
+        q, qd = self.system.initial_state()
+        self.motion(0.0, q, qd)
+
+    def motion(self, t, q, qd, bshift=None):
+        """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
+        bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ)."""
+        t = float(t)
+        with self.lock:
+            if self.module is not None:
+                self.module.evaluate(t, q, qd, self.p, self.gen)
+            status, residual = kernel.motion(t, q, qd, self.gen, EMPTY if bshift is None else bshift, self.L, self.W)
+            if status != kernel.OK:
+                return None
+            return Motion(qdd=self.W.qdd.copy(), unique=True, nullspace=np.zeros((self.n, 0)), Qc=self.W.Qc.copy(),
+                          residual=residual, method="tree (Baraff)")
+
+    def motion_batch(self, t, q, qd):
+        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,)."""
+        count = q.shape[0]
+        gen = np.zeros((count, self.outputs))
+        if self.module is not None and count:
+            self.module.evaluate_batch(t, q, qd, self.p, gen)
+        qdd, status = np.zeros((count, self.n)), np.zeros(count, dtype=np.int64)
+        chunks = max(1, min(count, 4 * (os.cpu_count() or 1)))
+        kernel.motion_batch(t, q, qd, gen, self.L, qdd, status, chunks)
+        return qdd, status

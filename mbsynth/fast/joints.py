@@ -1,0 +1,122 @@
+"""The rows of A and b of the holonomic joints (connectors/joints.py), differentiated by hand.
+
+Every joint row φ is built from a few world vectors of the two frames: the offset
+d = p_B − p_A and the frames' axes x_A, y_A, z_A, x_B, y_B, z_B. Each vector v(q) has a
+Jacobian J_v over the 14 coordinates of the two parts (7 per end: a rigid body's r, u; a
+particle's r) and a velocity-product term, v̈ = J_v q̈ + β_v:
+
+    frame origin  p = r + R(u) s:  J = [I, J_s(u)],  β = 2 R(u̇) s     (bodies.rotation_jacobian)
+    frame axis    a = R(u) c:      J = [0, J_c(u)],  β = 2 R(u̇) c
+    on a particle p = r, a = c; in the world both constant (J = 0, β = 0).
+
+A row's A and b then follow from φ̈ = a q̈ − b:
+
+    component   φ = d_k            a = J_d[k],              b = −β_d[k]
+    dot         φ = v·w            a = wᵀJ_v + vᵀJ_w,       b = −(w·β_v + v·β_w + 2 v̇·ẇ)
+    distance    φ = (d·d − L²)/2L  a = dᵀJ_d / L,           b = −(ḋ·ḋ + d·β_d)/L
+
+``PROGRAMS`` lists each kind's rows in the order and with the signs of
+``connectors.joints.joint_equations``; the tests compare with the sympy rows.
+"""
+
+import numpy as np
+from numba import njit
+
+from .bodies import OPTIONS, rotation, rotation_jacobian
+
+WORLD, RIGID, PARTICLE = 0, 1, 2  # what a joint's end sits on
+COMPONENT, DOT, DISTANCE = 0, 1, 2
+D, XA, YA, ZA, XB, YB, ZB = range(7)  # the vectors of a joint (and 7, 8: the two origins)
+
+PROGRAMS = {
+    "spherical": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2)],
+    "revolute": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2), (DOT, ZB, XA), (DOT, ZB, YA)],
+    "universal": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2), (DOT, ZA, ZB)],
+    "cylindrical": [(DOT, ZB, XA), (DOT, ZB, YA), (DOT, D, XA), (DOT, D, YA)],
+    "prismatic": [(DOT, XA, YB), (DOT, YA, ZB), (DOT, ZA, XB), (DOT, D, XA), (DOT, D, YA)],
+    "fixed": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2), (DOT, XA, YB), (DOT, YA, ZB),
+              (DOT, ZA, XB)],
+    "distance": [(DISTANCE, D, D)],
+}
+MAX_ROWS = 6
+VALUE, VELOCITY, BIAS, JAC = 0, 1, 2, 3  # columns of a vector's record: 3 values each, then 14 Jacobian columns
+
+
+def vector_work():
+    """Work space of ``joint_rows``: 9 vectors × 3 components × (value, velocity, bias, 14 Jacobian)."""
+    return np.zeros((9, 3, 17)), np.zeros((2, 3, 3)), np.zeros((3, 4))
+
+
+@njit(**OPTIONS)
+def _end(e, kind, o, s, Rf, q, qd, V, R, Jt):
+    """The origin (record 7 + e) and the three axes (1 + 3e ...) of end e into V."""
+    P, c0 = V[7 + e], JAC + 7 * e
+    V[7 + e, :, :] = 0.0
+    for a in range(3):
+        V[1 + 3 * e + a, :, :] = 0.0
+    if kind == WORLD:
+        for i in range(3):
+            P[i, VALUE] = s[i]
+            for a in range(3):
+                V[1 + 3 * e + a, i, VALUE] = Rf[i, a]
+        return
+    for i in range(3):
+        P[i, VALUE] = q[o + i]
+        P[i, VELOCITY] = qd[o + i]
+        P[i, c0 + i] = 1.0
+    if kind == PARTICLE:
+        for i in range(3):
+            for a in range(3):
+                V[1 + 3 * e + a, i, VALUE] = Rf[i, a]
+        return
+    u, ud = q[o + 3:o + 7], qd[o + 3:o + 7]
+    rotation(u, R[0])
+    rotation(ud, R[1])
+    for a in range(4):  # a = 0: the origin's offset s; a = 1, 2, 3: the frame's axes
+        X = P if a == 0 else V[3 * e + a]
+        c = (s[0], s[1], s[2]) if a == 0 else (Rf[0, a - 1], Rf[1, a - 1], Rf[2, a - 1])
+        rotation_jacobian(u, c, Jt)
+        for i in range(3):
+            X[i, VALUE] += R[0, i, 0] * c[0] + R[0, i, 1] * c[1] + R[0, i, 2] * c[2]
+            X[i, BIAS] += 2 * (R[1, i, 0] * c[0] + R[1, i, 1] * c[1] + R[1, i, 2] * c[2])
+            for k in range(4):
+                X[i, VELOCITY] += Jt[i, k] * ud[k]
+                X[i, c0 + 3 + k] = Jt[i, k]
+
+
+@njit(**OPTIONS)
+def joint_rows(program, k, kinds, starts, s, Rf, length, q, qd, V, R, Jt, A, b):
+    """Rows A[:k] (k × 14: end A's 7 coordinates, then end B's) and b[:k] of one joint.
+
+    program: k × 3 (operation, vector, vector or component); kinds, starts: per end, what it
+    sits on and its first coordinate; s, Rf: per end, the frame's offset and rotation in
+    its part (in the world for a world end); length: a distance joint's L."""
+    _end(0, kinds[0], starts[0], s[0], Rf[0], q, qd, V, R, Jt)
+    _end(1, kinds[1], starts[1], s[1], Rf[1], q, qd, V, R, Jt)
+    for i in range(3):  # d = p_B − p_A: value, velocity, bias and Jacobian alike
+        for col in range(17):
+            V[D, i, col] = V[8, i, col] - V[7, i, col]
+    for r in range(k):
+        op, i1, i2 = program[r, 0], program[r, 1], program[r, 2]
+        X, Y = V[i1], V[i2]
+        if op == COMPONENT:
+            for col in range(14):
+                A[r, col] = X[i2, JAC + col]
+            b[r] = -X[i2, BIAS]
+        elif op == DOT:
+            for col in range(14):
+                A[r, col] = (Y[0, VALUE] * X[0, JAC + col] + Y[1, VALUE] * X[1, JAC + col] + Y[2, VALUE] * X[2, JAC + col]
+                             + X[0, VALUE] * Y[0, JAC + col] + X[1, VALUE] * Y[1, JAC + col]
+                             + X[2, VALUE] * Y[2, JAC + col])
+            total = 0.0
+            for i in range(3):
+                total += Y[i, VALUE] * X[i, BIAS] + X[i, VALUE] * Y[i, BIAS] + 2 * X[i, VELOCITY] * Y[i, VELOCITY]
+            b[r] = -total
+        else:
+            for col in range(14):
+                A[r, col] = (X[0, VALUE] * X[0, JAC + col] + X[1, VALUE] * X[1, JAC + col]
+                             + X[2, VALUE] * X[2, JAC + col]) / length
+            total = 0.0
+            for i in range(3):
+                total += X[i, VELOCITY] * X[i, VELOCITY] + X[i, VALUE] * X[i, BIAS]
+            b[r] = -total / length

@@ -1,0 +1,36 @@
+"""Force elements along a joint's free motion (forces.ForceElement, added to Q).
+
+A revolute joint turns by ``angle`` θ at ``angle_rate``, a prismatic joint slides by
+``displacement`` s at ``displacement_rate`` (connectors.joints.Joint); a cylindrical
+joint does both. Along these:
+
+    actuation   effort τ(t) along the rate: a torque about the axis, a force along it
+    spring      V = ½ k (θ − θ0)²  or  ½ k (s − s0)²,   damper effort −c · rate
+
+θ is atan2 of the frames' x axes, in (−π, π]: a torsional spring holds over less than
+a turn from θ = 0 (its potential jumps where θ wraps).
+"""
+
+from .forces import ForceElement
+
+# the joint's (position, rate) attribute for each kind of motion
+MOTIONS = {"torque": ("angle", "angle_rate"), "force": ("displacement", "displacement_rate")}
+
+
+def joint_motion(joint):
+    """What acts along the joint's one motion: "torque" (revolute), "force" (prismatic), else None."""
+    return {"revolute": "torque", "prismatic": "force"}.get(joint.joint_kind)
+
+
+def actuation(name, joint, efforts, q, qd, params):
+    """A torque about / force along the joint's axis: ``efforts`` maps "torque" and/or
+    "force" to expressions (of t, parameters, coordinates)."""
+    pairs = [(effort, getattr(joint, MOTIONS[key][1])) for key, effort in efforts.items()]
+    return ForceElement(name, 0, pairs, q, qd, params)
+
+
+def joint_spring(name, joint, stiffness, damping, rest, q, qd, params):
+    """A torsional (revolute) or linear (prismatic) spring k with rest position ``rest``
+    and a damper c along the joint's one motion."""
+    position, rate = (getattr(joint, attr) for attr in MOTIONS[joint_motion(joint)])
+    return ForceElement(name, stiffness * (position - rest) ** 2 / 2, [(-damping * rate, rate)], q, qd, params)

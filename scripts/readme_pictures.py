@@ -1,0 +1,45 @@
+"""The README's pictures of the viewer, made the way a user sees them: the HTML animation
+written by ``mb.viewer.to_html``, photographed by headless Chromium (mbsynth.screenshot).
+
+    .venv/bin/python scripts/readme_pictures.py        # writes docs/viewer_*.png
+"""
+
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+import mbsynth as mb
+from mbsynth.screenshot import screenshot
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+
+
+def picture(system, trajectory, name, budget_ms):
+    """docs/<name>.png: the page after ``budget_ms`` of its animation, as an optimized PNG."""
+    with tempfile.TemporaryDirectory() as folder:
+        page = mb.viewer.to_html(system, trajectory, Path(folder) / f"{name}.html")
+        shot = screenshot(page, Path(folder) / f"{name}.png", budget_ms=budget_ms)
+        image = Image.open(shot).convert("RGB").quantize(colors=128)
+        out = DOCS / f"{name}.png"
+        image.save(out, optimize=True)
+    print(f"wrote {out} ({out.stat().st_size // 1024} kB)")
+
+
+def main():
+    DOCS.mkdir(exist_ok=True)
+    system = mb.load(ROOT / "models" / "paper" / "example3_two_masses.yaml")
+    picture(system, mb.simulate(system, 4.0, dt=1 / 30), "viewer_example3", budget_ms=1500)
+    from mbsynth.robots import from_robot
+
+    robot = from_robot("ur5")
+    q, qd = robot.initial_state()
+    still = mb.Trajectory(robot.coordinates, np.zeros(1), q[None], qd[None], *np.zeros((4, 1)))
+    picture(robot, still, "viewer_ur5", budget_ms=2000)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
