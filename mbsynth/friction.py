@@ -81,8 +81,8 @@ class CoulombFriction:
         local_q, local_qd = [q[i] for i in self.indices], [qd[i] for i in self.indices]
         direction = scale * sp.Matrix([w]).jacobian(sp.Matrix(local_qd)).T
         self._evaluate = compile_function((T_SYMBOL, local_q, local_qd, list(params)), [w, direction])
-        self.load_rows = np.array([joint.row_names.index(f"{joint.name}[{label}]")
-                                   for label in KINDS[joint.joint_kind][1]])
+        labels = [f"{joint.name}[{label}]" for label in KINDS[joint.joint_kind][1]]
+        self.load_rows = np.array([joint.row_names.index(x) for x in labels if x in joint.row_names], dtype=int)
 
     def evaluate(self, t, q, qd, p):
         """(w, μ r ∂w/∂q̇ on ``indices``) at the full state (q, q̇)."""

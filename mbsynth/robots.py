@@ -124,9 +124,9 @@ class Robot:
         base = (np.zeros(3), np.eye(3)) if base is None else tuple(np.asarray(x, dtype=float) for x in base)
         parts = _unique({link: prefix + identifier(link) for link in description.links})
         joints = _unique({j.name: prefix + identifier(j.name) for j in description.joints}
-                         | ({} if floating else {None: prefix + "fixed_base"}))
+                         | {None: prefix + "fixed_base"})
         torques = {j.name: f"tau_{joints[j.name]}" for j in description.joints if j.kind != "fixed"}
-        return cls(description, prefix, floating, base, parts, joints, torques, joints.pop(None, None))
+        return cls(description, prefix, floating, base, parts, joints, torques, joints.pop(None))
 
     @property
     def parameters(self):
@@ -166,11 +166,8 @@ class Robot:
 
     def connect(self, parts, q, qd, params):
         """(joints, torque force elements) between the bodies ``parts`` (name → part)."""
-        joints, elements = [], []
-        if not self.floating:
-            root = parts[self.parts[self.description.root]]
-            world = Frame("world", self.base_joint, exact(self.base[0]), exact(self.base[1]))
-            joints.append(Joint(self.base_joint, "fixed", None, world, root, root.frames[LINK_FRAME], q, qd, params))
+        joints = [] if self.floating else [self.weld(parts, q, qd, params)]
+        elements = []
         for joint in self.description.joints:
             on_parent, on_child = self.joint_frames(joint)
             connector = Joint(self.joints[joint.name], JOINT_KINDS[joint.kind], parts[on_parent.part], on_parent,
@@ -181,6 +178,12 @@ class Robot:
                 elements.append(actuation(f"{connector.name}.actuation", connector,
                                           {effort: sp.Symbol(self.torques[joint.name])}, q, qd, params))
         return joints, elements
+
+    def weld(self, parts, q, qd, params):
+        """The fixed joint that holds the root link's frame at ``base`` in the world."""
+        root = parts[self.parts[self.description.root]]
+        world = Frame("world", self.base_joint, exact(self.base[0]), exact(self.base[1]))
+        return Joint(self.base_joint, "fixed", None, world, root, root.frames[LINK_FRAME], q, qd, params)
 
 
 def from_robot(name_or_urdf, floating=False, *, base=None, gravity=GRAVITY, prefix="", package_dirs=()):
@@ -202,12 +205,22 @@ def from_robot(name_or_urdf, floating=False, *, base=None, gravity=GRAVITY, pref
     return replace(system, robots=(robot,))
 
 
+def fix_base(system):
+    """The System of one floating robot with its root link welded to the world at its
+    base: the fixed-base robot without building its parts again."""
+    (robot,) = system.robots
+    fixed = replace(robot, floating=False)
+    weld = fixed.weld({p.name: p for p in system.subsystems}, system.q_symbols, system.qd_symbols,
+                      system.parameter_symbols)
+    return replace(system.with_constraints([weld]), robots=(fixed,))
+
+
 def exact(values):
-    """A sympy matrix of ``values`` with entries within 1e-12 of −1, 0 or 1 made exact
+    """A sympy matrix of ``values`` with entries within 1e-15 of −1, 0 or 1 made exact
     integers: ``1.0*x`` and ``0.0*x`` terms would otherwise fill every derivative."""
     values = np.atleast_1d(np.asarray(values, dtype=float))
     near = np.round(values)
-    exact_entries = (np.abs(values - near) < 1e-12) & (np.abs(near) <= 1)
+    exact_entries = (np.abs(values - near) < 1e-15) & (np.abs(near) <= 1)
     return sp.Matrix(values.shape[0], values.shape[1] if values.ndim > 1 else 1,
                      [sp.Integer(int(n)) if e else sp.Float(v) for v, n, e in
                       zip(values.ravel(), near.ravel(), exact_entries.ravel())])

@@ -125,7 +125,7 @@ class MeshcatView:
                     target[f"{i}.{j}"].set_object(geometry, _material(shape["color"], g))
                     target[f"{i}.{j}"].set_transform(inner)
             if node.axes:
-                target["axes"].set_object(g.triad(0.08 * scene.size))
+                target["axes"].set_object(g.triad(0.04 * scene.size))
             target.set_transform(node.transforms[0])
         self.frame(scene)
         if len(scene.times) > 1:

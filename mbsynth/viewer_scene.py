@@ -65,7 +65,7 @@ class _Spec:
     path: str
     pose: int
     shapes: list
-    default: str = None  # the shape drawn when there is none: "sphere" or "box"
+    default: str = None  # the shape drawn when there is none: "sphere", "box" or "marker"
     color: list = None
     axes: bool = False
 
@@ -81,24 +81,18 @@ def build_scene(system, trajectory, axes=False, joints=False, fps=FPS):
     rows = drawn_rows(trajectory.t, fps)
     poses = _Poses()
     specs, lines = [], []
+    model_drawn = any(_has_geometry(part) for part in system.subsystems)
     for i, part in enumerate(system.subsystems):
         color = [*COLORS[PALETTE[i % len(PALETTE)]], 1.0]
-        specs += _part_specs(part, poses, color, axes)
+        specs += _part_specs(part, poses, color, axes, model_drawn)
         lines += _part_lines(part, poses)
-    for con in system.constraints:
-        if getattr(con, "joint_kind", None) is None:
-            continue
-        ends = [poses.add(part, frame) for part, frame in zip(con.parts, con.frames)]
-        if con.joint_kind == "distance":
-            lines.append((con.name, *ends, ROD_COLOR))
-        elif joints:
-            specs += [_Spec(f"joints/{con.name}.{end}", key, [], "marker", ROD_COLOR) for end, key in zip("AB", ends)]
+    joint_lines, markers = _joint_items(system, poses, joints)
+    specs = [s for s in specs + markers if s.shapes or s.default or s.axes]
+    lines += joint_lines
     for element in system.forces:
         ends = getattr(element, "points", None)  # a force element between two points may expose them
         if ends is not None:
             lines.append((element.name, *(poses.add_point(p) for p in ends), LINE_COLOR))
-
-    specs = [s for s in specs if s.shapes or s.default or s.axes]
     transforms = poses.evaluate(system, trajectory.t[rows], trajectory.q[rows])
     positions = transforms[:, :, :3, 3]
     drawn = positions[[s.pose for s in specs] + [i for line in lines for i in line[1:3]]]
@@ -166,15 +160,37 @@ def _default_shapes(spec, size):
     return []
 
 
-def _part_specs(part, poses, color, axes):
-    """The node of the part's own pose and one per frame (line shapes apart)."""
-    drawn = bool(part.geometry) or any(f.geometry for f in part.frames.values())
+def _joint_items(system, poses, markers):
+    """Lines of the distance joints (massless rods) and, if ``markers``, a marker at both
+    frames of every other joint."""
+    lines, specs = [], []
+    for con in system.constraints:
+        if getattr(con, "joint_kind", None) is None:
+            continue
+        ends = [poses.add(part, frame) for part, frame in zip(con.parts, con.frames)]
+        if con.joint_kind == "distance":
+            lines.append((con.name, *ends, ROD_COLOR))
+        elif markers:
+            specs += [_Spec(f"joints/{con.name}.{end}", key, [], "marker", ROD_COLOR) for end, key in zip("AB", ends)]
+    return lines, specs
+
+
+def _has_geometry(part):
+    return bool(part.geometry) or any(f.geometry for f in part.frames.values())
+
+
+def _part_specs(part, poses, color, axes, model_drawn):
+    """The node of the part's own pose and one per frame (line shapes apart). A part with
+    no geometry gets a default: a sphere for a particle; for a body a box, or only its
+    axes when the model draws other parts (a robot's frame-like links)."""
+    drawn = _has_geometry(part)
     specs = []
     if part.kind != "spring":
-        default = None if drawn else "sphere" if part.kind in POINT_LIKE else "box" if part.kind in BODIES else None
+        body = part.kind in BODIES and not drawn
+        default = "sphere" if part.kind in POINT_LIKE and not drawn else "box" if body and not model_drawn else None
         origin = Frame(part.name, "origin", sp.zeros(3, 1), sp.eye(3))
         specs.append(_Spec(part.name, poses.add(part, origin), _solid(part.geometry), default, color,
-                           axes and part.kind != "lagrangian"))
+                           (axes or (body and model_drawn)) and part.kind != "lagrangian"))
     for frame in part.frames.values():
         default = "sphere" if part.kind == "lagrangian" and not drawn else None
         specs.append(_Spec(f"{part.name}.{frame.name}", poses.add(part, frame), _solid(frame.geometry), default,

@@ -8,7 +8,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
 from PIL import Image
 
 import mbsynth as mb
@@ -19,13 +18,12 @@ DOCS = ROOT / "docs"
 
 
 def picture(system, trajectory, name, budget_ms):
-    """docs/<name>.png: the page after ``budget_ms`` of its animation, as an optimized PNG."""
+    """docs/<name>.png: the page after ``budget_ms`` of its animation."""
     with tempfile.TemporaryDirectory() as folder:
         page = mb.viewer.to_html(system, trajectory, Path(folder) / f"{name}.html")
         shot = screenshot(page, Path(folder) / f"{name}.png", budget_ms=budget_ms)
-        image = Image.open(shot).convert("RGB").quantize(colors=128)
         out = DOCS / f"{name}.png"
-        image.save(out, optimize=True)
+        Image.open(shot).convert("RGB").save(out, optimize=True)
     print(f"wrote {out} ({out.stat().st_size // 1024} kB)")
 
 
@@ -35,10 +33,8 @@ def main():
     picture(system, mb.simulate(system, 4.0, dt=1 / 30), "viewer_example3", budget_ms=1500)
     from mbsynth.robots import from_robot
 
-    robot = from_robot("ur5")
-    q, qd = robot.initial_state()
-    still = mb.Trajectory(robot.coordinates, np.zeros(1), q[None], qd[None], *np.zeros((4, 1)))
-    picture(robot, still, "viewer_ur5", budget_ms=2000)
+    robot = from_robot("ur5")  # unpowered: it falls from its zero configuration
+    picture(robot, mb.simulate(robot, 0.6, dt=1 / 30), "viewer_ur5", budget_ms=400)
 
 
 if __name__ == "__main__":

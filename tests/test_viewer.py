@@ -80,7 +80,13 @@ def test_rigid_and_planar_bodies_are_drawn_at_their_pose():
     np.testing.assert_allclose(slab[:3, :3], rotation_z(np.pi / 2), atol=1e-12)
     np.testing.assert_allclose(slab[:3, 3], [0.4, -0.2, 0], atol=1e-12)
     np.testing.assert_allclose(node(scene, "slab.corner").transforms[0, :3, 3], [0.4, 0.3, 0], atol=1e-12)
-    assert node(scene, "slab").shapes[0]["shape"] == "box"  # no geometry given: a small default box
+    assert node(scene, "slab").shapes == [] and node(scene, "slab").axes  # no geometry: axes, as the body has some
+
+
+def test_bodies_without_geometry_get_a_box_when_nothing_is_drawn():
+    system = mb.loads(BODIES.replace("    geometry: {box: [0.2, 0.1, 0.1]}\n", ""))
+    scene = build_scene(system, trajectory_of(system, system.initial_state()[0]))
+    assert [(n.path, n.shapes[0]["shape"]) for n in scene.nodes] == [("body", "box"), ("slab", "box")]
 
 
 def test_three_js_quaternion_of_a_turn_about_z():

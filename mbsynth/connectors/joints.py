@@ -78,7 +78,8 @@ JOINT_KINDS = ("fixed", "revolute", "prismatic", "cylindrical", "spherical", "un
 
 class Joint(Connector):
     """A holonomic joint between frame A (on ``parent``, or the world when None) and
-    frame B (on ``child``). Besides its rows it knows, where it has them, its free
+    frame B (on ``child``). Rows that vanish identically (a revolute joint between planar
+    bodies has no z or axis rows) are left out. Besides its rows it knows, where it has them, its free
     motions: ``angle`` about z_A with rate ``angle_rate`` = z_A·(ω_B − ω_A) (revolute,
     cylindrical), and ``displacement`` z_A·(p_B − p_A) along z_A with its rate
     (prismatic, cylindrical) — what actuation, joint springs and friction act on."""
@@ -89,6 +90,8 @@ class Joint(Connector):
         pA, RA = _pose(parent, frame_a)
         pB, RB = _pose(child, frame_b)
         phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
+        kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
+        phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
         a, b, psi = differentiated(phis, q, qd)
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         self.length = length  # a distance joint's L (sympy), None for the other kinds

@@ -1,1 +1,20 @@
-"""The production path of System.motion: linear-time assembly and solve in numba."""
+"""The production path of System.motion: linear-time assembly and solve in numba.
+
+    layout.py      a System as index and number arrays (tree of bodies, loops, the rest)
+    codegen.py     one compiled function for every expression the kernels do not cover
+    bodies.py      rigid-body blocks and the quaternion change of variables
+    joints.py      joint rows of A and b, differentiated by hand
+    assembly.py    one state's blocks
+    tree.py        Baraff's block elimination over the tree of bodies
+    eigen.py       small symmetric eigendecomposition (the loops' Schur system)
+    kernel.py      the whole evaluation and its checks
+    engine.py      an Engine per System: motion, motion_batch
+    background.py  building Engines off the caller's thread; MBSYNTH_FAST
+    cache.py       where compiled code is kept
+
+Importing this package does not import numba (``mbsynth check`` never needs it).
+"""
+
+from .background import engine_for
+
+__all__ = ["engine_for"]

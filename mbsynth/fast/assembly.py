@@ -56,40 +56,40 @@ class Work(NamedTuple):
     S: np.ndarray      # (n_x + m_x,)² Schur complement (kernel.py)
     rhs: np.ndarray    # (n_x + m_x,)
     lam: np.ndarray    # (n_x + m_x,) extra accelerations, then extra multipliers
+    vectors: np.ndarray  # (n_x + m_x,)² eigenvectors of S
     dyn: np.ndarray    # (N, 6) residual work
     qdd: np.ndarray    # (n,) result: q̈
     Qc: np.ndarray     # (n,) result: M q̈ − Q (2.5)
 
 
-@njit(**OPTIONS)
 def make_work(L):
-    n, nz, dsize, rows = L.sizes[0], L.sizes[2], L.sizes[3], L.sizes[4]
+    """A Work for the Layout L (numpy; one per thread)."""
+    n, nz, dsize, rows = (int(x) for x in L.sizes[[0, 2, 3, 4]])
     N, S = L.node_kind.shape[0], L.xseg_node.shape[0]
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
-    return Work(np.zeros(n), np.zeros(n), np.zeros((N, 6, 6)), np.zeros((N, 6)), np.zeros(N), np.ones(N),
-                np.zeros((N, 6, 6)), np.zeros(MAX_BLOCK, np.int64), np.zeros((rows, 6)), np.zeros((rows, 6)),
-                np.zeros(rows), np.zeros(dsize), np.zeros(nz), np.zeros(nz), np.zeros(nz), np.zeros(nz), np.zeros(nz),
-                np.zeros((9, 3, 17)), np.zeros((2, 3, 3)), np.zeros((3, 4)), np.zeros((MAX_ROWS, 14)),
-                np.zeros(MAX_ROWS), np.zeros(7), np.zeros((S, 7)), np.zeros((S, 6)), np.zeros(mx), np.zeros((mx, nx)),
-                np.zeros((nx, nx)), np.zeros(nx), np.zeros((p, p)), np.zeros(p), np.zeros(p), np.zeros((N, 6)),
-                np.zeros(n), np.zeros(n))
+    shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, acc=(N, 6, 6), J=(rows, 6), P=(rows, 6), rb=rows,
+                  Dinv=dsize, ry=nz, y=nz, z=nz, z0=nz, w=nz, V=(9, 3, 17), R=(2, 3, 3), Jt=(3, 4), A=(MAX_ROWS, 14),
+                  b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
+                  rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
+    arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
+    return Work(perm=np.zeros(MAX_BLOCK, np.int64), **arrays)
 
 
 @njit(**OPTIONS)
-def _rows_of(j, q, qd, L, W):
-    k = L.joint_k[j]
-    joint_rows(L.joint_program[j], k, L.joint_kinds[j], L.joint_start[j], L.joint_s[j], L.joint_R[j],
-               L.joint_length[j], q, qd, W.V, W.R, W.Jt, W.A, W.b)
-    return k
+def _joint(j, q, qd, joints, scratch):
+    """Rows of kernel joint j into scratch's A, b; returns their number."""
+    program, k, kinds, start, offset, rotation, length = joints
+    V, R, Jt, A, b = scratch
+    joint_rows(program[j], k[j], kinds[j], start[j], offset[j], rotation[j], length[j], q, qd, V, R, Jt, A, b)
+    return k[j]
 
 
 @njit(**OPTIONS)
-def _reduce(c7, i, q, L, W, out):
-    """A row segment on node i in its reduced unknowns; returns the right-side shift."""
-    if L.node_kind[i] == RIGID:
-        o = L.node_q[i]
-        return reduce_row(c7, q[o + 3:o + 7], W.nu[i], W.s[i], out)
+def _reduce(c7, rigid, q, o, nu, s, out):
+    """A row segment on a node in its reduced unknowns; returns the right-side shift."""
+    if rigid:
+        return reduce_row(c7, q[o + 3:o + 7], nu, s, out)
     for a in range(3):
         out[a] = c7[a]
         out[3 + a] = 0.0
@@ -97,145 +97,183 @@ def _reduce(c7, i, q, L, W, out):
 
 
 @njit(**OPTIONS)
-def _nodes(q, qd, bshift, L, W):
+def _nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu, q7):
     """Masses, forces and quaternion norm accelerations of the nodes; returns μ."""
     mu = 0.0
-    for i in range(L.node_kind.shape[0]):
-        c, m = L.node_q[i], L.node_mass[i]
-        H = W.H[i]
-        H[:, :] = 0.0
+    for i in range(kind.shape[0]):
+        c, m = start[i], mass[i]
+        H[i, :, :] = 0.0
         for a in range(3):
-            H[a, a] = m
+            H[i, a, a] = m
         mu = max(mu, abs(m))
-        if L.node_kind[i] != RIGID:
+        if kind[i] != RIGID:
             for a in range(3):
-                W.Qf[c + a] += L.node_mg[i, a]
-                W.F[i, a] = W.Qf[c + a] + W.Cf[c + a]
+                Qf[c + a] += mg[i, a]
+                F[i, a] = Qf[c + a] + Cf[c + a]
             continue
         u, ud = q[c + 3:c + 7], qd[c + 3:c + 7]
-        nu = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3])
-        W.nu[i] = nu
-        shift = bshift[L.quat_row[i]] if bshift.shape[0] else 0.0
-        W.s[i] = (shift - (ud[0] * ud[0] + ud[1] * ud[1] + ud[2] * ud[2] + ud[3] * ud[3])) / nu
-        body_force(L.node_mg[i], L.node_J[i], u, ud, W.q7)
+        length = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3])
+        nu[i] = length
+        shift = bshift[quat_row[i]] if bshift.shape[0] else 0.0
+        s[i] = (shift - (ud[0] * ud[0] + ud[1] * ud[1] + ud[2] * ud[2] + ud[3] * ud[3])) / length
+        body_force(mg[i], inertia[i], u, ud, q7)
         for a in range(7):
-            W.Qf[c + a] += W.q7[a]
-        f = (W.Qf[c + 3] + W.Cf[c + 3], W.Qf[c + 4] + W.Cf[c + 4], W.Qf[c + 5] + W.Cf[c + 5],
-             W.Qf[c + 6] + W.Cf[c + 6])
-        e = rate(u, f)
+            Qf[c + a] += q7[a]
+        e = rate(u, (Qf[c + 3] + Cf[c + 3], Qf[c + 4] + Cf[c + 4], Qf[c + 5] + Cf[c + 5], Qf[c + 6] + Cf[c + 6]))
         for a in range(3):
-            W.F[i, a] = W.Qf[c + a] + W.Cf[c + a]
-            W.F[i, 3 + a] = e[a] / nu
+            F[i, a] = Qf[c + a] + Cf[c + a]
+            F[i, 3 + a] = e[a] / length
             for b in range(3):
-                H[3 + a, 3 + b] = 4 * nu * nu * L.node_J[i, a, b]
-                mu = max(mu, abs(H[3 + a, 3 + b]))
+                H[i, 3 + a, 3 + b] = 4 * length * length * inertia[i, a, b]
+                mu = max(mu, abs(H[i, 3 + a, 3 + b]))
     return mu
 
 
 @njit(**OPTIONS)
-def _tree_rows(q, qd, bshift, L, W):
+def _normalize(row, count):
+    """1 / the 2-norm of row[:count] (1 for a zero row)."""
+    total = 0.0
+    for a in range(count):
+        total += row[a] * row[a]
+    return 1.0 / math.sqrt(total) if total > 0 else 1.0
+
+
+@njit(**OPTIONS)
+def _tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, joints, joint_row, scratch,
+               J, P, rb):
     """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated."""
-    for i in range(L.node_kind.shape[0]):
-        j = L.node_joint[i]
+    A, b = scratch[3], scratch[4]
+    for i in range(kind.shape[0]):
+        j = node_joint[i]
         if j < 0:
             continue
-        k = _rows_of(j, q, qd, L, W)
-        me, p, r0 = L.node_end[i], L.node_parent[i], L.node_rows[i]
+        k = _joint(j, q, qd, joints, scratch)
+        me, p, r0 = node_end[i], parent[i], rows[i]
         for r in range(k):
-            norm = 0.0
-            for col in range(14):
-                norm += W.A[r, col] * W.A[r, col]
-            norm = math.sqrt(norm) if norm > 0 else 1.0
-            rhs = W.b[r] + (bshift[L.joint_row[j] + r] if bshift.shape[0] else 0.0)
-            rhs += _reduce(W.A[r, 7 * me:7 * me + 7], i, q, L, W, W.J[r0 + r])
+            scale = _normalize(A[r], 14)
+            rhs = b[r] + (bshift[joint_row[j] + r] if bshift.shape[0] else 0.0)
+            rhs += _reduce(A[r, 7 * me:7 * me + 7], kind[i] == RIGID, q, start[i], nu[i], s[i], J[r0 + r])
             if p >= 0:
-                rhs += _reduce(W.A[r, 7 - 7 * me:14 - 7 * me], p, q, L, W, W.P[r0 + r])
+                rhs += _reduce(A[r, 7 - 7 * me:14 - 7 * me], kind[p] == RIGID, q, start[p], nu[p], s[p], P[r0 + r])
             else:
-                W.P[r0 + r, :] = 0.0
+                P[r0 + r, :] = 0.0
             for a in range(6):
-                W.J[r0 + r, a] /= norm
-                W.P[r0 + r, a] /= norm
-            W.rb[r0 + r] = rhs / norm
+                J[r0 + r, a] *= scale
+                P[r0 + r, a] *= scale
+            rb[r0 + r] = rhs * scale
 
 
 @njit(**OPTIONS)
-def _extra_rows(q, qd, gen, o, bshift, L, W):
-    """Loop-joint rows and the generated rows, as segments and Ax entries; equilibrated."""
-    W.seg7[:, :] = 0.0
-    W.Ax[:, :] = 0.0
-    W.xb[:] = 0.0
-    for j in range(L.joint_k.shape[0]):
-        x0 = L.joint_xrow[j]
+def _extra_rows(q, qd, gen, bshift, kind, start, nu, s, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
+                xseg_node, gen_rows, scratch, seg7, seg6, xb, Ax):
+    """Loop-joint rows and the generated rows (gen: their entries, then their b), as
+    segments and Ax entries; equilibrated."""
+    arow, aseg, acol, brow = gen_rows
+    A, b = scratch[3], scratch[4]
+    seg7[:, :] = 0.0
+    Ax[:, :] = 0.0
+    xb[:] = 0.0
+    for j in range(joint_xrow.shape[0]):
+        x0 = joint_xrow[j]
         if x0 < 0:
             continue
-        k = _rows_of(j, q, qd, L, W)
+        k = _joint(j, q, qd, joints, scratch)
         for r in range(k):
             for e in range(2):
-                place = L.joint_xseg[j, e]
-                if place >= 0:
-                    seg = L.xseg_ptr[x0 + r] + place
+                if joint_xseg[j, e] >= 0:
+                    seg = xseg_ptr[x0 + r] + joint_xseg[j, e]
                     for a in range(7):
-                        W.seg7[seg, a] = W.A[r, 7 * e + a]
-            W.xb[x0 + r] = W.b[r]
-    for e in range(L.gen_arow.shape[0]):
-        if L.gen_aseg[e] >= 0:
-            W.seg7[L.gen_aseg[e] // 7, L.gen_aseg[e] % 7] += gen[o + e]
+                        seg7[seg, a] = A[r, 7 * e + a]
+            xb[x0 + r] = b[r]
+    for e in range(arow.shape[0]):
+        if aseg[e] >= 0:
+            seg7[aseg[e] // 7, aseg[e] % 7] += gen[e]
         else:
-            W.Ax[L.gen_arow[e], L.gen_acol[e]] += gen[o + e]
-    o += L.gen_arow.shape[0]
-    for e in range(L.gen_brow.shape[0]):
-        W.xb[L.gen_brow[e]] += gen[o + e]
-    for x in range(L.xrow_row.shape[0]):
-        norm = 0.0
-        for seg in range(L.xseg_ptr[x], L.xseg_ptr[x + 1]):
+            Ax[arow[e], acol[e]] += gen[e]
+    for e in range(brow.shape[0]):
+        xb[brow[e]] += gen[arow.shape[0] + e]
+    nx = Ax.shape[1]
+    for x in range(xrow_row.shape[0]):
+        total = 0.0
+        for seg in range(xseg_ptr[x], xseg_ptr[x + 1]):
             for a in range(7):
-                norm += W.seg7[seg, a] * W.seg7[seg, a]
-        for c in range(W.Ax.shape[1]):
-            norm += W.Ax[x, c] * W.Ax[x, c]
-        norm = math.sqrt(norm) if norm > 0 else 1.0
-        rhs = W.xb[x] + (bshift[L.xrow_row[x]] if bshift.shape[0] else 0.0)
-        for seg in range(L.xseg_ptr[x], L.xseg_ptr[x + 1]):
-            rhs += _reduce(W.seg7[seg], L.xseg_node[seg], q, L, W, W.seg6[seg])
+                total += seg7[seg, a] * seg7[seg, a]
+        for c in range(nx):
+            total += Ax[x, c] * Ax[x, c]
+        scale = 1.0 / math.sqrt(total) if total > 0 else 1.0
+        rhs = xb[x] + (bshift[xrow_row[x]] if bshift.shape[0] else 0.0)
+        for seg in range(xseg_ptr[x], xseg_ptr[x + 1]):
+            i = xseg_node[seg]
+            rhs += _reduce(seg7[seg], kind[i] == RIGID, q, start[i], nu[i], s[i], seg6[seg])
             for a in range(6):
-                W.seg6[seg, a] /= norm
-        for c in range(W.Ax.shape[1]):
-            W.Ax[x, c] /= norm
-        W.xb[x] = rhs / norm
+                seg6[seg, a] *= scale
+        for c in range(nx):
+            Ax[x, c] *= scale
+        xb[x] = rhs * scale
 
 
 @njit(**OPTIONS)
-def assemble(t, q, qd, gen, bshift, L, W):
-    """Fill W at the state (t, q, q̇); gen: the generated function's outputs; bshift: added
-    to b per row of the System (empty for none). Returns μ."""
-    W.Qf[:] = 0.0
-    W.Cf[:] = 0.0
+def _generated(gen, gen_q, gen_c, gen_mi, gen_mj, Qf, Cf, Mx):
+    """Q additions, C and the extra coordinates' M from the generated outputs; returns
+    the offset of the row entries that follow."""
+    Qf[:] = 0.0
+    Cf[:] = 0.0
+    Mx[:, :] = 0.0
     o = 0
-    for e in range(L.gen_q.shape[0]):
-        W.Qf[L.gen_q[e]] += gen[o + e]
-    o += L.gen_q.shape[0]
-    for e in range(L.gen_c.shape[0]):
-        W.Cf[L.gen_c[e]] += gen[o + e]
-    o += L.gen_c.shape[0]
-    W.Mx[:, :] = 0.0
-    for e in range(L.gen_mi.shape[0]):
-        W.Mx[L.gen_mi[e], L.gen_mj[e]] += gen[o + e]
-    o += L.gen_mi.shape[0]
-    mu = _nodes(q, qd, bshift, L, W)
+    for e in range(gen_q.shape[0]):
+        Qf[gen_q[e]] += gen[o + e]
+    o += gen_q.shape[0]
+    for e in range(gen_c.shape[0]):
+        Cf[gen_c[e]] += gen[o + e]
+    o += gen_c.shape[0]
+    for e in range(gen_mi.shape[0]):
+        Mx[gen_mi[e], gen_mj[e]] += gen[o + e]
+    return o + gen_mi.shape[0]
+
+
+@njit(**OPTIONS)
+def _scale(mu, H, F, Mx, Fx):
+    """Divide the masses and forces by μ."""
+    inv = 1.0 / mu
+    for i in range(H.shape[0]):
+        for a in range(6):
+            F[i, a] *= inv
+            for b in range(6):
+                H[i, a, b] *= inv
+    for x in range(Fx.shape[0]):
+        Fx[x] *= inv
+        for c in range(Fx.shape[0]):
+            Mx[x, c] *= inv
+
+
+@njit(**OPTIONS)
+def _tree_rhs(v, k, yoff, rows, F, rb, ry):
+    for i in range(v.shape[0]):
+        for a in range(v[i]):
+            ry[yoff[i] + a] = F[i, a]
+        for r in range(k[i]):
+            ry[yoff[i] + v[i] + r] = rb[rows[i] + r]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def assemble(q, qd, gen, bshift, L, W):
+    """Fill W at the state (q, q̇); gen: the generated function's outputs at it (t enters
+    there only); bshift: added to b per row of the System (empty for none). Returns μ."""
+    o = _generated(gen, L.gen_q, L.gen_c, L.gen_mi, L.gen_mj, W.Qf, W.Cf, W.Mx)
+    mu = _nodes(q, qd, bshift, L.node_kind, L.node_q, L.node_mass, L.node_mg, L.node_J, L.quat_row, W.Qf, W.Cf,
+                W.H, W.F, W.s, W.nu, W.q7)
     for x in range(L.x_coord.shape[0]):
         W.Fx[x] = W.Qf[L.x_coord[x]] + W.Cf[L.x_coord[x]]
         for c in range(L.x_coord.shape[0]):
             mu = max(mu, abs(W.Mx[x, c]))
     mu = mu if mu > 0 else 1.0
-    W.H[:, :, :] /= mu
-    W.F[:, :] /= mu
-    W.Mx[:, :] /= mu
-    W.Fx[:] /= mu
-    _tree_rows(q, qd, bshift, L, W)
-    _extra_rows(q, qd, gen, o, bshift, L, W)
-    for i in range(L.node_kind.shape[0]):
-        y0, v = L.node_yoff[i], L.node_v[i]
-        for a in range(v):
-            W.ry[y0 + a] = W.F[i, a]
-        for r in range(L.node_k[i]):
-            W.ry[y0 + v + r] = W.rb[L.node_rows[i] + r]
+    _scale(mu, W.H, W.F, W.Mx, W.Fx)
+    joints = (L.joint_program, L.joint_k, L.joint_kinds, L.joint_start, L.joint_s, L.joint_R, L.joint_length)
+    scratch = (W.V, W.R, W.Jt, W.A, W.b)
+    _tree_rows(q, qd, bshift, L.node_kind, L.node_q, L.node_joint, L.node_end, L.node_parent, L.node_rows, W.nu,
+               W.s, joints, L.joint_row, scratch, W.J, W.P, W.rb)
+    _extra_rows(q, qd, gen[o:], bshift, L.node_kind, L.node_q, W.nu, W.s, joints, L.joint_xrow, L.joint_xseg,
+                L.xrow_row, L.xseg_ptr, L.xseg_node, (L.gen_arow, L.gen_aseg, L.gen_acol, L.gen_brow), scratch,
+                W.seg7, W.seg6, W.xb, W.Ax)
+    _tree_rhs(L.node_v, L.node_k, L.node_yoff, L.node_rows, W.F, W.rb, W.ry)
     return mu

@@ -8,6 +8,7 @@ kernel's checks send the problem to the exact treatment (kernel.py's status);
 
 import os
 import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from . import codegen, kernel, layout  # noqa: E402
 from .assembly import make_work  # noqa: E402
 
 EMPTY = np.zeros(0)
+THREADS = os.cpu_count() or 1
 
 
 class Engine:
@@ -53,19 +55,37 @@ class Engine:
         with self.lock:
             if self.module is not None:
                 self.module.evaluate(t, q, qd, self.p, self.gen)
-            status, residual = kernel.motion(t, q, qd, self.gen, EMPTY if bshift is None else bshift, self.L, self.W)
+            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, self.L, self.W)
             if status != kernel.OK:
                 return None
             return Motion(qdd=self.W.qdd.copy(), unique=True, nullspace=np.zeros((self.n, 0)), Qc=self.W.Qc.copy(),
                           residual=residual, method="tree (Baraff)")
 
     def motion_batch(self, t, q, qd):
-        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,)."""
+        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): blocks of
+        rows in threads, the kernels running without the GIL, each block with its own Work."""
         count = q.shape[0]
-        gen = np.zeros((count, self.outputs))
-        if self.module is not None and count:
-            self.module.evaluate_batch(t, q, qd, self.p, gen)
         qdd, status = np.zeros((count, self.n)), np.zeros(count, dtype=np.int64)
-        chunks = max(1, min(count, 4 * (os.cpu_count() or 1)))
-        kernel.motion_batch(t, q, qd, gen, self.L, qdd, status, chunks)
+        gen = np.zeros((count, self.outputs))
+        bounds = np.linspace(0, count, min(count, THREADS) + 1).astype(int)
+
+        def block(a, b):
+            if self.module is not None:
+                self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
+            kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], self.L, make_work(self.L), qdd[a:b], status[a:b])
+
+        if len(bounds) > 2:
+            list(_pool().map(block, bounds[:-1], bounds[1:]))
+        elif count:
+            block(0, count)
         return qdd, status
+
+
+_threads = None
+
+
+def _pool():
+    global _threads
+    if _threads is None:
+        _threads = ThreadPoolExecutor(THREADS, thread_name_prefix="mbsynth-batch")
+    return _threads

@@ -21,10 +21,11 @@ equations M q̈ + Aᵀλ = Q + C, A q̈ = b (it bounds that of (2.12): P Aᵀ = 
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .assembly import assemble, make_work
+from .assembly import assemble
 from .bodies import OPTIONS, rate_transpose
+from .eigen import symmetric_eigen
 from .joints import RIGID
 from .tree import factor, solve
 
@@ -38,199 +39,204 @@ RESIDUAL_MAX = 1e-9
 
 
 @njit(**OPTIONS)
-def _tree_solve(L, W, y, x):
-    solve(L.order, L.node_parent, L.node_v, L.node_k, L.node_doff, L.node_yoff, L.node_rows, W.P, W.Dinv, y, x)
+def _scatter(x, weight, segs, seg6, y):
+    """y += weight · (extra row x on the tree unknowns). segs: (xseg_ptr, xseg_node, v, yoff)."""
+    ptr, node, v, yoff = segs
+    for seg in range(ptr[x], ptr[x + 1]):
+        i = node[seg]
+        for a in range(v[i]):
+            y[yoff[i] + a] += weight * seg6[seg, a]
 
 
 @njit(**OPTIONS)
-def _scatter(x, weight, L, W, y):
-    """y += weight · (extra row x on the tree unknowns)."""
-    for seg in range(L.xseg_ptr[x], L.xseg_ptr[x + 1]):
-        i = L.xseg_node[seg]
-        for a in range(L.node_v[i]):
-            y[L.node_yoff[i] + a] += weight * W.seg6[seg, a]
-
-
-@njit(**OPTIONS)
-def _row_dot(x, L, W, z):
+def _row_dot(x, segs, seg6, z):
     """(extra row x on the tree unknowns) · z."""
+    ptr, node, v, yoff = segs
     total = 0.0
-    for seg in range(L.xseg_ptr[x], L.xseg_ptr[x + 1]):
-        i = L.xseg_node[seg]
-        for a in range(L.node_v[i]):
-            total += W.seg6[seg, a] * z[L.node_yoff[i] + a]
+    for seg in range(ptr[x], ptr[x + 1]):
+        i = node[seg]
+        for a in range(v[i]):
+            total += seg6[seg, a] * z[yoff[i] + a]
     return total
 
 
 @njit(**OPTIONS)
-def _moves(vec, nx, mx, L, W):
+def _moves(vec, nx, topology, segs, seg6, P, Dinv, y, w):
     """The acceleration a unit Schur direction (u_x, μ) moves: (u_x, −(K⁻¹Gᵀμ) on accelerations)."""
-    W.y[:] = 0.0
-    for x in range(mx):
-        _scatter(x, -vec[nx + x], L, W, W.y)
-    _tree_solve(L, W, W.y, W.w)
+    y[:] = 0.0
+    for x in range(vec.shape[0] - nx):
+        _scatter(x, -vec[nx + x], segs, seg6, y)
+    solve(topology, P, Dinv, y, w)
     total = 0.0
     for x in range(nx):
         total += vec[x] * vec[x]
-    for i in range(L.node_kind.shape[0]):
-        for a in range(L.node_v[i]):
-            total += W.w[L.node_yoff[i] + a] ** 2
+    v, yoff = segs[2], segs[3]
+    for i in range(v.shape[0]):
+        for a in range(v[i]):
+            total += w[yoff[i] + a] ** 2
     return math.sqrt(total)
 
 
 @njit(**OPTIONS)
-def _close(L, W):
-    """Solve the Schur system of the extra rows and coordinates into W.lam, then the tree
-    into W.z. Returns a status."""
-    nx, mx = L.x_coord.shape[0], L.xrow_row.shape[0]
-    S, rhs = W.S, W.rhs
+def _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam):
+    """Solve the Schur system of the extra rows and coordinates into lam (extra
+    accelerations, then extra multipliers), then the tree into z. Returns a status."""
+    mx, nx = Ax.shape[0], Ax.shape[1]
     S[:, :] = 0.0
-    S[:nx, :nx] = W.Mx
+    S[:nx, :nx] = Mx
     for x in range(mx):
         for c in range(nx):
-            S[c, nx + x] = W.Ax[x, c]
-            S[nx + x, c] = W.Ax[x, c]
-        rhs[nx + x] = W.xb[x] - _row_dot(x, L, W, W.z0)
-    rhs[:nx] = W.Fx
+            S[c, nx + x] = Ax[x, c]
+            S[nx + x, c] = Ax[x, c]
+        rhs[nx + x] = xb[x] - _row_dot(x, segs, seg6, z0)
+    rhs[:nx] = Fx
     for x in range(mx):
-        W.y[:] = 0.0
-        _scatter(x, 1.0, L, W, W.y)
-        _tree_solve(L, W, W.y, W.w)
+        y[:] = 0.0
+        _scatter(x, 1.0, segs, seg6, y)
+        solve(topology, P, Dinv, y, w)
         for r in range(mx):
-            S[nx + r, nx + x] = -_row_dot(r, L, W, W.w)
-    values, vectors = np.linalg.eigh(S)
+            S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
+    values = np.zeros(mx + nx)
+    symmetric_eigen(S, vectors, values)
     top = np.abs(values).max() if values.shape[0] else 0.0
-    W.lam[:] = 0.0
-    dropped = 0.0
+    lam[:] = 0.0
+    dropped = size = 0.0
     for e in range(values.shape[0]):
-        coef = vectors[:, e] @ rhs
+        size += rhs[e] * rhs[e]
+    for e in range(values.shape[0]):
+        coef = 0.0
+        for c in range(values.shape[0]):
+            coef += vectors[c, e] * rhs[c]
         if abs(values[e]) > EIG_RTOL * top:
             for c in range(values.shape[0]):
-                W.lam[c] += coef / values[e] * vectors[c, e]
+                lam[c] += coef / values[e] * vectors[c, e]
         else:
             dropped += coef * coef
-            if _moves(vectors[:, e], nx, mx, L, W) > NULL_RTOL:
+            if _moves(vectors[:, e], nx, topology, segs, seg6, P, Dinv, y, w) > NULL_RTOL:
                 return NOT_UNIQUE
-    if math.sqrt(dropped) > CONSISTENCY_RTOL * (math.sqrt(rhs @ rhs) + 1e-300):
+    if math.sqrt(dropped) > CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
         return INCONSISTENT
-    W.y[:] = W.ry
+    y[:] = ry
     for x in range(mx):
-        _scatter(x, -W.lam[nx + x], L, W, W.y)
-    _tree_solve(L, W, W.y, W.z)
+        _scatter(x, -lam[nx + x], segs, seg6, y)
+    solve(topology, P, Dinv, y, z)
     return OK
 
 
 @njit(**OPTIONS)
-def _recover(q, L, W, mu):
+def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, z, Qf, Mx, lam, mu, qdd, Qc):
     """q̈ (bodies.py: ü = (u s + Eᵀa)/ν) and Qc = M q̈ − Q from the solution."""
-    for i in range(L.node_kind.shape[0]):
-        c, o, m = L.node_q[i], L.node_yoff[i], L.node_mass[i]
+    for i in range(kind.shape[0]):
+        c, o, m = start[i], yoff[i], mass[i]
         for a in range(3):
-            W.qdd[c + a] = W.z[o + a]
-            W.Qc[c + a] = m * W.z[o + a] - W.Qf[c + a]
-        if L.node_kind[i] != RIGID:
+            qdd[c + a] = z[o + a]
+            Qc[c + a] = m * z[o + a] - Qf[c + a]
+        if kind[i] != RIGID:
             continue
-        u, nu, s, J = q[c + 3:c + 7], W.nu[i], W.s[i], L.node_J[i]
-        alpha = (W.z[o + 3], W.z[o + 4], W.z[o + 5])
+        u, J = q[c + 3:c + 7], inertia[i]
+        alpha = (z[o + 3], z[o + 4], z[o + 5])
         et = rate_transpose(u, alpha)
-        Ja = (J[0, 0] * alpha[0] + J[0, 1] * alpha[1] + J[0, 2] * alpha[2],
-              J[1, 0] * alpha[0] + J[1, 1] * alpha[1] + J[1, 2] * alpha[2],
-              J[2, 0] * alpha[0] + J[2, 1] * alpha[1] + J[2, 2] * alpha[2])
-        f = rate_transpose(u, Ja)
+        f = rate_transpose(u, (J[0, 0] * alpha[0] + J[0, 1] * alpha[1] + J[0, 2] * alpha[2],
+                               J[1, 0] * alpha[0] + J[1, 1] * alpha[1] + J[1, 2] * alpha[2],
+                               J[2, 0] * alpha[0] + J[2, 1] * alpha[1] + J[2, 2] * alpha[2]))
         for a in range(4):
-            W.qdd[c + 3 + a] = (u[a] * s + et[a]) / nu
-            W.Qc[c + 3 + a] = 4 * nu * f[a] - W.Qf[c + 3 + a]
-    nx = L.x_coord.shape[0]
+            qdd[c + 3 + a] = (u[a] * s[i] + et[a]) / nu[i]
+            Qc[c + 3 + a] = 4 * nu[i] * f[a] - Qf[c + 3 + a]
+    nx = x_coord.shape[0]
     for x in range(nx):
         total = 0.0
         for c in range(nx):
-            total += W.Mx[x, c] * W.lam[c]
-        W.qdd[L.x_coord[x]] = W.lam[x]
-        W.Qc[L.x_coord[x]] = mu * total - W.Qf[L.x_coord[x]]
+            total += Mx[x, c] * lam[c]
+        qdd[x_coord[x]] = lam[x]
+        Qc[x_coord[x]] = mu * total - Qf[x_coord[x]]
 
 
 @njit(**OPTIONS)
-def _residual(L, W):
+def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn):
     """Relative residual of the equilibrated KKT equations at the solution (module docstring)."""
-    N, nx, mx = L.node_kind.shape[0], L.x_coord.shape[0], L.xrow_row.shape[0]
-    z, dyn = W.z, W.dyn
+    _, parent, v, k, _, yoff, rows = topology
+    ptr, node = segs[0], segs[1]
+    mx, nx = Ax.shape[0], Ax.shape[1]
     res = norm_M = norm_A = norm_x = norm_r = 0.0
-    for i in range(N):
-        o, v, k, r0 = L.node_yoff[i], L.node_v[i], L.node_k[i], L.node_rows[i]
-        for a in range(v):
-            t = -W.F[i, a]
-            for c in range(v):
-                t += W.H[i, a, c] * z[o + c]
-                norm_M += W.H[i, a, c] ** 2
-            for r in range(k):
-                t += W.J[r0 + r, a] * z[o + v + r]
+    for i in range(kind.shape[0]):
+        o, r0 = yoff[i], rows[i]
+        for a in range(v[i]):
+            t = -F[i, a]
+            for c in range(v[i]):
+                t += H[i, a, c] * z[o + c]
+                norm_M += H[i, a, c] ** 2
+            for r in range(k[i]):
+                t += J[r0 + r, a] * z[o + v[i] + r]
             dyn[i, a] = t
             norm_x += z[o + a] ** 2
-            norm_r += W.F[i, a] ** 2
-        if L.node_kind[i] == RIGID:
-            norm_x += W.s[i] ** 2
-            norm_r += W.s[i] ** 2
+            norm_r += F[i, a] ** 2
+        if kind[i] == RIGID:  # the unit-norm row, exact by construction
+            norm_x += s[i] ** 2
+            norm_r += s[i] ** 2
             norm_A += 1.0
-    for i in range(N):
-        p, o, v, k, r0 = L.node_parent[i], L.node_yoff[i], L.node_v[i], L.node_k[i], L.node_rows[i]
-        for r in range(k):
-            lam, t = z[o + v + r], -W.rb[r0 + r]
-            for a in range(v):
-                t += W.J[r0 + r, a] * z[o + a]
-                norm_A += W.J[r0 + r, a] ** 2
+    for i in range(kind.shape[0]):
+        p, o, r0 = parent[i], yoff[i], rows[i]
+        for r in range(k[i]):
+            lam_r, t = z[o + v[i] + r], -rb[r0 + r]
+            for a in range(v[i]):
+                t += J[r0 + r, a] * z[o + a]
+                norm_A += J[r0 + r, a] ** 2
             if p >= 0:
-                op = L.node_yoff[p]
-                for a in range(L.node_v[p]):
-                    dyn[p, a] += W.P[r0 + r, a] * lam
-                    t += W.P[r0 + r, a] * z[op + a]
-                    norm_A += W.P[r0 + r, a] ** 2
+                for a in range(v[p]):
+                    dyn[p, a] += P[r0 + r, a] * lam_r
+                    t += P[r0 + r, a] * z[yoff[p] + a]
+                    norm_A += P[r0 + r, a] ** 2
             res += t * t
-            norm_r += W.rb[r0 + r] ** 2
+            norm_r += rb[r0 + r] ** 2
     for x in range(mx):
-        lam = W.lam[nx + x]
-        t = _row_dot(x, L, W, z) - W.xb[x]
-        for seg in range(L.xseg_ptr[x], L.xseg_ptr[x + 1]):
+        t = _row_dot(x, segs, seg6, z) - xb[x]
+        for seg in range(ptr[x], ptr[x + 1]):
             for a in range(6):
-                dyn[L.xseg_node[seg], a] += W.seg6[seg, a] * lam
-                norm_A += W.seg6[seg, a] ** 2
+                dyn[node[seg], a] += seg6[seg, a] * lam[nx + x]
+                norm_A += seg6[seg, a] ** 2
         for c in range(nx):
-            t += W.Ax[x, c] * W.lam[c]
-            norm_A += W.Ax[x, c] ** 2
+            t += Ax[x, c] * lam[c]
+            norm_A += Ax[x, c] ** 2
         res += t * t
-        norm_r += W.xb[x] ** 2
-    for i in range(N):
-        for a in range(L.node_v[i]):
+        norm_r += xb[x] ** 2
+    for i in range(kind.shape[0]):
+        for a in range(v[i]):
             res += dyn[i, a] ** 2
     for c in range(nx):
-        t = -W.Fx[c]
+        t = -Fx[c]
         for e in range(nx):
-            t += W.Mx[c, e] * W.lam[e]
-            norm_M += W.Mx[c, e] ** 2
+            t += Mx[c, e] * lam[e]
+            norm_M += Mx[c, e] ** 2
         for x in range(mx):
-            t += W.Ax[x, c] * W.lam[nx + x]
+            t += Ax[x, c] * lam[nx + x]
         res += t * t
-        norm_x += W.lam[c] ** 2
-        norm_r += W.Fx[c] ** 2
+        norm_x += lam[c] ** 2
+        norm_r += Fx[c] ** 2
     scale = (math.sqrt(norm_M) + math.sqrt(norm_A)) * math.sqrt(norm_x) + math.sqrt(norm_r) + 1e-300
     return math.sqrt(res) / scale
 
 
 @njit(**OPTIONS)
-def motion(t, q, qd, gen, bshift, L, W):
-    """(status, residual) at one state; on OK, W.qdd holds q̈ and W.Qc holds M q̈ − Q."""
-    mu = assemble(t, q, qd, gen, bshift, L, W)
-    if factor(L.order, L.node_parent, L.node_v, L.node_k, L.node_doff, L.node_rows, W.H, W.J, W.P, W.Dinv,
-              W.acc, W.perm) >= 0:
+def motion(q, qd, gen, bshift, L, W):
+    """(status, residual) at one state; on OK, W.qdd holds q̈ and W.Qc holds M q̈ − Q.
+    gen: the generated function's outputs at (t, q, q̇) — time enters only there."""
+    mu = assemble(q, qd, gen, bshift, L, W)
+    topology = (L.order, L.node_parent, L.node_v, L.node_k, L.node_doff, L.node_yoff, L.node_rows)
+    if factor(topology, W.H, W.J, W.P, W.Dinv, W.acc, W.perm) >= 0:
         return SINGULAR, 0.0
     W.y[:] = W.ry
-    _tree_solve(L, W, W.y, W.z0)
+    solve(topology, W.P, W.Dinv, W.y, W.z0)
     W.z[:] = W.z0
+    segs = (L.xseg_ptr, L.xseg_node, L.node_v, L.node_yoff)
     if L.x_coord.shape[0] + L.xrow_row.shape[0] > 0:
-        status = _close(L, W)
+        status = _close(topology, segs, W.seg6, W.P, W.Dinv, W.Mx, W.Ax, W.xb, W.Fx, W.ry, W.z0, W.y, W.w, W.z,
+                        W.S, W.vectors, W.rhs, W.lam)
         if status != OK:
             return status, 0.0
-    _recover(q, L, W, mu)
-    residual = _residual(L, W)
+    _recover(q, L.node_kind, L.node_q, L.node_mass, L.node_J, L.node_yoff, L.x_coord, W.nu, W.s, W.z, W.Qf, W.Mx,
+             W.lam, mu, W.qdd, W.Qc)
+    residual = _residual(topology, L.node_kind, segs, W.seg6, W.H, W.F, W.J, W.P, W.rb, W.s, W.z, W.lam, W.xb,
+                         W.Ax, W.Mx, W.Fx, W.dyn)
     for c in range(W.qdd.shape[0]):
         if not (math.isfinite(W.qdd[c]) and math.isfinite(W.Qc[c])):
             return NOT_FINITE, residual
@@ -239,15 +245,11 @@ def motion(t, q, qd, gen, bshift, L, W):
     return OK, residual
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
-def motion_batch(t, q, qd, gen, L, qdd, status, chunks):
-    """q̈ of each state (row) into qdd and its status into status, ``chunks`` blocks of
-    states in parallel (each with its own Work)."""
-    count = q.shape[0]
-    size = (count + chunks - 1) // chunks
+@njit(cache=True, error_model="numpy", nogil=True)
+def motion_rows(q, qd, gen, L, W, qdd, status):
+    """q̈ of each state (row of q, q̇, gen) into qdd and its status into status. Releases
+    the GIL: engine.py runs blocks of rows in threads, each with its own Work."""
     empty = np.zeros(0)
-    for chunk in prange(chunks):
-        W = make_work(L)
-        for row in range(chunk * size, min(count, (chunk + 1) * size)):
-            status[row] = motion(t[row], q[row], qd[row], gen[row], empty, L, W)[0]
-            qdd[row, :] = W.qdd
+    for row in range(q.shape[0]):
+        status[row] = motion(q[row], qd[row], gen[row], empty, L, W)[0]
+        qdd[row, :] = W.qdd

@@ -66,12 +66,14 @@ def invert(D, d, perm):
 
 
 @njit(**OPTIONS)
-def factor(order, parent, v, k, doff, rows, H, J, P, Dinv, acc, perm):
+def factor(topology, H, J, P, Dinv, acc, perm):
     """Eliminate leaves to roots; Dinv (flat) receives each block's inverse at doff[i].
 
-    H: (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on itself / on its
+    topology: (order, parent, v, k, doff, yoff, rows) of the nodes (layout.Layout); H:
+    (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on itself / on its
     parent, node i's starting at rows[i]; acc: (N, 6, 6) work for the children's
     contributions. Returns the first node whose block is singular, or −1."""
+    order, parent, v, k, doff, _, rows = topology
     for idx in range(order.shape[0]):
         acc[order[idx]] = 0.0
     for idx in range(order.shape[0] - 1, -1, -1):
@@ -105,8 +107,9 @@ def factor(order, parent, v, k, doff, rows, H, J, P, Dinv, acc, perm):
 
 
 @njit(**OPTIONS)
-def solve(order, parent, v, k, doff, yoff, rows, P, Dinv, y, x):
+def solve(topology, P, Dinv, y, x):
     """x = K⁻¹ y for the factored tree (y is overwritten)."""
+    order, parent, v, k, doff, yoff, rows = topology
     n = order.shape[0]
     for idx in range(n - 1, -1, -1):  # leaves to roots: x_i = D_i⁻¹ y_i, passed up through P
         i = order[idx]

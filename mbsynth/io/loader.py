@@ -20,6 +20,7 @@ from ..system import System
 from .forces import read_forces
 from .joints import read_joints, read_world
 from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
+from .robot import connect_robots, read_robot, read_robots
 from .source import Document, LineDict, LineList, read_document
 
 TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
@@ -119,6 +120,7 @@ class _Builder:
         if not isinstance(name, str):
             self.fail(("name",), f"expected a string, got {_kind(name)}")
         self.parameters = self.read_parameters()
+        self.robots = read_robots(self)  # before any part is built: their torque parameters join the model's
         self.param_symbols = {p: sp.Symbol(p) for p in self.parameters}
         self.param_values = {sp.Symbol(k): v for k, v in self.parameters.items()}
         self.gravity = self.vector(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3, self.param_symbols)
@@ -135,14 +137,15 @@ class _Builder:
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
         joints, joint_forces = read_joints(self)
-        constraints += self.read_constraints() + joints
+        robot_joints, robot_forces = connect_robots(self)
+        constraints += robot_joints + self.read_constraints() + joints
         self.check_names(constraints)
         initial = self.read_initial(parts)
         system = System.build(name, parts, constraints, self.q, self.qd, self.parameters, initial,
                               initial_fixed=self.read_initial_fixed(initial),
-                              forces=[*read_forces(self), *joint_forces])
+                              forces=[*robot_forces, *read_forces(self), *joint_forces])
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
-                         source=self.doc.text)
+                         source=self.doc.text, robots=tuple(entry.robot for entry in self.robots.values()))
         self.check_parts(system)
         closure = root.get("closure", "none")
         if closure not in ("auto", "none"):
@@ -182,8 +185,8 @@ class _Builder:
             kind = spec.get("type")
             if kind not in SUBSYSTEM_TYPES:
                 self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: {', '.join(SUBSYSTEM_TYPES)}")
-            reader = SUBSYSTEM_TYPES[kind]
-            parts.append(reader(self, name, spec, path))
+            made = SUBSYSTEM_TYPES[kind](self, name, spec, path)
+            parts += made if isinstance(made, list) else [made]  # a robot gives one part per link
         return parts
 
     def read_lagrangian(self, name, spec, path):
@@ -328,7 +331,8 @@ class _Builder:
 
 
 SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,
-                   "particle": read_particle, "planar_body": read_planar_body, "spring": read_spring}
+                   "particle": read_particle, "planar_body": read_planar_body, "spring": read_spring,
+                   "robot": read_robot}
 
 
 def _kind(value):

@@ -32,7 +32,7 @@ class RigidBody(Part):
         Q = sp.Matrix.vstack(mass * sp.Matrix(gravity), -8 * Ed.T * J * E * ud)
         T = mass * (rd.T * rd)[0] / 2 + 2 * (ud.T * E.T * J * E * ud)[0]
         V = -mass * (sp.Matrix(gravity).T * r)[0]
-        self.mass, self.inertia = mass, J
+        self.mass, self.inertia, self.gravity = mass, J, sp.Matrix(gravity)
         super().__init__(name, COORDINATES, q, qd, M, Q, T, V, params, frames, geometry, initial)
 
     def own_constraints(self, q, qd, params):

@@ -1,0 +1,34 @@
+"""``python -m mbsynth.fast``: compile the fast path's kernels into the cache ahead of use."""
+
+import time
+
+from . import cache
+
+
+def main():
+    started = time.perf_counter()
+    from . import background
+    from ..io import loads
+    for text in WARM_MODELS:
+        background.build(loads(text, "warm-up"))
+    print(f"mbsynth fast path compiled into {cache.cache_dir()} in {time.perf_counter() - started:.1f} s")
+
+
+# A body on a spherical joint and a loop (a second, redundant hinge): every kernel runs.
+WARM_MODELS = ["""
+name: warm_up
+gravity: [0, 0, -9.81]
+subsystems:
+  link: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5]}},
+         initial: {angular_velocity: [0.1, 0.2, 0.3]}}
+  bob: {type: particle, mass: 0.5, initial: {position: [0, 0, -0.5]}}
+joints:
+  - {name: pivot, type: spherical, parent: world, child: link.top}
+  - {name: rod, type: distance, parent: link, child: bob, length: 0.5}
+  - {name: again, type: spherical, parent: world, child: link.top}
+forces:
+  - {name: push, type: force, at: bob, value: ["sin(t)", 0, 0]}
+"""]
+
+if __name__ == "__main__":
+    main()

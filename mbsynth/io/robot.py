@@ -1,0 +1,99 @@
+"""Reading ``type: robot`` entries: one entry, a whole robot decomposed into parts.
+
+    arm:
+      type: robot
+      robot: ur5                 # an example-robot-data name, or a URDF file (relative to the model file)
+      floating: false            # default false: the root link welded to the world at ``base``
+      base: {position: [0, 0, 0.5], rpy: [0, 0, 0]}   # optional; the initial pose when floating
+
+The entry named ``arm`` gives one rigid body per link, named ``arm_<link>`` (frames: ``link``
+at the URDF link frame, one per joint named after it), one joint per URDF joint,
+``arm_<joint>``, and one torque parameter per movable joint, ``tau_arm_<joint>`` (default 0;
+a value under ``parameters:`` wins). Gravity is the model's ``gravity``.
+
+Entries are read in two steps: ``RobotEntry`` before any part is built, so that its torque
+parameters join the model's, then ``parts`` and ``connect`` once the parts' symbols are known.
+"""
+
+import os
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import ModelError
+from ..robots import Robot, describe
+from .parts import ORIENTATION_KEYS, read_rotation
+
+KEYS = {"type", "robot", "floating", "base", "description"}
+
+
+class RobotEntry:
+    """A ``type: robot`` entry: the URDF read and the names planned (``robot``)."""
+
+    def __init__(self, builder, name, spec, path):
+        builder.mapping(spec, path, KEYS, required=("robot",))
+        floating = spec.get("floating", False)
+        if not isinstance(floating, bool):
+            builder.fail(path + ("floating",), f"expected true or false, got {floating!r}")
+        source = spec["robot"]
+        if not isinstance(source, str) or not source:
+            builder.fail(path + ("robot",), "expected a robot name (see 'mbsynth robots') or a URDF file")
+        here = os.path.dirname(builder.doc.name)
+        if source.endswith(".urdf") and not os.path.isabs(source) and os.path.isfile(os.path.join(here, source)):
+            source = os.path.join(here, source)
+        try:
+            description = describe(source)
+        except ModelError as err:
+            builder.fail(path + ("robot",), str(err))
+        self.name, self.spec, self.path = name, spec, path
+        self.robot = Robot.plan(description, prefix=f"{name}_", floating=floating)
+
+    @property
+    def parameters(self):
+        return self.robot.parameters
+
+    def parts(self, builder):
+        """The robot's bodies, at ``base`` (read now: it may use the model's parameters)."""
+        node = builder.mapping(self.spec.get("base"), self.path + ("base",), {"position", *ORIENTATION_KEYS})
+        position = builder.numbers(node.get("position", [0, 0, 0]), self.path + ("base", "position"), 3)
+        rotation = read_rotation(builder, node, self.path + ("base",))
+        self.robot = replace(self.robot, base=(np.array(position), rotation))
+        return self.robot.bodies(builder.gravity, builder.param_symbols.values())
+
+    def connect(self, builder):
+        """(joints, torque force elements) of the robot, once every part is known."""
+        return self.robot.connect(builder.parts, builder.q, builder.qd, builder.param_symbols.values())
+
+
+def read_robots(builder):
+    """{entry name: RobotEntry} of the model's ``type: robot`` subsystems, read before any
+    part; their torque parameters join ``builder.parameters`` (a value given there wins)."""
+    node = builder.root.get("subsystems")
+    entries = {}
+    for name, spec in (node.items() if isinstance(node, dict) else ()):
+        if isinstance(spec, dict) and spec.get("type") == "robot":
+            path = ("subsystems", name)
+            builder.identifier(name, path, "subsystem name")
+            entries[name] = RobotEntry(builder, name, spec, path)
+            for key, value in entries[name].parameters.items():
+                builder.parameters.setdefault(key, value)
+    return entries
+
+
+def read_robot(builder, name, spec, path):
+    """The parts of a ``type: robot`` entry (a list: the loader adds each)."""
+    others = set(builder.root["subsystems"]) - {name}
+    for part in builder.robots[name].robot.parts.values():
+        if part in others or part in builder.parameters:
+            builder.fail(path, f"robot '{name}' has a link part '{part}', the name of another subsystem or "
+                               "of a parameter: rename one of them")
+    return builder.robots[name].parts(builder)
+
+
+def connect_robots(builder):
+    """(joints, torque force elements) of every robot of the model."""
+    joints, elements = [], []
+    for entry in builder.robots.values():
+        more_joints, more_elements = entry.connect(builder)
+        joints, elements = joints + more_joints, elements + more_elements
+    return joints, elements
