@@ -102,6 +102,30 @@ def _parser():
     view.add_argument("--joints", action="store_true", help="mark the frames of every joint")
     view.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
     view.set_defaults(run=run_view)
+
+    val = commands.add_parser(
+        "validate", help="compare with Pinocchio: a robot (fixed and floating base) or a model file",
+        description="Draw random states and joint torques (within the joint limits), compute mbsynth's "
+                    "joint accelerations and Pinocchio's (aba, or constraintDynamics where loops are closed) "
+                    "and print the largest differences. ROBOT_OR_MODEL is a robot name (see 'mbsynth robots'), "
+                    "a URDF file, or a model file (.yaml) of rigid bodies and robots, compared with its "
+                    "equivalent Pinocchio model. Exit 0 when every relative error is within the tolerance, "
+                    "1 when one is not (or no comparison is possible), 2 on a model error.")
+    val.add_argument("target", metavar="ROBOT_OR_MODEL", help="robot name, URDF file or model file")
+    val.add_argument("--samples", type=int, default=20, help="random states per base (default 20)")
+    val.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    val.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error that passes (default 1e-9)")
+    val.add_argument("--json", action="store_true", help="print one JSON object")
+    val.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    val.set_defaults(run=run_validate)
+
+    robots = commands.add_parser(
+        "robots", help="the robots example-robot-data ships",
+        description="List the robots of the example-robot-data package by the names 'mbsynth validate' and "
+                    "type: robot accept, with their links, movable joints and whether Pinocchio loads them.")
+    robots.add_argument("--json", action="store_true", help="print one JSON object")
+    robots.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    robots.set_defaults(run=run_robots)
     return parser
 
 
@@ -191,6 +215,61 @@ def run_view(args):
     else:
         viewer.show(system, traj, **options)
     return status
+
+
+def run_validate(args):
+    from .validate import validate_robot, validate_system
+
+    if args.samples < 1:
+        raise ModelError("--samples must be at least 1")
+    options = {"samples": args.samples, "seed": args.seed, "tolerance": args.tolerance}
+    if args.target.endswith((".yaml", ".yml")):
+        started = time.perf_counter()
+        system = load(args.target)
+        results = [validate_system(system, build_s=time.perf_counter() - started, **options)]
+    else:
+        results = validate_robot(args.target, **options)
+    passed = all(r.passed for r in results)
+    if args.json:
+        print(json.dumps({"robot": results[0].robot, "samples": args.samples,
+                          "max_abs_error": max(r.max_abs_error for r in results),
+                          "max_rel_error": max(r.max_rel_error for r in results), "passed": passed,
+                          "tolerance": args.tolerance, "results": [r.to_dict() for r in results]}, indent=2))
+    else:
+        print(format_validation(results, args.target))
+    return 0 if passed else 1
+
+
+def format_validation(results, target):
+    """The ``mbsynth validate`` table: one row per base."""
+    first = results[0]
+    lines = [f"{first.robot} ({target}): {first.links} bodies, against Pinocchio "
+             f"(relative tolerance {first.tolerance:.0e})",
+             f"  {'base':<9} {'dof':>4} {'samples':>7} {'max abs error':>14} {'max rel error':>14} "
+             f"{'build s':>8} {'motion ms':>9}  result"]
+    for r in results:
+        lines.append(f"  {r.base:<9} {r.dof:>4} {r.samples:>7} {r.max_abs_error:>14.3e} {r.max_rel_error:>14.3e} "
+                     f"{r.build_s:>8.2f} {r.motion_ms:>9.2f}  {'passed' if r.passed else 'FAILED'}")
+        if r.note:
+            lines.append(f"    {r.note}")
+    return "\n".join(lines)
+
+
+def run_robots(args):
+    from .validate import robot_table
+
+    rows = robot_table()
+    if args.json:
+        print(json.dumps({"robots": [{"name": n, "urdf": p, "links": k, "movable_joints": j, "pinocchio": ok}
+                                     for n, p, k, j, ok in rows]}, indent=2))
+        return 0
+    if not rows:
+        print("no robots: install the example-robot-data package")
+        return 0
+    print(f"{'robot':<28} {'links':>5} {'joints':>6}  pinocchio  urdf")
+    for name, path, links, joints, ok in rows:
+        print(f"{name:<28} {links:>5} {joints:>6}  {'loads' if ok else 'FAILS':<9}  {'/'.join(path.split('/')[-3:])}")
+    return 0
 
 
 def _sweep_progress(done, failed, total, eta):

@@ -88,6 +88,15 @@ def test_tennis_racket_flips_and_keeps_energy_and_angular_momentum():
     assert body_y_world[:, 1].min() < -0.9  # the intermediate axis turned over (Dzhanibekov)
 
 
+def test_rolling_disk_keeps_rolling_steadily_for_20_s():
+    """Steady circular rolling (models/rolling/rolling_disk.yaml): rolling without slip
+    is ideal, so the energy stays; the lean, hence the centre's height, stays constant."""
+    traj = simulate(mb.load(ROOT / "models" / "rolling" / "rolling_disk.yaml"), 20.0)
+    assert traj.energy_drift < 1e-8 and traj.max_residual < 1e-8
+    assert np.ptp(traj.column("disk.z")) < 1e-8
+    assert np.ptp(traj.column("disk.x")) > 0.05  # it does go round
+
+
 def test_baumgarte_keeps_drift_small_without_projection():
     system = mb.load(RIGID / "double_pendulum_spatial.yaml")
     q, qd, _ = consistent_initial_state(system)

@@ -255,7 +255,7 @@ def _tree_rhs(v, k, yoff, rows, F, rb, ry):
             ry[yoff[i] + v[i] + r] = rb[rows[i] + r]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(**OPTIONS)
 def assemble(q, qd, gen, bshift, L, W):
     """Fill W at the state (q, q̇); gen: the generated function's outputs at it (t enters
     there only); bshift: added to b per row of the System (empty for none). Returns μ."""
