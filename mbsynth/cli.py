@@ -245,10 +245,10 @@ def format_validation(results, target):
     first = results[0]
     lines = [f"{first.robot} ({target}): {first.links} bodies, against Pinocchio "
              f"(relative tolerance {first.tolerance:.0e})",
-             f"  {'base':<9} {'dof':>4} {'samples':>7} {'max abs error':>14} {'max rel error':>14} "
+             f"  {'base':<9} {'nv':>4} {'samples':>7} {'max abs error':>14} {'max rel error':>14} "
              f"{'build s':>8} {'motion ms':>9}  result"]
     for r in results:
-        lines.append(f"  {r.base:<9} {r.dof:>4} {r.samples:>7} {r.max_abs_error:>14.3e} {r.max_rel_error:>14.3e} "
+        lines.append(f"  {r.base:<9} {r.nv:>4} {r.samples:>7} {r.max_abs_error:>14.3e} {r.max_rel_error:>14.3e} "
                      f"{r.build_s:>8.2f} {r.motion_ms:>9.2f}  {'passed' if r.passed else 'FAILED'}")
         if r.note:
             lines.append(f"    {r.note}")

@@ -52,9 +52,12 @@ class ForceElement:
 
 
 def point_spring(name, pA, pB, stiffness, rest_length, damping, q, qd, params):
-    """A spring (k, ℓ0) and damper (c) between two world points (sympy 3-vectors of q)."""
+    """A spring (k, ℓ0) and damper (c) between two world points (sympy 3-vectors of q);
+    ``points`` keeps the two ends (the viewer draws the spring between them)."""
     V, efforts = spring_damper(pA, pB, stiffness, rest_length, damping, q, qd)
-    return ForceElement(name, V, efforts, q, qd, params)
+    element = ForceElement(name, V, efforts, q, qd, params)
+    element.points = (pA, pB)  # its ends, for drawing
+    return element
 
 
 def applied_force(name, point, force_world, q, qd, params):

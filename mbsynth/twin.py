@@ -10,7 +10,10 @@ joined by constraints. The twin of a System is built as follows:
 - every other rigid body hangs from a body already placed by the joint between them:
   fixed (welded to that body), revolute (``JointModelRZ``) or prismatic (``JointModelPZ``)
   in the joint's frame; a body no joint reaches is a free-flyer;
-- the remaining joints close loops: fixed → ``CONTACT_6D``, spherical → ``CONTACT_3D``.
+- the remaining joints close loops: fixed → ``CONTACT_6D``, spherical → ``CONTACT_3D``,
+  revolute → two ``CONTACT_3D`` at two points of its axis (the frame origin and one
+  metre along z), which hold the same five freedoms (one of the six rows is redundant,
+  as Pinocchio's proximal solver allows).
 
 State maps. Pinocchio → mbsynth is forward kinematics: a body at placement X in joint i
 has the world pose oMᵢ X and the spatial velocity X⁻¹ vᵢ in its own axes. mbsynth →
@@ -38,7 +41,9 @@ from .subsystems import Frame, RigidBody
 from .subsystems.base import frame_velocity
 from .symbolic import compile_function, jacobian
 
-LOOPS = {"fixed": pin.ContactType.CONTACT_6D, "spherical": pin.ContactType.CONTACT_3D}
+# loop-closing joints: Pinocchio's rigid constraints (type, point offsets along the frame's z)
+LOOPS = {"fixed": (pin.ContactType.CONTACT_6D, (0.0,)), "spherical": (pin.ContactType.CONTACT_3D, (0.0,)),
+         "revolute": (pin.ContactType.CONTACT_3D, (0.0, 1.0))}
 TREE_JOINTS = {"revolute": pin.JointModelRZ, "prismatic": pin.JointModelPZ}
 PROXIMAL = (1e-13, 1e-10, 200)  # constraintDynamics: accuracy, μ, iterations (redundant loop rows allowed)
 
@@ -180,8 +185,10 @@ class Twin:
         joint reaches becomes a free-flyer."""
         self.bodies.setdefault(None, Placed(0, pin.SE3.Identity()))  # the world
         while len(self.bodies) <= len(parts):
-            edge = next(((j, side) for j in joints if j.name not in used for side in (0, 1)
-                         if _name(j.parts[side]) in self.bodies and _name(j.parts[1 - side]) not in self.bodies), None)
+            edges = [(j, side) for j in joints if j.name not in used for side in (0, 1)
+                     if _name(j.parts[side]) in self.bodies and _name(j.parts[1 - side]) not in self.bodies]
+            edges.sort(key=lambda edge: edge[0].joint_kind not in (*TREE_JOINTS, "fixed"))  # tree joints first
+            edge = edges[0] if edges else None
             if edge is None:
                 part = next(p for name, p in parts.items() if name not in self.bodies)
                 jid = self.model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"{part.name}.free")
@@ -217,12 +224,14 @@ class Twin:
         for joint in joints:
             if joint.joint_kind not in LOOPS:
                 raise no_twin(self.system, f"joint '{joint.name}' ({joint.joint_kind}) closes a loop; Pinocchio's "
-                                           f"rigid constraints are {' and '.join(LOOPS)} joints")
+                                           f"rigid constraints stand for {', '.join(LOOPS)} joints only")
+            kind, offsets = LOOPS[joint.joint_kind]
             ends = [self.bodies[_name(part)] for part in joint.parts]
-            placements = [end.placement * self._se3(frame) for end, frame in zip(ends, joint.frames)]
-            self.constraints.append(pin.RigidConstraintModel(LOOPS[joint.joint_kind], self.model, ends[0].joint,
-                                                             placements[0], ends[1].joint, placements[1],
-                                                             pin.ReferenceFrame.LOCAL))
+            frames = [end.placement * self._se3(frame) for end, frame in zip(ends, joint.frames)]
+            for offset in offsets:
+                at = [frame * pin.SE3(np.eye(3), np.array([0.0, 0.0, offset])) for frame in frames]
+                self.constraints.append(pin.RigidConstraintModel(kind, self.model, ends[0].joint, at[0],
+                                                                 ends[1].joint, at[1], pin.ReferenceFrame.LOCAL))
 
     # -- maps -----------------------------------------------------------------------
     def to_maximal(self, q, v):

@@ -33,15 +33,15 @@ MAX_TRIES = 20  # samples drawn to find one a loop can close at
 @dataclass(frozen=True)
 class Validation:
     """The outcome of one comparison: ``robot`` (or model) with a ``base`` (fixed,
-    floating, or "model" for a model file), its ``links`` (bodies) and ``dof`` (Pinocchio's
-    nv); the largest errors over ``samples`` states; ``passed`` (below ``tolerance``);
+    floating, or "model" for a model file), its ``links`` (bodies) and ``nv`` (Pinocchio's
+    velocity count, before loops close); the largest errors over ``samples`` states; ``passed`` (below ``tolerance``);
     ``build_s`` (seconds to build the System), ``motion_ms`` (mean mbsynth evaluation);
     ``note`` says why a comparison was impossible (no unique motion, NaN from Pinocchio)."""
 
     robot: str
     base: str
     links: int
-    dof: int
+    nv: int
     samples: int
     max_abs_error: float
     max_rel_error: float
@@ -63,12 +63,14 @@ def validate_robot(name_or_urdf, samples=20, seed=0, bases=("fixed", "floating")
     results = []
     for base in bases:
         system = floating if base == "floating" else fix_base(floating)
-        results.append(validate_system(system, samples, seed, tolerance, base=base, build_s=build_s))
+        results.append(validate_system(system, samples, seed, tolerance, base=base, build_s=build_s,
+                                       label=str(name_or_urdf)))
     return results
 
 
-def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model", build_s=0.0):
-    """The Validation of ``system`` against its Pinocchio twin (ModelError when it has none)."""
+def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model", build_s=0.0, label=None):
+    """The Validation of ``system`` (named ``label``, by default its own name) against its
+    Pinocchio twin (ModelError when it has none)."""
     twin = Twin(system)
     rng = np.random.default_rng(seed)
     efforts = {robot.torques[j.name]: j.effort for robot in system.robots for j in robot.description.joints
@@ -90,10 +92,14 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
             tau += twin.velocity_map(q).T @ Q
         driven = system.with_parameters(**torques) if torques else system
         started = time.perf_counter()
-        motion = driven.motion(0.0, qm, qdm)
+        try:
+            motion = driven.motion(0.0, qm, qdm)
+        except SolveError as err:  # a force on a direction no mass resists: no motion at all
+            motion = err
         seconds.append(time.perf_counter() - started)
-        reference = twin.accelerations(q, v, tau)
-        if not motion.unique or not np.all(np.isfinite(reference)):
+        with np.errstate(all="ignore"):
+            reference = twin.accelerations(q, v, tau)
+        if isinstance(motion, SolveError) or not motion.unique or not np.all(np.isfinite(reference)):
             notes.append(_why(motion, reference, system))
             continue
         error = np.abs(twin.to_pinocchio(qm, qdm, motion.qdd)[2] - reference).max() if reference.size else 0.0
@@ -102,7 +108,7 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
         worst_rel = max(worst_rel, error / scale if scale > 0 else error)
     links = len(system.subsystems)
     note = notes[0] if notes else ""
-    return Validation(system.name, base, links, twin.model.nv, samples, float(worst_abs), float(worst_rel),
+    return Validation(label or system.name, base, links, twin.model.nv, samples, float(worst_abs), float(worst_rel),
                       not notes and worst_rel <= tolerance, tolerance, round(build_s, 3),
                       round(1e3 * float(np.mean(seconds)), 3) if seconds else 0.0, note)
 
@@ -127,7 +133,9 @@ def sample_pinocchio_state(twin, rng):
 
 def _consistent_sample(system, twin, rng):
     """(q, v) for Pinocchio and the same state (q, q̇) for mbsynth; with loops, the drawn
-    state projected onto the constraints (a draw the loops cannot close at is replaced)."""
+    state projected onto the constraints. A draw is replaced when the loops cannot close
+    from it, or when the projection (in maximal coordinates) lands on the spurious branch
+    of a revolute joint's equations (z_B = −z_A), which no joint angle reaches."""
     for _ in range(MAX_TRIES):
         q, v = sample_pinocchio_state(twin, rng)
         qm, qdm = twin.to_maximal(q, v)
@@ -138,8 +146,17 @@ def _consistent_sample(system, twin, rng):
         except SolveError:
             continue
         q, v, _ = twin.to_pinocchio(qm, qdm)
-        return q, v, qm, qdm
+        if _same_state(twin.to_maximal(q, v), (qm, qdm)):
+            return q, v, qm, qdm
     raise SolveError(f"model '{system.name}': no random state of {MAX_TRIES} could be put on its constraints")
+
+
+def _same_state(a, b, tol=1e-8):
+    """Whether two maximal states (q, q̇) of rigid bodies agree, a quaternion's sign aside."""
+    (qa, qda), (qb, qdb) = (np.reshape(x, (-1, 7)) for x in a), (np.reshape(x, (-1, 7)) for x in b)
+    sign = np.sign(np.sum(qa[:, 3:] * qb[:, 3:], axis=1))[:, None]
+    flip = np.hstack([np.ones((len(qa), 3)), np.repeat(sign, 4, axis=1)])
+    return np.abs(qa - flip * qb).max() < tol and np.abs(qda - flip * qdb).max() < tol * (1 + np.abs(qdb).max())
 
 
 def _torque(rng, effort):
@@ -155,7 +172,9 @@ def _why(motion, reference, system):
     parts = []
     if not np.all(np.isfinite(reference)):
         parts.append("Pinocchio returns NaN or inf")
-    if not motion.unique:
+    if isinstance(motion, SolveError):
+        parts.append(f"mbsynth: no motion exists ({motion})")
+    elif not motion.unique:
         worst = np.abs(motion.nullspace).max(axis=1)
         moving = [c for c, x in zip(system.coordinates, worst) if x > 1e-6]
         parts.append(f"mbsynth: the motion is not unique ({motion.nullspace.shape[1]} indeterminate "

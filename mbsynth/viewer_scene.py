@@ -93,14 +93,13 @@ def build_scene(system, trajectory, axes=False, joints=False, fps=FPS):
         ends = getattr(element, "points", None)  # a force element between two points may expose them
         if ends is not None:
             lines.append((element.name, *(poses.add_point(p) for p in ends), LINE_COLOR))
-    transforms = poses.evaluate(system, trajectory.t[rows], trajectory.q[rows])
-    positions = transforms[:, :, :3, 3]
-    drawn = positions[[s.pose for s in specs] + [i for line in lines for i in line[1:3]]]
-    if drawn.size == 0:
+    if not specs and not lines:
         raise ModelError(f"model '{system.name}' has nothing to draw: give its lagrangian parts frames "
                          "(positions in their coordinates) with geometry")
-    reach = max([shape_reach(s) for spec in specs for s in spec.shapes] + [0.0])
-    scene = Scene(trajectory.t[rows], [], drawn.min(axis=(0, 1)) - reach, drawn.max(axis=(0, 1)) + reach)
+    transforms = poses.evaluate(system, trajectory.t[rows], trajectory.q[rows])
+    positions = transforms[:, :, :3, 3]
+    lower, upper = _bounds(specs, lines, transforms)
+    scene = Scene(trajectory.t[rows], [], lower, upper)
     for spec in specs:
         scene.nodes.append(Node(spec.path, transforms[spec.pose], spec.shapes or _default_shapes(spec, scene.size),
                                 spec.axes))
@@ -139,18 +138,31 @@ def segment_transforms(a, b):
     return T
 
 
-def shape_reach(shape):
-    """How far a shape reaches from its node (0 for meshes, whose size is not known here)."""
+def _bounds(specs, lines, transforms):
+    """The box holding every drawn node and line end, and each shape's bounding sphere
+    about its centre, over all rows."""
+    points = [transforms[i][:, :3, 3] for line in lines for i in line[1:3]]
+    for spec in specs:
+        T = transforms[spec.pose]
+        points.append(T[:, :3, 3])
+        for shape in spec.shapes:
+            centre = T[:, :3, :3] @ np.asarray(shape.get("position", [0, 0, 0]), dtype=float) + T[:, :3, 3]
+            points += [centre - shape_radius(shape), centre + shape_radius(shape)]
+    points = np.concatenate(points)
+    return points.min(axis=0), points.max(axis=0)
+
+
+def shape_radius(shape):
+    """The radius of a sphere about the shape's centre that holds it (0 for meshes, whose
+    size is not known here)."""
     size = np.asarray(shape.get("size", [0.0]), dtype=float)
-    offset = np.linalg.norm(shape.get("position", [0, 0, 0]))
-    extent = {"box": lambda: np.linalg.norm(size) / 2, "sphere": lambda: size[0],
-              "cylinder": lambda: np.hypot(size[0], size[1] / 2),
-              "capsule": lambda: size[0] + size[1] / 2}.get(shape["shape"], lambda: 0.0)()
-    return offset + extent
+    return {"box": lambda: np.linalg.norm(size) / 2, "sphere": lambda: size[0],
+            "cylinder": lambda: np.hypot(size[0], size[1] / 2),
+            "capsule": lambda: size[0] + size[1] / 2}.get(shape["shape"], lambda: 0.0)()
 
 
 def _default_shapes(spec, size):
-    """A small sphere for points, a small box for bodies, in the part's colour."""
+    """A small sphere for points, a smaller one for joint markers, a small box for bodies."""
     if spec.default == "sphere":
         return [{"shape": "sphere", "size": [0.02 * size], "color": spec.color}]
     if spec.default == "marker":

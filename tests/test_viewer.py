@@ -8,6 +8,8 @@ picture of the same scene without the model: the model must change many pixels.
 import re
 import socket
 import struct
+import subprocess
+import sys
 from pathlib import Path
 from urllib.parse import urlparse
 
@@ -181,6 +183,15 @@ def test_mesh_paths_are_relative_to_the_model_file(tmp_path, monkeypatch):
     model.write_text(model.read_text().replace("meshes/tetra.stl", "meshes/missing.stl"))
     with pytest.raises(mb.ModelError, match=r"tetra\.yaml:\d+: at subsystems\.body\.geometry\.mesh: mesh file"):
         mb.load(model)
+
+
+def test_meshcat_imports_without_the_zmq_deprecation_warning():
+    plain = subprocess.run([sys.executable, "-W", "error::DeprecationWarning", "-c", "import meshcat"],
+                           capture_output=True, text=True)
+    assert "zmq.eventloop.ioloop is deprecated" in plain.stderr  # the quirk is there ...
+    ours = subprocess.run([sys.executable, "-W", "error::DeprecationWarning", "-c",
+                           "from mbsynth import viewer; viewer.import_meshcat()"], capture_output=True, text=True)
+    assert ours.returncode == 0, ours.stderr  # ... and handled
 
 
 # -- pictures in a real browser ------------------------------------------------------

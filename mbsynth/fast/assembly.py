@@ -1,12 +1,15 @@
 """One state's blocks for the tree solver, in numba: bodies (bodies.py), joint rows
 (joints.py) and the generated function's outputs (codegen.py), laid out by layout.py.
 
-``assemble`` fills a Work: each node's mass H and force F in its reduced unknowns
-(bodies.py), its parent joint's rows on itself (J) and on its parent (P) with their right
-sides, the extra rows as segments of 6 reduced coefficients per node plus their entries on
-the extra coordinates (Ax), and the extra coordinates' M and F. Every row of A and b is
-divided by the 2-norm of its row of A and M, Q, C by μ, the largest mass entry — the
-equilibration of equations.py, so that pivots and tolerances compare like with like.
+In the order kernel.motion calls them, the functions below fill a Work with: the
+generated Q, C and extra M (``generated``); each node's mass H and force F in its reduced
+unknowns (``nodes``, bodies.py); the masses and forces divided by μ, the largest mass
+entry (``divide_masses``); each node's parent-joint rows on itself (J) and on its parent
+(P) with their right sides (``tree_rows``); the extra rows as segments of 6 reduced
+coefficients per node plus their entries on the extra coordinates, Ax (``extra_rows``);
+the tree's right side (``tree_rhs``). Every row of A and b is divided by the 2-norm of
+its row of A — with μ, the equilibration of equations.py, so that pivots and tolerances
+compare like with like.
 """
 
 import math
@@ -97,7 +100,7 @@ def _reduce(c7, rigid, q, o, nu, s, out):
 
 
 @njit(**OPTIONS)
-def _nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu, q7):
+def nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu, q7):
     """Masses, forces and quaternion norm accelerations of the nodes; returns μ."""
     mu = 0.0
     for i in range(kind.shape[0]):
@@ -139,7 +142,7 @@ def _normalize(row, count):
 
 
 @njit(**OPTIONS)
-def _tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, joints, joint_row, scratch,
+def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, joints, joint_row, scratch,
                J, P, rb):
     """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated."""
     A, b = scratch[3], scratch[4]
@@ -164,7 +167,7 @@ def _tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, n
 
 
 @njit(**OPTIONS)
-def _extra_rows(q, qd, gen, bshift, kind, start, nu, s, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
+def extra_rows(q, qd, gen, bshift, kind, start, nu, s, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
                 xseg_node, gen_rows, scratch, seg7, seg6, xb, Ax):
     """Loop-joint rows and the generated rows (gen: their entries, then their b), as
     segments and Ax entries; equilibrated."""
@@ -213,7 +216,7 @@ def _extra_rows(q, qd, gen, bshift, kind, start, nu, s, joints, joint_xrow, join
 
 
 @njit(**OPTIONS)
-def _generated(gen, gen_q, gen_c, gen_mi, gen_mj, Qf, Cf, Mx):
+def generated(gen, gen_q, gen_c, gen_mi, gen_mj, Qf, Cf, Mx):
     """Q additions, C and the extra coordinates' M from the generated outputs; returns
     the offset of the row entries that follow."""
     Qf[:] = 0.0
@@ -232,7 +235,7 @@ def _generated(gen, gen_q, gen_c, gen_mi, gen_mj, Qf, Cf, Mx):
 
 
 @njit(**OPTIONS)
-def _scale(mu, H, F, Mx, Fx):
+def divide_masses(mu, H, F, Mx, Fx):
     """Divide the masses and forces by μ."""
     inv = 1.0 / mu
     for i in range(H.shape[0]):
@@ -247,33 +250,9 @@ def _scale(mu, H, F, Mx, Fx):
 
 
 @njit(**OPTIONS)
-def _tree_rhs(v, k, yoff, rows, F, rb, ry):
+def tree_rhs(v, k, yoff, rows, F, rb, ry):
     for i in range(v.shape[0]):
         for a in range(v[i]):
             ry[yoff[i] + a] = F[i, a]
         for r in range(k[i]):
             ry[yoff[i] + v[i] + r] = rb[rows[i] + r]
-
-
-@njit(**OPTIONS)
-def assemble(q, qd, gen, bshift, L, W):
-    """Fill W at the state (q, q̇); gen: the generated function's outputs at it (t enters
-    there only); bshift: added to b per row of the System (empty for none). Returns μ."""
-    o = _generated(gen, L.gen_q, L.gen_c, L.gen_mi, L.gen_mj, W.Qf, W.Cf, W.Mx)
-    mu = _nodes(q, qd, bshift, L.node_kind, L.node_q, L.node_mass, L.node_mg, L.node_J, L.quat_row, W.Qf, W.Cf,
-                W.H, W.F, W.s, W.nu, W.q7)
-    for x in range(L.x_coord.shape[0]):
-        W.Fx[x] = W.Qf[L.x_coord[x]] + W.Cf[L.x_coord[x]]
-        for c in range(L.x_coord.shape[0]):
-            mu = max(mu, abs(W.Mx[x, c]))
-    mu = mu if mu > 0 else 1.0
-    _scale(mu, W.H, W.F, W.Mx, W.Fx)
-    joints = (L.joint_program, L.joint_k, L.joint_kinds, L.joint_start, L.joint_s, L.joint_R, L.joint_length)
-    scratch = (W.V, W.R, W.Jt, W.A, W.b)
-    _tree_rows(q, qd, bshift, L.node_kind, L.node_q, L.node_joint, L.node_end, L.node_parent, L.node_rows, W.nu,
-               W.s, joints, L.joint_row, scratch, W.J, W.P, W.rb)
-    _extra_rows(q, qd, gen[o:], bshift, L.node_kind, L.node_q, W.nu, W.s, joints, L.joint_xrow, L.joint_xseg,
-                L.xrow_row, L.xseg_ptr, L.xseg_node, (L.gen_arow, L.gen_aseg, L.gen_acol, L.gen_brow), scratch,
-                W.seg7, W.seg6, W.xb, W.Ax)
-    _tree_rhs(L.node_v, L.node_k, L.node_yoff, L.node_rows, W.F, W.rb, W.ry)
-    return mu

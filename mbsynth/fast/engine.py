@@ -18,7 +18,8 @@ cache.configure()
 
 from ..equations import Motion  # noqa: E402  (numba must see the cache directory first)
 from . import codegen, kernel, layout  # noqa: E402
-from .assembly import make_work  # noqa: E402
+from .assembly import Work, make_work  # noqa: E402
+from .packing import pack, views  # noqa: E402
 
 EMPTY = np.zeros(0)
 THREADS = os.cpu_count() or 1
@@ -35,8 +36,15 @@ class Engine:
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.gen = np.zeros(self.outputs)
-        self.W = make_work(L)
+        self.packed = pack(L)
+        self.work, self.W = self.new_work()
         self.lock = threading.Lock()
+
+    def new_work(self):
+        """(packed buffers, Work of views into them)."""
+        work = make_work(self.L)
+        packed = pack(work)
+        return packed, views(Work, work, *packed)
 
     @classmethod
     def build(cls, system):
@@ -55,7 +63,8 @@ class Engine:
         with self.lock:
             if self.module is not None:
                 self.module.evaluate(t, q, qd, self.p, self.gen)
-            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, self.L, self.W)
+            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.packed,
+                                             *self.work)
             if status != kernel.OK:
                 return None
             return Motion(qdd=self.W.qdd.copy(), unique=True, nullspace=np.zeros((self.n, 0)), Qc=self.W.Qc.copy(),
@@ -72,7 +81,7 @@ class Engine:
         def block(a, b):
             if self.module is not None:
                 self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
-            kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], self.L, make_work(self.L), qdd[a:b], status[a:b])
+            kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *self.new_work()[0], qdd[a:b], status[a:b])
 
         if len(bounds) > 2:
             list(_pool().map(block, bounds[:-1], bounds[1:]))

@@ -48,36 +48,37 @@ def vector_work():
 
 
 @njit(**OPTIONS)
-def _end(e, kind, o, s, Rf, q, qd, V, R, Jt):
-    """The origin (record 7 + e) and the three axes (1 + 3e ...) of end e into V."""
-    P, c0 = V[7 + e], JAC + 7 * e
-    V[7 + e, :, :] = 0.0
-    for a in range(3):
-        V[1 + 3 * e + a, :, :] = 0.0
-    if kind == WORLD:
+def _end(e, kind, o, s, Rf, axes, q, qd, V, R, Jt):
+    """The origin (record 7 + e) and, when ``axes``, the three axes (1 + 3e ...) of end e
+    into V (only the values, velocities, biases and the end's own 7 Jacobian columns)."""
+    c0 = JAC + 7 * e
+    count = 4 if axes else 1
+    for a in range(count):  # the records: a = 0 the origin, a = 1, 2, 3 the axes
+        X = V[7 + e] if a == 0 else V[3 * e + a]
         for i in range(3):
-            P[i, VALUE] = s[i]
-            for a in range(3):
-                V[1 + 3 * e + a, i, VALUE] = Rf[i, a]
+            for col in range(3):
+                X[i, col] = 0.0
+            for col in range(7):
+                X[i, c0 + col] = 0.0
+            X[i, VALUE] = s[i] if a == 0 else Rf[i, a - 1]
+    P = V[7 + e]
+    if kind == WORLD:
         return
     for i in range(3):
         P[i, VALUE] = q[o + i]
         P[i, VELOCITY] = qd[o + i]
         P[i, c0 + i] = 1.0
     if kind == PARTICLE:
-        for i in range(3):
-            for a in range(3):
-                V[1 + 3 * e + a, i, VALUE] = Rf[i, a]
         return
     u, ud = q[o + 3:o + 7], qd[o + 3:o + 7]
     rotation(u, R[0])
     rotation(ud, R[1])
-    for a in range(4):  # a = 0: the origin's offset s; a = 1, 2, 3: the frame's axes
+    for a in range(count):  # a = 0: the origin's offset s; a = 1, 2, 3: the frame's axes
         X = P if a == 0 else V[3 * e + a]
         c = (s[0], s[1], s[2]) if a == 0 else (Rf[0, a - 1], Rf[1, a - 1], Rf[2, a - 1])
         rotation_jacobian(u, c, Jt)
         for i in range(3):
-            X[i, VALUE] += R[0, i, 0] * c[0] + R[0, i, 1] * c[1] + R[0, i, 2] * c[2]
+            X[i, VALUE] = (P[i, VALUE] if a == 0 else 0.0) + R[0, i, 0] * c[0] + R[0, i, 1] * c[1] + R[0, i, 2] * c[2]
             X[i, BIAS] += 2 * (R[1, i, 0] * c[0] + R[1, i, 1] * c[1] + R[1, i, 2] * c[2])
             for k in range(4):
                 X[i, VELOCITY] += Jt[i, k] * ud[k]
@@ -91,8 +92,14 @@ def joint_rows(program, k, kinds, starts, s, Rf, length, q, qd, V, R, Jt, A, b):
     program: k × 3 (operation, vector, vector or component); kinds, starts: per end, what it
     sits on and its first coordinate; s, Rf: per end, the frame's offset and rotation in
     its part (in the world for a world end); length: a distance joint's L."""
-    _end(0, kinds[0], starts[0], s[0], Rf[0], q, qd, V, R, Jt)
-    _end(1, kinds[1], starts[1], s[1], Rf[1], q, qd, V, R, Jt)
+    axes_a = axes_b = False
+    for r in range(k):
+        if program[r, 0] == DOT:
+            for x in (program[r, 1], program[r, 2]):
+                axes_a |= XA <= x <= ZA
+                axes_b |= XB <= x <= ZB
+    _end(0, kinds[0], starts[0], s[0], Rf[0], axes_a, q, qd, V, R, Jt)
+    _end(1, kinds[1], starts[1], s[1], Rf[1], axes_b, q, qd, V, R, Jt)
     for i in range(3):  # d = p_B − p_A: value, velocity, bias and Jacobian alike
         for col in range(17):
             V[D, i, col] = V[8, i, col] - V[7, i, col]

@@ -23,9 +23,11 @@ import math
 import numpy as np
 from numba import njit
 
-from .assembly import assemble
+from .assembly import Work, divide_masses, extra_rows, generated, nodes, tree_rhs, tree_rows
 from .bodies import OPTIONS, rate_transpose
 from .eigen import symmetric_eigen
+from .layout import Layout
+from .packing import fields, view1, view2, view3, view4
 from .joints import RIGID
 from .tree import factor, solve
 
@@ -36,6 +38,14 @@ EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of the largest count a
 CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions
 NULL_RTOL = 1e-8  # largest acceleration a dropped (unit) direction may move
 RESIDUAL_MAX = 1e-9
+LAYOUT, WORK = fields(Layout), fields(Work)
+
+
+@njit(**OPTIONS)
+def _copy(a, b):
+    """b ← a (a loop: numba's slice assignment compiles slowly)."""
+    for i in range(a.shape[0]):
+        b[i] = a[i]
 
 
 @njit(**OPTIONS)
@@ -83,13 +93,15 @@ def _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, ve
     accelerations, then extra multipliers), then the tree into z. Returns a status."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     S[:, :] = 0.0
-    S[:nx, :nx] = Mx
+    for x in range(nx):
+        rhs[x] = Fx[x]
+        for c in range(nx):
+            S[x, c] = Mx[x, c]
     for x in range(mx):
         for c in range(nx):
             S[c, nx + x] = Ax[x, c]
             S[nx + x, c] = Ax[x, c]
         rhs[nx + x] = xb[x] - _row_dot(x, segs, seg6, z0)
-    rhs[:nx] = Fx
     for x in range(mx):
         y[:] = 0.0
         _scatter(x, 1.0, segs, seg6, y)
@@ -116,7 +128,7 @@ def _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, ve
                 return NOT_UNIQUE
     if math.sqrt(dropped) > CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
         return INCONSISTENT
-    y[:] = ry
+    _copy(ry, y)
     for x in range(mx):
         _scatter(x, -lam[nx + x], segs, seg6, y)
     solve(topology, P, Dinv, y, z)
@@ -217,28 +229,67 @@ def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx,
 
 
 @njit(**OPTIONS)
-def motion(q, qd, gen, bshift, L, W):
-    """(status, residual) at one state; on OK, W.qdd holds q̈ and W.Qc holds M q̈ − Q.
-    gen: the generated function's outputs at (t, q, q̇) — time enters only there."""
-    mu = assemble(q, qd, gen, bshift, L, W)
-    topology = (L.order, L.node_parent, L.node_v, L.node_k, L.node_doff, L.node_yoff, L.node_rows)
-    if factor(topology, W.H, W.J, W.P, W.Dinv, W.acc, W.perm) >= 0:
+def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
+    """(status, residual) at one state; on OK, the Work's qdd holds q̈ and its Qc M q̈ − Q.
+    gen: the generated function's outputs at (t, q, q̇) — time enters only there; bshift:
+    added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
+    Layout and the Work packed (packing.py)."""
+    kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
+    mass, mg, inertia = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), view3(LF, LX, LAYOUT.node_J)
+    v, k, yoff, rows = (view1(LI, LX, LAYOUT.node_v), view1(LI, LX, LAYOUT.node_k), view1(LI, LX, LAYOUT.node_yoff),
+                        view1(LI, LX, LAYOUT.node_rows))
+    parent, x_coord = view1(LI, LX, LAYOUT.node_parent), view1(LI, LX, LAYOUT.x_coord)
+    topology = (view1(LI, LX, LAYOUT.order), parent, v, k, view1(LI, LX, LAYOUT.node_doff), yoff, rows)
+    joints = (view3(LI, LX, LAYOUT.joint_program), view1(LI, LX, LAYOUT.joint_k), view2(LI, LX, LAYOUT.joint_kinds),
+              view2(LI, LX, LAYOUT.joint_start), view3(LF, LX, LAYOUT.joint_s), view4(LF, LX, LAYOUT.joint_R),
+              view1(LF, LX, LAYOUT.joint_length))
+    xseg_ptr, xseg_node = view1(LI, LX, LAYOUT.xseg_ptr), view1(LI, LX, LAYOUT.xseg_node)
+    segs = (xseg_ptr, xseg_node, v, yoff)
+    gen_rows = (view1(LI, LX, LAYOUT.gen_arow), view1(LI, LX, LAYOUT.gen_aseg), view1(LI, LX, LAYOUT.gen_acol),
+                view1(LI, LX, LAYOUT.gen_brow))
+    Qf, Cf, qdd, Qc = view1(WF, WX, WORK.Qf), view1(WF, WX, WORK.Cf), view1(WF, WX, WORK.qdd), view1(WF, WX, WORK.Qc)
+    H, F, acc, dyn = view3(WF, WX, WORK.H), view2(WF, WX, WORK.F), view3(WF, WX, WORK.acc), view2(WF, WX, WORK.dyn)
+    s, nu = view1(WF, WX, WORK.s), view1(WF, WX, WORK.nu)
+    J, P, rb, Dinv = view2(WF, WX, WORK.J), view2(WF, WX, WORK.P), view1(WF, WX, WORK.rb), view1(WF, WX, WORK.Dinv)
+    ry, y, z, z0, w = (view1(WF, WX, WORK.ry), view1(WF, WX, WORK.y), view1(WF, WX, WORK.z), view1(WF, WX, WORK.z0),
+                       view1(WF, WX, WORK.w))
+    scratch = (view3(WF, WX, WORK.V), view3(WF, WX, WORK.R), view2(WF, WX, WORK.Jt), view2(WF, WX, WORK.A),
+               view1(WF, WX, WORK.b))
+    seg7, seg6, xb, Ax = view2(WF, WX, WORK.seg7), view2(WF, WX, WORK.seg6), view1(WF, WX, WORK.xb), view2(WF, WX, WORK.Ax)
+    Mx, Fx, lam = view2(WF, WX, WORK.Mx), view1(WF, WX, WORK.Fx), view1(WF, WX, WORK.lam)
+
+    o = generated(gen, view1(LI, LX, LAYOUT.gen_q), view1(LI, LX, LAYOUT.gen_c), view1(LI, LX, LAYOUT.gen_mi),
+                  view1(LI, LX, LAYOUT.gen_mj), Qf, Cf, Mx)
+    mu = nodes(q, qd, bshift, kind, start, mass, mg, inertia, view1(LI, LX, LAYOUT.quat_row), Qf, Cf, H, F, s, nu,
+               view1(WF, WX, WORK.q7))
+    for x in range(x_coord.shape[0]):
+        Fx[x] = Qf[x_coord[x]] + Cf[x_coord[x]]
+        for c in range(x_coord.shape[0]):
+            mu = max(mu, abs(Mx[x, c]))
+    mu = mu if mu > 0 else 1.0
+    divide_masses(mu, H, F, Mx, Fx)
+    tree_rows(q, qd, bshift, kind, start, view1(LI, LX, LAYOUT.node_joint), view1(LI, LX, LAYOUT.node_end), parent,
+              rows, nu, s, joints, view1(LI, LX, LAYOUT.joint_row), scratch, J, P, rb)
+    if xb.shape[0]:
+        extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, joints, view1(LI, LX, LAYOUT.joint_xrow),
+                   view2(LI, LX, LAYOUT.joint_xseg), view1(LI, LX, LAYOUT.xrow_row), xseg_ptr, xseg_node, gen_rows,
+                   scratch, seg7, seg6, xb, Ax)
+    tree_rhs(v, k, yoff, rows, F, rb, ry)
+
+    if factor(topology, H, J, P, Dinv, acc, view1(WI, WX, WORK.perm)) >= 0:
         return SINGULAR, 0.0
-    W.y[:] = W.ry
-    solve(topology, W.P, W.Dinv, W.y, W.z0)
-    W.z[:] = W.z0
-    segs = (L.xseg_ptr, L.xseg_node, L.node_v, L.node_yoff)
-    if L.x_coord.shape[0] + L.xrow_row.shape[0] > 0:
-        status = _close(topology, segs, W.seg6, W.P, W.Dinv, W.Mx, W.Ax, W.xb, W.Fx, W.ry, W.z0, W.y, W.w, W.z,
-                        W.S, W.vectors, W.rhs, W.lam)
+    _copy(ry, y)
+    solve(topology, P, Dinv, y, z0)
+    _copy(z0, z)
+    if x_coord.shape[0] + xb.shape[0] > 0:
+        status = _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
+                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam)
         if status != OK:
             return status, 0.0
-    _recover(q, L.node_kind, L.node_q, L.node_mass, L.node_J, L.node_yoff, L.x_coord, W.nu, W.s, W.z, W.Qf, W.Mx,
-             W.lam, mu, W.qdd, W.Qc)
-    residual = _residual(topology, L.node_kind, segs, W.seg6, W.H, W.F, W.J, W.P, W.rb, W.s, W.z, W.lam, W.xb,
-                         W.Ax, W.Mx, W.Fx, W.dyn)
-    for c in range(W.qdd.shape[0]):
-        if not (math.isfinite(W.qdd[c]) and math.isfinite(W.Qc[c])):
+    _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, z, Qf, Mx, lam, mu, qdd, Qc)
+    residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn)
+    for c in range(qdd.shape[0]):
+        if not (math.isfinite(qdd[c]) and math.isfinite(Qc[c])):
             return NOT_FINITE, residual
     if not residual <= RESIDUAL_MAX:
         return RESIDUAL, residual
@@ -246,10 +297,11 @@ def motion(q, qd, gen, bshift, L, W):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def motion_rows(q, qd, gen, L, W, qdd, status):
+def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, qdd, status):
     """q̈ of each state (row of q, q̇, gen) into qdd and its status into status. Releases
     the GIL: engine.py runs blocks of rows in threads, each with its own Work."""
     empty = np.zeros(0)
+    qdd_view = view1(WF, WX, WORK.qdd)
     for row in range(q.shape[0]):
-        status[row] = motion(q[row], qd[row], gen[row], empty, L, W)[0]
-        qdd[row, :] = W.qdd
+        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX)[0]
+        _copy(qdd_view, qdd[row])

@@ -1,0 +1,81 @@
+"""`mbsynth validate` for every robot of example-robot-data that Pinocchio loads, fixed and
+floating base, and for the model files of robots and loops; writes a results table.
+
+    .venv/bin/python benchmarks/validate_all_robots.py [--samples 20] [--only ur5 panda ...]
+
+Each robot is built once (floating; the fixed base adds a weld), so "build s" is the time
+to derive and compile every part, joint and torque symbolically (sympy), shared by both
+rows. "motion ms" is one evaluation of (2.14) by the dense fast path (issue 7 makes it
+fast). BLAS runs single-threaded (OPENBLAS_NUM_THREADS=1): on a busy 2-core machine its
+threads otherwise fight over the cores. Writes benchmarks/validate_results.md after every
+robot, so an interrupted run keeps what it measured.
+"""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from mbsynth.errors import ModelError, SolveError  # noqa: E402
+from mbsynth.io import load  # noqa: E402
+from mbsynth.validate import TOLERANCE, Validation, robot_table, validate_robot, validate_system  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+MODELS = [HERE.parent / "models" / "mechanisms" / "four_bar_3d.yaml", *sorted((HERE.parent / "models" / "robots").glob("*.yaml"))]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=20)
+    parser.add_argument("--only", nargs="*", help="robot names (default: all that Pinocchio loads)")
+    parser.add_argument("--out", default=str(HERE / "validate_results.md"))
+    args = parser.parse_args()
+    robots = [(name, links) for name, _, links, _, loads in robot_table() if loads]
+    if args.only:
+        robots = [(name, links) for name, links in robots if name in args.only]
+    rows, started = [], time.perf_counter()
+    for name, _ in robots:
+        try:
+            rows += [(name, r) for r in validate_robot(name, samples=args.samples)]
+        except (ModelError, SolveError) as err:
+            rows.append((name, Validation(name, "-", 0, 0, args.samples, float("nan"), float("nan"), False,
+                                          TOLERANCE, 0.0, 0.0, str(err))))
+        write(args, rows, time.perf_counter() - started)
+    if not args.only:
+        for path in MODELS:
+            began = time.perf_counter()
+            system = load(path)
+            rows.append((str(path.relative_to(HERE.parent)),
+                         validate_system(system, samples=args.samples, build_s=time.perf_counter() - began)))
+            write(args, rows, time.perf_counter() - started)
+
+
+def write(args, rows, elapsed):
+    passed = sum(r.passed for _, r in rows)
+    worst = max((r.max_rel_error for _, r in rows if r.passed), default=0.0)
+    lines = ["# mbsynth against Pinocchio", "",
+             f"`benchmarks/validate_all_robots.py --samples {args.samples}` on {platform.node()} "
+             f"({platform.processor() or platform.machine()}, {os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}, "
+             f"{elapsed / 60:.1f} min in all.", "",
+             f"Joint accelerations v̇ of mbsynth (every link a rigid body in 7 coordinates, (2.14)) against "
+             f"`pinocchio.aba` (`constraintDynamics` for loops) at {args.samples} random states and torques "
+             f"each: {passed} of {len(rows)} comparisons pass the relative tolerance {TOLERANCE:.0e}; the largest "
+             f"relative error among them is {worst:.1e}.", "",
+             "| robot or model | bodies | base | nv | max rel error | max abs error | build s | motion ms | result |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for name, r in rows:
+        result = "passed" if r.passed else f"**failed**: {r.note}" if r.note else "**failed**"
+        lines.append(f"| {name} | {r.links} | {r.base} | {r.nv} | {r.max_rel_error:.1e} | {r.max_abs_error:.1e} "
+                     f"| {r.build_s:.1f} | {r.motion_ms:.2f} | {result} |")
+    Path(args.out).write_text("\n".join(lines) + "\n")
+    name, r = rows[-1]
+    print(f"{name} {r.base}: rel {r.max_rel_error:.1e}, build {r.build_s:.1f} s, {'passed' if r.passed else 'FAILED ' + r.note}",
+          flush=True)
+
+
+if __name__ == "__main__":
+    main()

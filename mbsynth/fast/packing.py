@@ -1,0 +1,68 @@
+"""A NamedTuple of arrays as two flat buffers, so that a call into numba unboxes a few
+arrays rather than seventy (each costs about 0.1 µs on entry).
+
+``pack(arrays)`` returns (ints, floats, index): every int64 field lives in ``ints``,
+every float64 field in ``floats``; row k of ``index`` is (offset, size, ndim, shape...)
+of field k. ``views(cls, arrays, ints, floats, index)`` rebuilds the NamedTuple from views into the
+buffers (numpy). In numba, ``view1`` … ``view4`` give one field by its number, named by
+``fields(cls)`` (an IntEnum, which numba reads as a constant); the kernel keeps the
+views in local variables, since numba compiles tuples of many arrays very slowly.
+"""
+
+import enum
+
+import numpy as np
+from numba import njit
+
+from .bodies import OPTIONS
+
+MAX_NDIM = 4
+
+
+def fields(cls):
+    """The field numbers of a NamedTuple class, as an IntEnum."""
+    return enum.IntEnum(f"{cls.__name__}Field", {name: i for i, name in enumerate(cls._fields)})
+
+
+def pack(arrays):
+    index = np.zeros((len(arrays), 3 + MAX_NDIM), dtype=np.int64)
+    parts = {np.int64: [], np.float64: []}
+    sizes = {np.int64: 0, np.float64: 0}
+    for k, a in enumerate(arrays):
+        kind = np.int64 if np.issubdtype(a.dtype, np.integer) else np.float64
+        index[k, :3] = sizes[kind], a.size, a.ndim
+        index[k, 3:3 + a.ndim] = a.shape
+        parts[kind].append(np.ascontiguousarray(a, dtype=kind).ravel())
+        sizes[kind] += a.size
+    ints, floats = (np.concatenate([np.zeros(0, kind)] + parts[kind]) for kind in (np.int64, np.float64))
+    return ints, floats, index
+
+
+def views(cls, arrays, ints, floats, index):
+    """``cls`` (a NamedTuple class) of views into the buffers, typed like ``arrays``."""
+    out = []
+    for k, a in enumerate(arrays):
+        buf = ints if np.issubdtype(a.dtype, np.integer) else floats
+        offset, size, ndim = index[k, :3]
+        out.append(buf[offset:offset + size].reshape(tuple(index[k, 3:3 + ndim])))
+    return cls(*out)
+
+
+@njit(**OPTIONS)
+def view1(buf, index, k):
+    return buf[index[k, 0]:index[k, 0] + index[k, 1]]
+
+
+@njit(**OPTIONS)
+def view2(buf, index, k):
+    return view1(buf, index, k).reshape((index[k, 3], index[k, 4]))
+
+
+@njit(**OPTIONS)
+def view3(buf, index, k):
+    return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5]))
+
+
+@njit(**OPTIONS)
+def view4(buf, index, k):
+    return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5], index[k, 6]))

@@ -1,0 +1,249 @@
+"""Whole robots as parts, checked against Pinocchio's reduced-coordinate dynamics.
+
+Every robot is built once per module (building one costs about a second per link: the
+joints' rows are derived symbolically). The references are Pinocchio's own: its URDF
+parser and aba / crba / constraintDynamics; only the state maps are ours, and those are
+checked by a round trip and by finite differences.
+"""
+
+import json
+import textwrap
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import mbsynth as mb
+from mbsynth.cli import main
+from mbsynth.diagnose import diagnose
+from mbsynth.robots import fix_base, robot_files
+from mbsynth.twin import Twin
+from mbsynth.validate import TOLERANCE, sample_pinocchio_state, validate_system
+
+pytestmark = pytest.mark.skipif(not robot_files(), reason="example-robot-data is not installed")
+SAMPLES = 4
+MODELS = Path(__file__).resolve().parent.parent / "models"
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return mb.from_robot("ur5", floating=True)
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return mb.from_robot("panda", floating=True)
+
+
+@pytest.fixture(scope="module")
+def solo12():
+    return mb.from_robot("solo12", floating=True)
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "solo12"])
+def test_joint_accelerations_equal_pinocchio_aba(name, request):
+    """ur5 (revolute), panda (revolute and prismatic fingers), solo12 (a quadruped), each
+    floating and fixed: v̇ from (2.14) in 7 coordinates per link equals pinocchio.aba."""
+    system = request.getfixturevalue(name)
+    model = pin.buildModelFromUrdf(robot_files()[name])
+    for base, variant, nv in (("floating", system, model.nv + 6), ("fixed", fix_base(system), model.nv)):
+        result = validate_system(variant, samples=SAMPLES, base=base)
+        assert result.nv == nv and result.links == len(system.robots[0].description.links)
+        assert result.passed and result.max_rel_error <= TOLERANCE, result
+
+
+def test_parts_are_the_links_with_their_masses(ur5):
+    """One rigid body per URDF link, massless links included (a zero block of M); the
+    masses add up to Pinocchio's total mass of the floating robot."""
+    description = ur5.robots[0].description
+    assert [p.name for p in ur5.subsystems] == list(description.links)
+    assert all(p.kind == "rigid_body" for p in ur5.subsystems)
+    model = pin.buildModelFromUrdf(description.path, pin.JointModelFreeFlyer())
+    assert sum(float(p.mass) for p in ur5.subsystems) == pytest.approx(pin.computeTotalMass(model), rel=1e-12)
+    q, qd = ur5.initial_state()
+    M = ur5.evaluate(0.0, q, qd).M
+    tool = ur5.coordinates.index("tool0.x")
+    assert np.all(M[tool:tool + 7, tool:tool + 7] == 0)
+    assert sorted(ur5.parameters) == sorted(f"tau_{j}" for j in ("shoulder_pan_joint", "shoulder_lift_joint",
+                                                                   "elbow_joint", "wrist_1_joint", "wrist_2_joint",
+                                                                   "wrist_3_joint"))
+
+
+def test_a_joint_torque_accelerates_by_the_inverse_mass_matrix(ur5):
+    """At rest, the change of v̇ that a torque τ on one joint makes is M⁻¹ e τ, with M
+    from Pinocchio's crba (an algorithm independent of aba)."""
+    fixed = fix_base(ur5)
+    twin = Twin(fixed)
+    q, _ = sample_pinocchio_state(twin, np.random.default_rng(3))
+    v = np.zeros(twin.model.nv)
+    qm, qdm = twin.to_maximal(q, v)
+    base = twin.to_pinocchio(qm, qdm, fixed.motion(0.0, qm, qdm).qdd)[2]
+    driven = fixed.with_parameters(tau_elbow_joint=7.5)
+    pushed = twin.to_pinocchio(qm, qdm, driven.motion(0.0, qm, qdm).qdd)[2]
+    M = pin.crba(twin.model, twin.data, q)
+    M = np.triu(M) + np.triu(M, 1).T
+    e = np.zeros(twin.model.nv)
+    e[twin.model.joints[twin.model.getJointId("elbow_joint")].idx_v] = 7.5
+    np.testing.assert_allclose(pushed - base, np.linalg.solve(M, e), rtol=1e-10, atol=1e-10)
+
+
+def test_state_maps_round_trip(ur5):
+    """Pinocchio (q, v) → maximal (q, q̇) → Pinocchio gives (q, v) back: the quaternion
+    up to its sign, the joint angles modulo 2π."""
+    twin = Twin(ur5)
+    q, v = sample_pinocchio_state(twin, np.random.default_rng(5))
+    back_q, back_v, _ = twin.to_pinocchio(*twin.to_maximal(q, v))
+    np.testing.assert_allclose(back_v, v, atol=1e-12)
+    np.testing.assert_allclose(back_q[:3], q[:3], atol=1e-12)
+    assert abs(abs(back_q[3:7] @ q[3:7]) - 1) < 1e-12
+    np.testing.assert_allclose(np.angle(np.exp(1j * (back_q[7:] - q[7:]))), 0, atol=1e-12)
+
+
+def test_free_flyer_acceleration_is_the_derivative_of_its_velocity(ur5):
+    """Pinocchio's free-flyer v̇ is d/dt of (Rᵀṗ, Rᵀω) (a spatial acceleration): the map
+    from q̈ agrees with central differences of v along q(t) = q + t q̇ + t²/2 q̈."""
+    twin = Twin(ur5)
+    q, v = sample_pinocchio_state(twin, np.random.default_rng(7))
+    qm, qdm = twin.to_maximal(q, v)
+    qdd = ur5.motion(0.0, qm, qdm).qdd
+    h = 1e-5
+    ahead, behind = (twin.to_pinocchio(qm + s * h * qdm + h**2 / 2 * qdd, qdm + s * h * qdd)[1] for s in (1, -1))
+    np.testing.assert_allclose(twin.to_pinocchio(qm, qdm, qdd)[2][:6], ((ahead - behind) / (2 * h))[:6],
+                               rtol=1e-6, atol=1e-6)
+
+
+def test_continuous_joints_read_as_cos_and_sin():
+    """Continuous joints: Pinocchio's q is (cos θ, sin θ); fixed and floating agree with aba."""
+    system = mb.from_robot("double_pendulum_continuous", floating=True)
+    twin = Twin(system)
+    assert [c.kind for c in twin.coordinates] == ["free", "continuous", "continuous"]
+    q, v = sample_pinocchio_state(twin, np.random.default_rng(2))
+    np.testing.assert_allclose(twin.to_pinocchio(*twin.to_maximal(q, v))[0][7:], q[7:], atol=1e-12)
+    for variant in (system, fix_base(system)):
+        assert validate_system(variant, samples=SAMPLES).max_rel_error <= TOLERANCE
+
+
+def test_four_bar_loop_equals_constraint_dynamics():
+    """The spatial four-bar (three rigid bodies, four revolute joints, one closing the
+    loop) against pinocchio.constraintDynamics with two CONTACT_3D on the closing axis."""
+    system = mb.load(MODELS / "mechanisms" / "four_bar_3d.yaml")
+    twin = Twin(system)
+    assert len(twin.constraints) == 2 and twin.model.nv == 3
+    result = validate_system(system, samples=SAMPLES)
+    assert result.passed and result.max_rel_error <= TOLERANCE, result
+
+
+ARM_WITH_LOOP = """\
+name: ur5_bar_payload
+parameters: {L: 0.6, k: 300.0, m: 1.5, g: 9.81, tau_arm_elbow_joint: 4.0}
+gravity: [0, 0, -g]
+world:
+  frames:
+    anchor: {position: [0.81725, 0.19145 + L, 0.994509]}
+subsystems:
+  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}
+  bar:
+    type: rigid_body
+    mass: 1.0
+    inertia: [0.03, 0.03, 0.0002]
+    frames:
+      grip: {position: [0, 0, -L/2]}
+      tip: {position: [0, 0, L/2]}
+    initial: {position: [0.81725, 0.19145 + L/2, 0.994509], rpy: [pi/2, 0, pi]}
+  payload:
+    type: rigid_body
+    mass: m
+    inertia: [0.004, 0.005, 0.006]
+    initial: {position: [0.81725, 0.49145, 0.6]}
+joints:
+  - {name: grip, type: fixed, parent: arm_tool0, child: bar.grip}
+  - {name: pin, type: spherical, parent: world.anchor, child: bar.tip}
+forces:
+  - {name: hang, type: spring, between: [bar, payload], stiffness: k, rest_length: 0.3}
+"""
+
+
+def test_robot_holding_a_pinned_bar_with_a_hanging_payload(tmp_path):
+    """A model file: a UR5 (type: robot) welded to a bar whose tip is pinned to the world
+    (a loop: CONTACT_3D) and a free payload hanging from the bar by a spring (a free-flyer
+    driven by Sᵀ Q_spring). Unique motion at the initial state; equal to constraintDynamics."""
+    path = tmp_path / "arm.yaml"
+    path.write_text(ARM_WITH_LOOP)
+    system = mb.load(path)
+    assert system.parameters["tau_arm_elbow_joint"] == 4.0  # the model's value wins over the default 0
+    assert "arm_wrist_3_link" in [p.name for p in system.subsystems] and system.robots[0].prefix == "arm_"
+    report = diagnose(system)
+    assert report.unique and report.consistent
+    twin = Twin(system)
+    assert len(twin.constraints) == 1 and twin.model.nv == 6 + 6
+    result = validate_system(system, samples=SAMPLES)
+    assert result.passed and result.max_rel_error <= TOLERANCE, result
+
+
+def massless_leaf_urdf(tmp_path):
+    """The double pendulum of example-robot-data with its last link's mass taken away."""
+    tree = ET.parse(robot_files()["double_pendulum"])
+    inertial = next(link for link in tree.getroot().findall("link") if link.get("name") == "link2").find("inertial")
+    inertial.find("mass").set("value", "0")
+    for key in inertial.find("inertia").attrib:
+        inertial.find("inertia").set(key, "0")
+    path = tmp_path / "massless_leaf.urdf"
+    tree.write(path)
+    return path
+
+
+def test_massless_leaf_pinocchio_nan_mbsynth_names_the_direction(tmp_path):
+    """A massless link on a revolute joint at the end of the chain: pinocchio.aba divides
+    by its zero articulated inertia (NaN); mbsynth finds one indeterminate direction, the
+    leaf turning about its joint, on which no force acts (free); a torque on that joint
+    would leave no motion at all (a force on a direction no mass resists)."""
+    system = mb.from_robot(massless_leaf_urdf(tmp_path))
+    twin = Twin(system)
+    q, v = sample_pinocchio_state(twin, np.random.default_rng(0))
+    with np.errstate(all="ignore"):
+        assert not np.all(np.isfinite(pin.aba(twin.model, twin.data, q, v, np.zeros(twin.model.nv))))
+    qm, qdm = twin.to_maximal(q, v)
+    motion = system.motion(0.0, qm, qdm)
+    assert not motion.unique and motion.nullspace.shape[1] == 1
+    moving = {c.split(".")[0] for c, x in zip(system.coordinates, motion.nullspace[:, 0]) if abs(x) > 1e-9}
+    assert moving == {"link2"}
+    report = diagnose(system, q=qm, qd=qdm)
+    assert [b["free"] for b in report.balances] == [True]
+    result = validate_system(system, samples=2)
+    assert not result.passed and "NaN" in result.note and "mbsynth: no motion exists" in result.note
+
+
+def test_yaml_robot_entry_errors_name_file_line_and_key(tmp_path):
+    def load(text):
+        path = tmp_path / "model.yaml"
+        path.write_text(textwrap.dedent(text))
+        return mb.load(path)
+
+    with pytest.raises(mb.ModelError, match=r"model\.yaml:3: at subsystems\.arm\.robot: no robot or URDF file"):
+        load("""\
+            subsystems:
+              arm:
+                robot: no_such_robot
+                type: robot
+            """)
+    with pytest.raises(mb.ModelError, match=r"at subsystems\.arm\.floating: expected true or false"):
+        load("subsystems:\n  arm: {type: robot, robot: double_pendulum, floating: 'yes'}\n")
+    with pytest.raises(mb.ModelError, match=r"at subsystems\.arm\.base\.rpy: expected a list of 3"):
+        load("subsystems:\n  arm: {type: robot, robot: double_pendulum, base: {rpy: [0, 1]}}\n")
+    with pytest.raises(mb.ModelError, match=r"at subsystems\.arm: robot 'arm' has a link part 'arm_link1'"):
+        load("subsystems:\n  arm: {type: robot, robot: double_pendulum}\n"
+             "  arm_link1: {type: particle, mass: 1}\n")
+
+
+def test_validate_command_json_and_the_robot_list(capsys):
+    assert main(["validate", "double_pendulum", "--samples", "3", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["robot"] == "double_pendulum" and report["passed"] is True and report["samples"] == 3
+    assert report["max_rel_error"] <= TOLERANCE and [r["base"] for r in report["results"]] == ["fixed", "floating"]
+    assert main(["robots", "--json"]) == 0
+    robots = {r["name"]: r for r in json.loads(capsys.readouterr().out)["robots"]}
+    assert robots["ur5"]["pinocchio"] and robots["ur5"]["links"] == 11 and robots["talos"]["movable_joints"] == 32
+    assert main(["validate", str(MODELS / "mechanisms" / "four_bar.yaml")]) == 2  # planar bodies: no Pinocchio twin
+    assert "no equivalent Pinocchio model" in capsys.readouterr().err
