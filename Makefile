@@ -22,6 +22,7 @@ $(VENV)/bin/python:
 
 $(STAMP): pyproject.toml | $(VENV)/bin/python
 	$(PY) -m pip install --quiet -e .
+	$(PY) -m mbsynth.fast
 	touch $@
 
 $(TEST_STAMP): pyproject.toml $(STAMP)

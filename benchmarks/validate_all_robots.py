@@ -34,11 +34,12 @@ def main():
     parser.add_argument("--only", nargs="*", help="robot names (default: all that Pinocchio loads)")
     parser.add_argument("--out", default=str(HERE / "validate_results.md"))
     args = parser.parse_args()
-    robots = [(name, links) for name, _, links, _, loads in robot_table() if loads]
+    robots = sorted((links, name) for name, _, links, _, loads in robot_table() if loads)  # small first
     if args.only:
-        robots = [(name, links) for name, links in robots if name in args.only]
+        robots = [(links, name) for links, name in robots if name in args.only]
+    args.total = len(robots)
     rows, started = [], time.perf_counter()
-    for name, _ in robots:
+    for _, name in robots:
         try:
             rows += [(name, r) for r in validate_robot(name, samples=args.samples)]
         except (ModelError, SolveError) as err:
@@ -60,7 +61,8 @@ def write(args, rows, elapsed):
     lines = ["# mbsynth against Pinocchio", "",
              f"`benchmarks/validate_all_robots.py --samples {args.samples}` on {platform.node()} "
              f"({platform.processor() or platform.machine()}, {os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}, "
-             f"{elapsed / 60:.1f} min in all.", "",
+             f"{elapsed / 60:.1f} min in all; {len({n for n, r in rows if r.base != 'model'})} of {args.total} robots "
+             "(smallest first).", "",
              f"Joint accelerations v̇ of mbsynth (every link a rigid body in 7 coordinates, (2.14)) against "
              f"`pinocchio.aba` (`constraintDynamics` for loops) at {args.samples} random states and torques "
              f"each: {passed} of {len(rows)} comparisons pass the relative tolerance {TOLERANCE:.0e}; the largest "

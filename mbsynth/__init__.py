@@ -9,6 +9,7 @@ Result 3 (full column rank of [M; A]) as the exact test of uniqueness.
 from .equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
 from .errors import ModelError, SimulationError, SolveError
 from .io import load, loads
+from .robots import from_robot
 from .simulate import simulate
 from .sweep import sweep
 from .system import System
@@ -20,5 +21,5 @@ __version__ = "0.1.0"
 __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
     "ModelError", "SolveError", "SimulationError", "load", "loads", "System",
-    "simulate", "sweep", "Trajectory", "load_trajectory",
+    "simulate", "sweep", "Trajectory", "load_trajectory", "from_robot",
 ]

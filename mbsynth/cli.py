@@ -1,15 +1,20 @@
 """The ``mbsynth`` command.
 
 Exit codes: 0 success; 1 a verdict that needs attention (``check``: the model needs
-a balance it does not have, or admits no motion at its initial state); 2 a usage or
-model error (one readable line on stderr, or ``{"error": ...}`` with ``--json``).
+a balance it does not have, or admits no motion at its initial state; a run that had
+to stop); 2 a usage or model error, a bad flag value, a file that cannot be read or
+written; 3 an internal error (a bug: please report it); 130 interrupted (Ctrl-C; a
+run's output so far is kept). Every error is one readable line on stderr, or
+``{"error": ...}`` on stdout with ``--json``; ``--debug`` adds the traceback.
 """
 
 import argparse
 import json
+import math
 import sys
 import time
 import traceback
+from pathlib import Path
 
 from .diagnose import diagnose
 from .errors import ModelError, SimulationError, SolveError
@@ -19,19 +24,53 @@ from .simulate import STABILIZATIONS, simulate
 from .trajectory import load_trajectory
 
 
+INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # scipy solve_ivp's methods
+PLOT_FORMATS = (".png", ".pdf", ".svg")
+
+
 def main(argv=None):
     parser = _parser()
     args = parser.parse_args(argv)
     try:
         return args.run(args)
     except (ModelError, SolveError, OSError) as err:
-        if args.debug:
-            traceback.print_exc()
-        if getattr(args, "json", False):
-            print(json.dumps({"error": str(err)}))
-        else:
-            print(f"error: {err}", file=sys.stderr)
-        return 2
+        return _fail(args, err, 2)
+    except KeyboardInterrupt:
+        kept = f"; the output so far is in {args.out}" if getattr(args, "out", None) else ""
+        return _fail(args, f"interrupted{kept}", 130)
+    except Exception as err:  # noqa: BLE001  (a bug: say so in one line, not a traceback)
+        return _fail(args, f"internal error, a bug in mbsynth ({type(err).__name__}: {err}); "
+                           "--debug shows where", 3)
+
+
+def _fail(args, error, code):
+    """Report ``error`` in one line (stderr, or JSON on stdout with --json); return ``code``."""
+    if args.debug and isinstance(error, BaseException):
+        traceback.print_exc()
+    message = " ".join(str(error).split("\n"))
+    if getattr(args, "json", False):
+        print(json.dumps({"error": message}))
+    else:
+        print(f"error: {message}", file=sys.stderr)
+    return code
+
+
+def _check_flags(args, positive=(), outputs=()):
+    """ModelError for a flag given a value the command cannot use: each of ``positive``
+    must be a positive finite number; each of ``outputs`` (flag, suffixes) must be a
+    path in an existing folder, ending in one of the suffixes."""
+    for flag in positive:
+        value = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ModelError(f"{flag} must be a positive number, got {value}")
+    for flag, suffixes in outputs:
+        value = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if value is None:
+            continue
+        if Path(value).suffix.lower() not in suffixes:
+            raise ModelError(f"{flag} {value}: the file must end in {', '.join(suffixes)}")
+        if not Path(value).parent.is_dir():
+            raise ModelError(f"{flag} {value}: the folder {Path(value).parent} does not exist")
 
 
 def _parser():
@@ -46,7 +85,7 @@ def _parser():
                     "remain, 1 when a balance is missing or no motion exists, 2 on a model error.")
     check.add_argument("model", help="model file (YAML)")
     check.add_argument("--json", action="store_true", help="print one JSON object")
-    check.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     check.set_defaults(run=run_check)
 
     sim = commands.add_parser(
@@ -64,7 +103,7 @@ def _parser():
     sim.add_argument("--stabilization", choices=STABILIZATIONS, default="projection",
                      help="drift control (default projection)")
     sim.add_argument("--json", action="store_true", help="print the summary as one JSON object")
-    sim.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    sim.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     sim.set_defaults(run=run_simulate)
 
     sw = commands.add_parser(
@@ -86,7 +125,7 @@ def _parser():
     sw.add_argument("--trajectories", metavar="DIR", help="also save each run's trajectory as DIR/<run_id>.npz")
     sw.add_argument("--dt", type=float, help="output interval of each run [s]")
     sw.add_argument("--json", action="store_true", help="print a summary as one JSON object")
-    sw.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    sw.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     sw.set_defaults(run=run_sweep)
 
     view = commands.add_parser(
@@ -100,7 +139,7 @@ def _parser():
     view.add_argument("--html", metavar="FILE.html", help="write the animation to this file instead of serving it")
     view.add_argument("--axes", action="store_true", help="draw a triad at every body and frame")
     view.add_argument("--joints", action="store_true", help="mark the frames of every joint")
-    view.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    view.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     view.set_defaults(run=run_view)
 
     val = commands.add_parser(
@@ -116,7 +155,7 @@ def _parser():
     val.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     val.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error that passes (default 1e-9)")
     val.add_argument("--json", action="store_true", help="print one JSON object")
-    val.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    val.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     val.set_defaults(run=run_validate)
 
     robots = commands.add_parser(
@@ -124,7 +163,7 @@ def _parser():
         description="List the robots of the example-robot-data package by the names 'mbsynth validate' and "
                     "type: robot accept, with their links, movable joints and whether Pinocchio loads them.")
     robots.add_argument("--json", action="store_true", help="print one JSON object")
-    robots.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    robots.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     robots.set_defaults(run=run_robots)
     return parser
 
@@ -140,6 +179,10 @@ def run_check(args):
 
 
 def run_simulate(args):
+    _check_flags(args, positive=("--t-end", "--dt", "--rtol", "--atol"),
+                 outputs=(("--out", (".npz", ".csv")), ("--plot", PLOT_FORMATS)))
+    if args.method not in INTEGRATORS:
+        raise ModelError(f"--method {args.method}: not one of {', '.join(INTEGRATORS)}")
     system = load(args.model)
     bar = ProgressBar(args.t_end) if sys.stderr.isatty() and not args.json else None
     started = time.perf_counter()
@@ -173,6 +216,7 @@ def run_simulate(args):
 def run_sweep(args):
     from .sweep import parse_range, sweep
 
+    _check_flags(args, positive=("--t-end", "--dt", "--workers"), outputs=(("--out", (".parquet", ".csv")),))
     params = dict(parse_range(p) for p in args.param) if args.param else None
     metrics = args.metric or ["energy_drift", "max_residual"]
     options = {} if args.dt is None else {"dt": args.dt}
@@ -198,6 +242,7 @@ def run_sweep(args):
 def run_view(args):
     from . import viewer
 
+    _check_flags(args, positive=("--t-end",), outputs=(("--html", (".html",)),))
     system = load(args.model)
     status = 0
     if args.trajectory:
@@ -222,6 +267,7 @@ def run_validate(args):
 
     if args.samples < 1:
         raise ModelError("--samples must be at least 1")
+    _check_flags(args, positive=("--tolerance",))
     options = {"samples": args.samples, "seed": args.seed, "tolerance": args.tolerance}
     if args.target.endswith((".yaml", ".yml")):
         started = time.perf_counter()
@@ -331,6 +377,11 @@ def format_check(report, path):
         if report.state_dependent:
             lines.append("    note: these directions depend on the state; the balances hold only "
                          "where the null space keeps this form")
+    condition = "infinite" if report.condition is None else f"{report.condition:.3g}"
+    margin = "" if report.verdict_margin is None else f", verdict margin {report.verdict_margin:.3g}"
+    lines.append(f"  condition number of the equilibrated [M; A] = {condition} "
+                 f"(rank tolerance {report.rank_tolerance:g} × σ_max{margin})")
+    lines += [f"  warning: {warning}" for warning in report.warnings]
     if report.error:
         lines.append(f"  no motion at the initial state: {report.error}")
     else:

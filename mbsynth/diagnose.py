@@ -2,7 +2,9 @@
 
 Counts coordinates and constraints, the ranks of M, A and M̂ = [M; A], whether the
 motion is unique, each indeterminate direction, and for each the balance
-wᵀ(Q + C) = 0 that would close the model (see closure.py).
+wᵀ(Q + C) = 0 that would close the model (see closure.py). How firm the verdict is:
+the condition number of the equilibrated M̂, the rank tolerance, the verdict margin
+(equations.py) and a warning when that margin is below ``VERDICT_MARGIN``.
 """
 
 from dataclasses import asdict, dataclass, field
@@ -10,7 +12,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from .closure import balances
-from .equations import rank_report
+from .equations import VERDICT_MARGIN, rank_report
 from .errors import SolveError
 
 COMPONENT_TOL = 1e-12
@@ -33,6 +35,10 @@ class Diagnosis:
     constraint_residuals: dict
     qdd: dict = field(default_factory=dict)
     error: str = None
+    condition: float = None  # σ₁/σ_n of the equilibrated [M; A]; None when infinite
+    rank_tolerance: float = None  # singular values below rank_tolerance · σ₁ count as zero
+    verdict_margin: float = None  # see RankReport.verdict_margin; None when infinite
+    warnings: list = field(default_factory=list)
 
     @property
     def consistent(self):
@@ -68,7 +74,28 @@ def diagnose(system, t=0.0, q=None, qd=None):
         state_dependent=any(b.state_dependent for b in found),
         closures=[{"constraint": c.constraint, "equation": c.equation, "direction": c.direction,
                    "state_dependent": c.state_dependent} for c in system.closures],
-        constraint_residuals=residuals, qdd=qdd, error=error)
+        constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
+        rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report))
+
+
+def _warnings(report):
+    """A warning for each side of the rank cut-off that a singular value comes close to."""
+    kept, dropped = report.margins
+    found = []
+    if kept < VERDICT_MARGIN:
+        found.append(f"uncertain verdict: the smallest singular value kept in rank [M; A] = {report.rank_Mhat} "
+                     f"is only {kept:.3g} times the cut-off ({report.rtol:g} of the largest, equilibrated); "
+                     "a nearly singular mass or nearly dependent constraints: the motion may in fact not "
+                     "be unique")
+    if dropped < VERDICT_MARGIN:
+        found.append(f"uncertain verdict: the largest singular value of [M; A] counted as zero is only "
+                     f"{dropped:.3g} times below the cut-off ({report.rtol:g} of the largest, equilibrated); "
+                     "the motion may in fact be unique")
+    return found
+
+
+def _finite(x):
+    return float(x) if np.isfinite(x) else None
 
 
 def _components(w, coordinates):

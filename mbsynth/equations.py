@@ -17,7 +17,10 @@ the rank, nor, for consistent data, the minimum-norm solution of (2.12), so the 
 system is solved in place of the literal one. ``RANK_RTOL`` = 1e-12 lies far above the
 rounding noise of evaluated expressions (~n ε ≈ 1e-15) and below any physically meaningful
 mass ratio (after dividing by the largest entry of M). rank M and rank A use the same rule on
-their own blocks.
+their own blocks. How firm a verdict is: the condition number σ₁/σ_n of the equilibrated
+M̂, and the margin between the cut-off rtol σ₁ and the singular values on either side of
+it (the smallest kept one, the largest dropped one); a margin below ``VERDICT_MARGIN``
+means a rounding error or a slightly different parameter could change the rank.
 
 Consistency rule. (2.12) has a solution iff (a) b ∈ range(A) and (b) wᵀ(Q + C) = 0 for
 every w ∈ null([M; A]) (proof in ``constrained_acceleration``). Either failure raises
@@ -43,6 +46,8 @@ RANK_RTOL = 1e-12  # singular values below RANK_RTOL · σ_max of the equilibrat
 CONSISTENCY_RTOL = 1e-9  # least relative size of b ∉ range(A) or of wᵀ(Q + C) that is an error
 SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
 NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
+VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off makes the verdict uncertain
+# (a mass ratio of 1e-9, 1e3 times the cut-off, is a legitimate model and is not flagged)
 
 _EPS = np.finfo(float).eps
 _TINY = np.finfo(float).tiny
@@ -52,7 +57,9 @@ _TINY = np.finfo(float).tiny
 class RankReport:
     """Ranks behind Lemma 3.1 and Result 3 (equilibrated as in the module docstring).
 
-    ``nullspace``: n × (n − rank_Mhat) orthonormal basis of null([M; A]) = null(M̄).
+    ``nullspace``: n × (n − rank_Mhat) orthonormal basis of null([M; A]) = null(M̄);
+    ``singular_values``: those of the equilibrated M̂ (descending); ``rtol``: the rule's
+    relative tolerance.
     """
 
     rank_M: int
@@ -61,11 +68,38 @@ class RankReport:
     n: int
     m: int
     nullspace: np.ndarray
+    singular_values: np.ndarray
+    rtol: float
 
     @property
     def unique(self) -> bool:
         """Result 3: the acceleration is unique iff M̂ = [M; A] has full column rank n."""
         return self.rank_Mhat == self.n
+
+    @property
+    def condition(self) -> float:
+        """σ₁/σ_n of the equilibrated M̂ (inf when σ_n = 0)."""
+        s = self.singular_values
+        return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+
+    @property
+    def margins(self) -> tuple:
+        """(σ_r / cut-off, cut-off / σ_(r+1)) for the cut-off rtol σ₁ and r = rank M̂: how
+        far the smallest kept and the largest dropped singular value lie from it (inf
+        where there is none, or when M̂ = 0)."""
+        s, r = self.singular_values, self.rank_Mhat
+        cut = self.rtol * s[0]
+        if cut == 0:
+            return float("inf"), float("inf")
+        kept = s[r - 1] / cut if r > 0 else float("inf")
+        dropped = cut / s[r] if r < s.size and s[r] > 0 else float("inf")
+        return float(kept), float(dropped)
+
+    @property
+    def verdict_margin(self) -> float:
+        """The smaller of the two ``margins``: below VERDICT_MARGIN the rank, and with it the
+        verdict on uniqueness, is uncertain."""
+        return min(self.margins)
 
 
 @dataclass(frozen=True, eq=False)
@@ -272,7 +306,7 @@ def _rank_report(d: _Data, rtol):
     rank_M = _rank(np.linalg.svd(d.M / d.mu, compute_uv=False), rtol)
     rank_A = _rank(np.linalg.svd(d.Ae, compute_uv=False), rtol) if d.m else 0
     report = RankReport(rank_M=rank_M, rank_A=rank_A, rank_Mhat=r, n=d.n, m=d.m,
-                        nullspace=Vt[r:].T.copy())
+                        nullspace=Vt[r:].T.copy(), singular_values=s, rtol=rtol)
     return report, s
 
 

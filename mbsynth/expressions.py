@@ -141,9 +141,15 @@ class _Translator:
             hint = " (use ** for powers)" if isinstance(node.op, ast.BitXor) else ""
             self.fail(node, f"operator '{self.source(node)}' is not allowed{hint}")
         base, exponent = self.visit(node.left), self.visit(node.right)
-        if _huge_power(base, exponent) or not _in_range(exponent):
+        if _huge_power(base, exponent) or not _finite_real(exponent):
             self.fail(node, f"the power '{self.source(node)}' is too large to compute")
-        return base**exponent
+        return self.real(node, base**exponent)
+
+    def real(self, node, value):
+        """``value`` of ``node``, unless it is a number that is complex or beyond the double range."""
+        if not _finite_real(value):
+            self.fail(node, f"'{self.source(node)}' is not a finite real number")
+        return value
 
     def visit_UnaryOp(self, node):
         if isinstance(node.op, ast.USub):
@@ -174,24 +180,26 @@ class _Translator:
         if node.keywords:
             self.fail(node, f"keyword arguments are not allowed in {name}()")
         args = [self.visit(arg) for arg in node.args]
-        if not all(map(_in_range, args)):
+        if not all(map(_finite_real, args)):
             self.fail(node, f"an argument of '{self.source(node)}' is not finite in double precision")
         try:
-            return FUNCTIONS[name](*args)
+            value = FUNCTIONS[name](*args)
         except (TypeError, ValueError) as err:
             self.fail(node, f"bad call {self.source(node)}: {err}")
+        return self.real(node, value)
 
 
-def _in_range(expr):
-    """Whether ``expr`` is not a number, or a number of the double range (evaluating, say,
-    exp(exp(exp(100))) would need mpmath to reduce an argument of 10^(10^43))."""
+def _finite_real(expr):
+    """Whether ``expr`` is not a number, or a real number of the double range. Checked on
+    every numeric argument and result, so that no evaluation is ever asked of a number
+    beyond it (exp(exp(exp(100))) would need mpmath to reduce an argument of 10^(10^43))."""
     if not expr.is_number:
         return True
     try:
         value = complex(expr.evalf(15))
     except (TypeError, ValueError, OverflowError):
         return False
-    return bool(np.isfinite(value))
+    return bool(np.isfinite(value)) and value.imag == 0
 
 
 def _huge_power(base, exponent):

@@ -125,8 +125,9 @@ class Robot:
         parts = _unique({link: prefix + identifier(link) for link in description.links})
         joints = _unique({j.name: prefix + identifier(j.name) for j in description.joints}
                          | {None: prefix + "fixed_base"})
+        base_joint = joints.pop(None)
         torques = {j.name: f"tau_{joints[j.name]}" for j in description.joints if j.kind != "fixed"}
-        return cls(description, prefix, floating, base, parts, joints, torques, joints.pop(None))
+        return cls(description, prefix, floating, base, parts, joints, torques, base_joint)
 
     @property
     def parameters(self):

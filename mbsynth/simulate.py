@@ -23,6 +23,11 @@ log = logging.getLogger(__name__)
 STABILIZATIONS = ("projection", "baumgarte", "none")
 DEFAULT_OUTPUTS = 500
 MAX_STATE = 1e12  # a coordinate or velocity beyond this counts as an exploding state
+# a step-size collapse: COLLAPSE_CALLS evaluations (~80 steps) advance t by less than
+# COLLAPSE_SPAN of the output interval, or than 1e4 ε |t| (steps near the resolution of t);
+# scipy would crawl on for minutes at that step size before it gives up by itself
+COLLAPSE_CALLS = 1000
+COLLAPSE_SPAN = 1e-8
 
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
@@ -101,6 +106,7 @@ class _Run:
         self.first_step = None
         self.t_failed = float("nan")
         self.non_unique = False
+        self.calls, self.t_mark, self.span = 0, 0.0, 0.0
 
     @property
     def t(self):
@@ -108,6 +114,11 @@ class _Run:
 
     def rhs(self, t, y):
         self.t_failed = t
+        self.calls += 1
+        if self.calls % COLLAPSE_CALLS == 0:
+            if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
+                raise self._collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
+            self.t_mark = t
         q, qd = y[:self.n], y[self.n:]
         motion = self.system.motion(t, q, qd, baumgarte=self.baumgarte)
         self.non_unique |= not motion.unique
@@ -116,6 +127,7 @@ class _Run:
     def advance(self, t_next, q, qd):
         """Integrate to t_next, check the state, project it if asked."""
         t = self.t[-1]
+        self.t_mark, self.span = t, t_next - t
         first_step = min(self.first_step, t_next - t) if self.first_step else None
         sol = solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=self.rtol,
                         atol=self.atol, first_step=first_step)
@@ -123,7 +135,7 @@ class _Run:
         self.steps += len(sol.t) - 1
         if sol.status != 0:
             self.t_failed = sol.t[-1]
-            raise SolveError(f"the integrator gave up: {sol.message}")
+            raise self._collapse(sol.t[-1], sol.y[:, -1], sol.message.rstrip("."))
         steps = np.diff(sol.t)
         self.first_step = steps[-2] if steps.size > 1 else self.first_step  # the last step was cut short
         y = sol.y[:, -1]
@@ -133,6 +145,15 @@ class _Run:
             self.t_failed = t_next
             q, qd = project(self.system, t_next, q, qd)
         return q, qd
+
+    def _collapse(self, t, y, why):
+        """The SolveError of a step-size collapse at (t, y), naming the coordinates of the
+        largest accelerations (within a factor 10 of the largest): what the steps chase."""
+        qdd = np.abs(self.system.motion(t, y[:self.n], y[self.n:], baumgarte=self.baumgarte).qdd)
+        fastest = [(c, a) for c, a in zip(self.system.coordinates, qdd) if a >= qdd.max() / 10]
+        return SolveError(f"step-size collapse, the integrator gave up ({why}); fastest changing: "
+                          f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}",
+                          coordinates=[c for c, _ in fastest])
 
     def _check(self, t, y):
         bad = ~np.isfinite(y) | (np.abs(y) > MAX_STATE)

@@ -9,11 +9,17 @@
 - ``compile_function(args, exprs)``: one fast numpy function for many expressions.
 """
 
+import functools
+
 import numpy as np
 import sympy as sp
 
 T_SYMBOL = sp.Symbol("t")
 _LARGEST = sp.Float(np.finfo(float).max)
+# pi and e as numpy floats, so that all arithmetic of a compiled expression is numpy's:
+# Python floats raise on overflow and division by zero ((2*pi + 1e308)**251, 1/(1 - t) at
+# t = 1) where numpy's give inf, which the checks of M, Q, A, b then report
+_FLOAT64 = {"pi": np.float64(np.pi), "e": np.float64(np.e)}
 SIMPLIFY_MAX_OPS = 60  # sympy.simplify takes seconds beyond this, growing fast (nested sin, exp)
 
 
@@ -88,15 +94,30 @@ def compile_function(args, exprs):
         def empty(*_):
             return tuple(np.zeros(s) for s in shapes)
         return empty
-    raw = sp.lambdify(args, [_beyond_double_as_inf(x) for x in flat], modules="numpy", cse=True, dummify=True)
+    raw = _lambdify(_frozen(args), tuple(flat))
     sizes = [int(np.prod(s)) for s in shapes]
     splits = np.cumsum(sizes)[:-1]
 
     def evaluate(*values):
-        out = np.asarray(raw(*values), dtype=float)
+        values = [np.float64(v) if isinstance(v, (int, float)) else v for v in values]
+        with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
+            out = np.asarray(raw(*values), dtype=float)
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
 
     return evaluate
+
+
+@functools.lru_cache(maxsize=1024)
+def _lambdify(args, flat):
+    """The numpy function of (args) -> [flat], made once per distinct (args, flat): models
+    loaded again (a sweep's workers, a file checked then simulated) reuse it."""
+    return sp.lambdify(args, [_beyond_double_as_inf(x) for x in flat], modules=[_FLOAT64, "numpy"], cse=True,
+                       dummify=True)
+
+
+def _frozen(args):
+    """``args`` with its lists made tuples (hashable), nested."""
+    return tuple(_frozen(a) if isinstance(a, (list, tuple)) else a for a in args)
 
 
 def _beyond_double_as_inf(expr):

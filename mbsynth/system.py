@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
-from . import equations, friction, solvers
+from . import equations, fast, friction, solvers
 from .errors import ModelError
 
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
@@ -197,8 +197,11 @@ class System:
 
     def motion(self, t, q, qd, method="fast", baumgarte=None):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
-        Qc, residual). ``method``: "fast" (KKT, falling back to the exact treatment when
-        it is not well posed) or "reference" (the literal pseudo-inverse of (2.14)).
+        Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
+        (2.14)). "fast" is the linear-time tree path (``mbsynth.fast``) once its compiled
+        kernels are ready (they build in the background on first use) and where its checks
+        pass, else the KKT path; both fall back to the exact treatment when the problem is
+        not well posed.
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
         residuals (drift control during integration; b itself when they are zero).
         Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``
@@ -206,6 +209,10 @@ class System:
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
+        if method == "fast":
+            motion = self._tree_motion(t, q, qd, baumgarte)
+            if motion is not None:
+                return motion
         arrays = self.evaluate(t, q, qd)
         b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
 
@@ -215,6 +222,20 @@ class System:
         if any(getattr(con, "coulomb", None) for con in self.constraints):  # C depends on q̈ (friction.py)
             return friction.coulomb_motion(self.constraints, arrays, solve, t, q, qd, self.parameter_values)
         return solve(arrays.C)
+
+    def _tree_motion(self, t, q, qd, baumgarte):
+        """The Motion from mbsynth.fast, or None: kernels not ready, model not covered (no
+        rigid body or particle, Coulomb friction) or a case for the exact treatment."""
+        engine = fast.engine_for(self)
+        if engine is None:
+            return None
+        shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
+        return engine.motion(t, q, qd, shift)
+
+    def motion_batch(self, t, q_batch, qd_batch):
+        """q̈ at many states, one per row of ``q_batch`` and ``qd_batch`` (t: a number or one
+        per row), in parallel: (qdd (B × n), unique (B,)). See ``mbsynth.fast.batch``."""
+        return fast.motion_batch(self, t, q_batch, qd_batch)
 
     def _stabilized(self, t, q, qd, b, alpha, beta):
         phi, psi = self.constraint_residuals(t, q, qd)

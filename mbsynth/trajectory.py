@@ -9,8 +9,10 @@ position and velocity constraint residuals, and the total energy. Files:
 
 ``TrajectoryWriter`` writes while a run goes on, so an interrupted or failed run keeps
 everything computed so far, and never leaves half a file under the final name: CSV
-rows are appended to ``FILE.partial`` (renamed to FILE when the run ends, however it
-ends); NPZ is checkpointed to a temporary file that replaces FILE atomically.
+rows are appended to ``FILE.partial`` (cut back to its last complete row and renamed to
+FILE when the run ends, however it ends; a killed run leaves only FILE.partial); NPZ is
+checkpointed to a temporary file that replaces FILE atomically (and is removed if
+writing it fails).
 """
 
 import csv
@@ -100,7 +102,7 @@ class TrajectoryWriter:
         self.path = Path(path)
         if self.path.suffix not in FORMATS:
             raise ModelError(f"{self.path}: output must end in {' or '.join(FORMATS)}")
-        if not self.path.parent.exists():
+        if not self.path.parent.is_dir():
             raise ModelError(f"{self.path}: the folder {self.path.parent} does not exist")
         self.coordinates = tuple(coordinates)
         self.checkpoint_seconds = checkpoint_seconds
@@ -109,9 +111,16 @@ class TrajectoryWriter:
         self._last_checkpoint = time.monotonic()
         if self.path.suffix == ".csv":
             self._partial = self.path.with_name(self.path.name + ".partial")
-            self._csv_file = self._partial.open("w", newline="")
+            try:
+                self._csv_file = self._partial.open("w", newline="")
+            except OSError as err:
+                raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
             self._csv = csv.writer(self._csv_file)
             self._csv.writerow(["t", *self.coordinates, *(c + "_dot" for c in self.coordinates), "energy"])
+            self._csv_file.flush()
+            self._complete = self._csv_file.tell()  # bytes of complete rows
+        else:
+            self._write_npz()  # an empty file at once: a path that cannot be written fails before the run
 
     def __enter__(self):
         return self
@@ -126,6 +135,7 @@ class TrajectoryWriter:
                 self._csv.writerow([repr(float(row[0])), *map(repr, map(float, row[1])),
                                     *map(repr, map(float, row[2])), repr(float(row[3]))])
             self._csv_file.flush()
+            self._complete = self._csv_file.tell()
         else:
             self._chunks.append(traj)
             if time.monotonic() - self._last_checkpoint > self.checkpoint_seconds:
@@ -135,6 +145,7 @@ class TrajectoryWriter:
         """Finish the file under its final name, whatever the state of the run."""
         if self.path.suffix == ".csv":
             self._csv_file.close()
+            os.truncate(self._partial, self._complete)  # drop a row cut short by a failed write
             os.replace(self._partial, self.path)
         else:
             self._write_npz()
@@ -151,7 +162,13 @@ class TrajectoryWriter:
             return np.concatenate(parts)
 
         tmp = self.path.with_name(self.path.name + ".tmp.npz")
-        np.savez(tmp, t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
-                 energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
-                 residual_velocity=stack("residual_velocity"), status=np.array(self.status))
-        os.replace(tmp, self.path)
+        try:
+            np.savez(tmp, t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
+                     energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
+                     residual_velocity=stack("residual_velocity"), status=np.array(self.status))
+            os.replace(tmp, self.path)
+        except BaseException as err:
+            tmp.unlink(missing_ok=True)
+            if isinstance(err, OSError):
+                raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
+            raise

@@ -63,10 +63,11 @@ class Description:
         """The joints that hang links from ``link``."""
         return [j for j in self.joints if j.parent == link]
 
-    def zero_poses(self, base=(np.zeros(3), np.eye(3))):
+    def zero_poses(self, base=None):
         """World (position, rotation) of every link's frame with all joints at zero and
-        the root link's frame at ``base``."""
-        poses = {self.root: (np.asarray(base[0], float), np.asarray(base[1], float))}
+        the root link's frame at ``base`` (the world origin by default)."""
+        position, rotation = (np.zeros(3), np.eye(3)) if base is None else base
+        poses = {self.root: (np.asarray(position, float), np.asarray(rotation, float))}
         for joint in self.tree_order():
             p, R = poses[joint.parent]
             poses[joint.child] = (p + R @ joint.position, R @ joint.rotation)

@@ -109,7 +109,7 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
     links = len(system.subsystems)
     note = notes[0] if notes else ""
     return Validation(label or system.name, base, links, twin.model.nv, samples, float(worst_abs), float(worst_rel),
-                      not notes and worst_rel <= tolerance, tolerance, round(build_s, 3),
+                      bool(not notes and worst_rel <= tolerance), tolerance, round(build_s, 3),
                       round(1e3 * float(np.mean(seconds)), 3) if seconds else 0.0, note)
 
 

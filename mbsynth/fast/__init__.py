@@ -10,11 +10,13 @@
     kernel.py      the whole evaluation and its checks
     engine.py      an Engine per System: motion, motion_batch
     background.py  building Engines off the caller's thread; MBSYNTH_FAST
+    batch.py       System.motion_batch
     cache.py       where compiled code is kept
 
 Importing this package does not import numba (``mbsynth check`` never needs it).
 """
 
 from .background import engine_for
+from .batch import motion_batch
 
-__all__ = ["engine_for"]
+__all__ = ["engine_for", "motion_batch"]

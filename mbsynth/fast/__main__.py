@@ -2,6 +2,8 @@
 
 import time
 
+import numpy as np
+
 from . import cache
 
 
@@ -10,7 +12,10 @@ def main():
     from . import background
     from ..io import loads
     for text in WARM_MODELS:
-        background.build(loads(text, "warm-up"))
+        system = loads(text, "warm-up")
+        engine = background.build(system)
+        q, qd = system.initial_state()
+        engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
     print(f"mbsynth fast path compiled into {cache.cache_dir()} in {time.perf_counter() - started:.1f} s")
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from .bodies import OPTIONS, body_force, rate, reduce_row
-from .joints import MAX_ROWS, RIGID, joint_rows
+from .joints import MAX_ROWS, RIGID, joint_rows, vector_work
 
 MAX_BLOCK = 6 + MAX_ROWS
 
@@ -72,11 +72,11 @@ def make_work(L):
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
     shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, acc=(N, 6, 6), J=(rows, 6), P=(rows, 6), rb=rows,
-                  Dinv=dsize, ry=nz, y=nz, z=nz, z0=nz, w=nz, V=(9, 3, 17), R=(2, 3, 3), Jt=(3, 4), A=(MAX_ROWS, 14),
-                  b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
+                  Dinv=dsize, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
                   rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
-    return Work(perm=np.zeros(MAX_BLOCK, np.int64), **arrays)
+    V, R, Jt = vector_work()
+    return Work(perm=np.zeros(MAX_BLOCK, np.int64), V=V, R=R, Jt=Jt, **arrays)
 
 
 @njit(**OPTIONS)

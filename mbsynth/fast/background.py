@@ -23,6 +23,7 @@ log = logging.getLogger(__name__)
 MODES = ("background", "wait", "off")
 
 _engines = {}  # id(system) -> Future of its Engine (None when the fast path does not apply)
+_ready = {}  # id(system) -> its Engine, once built (the quick answer)
 _lock = threading.Lock()
 _tasks = queue.Queue()
 _worker = None
@@ -37,6 +38,9 @@ def mode():
 
 def engine_for(system, wait=False):
     """The Engine of ``system`` when it is ready (``wait``: build it now), else None."""
+    engine = _ready.get(id(system))
+    if engine is not None:
+        return engine
     setting = mode()
     if setting == "off":
         return None
@@ -57,12 +61,17 @@ def _submit(system):
         key = id(system)
         if key not in _engines:
             _engines[key] = Future()
-            weakref.finalize(system, _engines.pop, key, None)
+            weakref.finalize(system, _forget, key)
             _tasks.put((weakref.ref(system), _engines[key]))
             if _worker is None:
                 _worker = threading.Thread(target=_work, name="mbsynth-compile", daemon=True)
                 _worker.start()
         return _engines[key]
+
+
+def _forget(key):
+    _engines.pop(key, None)
+    _ready.pop(key, None)
 
 
 def _work():
@@ -72,7 +81,10 @@ def _work():
         if system is None or not future.set_running_or_notify_cancel():
             continue
         try:
-            future.set_result(build(system))
+            engine = build(system)
+            if engine is not None:
+                _ready[id(system)] = engine
+            future.set_result(engine)
         except Exception as err:
             log.warning("model %s: the fast path is unavailable (%s: %s); using the KKT path",
                         system.name, type(err).__name__, err)

@@ -17,7 +17,6 @@ The norm row's multiplier only balances the s component, which no other unknown 
 the row and its multiplier leave the system exactly (an orthogonal change of variables).
 """
 
-import numpy as np
 from numba import njit
 
 OPTIONS = dict(cache=True, error_model="numpy")

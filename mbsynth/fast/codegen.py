@@ -15,6 +15,7 @@ Models that differ only in parameter values share the module: parameters are inp
 import hashlib
 import importlib.util
 import os
+import sys
 import threading
 
 import sympy as sp
@@ -75,6 +76,7 @@ def compile_expressions(exprs, q, qd, p):
             os.replace(partial, path)
         spec = importlib.util.spec_from_file_location(path.stem, path)
         module = importlib.util.module_from_spec(spec)
+        sys.modules[path.stem] = module  # numba's cache finds the functions' module by name
         spec.loader.exec_module(module)
         _modules[digest] = module
         return module

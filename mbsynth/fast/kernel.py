@@ -15,7 +15,8 @@ must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 Status: OK, or why the caller must hand the problem to the exact treatment — a singular
 tree block (SINGULAR), the two cases above, a residual above ``RESIDUAL_MAX`` or a
 non-finite result. ``residual`` is the relative residual of the equilibrated KKT
-equations M q̈ + Aᵀλ = Q + C, A q̈ = b (it bounds that of (2.12): P Aᵀ = 0, ‖P‖ = 1).
+equations M q̈ + Aᵀλ = Q + C, A q̈ = b (its numerator bounds that of (2.12), since
+P Aᵀ = 0 and ‖P‖ = 1).
 """
 
 import math
@@ -26,14 +27,12 @@ from numba import njit
 from .assembly import Work, divide_masses, extra_rows, generated, nodes, tree_rhs, tree_rows
 from .bodies import OPTIONS, rate_transpose
 from .eigen import symmetric_eigen
+from .joints import RIGID
 from .layout import Layout
 from .packing import fields, view1, view2, view3, view4
-from .joints import RIGID
 from .tree import factor, solve
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
-REASONS = ("ok", "a singular tree block", "contradictory extra rows", "a free direction",
-           "a large residual", "a value that is not finite")
 EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of the largest count as zero
 CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions
 NULL_RTOL = 1e-8  # largest acceleration a dropped (unit) direction may move

@@ -19,7 +19,6 @@ reports a pivot below ``PIVOT_RTOL`` of the block's largest entry as singular: t
 then hands the problem to the exact treatment.
 """
 
-import numpy as np
 from numba import njit
 
 from .bodies import OPTIONS

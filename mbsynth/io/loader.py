@@ -83,8 +83,7 @@ class _Builder:
     def constant(self, text, path):
         """An expression of parameters only (a mass, a length), checked finite and real."""
         expr = self.expression(text, path, self.param_symbols)
-        value = complex(expr.subs(self.param_values).evalf())
-        if value.imag != 0 or not np.isfinite(value.real):
+        if _real(expr, self.param_values) is None:
             self.fail(path, f"{text!r} is not a finite real number")
         return expr
 
@@ -105,8 +104,12 @@ class _Builder:
 
     def numbers(self, node, path, size):
         """A list of ``size`` floats (expressions of parameters allowed)."""
+        return [self.value(x) for x in self.constants(node, path, size)]
+
+    def constants(self, node, path, size):
+        """A sympy column of ``size`` expressions of parameters, each finite and real."""
         node = self.sized_list(node, path, size)
-        return [self.value(self.constant(x, path + (i,))) for i, x in enumerate(node)]
+        return sp.Matrix([self.constant(x, path + (i,)) for i, x in enumerate(node)])
 
     def part_symbols(self, name, coordinates):
         """The model's symbols of a part's coordinates and velocities."""
@@ -123,7 +126,7 @@ class _Builder:
         self.robots = read_robots(self)  # before any part is built: their torque parameters join the model's
         self.param_symbols = {p: sp.Symbol(p) for p in self.parameters}
         self.param_values = {sp.Symbol(k): v for k, v in self.parameters.items()}
-        self.gravity = self.vector(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3, self.param_symbols)
+        self.gravity = self.constants(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3)
         self.world_frames = {f.name: f for f in read_world(self)}
         parts = self.read_subsystems()
         self.parts = {part.name: part for part in parts}
@@ -162,10 +165,10 @@ class _Builder:
             path = ("parameters", key)
             self.identifier(key, path, "parameter")
             expr = self.expression(text, path, symbols)
-            value = complex(expr.subs(values).evalf())
-            if value.imag != 0 or not np.isfinite(value.real):
+            value = _real(expr, values)
+            if value is None:
                 self.fail(path, f"parameter '{key}' = {text!r} is not a finite real number")
-            values[sp.Symbol(key)] = value.real
+            values[sp.Symbol(key)] = value
             symbols[key] = sp.Symbol(key)
             self.definitions[key] = expr
         return {str(k): v for k, v in values.items()}
@@ -333,6 +336,16 @@ class _Builder:
 SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,
                    "particle": read_particle, "planar_body": read_planar_body, "spring": read_spring,
                    "robot": read_robot}
+
+
+def _real(expr, values):
+    """The float value of ``expr`` at the parameter ``values``, or None when that is not a
+    finite real number."""
+    try:
+        value = complex(expr.subs(values).evalf())
+    except (TypeError, ValueError, OverflowError):  # a value sympy cannot make a number
+        return None
+    return value.real if value.imag == 0 and np.isfinite(value.real) else None
 
 
 def _kind(value):

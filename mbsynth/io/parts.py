@@ -148,8 +148,8 @@ def read_frames(builder, part, node, path, offsets, symbols=None):
         builder.identifier(name, fpath, "frame name")
         spec = builder.mapping(spec, fpath,
                                {"position", "geometry", *ORIENTATION_KEYS})
-        position = builder.vector(spec.get("position", [0, 0, 0]), fpath + ("position",), 3,
-                                  symbols or builder.param_symbols)
+        position = (builder.vector(spec.get("position", [0, 0, 0]), fpath + ("position",), 3, symbols) if symbols
+                    else builder.constants(spec.get("position", [0, 0, 0]), fpath + ("position",), 3))
         if not offsets and any(x != 0 for x in position):
             builder.fail(fpath + ("position",), "a particle is a point: its frames cannot be offset")
         rotation = sp.Matrix(read_rotation(builder, spec, fpath))

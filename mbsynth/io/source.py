@@ -78,18 +78,25 @@ class _Loader(yaml.SafeLoader):
 
 
 def _construct_mapping(loader, node):
+    """A LineDict; a key given twice is an error, except that a key of the mapping itself
+    overrides one merged in with ``<<: *anchor`` (merged pairs come first, YAML's rule)."""
+    own = sum(key_node.tag != "tag:yaml.org,2002:merge" for key_node, _ in node.value)
     loader.flatten_mapping(node)
+    merged = len(node.value) - own
     mapping = LineDict()
     mapping.line = node.start_mark.line + 1
     mapping.key_lines = {}
-    for key_node, value_node in node.value:
+    own_keys = set()
+    for i, (key_node, value_node) in enumerate(node.value):
         key = loader.construct_object(key_node, deep=True)
         line = key_node.start_mark.line + 1
         if not isinstance(key, (str, int, float)):
             raise ModelError(f"{loader.name}:{line}: mapping keys must be plain names, got {key!r}")
-        if key in mapping:
+        if key in own_keys:
             raise ModelError(f"{loader.name}:{line}: duplicate key '{key}' "
                              f"(first given on line {mapping.key_lines[key]})")
+        if i >= merged:
+            own_keys.add(key)
         mapping[key] = loader.construct_object(value_node, deep=True)
         mapping.key_lines[key] = line
     return mapping

@@ -1,0 +1,324 @@
+"""The fast path (mbsynth.fast): its hand-differentiated rows and body blocks against the
+sympy-compiled ones, its accelerations against the reference (2.14) on every model file and
+on random chains, trees and loops, its fallback to the exact treatment, and the batch.
+
+The kernels compile once per machine (numba's cache); ``engine_for(..., wait=True)``
+builds an Engine synchronously, so each test knows the tree path answered.
+"""
+
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbsynth as mb
+from mbsynth.connectors import Joint
+from mbsynth.errors import SolveError
+from mbsynth.fast import engine_for
+from mbsynth.fast.bodies import body_force, rate_transpose
+from mbsynth.fast.joints import vector_work
+from mbsynth.fast.joints import joint_rows as kernel_rows
+from mbsynth.fast.layout import build as build_layout
+from mbsynth.kinematics import body_rate_matrix
+from mbsynth.subsystems import RigidBody
+
+MODELS = sorted((Path(__file__).resolve().parent.parent / "models").glob("**/*.yaml"))
+TREE = "tree (Baraff)"
+
+# Every joint kind once, between bodies, a particle and the world, with frames turned and
+# offset (rpy, axis), and a loop: a distance rod from the last body back to the world.
+ALL_JOINTS = """
+name: all_joints
+parameters: {m: 1.3, L: 0.4}
+gravity: [0.3, -0.2, -9.81]
+world:
+  frames:
+    pivot: {position: [0.1, -0.2, 1.5], rpy: [0.3, -0.2, 0.5]}
+    hook: {position: [0.7, 0.4, 0.2], axis: [1, 1, 0]}
+subsystems:
+  b0: {type: rigid_body, mass: m, inertia: [[0.05, 0.01, 0], [0.01, 0.04, 0.002], [0, 0.002, 0.03]],
+       frames: {top: {position: [0, 0, L], rpy: [0.1, 0.2, 0.3]}, low: {position: [0.1, 0, -L], axis: [0, 1, 1]}}}
+  b1: {type: rigid_body, mass: 0.7, inertia: [0.02, 0.03, 0.04],
+       frames: {a: {position: [0.05, 0.1, 0.2], rpy: [-0.4, 0.1, 0.2]}, b: {position: [0, -0.1, -0.3]}}}
+  b2: {type: rigid_body, mass: 0.9, inertia: [0.03, 0.02, 0.02],
+       frames: {a: {position: [0.1, 0, 0.1], axis: [1, 0, 1]}, b: {position: [-0.1, 0.2, 0], rpy: [0.5, 0, 0]}}}
+  b3: {type: rigid_body, mass: 1.1, inertia: [0.04, 0.05, 0.02],
+       frames: {a: {position: [0, 0.1, 0.1], rpy: [0, 0.3, -0.2]}, b: {position: [0.2, 0, 0]}}}
+  b4: {type: rigid_body, mass: 0.5, inertia: [0.01, 0.02, 0.02],
+       frames: {a: {position: [0, 0, 0.2], rpy: [0.2, 0.2, 0.2]}, b: {position: [0.1, 0.1, 0], axis: [0, 0, 1]}}}
+  bob: {type: particle, mass: 0.3}
+  b5: {type: rigid_body, mass: 0.6, inertia: [0.02, 0.02, 0.01], frames: {a: {position: [0, 0.1, 0.3]}}}
+joints:
+  - {name: j_spherical, type: spherical, parent: world.pivot, child: b0.top}
+  - {name: j_revolute, type: revolute, parent: b0.low, child: b1.a}
+  - {name: j_universal, type: universal, parent: b1.b, child: b2.a}
+  - {name: j_cylindrical, type: cylindrical, parent: b2.b, child: b3.a}
+  - {name: j_prismatic, type: prismatic, parent: b3.b, child: b4.a}
+  - {name: j_fixed, type: fixed, parent: b4.b, child: b5.a}
+  - {name: j_distance, type: distance, parent: b4, child: bob, length: 0.35}
+  - {name: j_world_revolute, type: revolute, parent: world.hook, child: b5}
+"""
+
+
+def loads(text):
+    return mb.loads(textwrap.dedent(text), name="model.yaml")
+
+
+def rel(x, y):
+    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
+
+
+def random_state(system, rng, unit=True, spread=1.0):
+    """Random coordinates and velocities; quaternions of unit length unless ``unit`` is False."""
+    q = spread * rng.standard_normal(system.n)
+    qd = rng.standard_normal(system.n)
+    for part, start in zip(system.subsystems, np.cumsum([0] + [len(p.coordinates) for p in system.subsystems])):
+        if isinstance(part, RigidBody):
+            u = q[start + 3:start + 7]
+            q[start + 3:start + 7] = u / np.linalg.norm(u) * (1.0 if unit else rng.uniform(0.7, 1.4))
+    return q, qd
+
+
+@pytest.fixture(scope="module")
+def all_joints():
+    return loads(ALL_JOINTS)
+
+
+def test_joint_rows_equal_the_sympy_rows(all_joints):
+    """joints.joint_rows (differentiated by hand) against Joint.evaluate (sympy), every kind,
+    at random states with quaternions of any length (the forms are homogeneous)."""
+    system = all_joints
+    L, _ = build_layout(system)
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
+    assert len(L.joint_k) == len(kernel_joints) == 8
+    V, R, Jt = vector_work()
+    A, b = np.zeros((6, 14)), np.zeros(6)
+    rng = np.random.default_rng(3)
+    for trial in range(5):
+        q, qd = random_state(system, rng, unit=trial % 2 == 0)
+        for j, con in enumerate(kernel_joints):
+            a_ref, b_ref, _ = con.evaluate(0.0, q, qd, system.parameter_values)
+            k = int(L.joint_k[j])
+            kernel_rows(L.joint_program[j], k, L.joint_kinds[j], L.joint_start[j], L.joint_s[j], L.joint_R[j],
+                        L.joint_length[j], q, qd, V, R, Jt, A, b)
+            full = np.zeros((k, system.n))
+            for e in range(2):
+                if L.joint_kinds[j, e]:
+                    width = 7 if L.joint_kinds[j, e] == 1 else 3
+                    full[:, L.joint_start[j, e]:L.joint_start[j, e] + width] += A[:k, 7 * e:7 * e + width]
+            expected = np.zeros((k, system.n))
+            expected[:, con.indices] = a_ref
+            assert np.abs(full - expected).max() <= 1e-12 * max(1.0, np.abs(expected).max()), con.joint_kind
+            assert np.abs(b[:k] - b_ref).max() <= 1e-12 * max(1.0, np.abs(b_ref).max()), con.joint_kind
+
+
+def test_body_blocks_equal_the_sympy_blocks(all_joints):
+    """Q of bodies.body_force and the reduced mass blockdiag(0, 4ν²J) = U (4EᵀJE) Uᵀ with
+    U = [uᵀ; E(u)]/ν, against RigidBody.evaluate."""
+    system = all_joints
+    rng = np.random.default_rng(5)
+    part = system.subsystems[0]
+    values = dict(zip(system.parameter_symbols, system.parameter_values))
+    J = np.array(part.inertia.subs(values).tolist(), dtype=float)
+    mg = np.array(part.Q[:3, 0].subs(values).tolist(), dtype=float).ravel()
+    for _ in range(5):
+        q, qd = rng.standard_normal(7), rng.standard_normal(7)
+        M, Q = part.evaluate(0.0, q, qd, system.parameter_values)
+        out = np.zeros(7)
+        body_force(mg, J, q[3:], qd[3:], out)
+        assert rel(out, Q) < 1e-13
+        u = q[3:]
+        nu = np.linalg.norm(u)
+        E = np.array(body_rate_matrix(list(u)).tolist(), dtype=float)
+        U = np.vstack([u, E]) / nu
+        assert np.allclose(U @ U.T, np.eye(4), atol=1e-14)
+        reduced = U @ M[3:, 3:] @ U.T
+        assert np.abs(reduced[0]).max() < 1e-12 * np.abs(M).max()
+        assert rel(reduced[1:, 1:], 4 * nu**2 * J) < 1e-13
+        assert np.allclose(rate_transpose(u, (1.0, 2.0, 3.0)), E.T @ [1.0, 2.0, 3.0], atol=1e-14)
+
+
+def assert_same_motion(system, t, q, qd, *, rtol=1e-10):
+    """The fast path answers, and as (2.15) does."""
+    engine = engine_for(system, wait=True)
+    assert engine is not None
+    fast = engine.motion(t, q, qd)
+    ref = system.motion(t, q, qd, method="reference")
+    assert ref.unique
+    assert fast is not None and fast.method == TREE
+    assert rel(fast.qdd, ref.qdd) < rtol
+    assert rel(fast.Qc, ref.Qc) < 1e3 * rtol
+    assert fast.unique and fast.nullspace.shape == (system.n, 0) and fast.residual < 1e-12
+    return fast
+
+
+def test_all_joints_and_a_loop_agree_with_the_reference(all_joints):
+    rng = np.random.default_rng(11)
+    for _ in range(4):
+        q, qd = random_state(all_joints, rng)
+        assert_same_motion(all_joints, 0.0, q, qd)
+
+
+@pytest.mark.parametrize("path", MODELS, ids=[f"{p.parent.name}/{p.name}" for p in MODELS])
+def test_every_model_file(path):
+    """Wherever the kernels cover a model: at its initial state and nearby states, the same
+    acceleration as (2.15) when that is unique, the same verdict or error when not."""
+    system = mb.load(path)
+    engine = engine_for(system, wait=True)
+    if engine is None:
+        assert build_layout(system) is None
+        return
+    rng = np.random.default_rng(1)
+    q0, qd0 = system.initial_state()
+    for trial in range(3):
+        q = q0 if trial == 0 else q0 + 0.02 * rng.standard_normal(system.n)
+        qd = qd0 if trial == 0 else qd0 + 0.3 * rng.standard_normal(system.n)
+        try:
+            ref = system.motion(0.25, q, qd, method="reference")
+        except SolveError as err:
+            with pytest.raises(SolveError) as caught:
+                system.motion(0.25, q, qd)
+            assert str(caught.value) == str(err)
+            continue
+        fast = engine.motion(0.25, q, qd)
+        if not ref.unique:
+            assert fast is None
+            motion = system.motion(0.25, q, qd)
+            assert not motion.unique and motion.nullspace.shape == ref.nullspace.shape
+            assert rel(motion.qdd, ref.qdd) < 1e-8
+            continue
+        assert fast is not None and rel(fast.qdd, ref.qdd) < 1e-10, path.name
+
+
+def numbers(values):
+    return "[" + ", ".join(f"{float(x):.6f}" for x in values) + "]"
+
+
+def chain(count, kinds, masses, rng, loop=None):
+    """A random open chain of rigid bodies hanging from the world; ``loop``: a distance rod
+    (or a second spherical joint, 'redundant') from the last body back to the world."""
+    lines = ["name: chain", "gravity: [0, 0, -9.81]", "subsystems:"]
+    for i in range(count):
+        moments = np.sort(rng.uniform(0.01, 0.05, 3))
+        moments[2] = min(moments[2], 0.9 * (moments[0] + moments[1]))
+        top, low = rng.uniform(-0.2, 0.2, 3) + [0, 0, 0.3], rng.uniform(-0.2, 0.2, 3) - [0, 0, 0.3]
+        rpy_top, rpy_low = [rng.uniform(-0.5, 0.5), 0, 0], [0, 0, rng.uniform(-0.5, 0.5)]  # sparse: quick sympy
+        lines.append(f"  b{i}: {{type: rigid_body, mass: {masses[i]:.6f}, inertia: {numbers(moments)}, frames: "
+                     f"{{top: {{position: {numbers(top)}, rpy: {numbers(rpy_top)}}}, "
+                     f"low: {{position: {numbers(low)}, rpy: {numbers(rpy_low)}}}}}}}")
+    lines.append("joints:")
+    for i, kind in enumerate(kinds):
+        parent = "world" if i == 0 else f"b{i - 1}.low"
+        extra = ", length: 0.3" if kind == "distance" else ""
+        lines.append(f"  - {{name: j{i}, type: {kind}, parent: {parent}, child: b{i}.top{extra}}}")
+    if loop == "rod":
+        lines.append(f"  - {{name: closing, type: distance, parent: world, child: b{count - 1}.low, length: 1.0}}")
+    elif loop == "redundant":
+        lines.append("  - {name: again, type: spherical, parent: world, child: b0.top}")
+    return loads("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_chains(seed):
+    """Random joint kinds and frames; seed 1 has a massless body inside the chain (its block
+    is singular alone, invertible with its child's fixed joint), seed 2 closes a loop with a
+    rod, seed 3 repeats the first joint (three redundant rows)."""
+    rng = np.random.default_rng(seed)
+    count = 3
+    kinds = list(rng.choice(["spherical", "revolute", "universal", "cylindrical", "prismatic"], count))
+    masses = list(rng.uniform(0.5, 2.0, count))
+    if seed == 1:
+        masses[1], kinds[2] = 0.0, "fixed"
+    if seed == 3:
+        kinds[0] = "spherical"
+    system = chain(count, kinds, masses, rng, loop={2: "rod", 3: "redundant"}.get(seed))
+    for _ in range(2):
+        q, qd = random_state(system, rng)
+        assert_same_motion(system, 0.0, q, qd)
+
+
+def test_indeterminate_and_inconsistent_cases_fall_back():
+    """A massless leaf body on a spherical joint can spin freely (not unique); a row
+    contradicting a fixed joint (no motion); a force on a massless particle (no motion):
+    the same verdict and the same SolveError as (2.14)."""
+    free = loads("""
+        name: free_spin
+        subsystems:
+          heavy: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1], frames: {tip: {position: [0, 0, -0.5]}}}
+          ghost: {type: rigid_body, mass: 0.0, inertia: [0, 0, 0]}
+        gravity: [0, 0, -9.81]
+        joints:
+          - {name: hang, type: spherical, parent: world, child: heavy}
+          - {name: tip, type: spherical, parent: heavy.tip, child: ghost}
+        """)
+    q, qd = free.initial_state()
+    assert engine_for(free, wait=True).motion(0.0, q, qd) is None
+    motion, ref = free.motion(0.0, q, qd), free.motion(0.0, q, qd, method="reference")
+    assert not motion.unique and motion.nullspace.shape == ref.nullspace.shape == (14, 3)
+    assert rel(motion.qdd, ref.qdd) < 1e-10
+
+    contradiction = loads("""
+        name: contradiction
+        subsystems:
+          block: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1]}
+        joints:
+          - {name: weld, type: fixed, parent: world, child: block}
+        constraints:
+          - {name: push, acceleration: {A: {block.z: 1}, b: 1}}
+        """)
+    pushed = loads("""
+        name: pushed
+        subsystems:
+          dot: {type: particle, mass: 0.0}
+        forces:
+          - {name: shove, type: force, at: dot, value: [1, 0, 0]}
+        """)
+    for system in (contradiction, pushed):
+        q, qd = system.initial_state()
+        assert engine_for(system, wait=True).motion(0.0, q, qd) is None
+        with pytest.raises(SolveError) as ref:
+            system.motion(0.0, q, qd, method="reference")
+        with pytest.raises(SolveError) as fast:
+            system.motion(0.0, q, qd)
+        assert str(fast.value) == str(ref.value)
+        assert fast.value.constraints == ref.value.constraints and fast.value.coordinates == ref.value.coordinates
+
+
+def test_batch_equals_single_states(all_joints):
+    """motion_batch row by row equals motion; a state the kernels hand back (a NaN) is
+    reported as the exact path reports it, naming its row."""
+    system = mb.load(next(p for p in MODELS if p.name == "spring_pendulum.yaml"))
+    rng = np.random.default_rng(2)
+    states = [random_state(system, rng) for _ in range(37)]
+    q, qd = np.array([s[0] for s in states]), np.array([s[1] for s in states])
+    t = rng.uniform(0, 2, len(states))
+    qdd, unique = system.motion_batch(t, q, qd)
+    assert unique.all()
+    engine = engine_for(system, wait=True)
+    for row in range(len(states)):
+        assert rel(qdd[row], engine.motion(t[row], q[row], qd[row]).qdd) < 1e-14
+    for row in range(3):  # the reference's own rounding reaches 1e-10 here (its SVD), so fewer digits
+        assert rel(qdd[row], system.motion(t[row], q[row], qd[row], method="reference").qdd) < 1e-9
+    q[5, 3] = np.nan  # a quaternion component: M is not finite
+    with pytest.raises(SolveError, match="state 5 of the batch"):
+        system.motion_batch(t, q, qd)
+    q, qd = random_state(all_joints, rng)
+    qdd, unique = all_joints.motion_batch(0.0, [q, q], [qd, qd])
+    assert unique.all() and rel(qdd[1], all_joints.motion(0.0, q, qd, method="reference").qdd) < 1e-10
+
+
+def test_baumgarte_and_parameters(all_joints):
+    """Baumgarte's shifted b and changed parameters reach the kernels."""
+    rng = np.random.default_rng(9)
+    q, qd = random_state(all_joints, rng)
+    engine = engine_for(all_joints, wait=True)
+    phi, psi = all_joints.constraint_residuals(0.0, q, qd)
+    shift = -2 * 3.0 * np.nan_to_num(psi) - 4.0**2 * np.nan_to_num(phi)
+    fast = engine.motion(0.0, q, qd, shift)
+    assert fast is not None
+    assert rel(fast.qdd, all_joints.motion(0.0, q, qd, method="reference", baumgarte=(3.0, 4.0)).qdd) < 1e-10
+    assert rel(all_joints.motion(0.0, q, qd, baumgarte=(3.0, 4.0)).qdd, fast.qdd) < 1e-12
+    heavier = all_joints.with_parameters(m=4.0)
+    assert_same_motion(heavier, 0.0, q, qd)
+    assert rel(engine_for(heavier).motion(0.0, q, qd).qdd, fast.qdd) > 1e-3
