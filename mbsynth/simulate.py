@@ -127,7 +127,7 @@ class _Run:
     def advance(self, t_next, q, qd):
         """Integrate to t_next, check the state, project it if asked."""
         t = self.t[-1]
-        self.t_mark, self.span = t, t_next - t
+        self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
         first_step = min(self.first_step, t_next - t) if self.first_step else None
         sol = solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=self.rtol,
                         atol=self.atol, first_step=first_step)

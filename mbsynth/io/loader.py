@@ -80,6 +80,22 @@ class _Builder:
         except ExpressionError as err:
             self.fail(path, str(err))
 
+    def differentiable(self, expr, path, second=None):
+        """``expr``, checked to have the derivatives the equations of motion take of it: by
+        each coordinate, velocity and t, then of those by the symbols ``second`` (None: by
+        each again). abs and sign of such a symbol have none sympy can evaluate (it takes
+        their argument as complex), min and max no second one (a DiracDelta)."""
+        if not expr.has(sp.Abs, sp.sign, sp.Min, sp.Max):
+            return expr
+        variables = sorted(expr.free_symbols - set(self.param_symbols.values()), key=str)
+        derived = [expr.diff(v) for v in variables]
+        derived += [d.diff(v) for d in derived for v in (variables if second is None else second)]
+        if any(d.has(sp.Derivative, sp.DiracDelta) for d in derived):
+            self.fail(path, "cannot be differentiated in closed form: abs() and sign() of a coordinate, velocity "
+                            "or t have no derivative, min() and max() no second one; write it smoothly, "
+                            "e.g. sqrt(x**2 + eps**2) for abs(x)")
+        return expr
+
     def constant(self, text, path):
         """An expression of parameters only (a mass, a length), checked finite and real."""
         expr = self.expression(text, path, self.param_symbols)
@@ -210,8 +226,8 @@ class _Builder:
         symbols = dict(self.param_symbols, t=T_SYMBOL)
         symbols.update(zip(coords, q))
         symbols.update(zip((f"{c}_dot" for c in coords), qd))
-        T = self.expression(spec["T"], path + ("T",), symbols)
-        V = self.expression(spec.get("V", 0), path + ("V",), symbols)
+        T = self.differentiable(self.expression(spec["T"], path + ("T",), symbols), path + ("T",), qd)
+        V = self.differentiable(self.expression(spec.get("V", 0), path + ("V",), symbols), path + ("V",), ())
         if V.free_symbols & set(qd):
             self.fail(path + ("V",), "potential energy V must not depend on velocities")
         forces_node = self.mapping(spec.get("forces", LineDict()), path + ("forces",), set(coords))
@@ -248,6 +264,7 @@ class _Builder:
                 constraints.append(Connector.acceleration(name, a, b, *args, C=C))
                 continue
             expr = self.expression(spec[kind], kpath, self.global_symbols)
+            self.differentiable(expr, kpath, None if kind == "holonomic" else ())
             has_q = expr.free_symbols & set(self.q)
             has_qd = expr.free_symbols & set(self.qd)
             if kind == "holonomic" and has_qd:

@@ -150,6 +150,8 @@ def read_frames(builder, part, node, path, offsets, symbols=None):
                                {"position", "geometry", *ORIENTATION_KEYS})
         position = (builder.vector(spec.get("position", [0, 0, 0]), fpath + ("position",), 3, symbols) if symbols
                     else builder.constants(spec.get("position", [0, 0, 0]), fpath + ("position",), 3))
+        for i, x in enumerate(position):
+            builder.differentiable(x, fpath + ("position", i))
         if not offsets and any(x != 0 for x in position):
             builder.fail(fpath + ("position",), "a particle is a point: its frames cannot be offset")
         rotation = sp.Matrix(read_rotation(builder, spec, fpath))
