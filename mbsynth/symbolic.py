@@ -7,6 +7,11 @@
   the row ``A q̈ = b`` (2.4), once if phi contains velocities, twice if not.
 - ``generalized_force(V, efforts, q, qd)``: Q of a potential and (effort, rate) pairs.
 - ``compile_function(args, exprs)``: one fast numpy function for many expressions.
+
+Both the derivations and the compiled functions are shared between expressions of the
+same *structure* (``canonical``): a robot's fifty revolute joints differ only in the
+names of their coordinates and the numbers of their frames, so their rows are
+differentiated and compiled a handful of times, not fifty.
 """
 
 import functools
@@ -70,6 +75,91 @@ def generalized_force(V, efforts, q, qd):
     return Q
 
 
+class _Slots:
+    """Positional placeholder symbols (Dummies: they clash with no model's names)."""
+
+    def __init__(self, prefix):
+        self.prefix, self.items = prefix, []
+
+    def __getitem__(self, i):
+        while len(self.items) <= i:
+            self.items.append(sp.Dummy(f"{self.prefix}{len(self.items)}"))
+        return self.items[i]
+
+
+_ARGUMENT, _RATE, _NUMBER = _Slots("a"), _Slots("r"), _Slots("k")
+
+
+def _numbers(expr, found):
+    """The non-integer numbers of ``expr`` into the dict ``found``, in preorder, numeric
+    exponents left alone (x**2, sqrt)."""
+    if expr.is_Number:
+        if expr.is_Float or (expr.is_Rational and not expr.is_Integer):  # not nan, oo
+            found.setdefault(expr, None)
+        return
+    args = expr.args[:1] if expr.is_Pow and expr.exp.is_Number else expr.args
+    for arg in args:
+        _numbers(arg, found)
+
+
+def canonical(exprs, symbols):
+    """(placeholder forms of ``exprs``, the numbers they stand for): ``symbols`` become
+    positional placeholders and each distinct non-integer number a placeholder ``k_i``.
+    Two expressions with equal placeholder forms have the same structure, whatever the
+    names of their symbols and the values of their numbers."""
+    found = {}
+    for e in exprs:
+        _numbers(e, found)
+    forward = {s: _ARGUMENT[i] for i, s in enumerate(symbols)}
+    forward.update({x: _NUMBER[i] for i, x in enumerate(found)})
+    return tuple(e.xreplace(forward) for e in exprs), tuple(found)
+
+
+def differentiated(exprs, q, qd, t=T_SYMBOL):
+    """(A rows (sparse, len(exprs) × len(q)), b, velocity-level forms) of the
+    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure."""
+    exprs = [sp.sympify(e) for e in exprs]
+    where = positions(q, qd)
+    involved = sorted({where[s] for e in exprs for s in e.free_symbols if s in where})
+    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved])
+    a, b, psi = _differentiated(forms, len(involved), t)
+    back = {_ARGUMENT[j]: q[i] for j, i in enumerate(involved)}
+    back.update({_ARGUMENT[len(involved) + j]: qd[i] for j, i in enumerate(involved)})
+    back.update({_NUMBER[j]: x for j, x in enumerate(numbers)})
+    entries = {}
+    for r, row in enumerate(a):
+        for j, entry in enumerate(row):
+            if entry != 0:
+                entries[r, involved[j]] = entry.xreplace(back)
+    return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
+            [x.xreplace(back) for x in psi])
+
+
+_last_positions = ((), (), {})
+
+
+def positions(q, qd):
+    """{symbol: index} of the coordinates q and velocities q̇, kept for the last pair
+    asked (every constraint of a model asks for the same two)."""
+    global _last_positions
+    q, qd = tuple(q), tuple(qd)
+    if _last_positions[:2] != (q, qd):  # tuples of the same symbols compare by identity first: fast
+        where = {s: i for i, s in enumerate(q)}
+        where.update({s: i for i, s in enumerate(qd)})
+        _last_positions = (q, qd, where)
+    return _last_positions[2]
+
+
+@functools.lru_cache(maxsize=4096)
+def _differentiated(forms, count, t):
+    """``differentiate`` of each placeholder form in the coordinates a_0 … a_{count−1}
+    and velocities a_count …: (rows of a over the involved coordinates, b, ψ)."""
+    q = [_ARGUMENT[i] for i in range(count)]
+    qd = [_ARGUMENT[count + i] for i in range(count)]
+    rows = [differentiate(e, q, qd, t) for e in forms]
+    return tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows), tuple(r[2] for r in rows)
+
+
 def differentiate(phi, q, qd, t=T_SYMBOL):
     """Row (a, b, phidot) of A q̈ = b (2.4) for the constraint phi(q, q̇, t) = 0.
 
@@ -89,35 +179,50 @@ def compile_function(args, exprs):
     """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
     ``exprs`` (scalars, vectors or matrices), with common subexpressions shared."""
     shapes = [sp.Matrix(e).shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
-    flat = [x for e in exprs for x in (e if isinstance(e, sp.MatrixBase) else [e])]
+    flat = [sp.sympify(x) for e in exprs for x in (e if isinstance(e, sp.MatrixBase) else [e])]
     if not flat:
         def empty(*_):
             return tuple(np.zeros(s) for s in shapes)
         return empty
-    raw = _lambdify(_frozen(args), tuple(flat))
+    symbols = _flat(args)
+    forms, numbers = canonical(flat, symbols)
+    slots = _placed(args, iter(_ARGUMENT[i] for i in range(len(symbols))))
+    raw = _lambdify(slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms)
+    constants = np.array([_as_double(x) for x in numbers], dtype=float)
     sizes = [int(np.prod(s)) for s in shapes]
     splits = np.cumsum(sizes)[:-1]
 
     def evaluate(*values):
         values = [np.float64(v) if isinstance(v, (int, float)) else v for v in values]
         with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
-            out = np.asarray(raw(*values), dtype=float)
+            out = np.asarray(raw(*values, constants), dtype=float)
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
 
     return evaluate
 
 
-@functools.lru_cache(maxsize=1024)
-def _lambdify(args, flat):
-    """The numpy function of (args) -> [flat], made once per distinct (args, flat): models
-    loaded again (a sweep's workers, a file checked then simulated) reuse it."""
-    return sp.lambdify(args, [_beyond_double_as_inf(x) for x in flat], modules=[_FLOAT64, "numpy"], cse=True,
+@functools.lru_cache(maxsize=4096)
+def _lambdify(args, forms):
+    """The numpy function of (args, numbers) -> [forms], made once per structure
+    (``canonical``): joints alike, and models loaded again (a sweep's workers, a file
+    checked then simulated) reuse it."""
+    return sp.lambdify(args, [_beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True,
                        dummify=True)
 
 
-def _frozen(args):
-    """``args`` with its lists made tuples (hashable), nested."""
-    return tuple(_frozen(a) if isinstance(a, (list, tuple)) else a for a in args)
+def _flat(args):
+    """The symbols of nested argument lists, in order."""
+    return [s for a in args for s in (_flat(a) if isinstance(a, (list, tuple)) else [a])]
+
+
+def _placed(args, slots):
+    """``args`` (nested lists) with each symbol replaced by the next of ``slots``; tuples."""
+    return tuple(_placed(a, slots) if isinstance(a, (list, tuple)) else next(slots) for a in args)
+
+
+def _as_double(x):
+    """A number as a double; ±inf beyond the double range (as float arithmetic gives)."""
+    return float(x) if abs(x) <= _LARGEST else float(sp.sign(x)) * np.inf
 
 
 def _beyond_double_as_inf(expr):

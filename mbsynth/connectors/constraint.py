@@ -3,7 +3,7 @@
 import numpy as np
 import sympy as sp
 
-from ..symbolic import T_SYMBOL, compile_function, differentiate
+from ..symbolic import T_SYMBOL, compile_function, differentiated, positions
 
 
 class Connector:
@@ -13,24 +13,26 @@ class Connector:
     Build one with ``holonomic`` (φ(q, t) = 0, differentiated twice), ``nonholonomic``
     (ψ(q, q̇, t) = 0, differentiated once) or ``acceleration`` (rows given directly, as
     the paper writes (5.41)). ``a`` (k × n) and ``C`` (n) are over all the model's
-    coordinates; numeric evaluation touches only ``indices``, the coordinates involved.
+    coordinates, kept sparse (a model has thousands of coordinates, a row a handful);
+    numeric evaluation touches only ``indices``, the coordinates involved.
     ``row_labels`` name the rows (``hinge[x]``) in error messages.
     """
 
     def __init__(self, name, kind, a, b, C, phi, psi, q, qd, params, row_labels=None):
         self.name, self.kind = name, kind
         n = len(q)
-        self.a = sp.Matrix(a).reshape(len(b), n) if len(b) else sp.zeros(0, n)
-        self.b, self.C = sp.Matrix(b), sp.Matrix(C)
+        self.a = sp.SparseMatrix(a if isinstance(a, sp.SparseMatrix) else sp.Matrix(a).reshape(len(b), n))
+        self.b, self.C = sp.Matrix(b), sp.SparseMatrix(C)
         self.phi = None if phi is None else sp.Matrix(phi)
         self.psi = None if psi is None else sp.Matrix(psi)
         k = len(b)
         labels = row_labels or [str(i) for i in range(k)]
         self.row_names = [name] if k == 1 and row_labels is None else [f"{name}[{x}]" for x in labels]
         exprs = [self.a, self.b, self.C] + [e for e in (self.phi, self.psi) if e is not None]
-        used = set().union(*(e.free_symbols for e in exprs))
-        self.indices = np.array([i for i in range(n) if q[i] in used or qd[i] in used
-                                 or any(self.a[:, i]) or self.C[i] != 0], dtype=int)
+        where = positions(q, qd)
+        used = {where[s] for e in exprs for s in e.free_symbols if s in where}
+        used |= {i for _, i in self.a.todok()} | {i for i, _ in self.C.todok()}
+        self.indices = np.array(sorted(used), dtype=int)
         local = [int(i) for i in self.indices]
         zeros = sp.zeros(k, 1)
         self._rows = compile_function(
@@ -68,12 +70,6 @@ class Connector:
         return (nan if self.phi is None else phi.ravel(), nan if self.psi is None else psi.ravel())
 
 
-def differentiated(exprs, q, qd):
-    """(A rows, b, velocity-level forms) of the constraints ``exprs`` = 0 (2.4)."""
-    rows = [differentiate(sp.sympify(e), q, qd) for e in exprs]
-    return sp.Matrix.vstack(*[r[0] for r in rows]), [r[1] for r in rows], [r[2] for r in rows]
-
-
 def mixed(holonomic, nonholonomic, q, qd):
     """(a, b, φ, ψ) of position-level rows φ(q, t) = 0 followed by velocity-level rows
     ψ(q, q̇, t) = 0 in one connector (2.4): φ is NaN on the velocity-level rows, which
@@ -83,4 +79,4 @@ def mixed(holonomic, nonholonomic, q, qd):
 
 
 def _vector(C, n):
-    return sp.zeros(n, 1) if C is None else sp.Matrix(C)
+    return sp.SparseMatrix(n, 1, {}) if C is None else sp.SparseMatrix(C)

@@ -13,13 +13,18 @@ frame origins and x, y, z their axes in the world:
 
 The orientation lock is x_A·y_B = y_A·z_B = z_A·x_B = 0: independent near aligned
 frames, so assemble the frames aligned. Rows of A and b follow by differentiating φ
-twice (symbolic.differentiate), exactly.
+twice (symbolic.differentiate), exactly — once per kind of joint and kinds of parts:
+φ is derived with the frames' offsets and rotations as placeholder symbols
+(``_PLACEHOLDERS``), differentiated (shared between joints alike,
+symbolic.differentiated), and the frames' values put in afterwards.
 """
 
 import sympy as sp
 
+from ..subsystems import Frame
 from ..symbolic import time_derivative
-from .constraint import Connector, differentiated
+from ..symbolic import differentiated, positions
+from .constraint import Connector
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}
@@ -87,12 +92,17 @@ class Joint(Connector):
     def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None, friction=None):
         """``friction`` (a ``friction.Friction``) puts viscous friction into the joint's C
         (2.6) and keeps Coulomb friction, which needs the joint's load, in ``coulomb``."""
-        pA, RA = _pose(parent, frame_a)
-        pB, RB = _pose(child, frame_b)
-        phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
-        kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
+        where = positions(q, qd)
+        values = _frame_values(frame_a, 0, where) | _frame_values(frame_b, 1, where)
+        pA, RA = _pose(parent, _placeholder(frame_a, 0) if _PLACEHOLDERS[0][0][0] in values else frame_a)
+        pB, RB = _pose(child, _placeholder(frame_b, 1) if _PLACEHOLDERS[1][0][0] in values else frame_b)
+        generic, labels = joint_equations(kind, pA, RA, pB, RB, length)
+        phis = [sp.sympify(phi).xreplace(values) for phi in generic]
+        kept = [i for i, phi in enumerate(phis) if phi != 0]  # e.g. z rows of planar parts
         phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
-        a, b, psi = differentiated(phis, q, qd)
+        a, b, psi = differentiated([generic[i] for i in kept], q, qd)
+        a, b, psi = a.xreplace(values), [x.xreplace(values) for x in b], [x.xreplace(values) for x in psi]
+        pA, RA, pB, RB = (x.xreplace(values) for x in (pA, RA, pB, RB))
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         self.length = length  # a distance joint's L (sympy), None for the other kinds
         xa, ya, za = _axes(RA)
@@ -105,9 +115,29 @@ class Joint(Connector):
         if kind in SLIDING:
             self.displacement = za.dot(pB - pA)
             self.displacement_rate = time_derivative(self.displacement, q, qd)
-        C = sp.zeros(len(q), 1) if friction is None else friction.viscous_force(self, qd)
+        C = sp.SparseMatrix(len(q), 1, {}) if friction is None else friction.viscous_force(self, qd)
         super().__init__(name, "holonomic", a, b, C, phis, psi, q, qd, params, labels)
         self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
+
+
+# the offset (3) and rotation (3 × 3) of frames A and B in their parts, as symbols
+_PLACEHOLDERS = [(sp.Matrix(sp.symbols(f"_s{e}:3", cls=sp.Dummy)), sp.Matrix(3, 3, sp.symbols(f"_R{e}:9", cls=sp.Dummy)))
+                 for e in "AB"]
+
+
+def _placeholder(frame, end):
+    """``frame`` with placeholder symbols for its offset and rotation."""
+    return Frame(frame.part, frame.name, *_PLACEHOLDERS[end])
+
+
+def _frame_values(frame, end, coordinates):
+    """{placeholder: value} of ``frame`` as end A (0) or B (1); empty when the frame
+    moves on its part (its values depend on ``coordinates``)."""
+    s, R = _PLACEHOLDERS[end]
+    entries = list(frame.position) + list(frame.rotation)
+    if any(x in coordinates for e in entries for x in sp.sympify(e).free_symbols):
+        return {}
+    return dict(zip(list(s) + list(R), entries))
 
 
 def _pose(part, frame):

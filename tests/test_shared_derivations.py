@@ -1,0 +1,43 @@
+"""Joints alike share one derivation (symbolic.canonical): the rows a joint gets that way
+equal those of differentiating its own φ directly, and the derivation is done once."""
+
+import numpy as np
+import sympy as sp
+
+from mbsynth.connectors import Joint
+from mbsynth.kinematics import rpy_matrix
+from mbsynth.subsystems import Frame, RigidBody
+from mbsynth.symbolic import _differentiated, differentiate
+
+RNG = np.random.default_rng(7)
+
+
+def frame(part, name):
+    """A frame at a random offset and orientation, exact rationals as the loaders give."""
+    offset = [sp.Rational(int(x), 1000) for x in RNG.integers(-500, 500, 3)]
+    rotation = sp.Matrix(rpy_matrix(*RNG.uniform(-3, 3, 3))).applyfunc(sp.nsimplify)
+    return Frame(part, name, sp.Matrix(offset), rotation)
+
+
+def two_bodies(count):
+    q = sp.symbols(f"q0:{7 * count}")
+    qd = sp.symbols(f"qd0:{7 * count}")
+    bodies = [RigidBody(f"b{i}", q[7 * i:7 * i + 7], qd[7 * i:7 * i + 7], sp.Integer(1 + i), sp.diag(1, 2, 3),
+                        (0, 0, -9.81), []) for i in range(count)]
+    return list(q), list(qd), bodies
+
+
+def test_joints_alike_share_one_derivation_and_keep_their_own_rows():
+    q, qd, (b0, b1, b2) = two_bodies(3)
+    first = Joint("j1", "revolute", b0, frame("b0", "f"), b1, frame("b1", "f"), q, qd, [])
+    before = _differentiated.cache_info()
+    second = Joint("j2", "revolute", b1, frame("b1", "g"), b2, frame("b2", "g"), q, qd, [])
+    after = _differentiated.cache_info()
+    assert after.misses == before.misses and after.hits == before.hits + 1
+    state = dict(zip(q + qd, RNG.normal(size=len(q) + len(qd))))
+    for joint in (first, second):
+        for r, phi in enumerate(joint.phi):
+            a, b, _ = differentiate(phi, q, qd)  # the joint's own φ, numbers in place
+            for i in joint.indices:
+                assert abs(float(joint.a[r, int(i)].subs(state)) - float(a[0, int(i)].subs(state))) < 1e-12
+            assert abs(float(joint.b[r].subs(state)) - float(b.subs(state))) < 1e-10
