@@ -115,14 +115,19 @@ def canonical(exprs, symbols):
     return tuple(e.xreplace(forward) for e in exprs), tuple(found)
 
 
-def differentiated(exprs, q, qd, t=T_SYMBOL):
+def differentiated(exprs, q, qd, t=T_SYMBOL, constants=()):
     """(A rows (sparse, len(exprs) × len(q)), b, velocity-level forms) of the
-    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure."""
+    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure.
+
+    ``constants``: (symbol, value) pairs put into the rows after differentiating —
+    ``exprs`` generic in those symbols (a joint's frame offsets and rotations) are then
+    differentiated once for all values, and once per distinct values put in."""
     exprs = [sp.sympify(e) for e in exprs]
     where = positions(q, qd)
     involved = sorted({where[s] for e in exprs for s in e.free_symbols if s in where})
-    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved])
-    a, b, psi = _differentiated(forms, len(involved), t)
+    symbols, values = [c[0] for c in constants], [sp.sympify(c[1]) for c in constants]
+    forms, numbers = canonical(exprs + values, [q[i] for i in involved] + [qd[i] for i in involved])
+    a, b, psi = _put(_differentiated(forms[:len(exprs)], len(involved), t), tuple(symbols), forms[len(exprs):])
     back = {_ARGUMENT[j]: q[i] for j, i in enumerate(involved)}
     back.update({_ARGUMENT[len(involved) + j]: qd[i] for j, i in enumerate(involved)})
     back.update({_NUMBER[j]: x for j, x in enumerate(numbers)})
@@ -133,6 +138,18 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
                 entries[r, involved[j]] = entry.xreplace(back)
     return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
             [x.xreplace(back) for x in psi])
+
+
+@functools.lru_cache(maxsize=4096)
+def _put(rows, symbols, values):
+    """(a, b, ψ) of ``_differentiated`` with ``symbols`` replaced by ``values``
+    (placeholder forms: joints alike with equal frames share the result)."""
+    if not symbols:
+        return rows
+    put = dict(zip(symbols, values))
+    a, b, psi = rows
+    return (tuple(tuple(x.xreplace(put) for x in row) for row in a), tuple(x.xreplace(put) for x in b),
+            tuple(x.xreplace(put) for x in psi))
 
 
 _last_positions = ((), (), {})

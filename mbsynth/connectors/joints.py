@@ -100,8 +100,7 @@ class Joint(Connector):
         phis = [sp.sympify(phi).xreplace(values) for phi in generic]
         kept = [i for i, phi in enumerate(phis) if phi != 0]  # e.g. z rows of planar parts
         phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
-        a, b, psi = differentiated([generic[i] for i in kept], q, qd)
-        a, b, psi = a.xreplace(values), [x.xreplace(values) for x in b], [x.xreplace(values) for x in psi]
+        a, b, psi = differentiated([generic[i] for i in kept], q, qd, constants=list(values.items()))
         pA, RA, pB, RB = (x.xreplace(values) for x in (pA, RA, pB, RB))
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         self.length = length  # a distance joint's L (sympy), None for the other kinds
