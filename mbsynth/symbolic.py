@@ -115,19 +115,14 @@ def canonical(exprs, symbols):
     return tuple(e.xreplace(forward) for e in exprs), tuple(found)
 
 
-def differentiated(exprs, q, qd, t=T_SYMBOL, constants=()):
+def differentiated(exprs, q, qd, t=T_SYMBOL):
     """(A rows (sparse, len(exprs) × len(q)), b, velocity-level forms) of the
-    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure.
-
-    ``constants``: (symbol, value) pairs put into the rows after differentiating —
-    ``exprs`` generic in those symbols (a joint's frame offsets and rotations) are then
-    differentiated once for all values, and once per distinct values put in."""
+    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure."""
     exprs = [sp.sympify(e) for e in exprs]
     where = positions(q, qd)
     involved = sorted({where[s] for e in exprs for s in e.free_symbols if s in where})
-    symbols, values = [c[0] for c in constants], [sp.sympify(c[1]) for c in constants]
-    forms, numbers = canonical(exprs + values, [q[i] for i in involved] + [qd[i] for i in involved])
-    a, b, psi = _put(_differentiated(forms[:len(exprs)], len(involved), t), tuple(symbols), forms[len(exprs):])
+    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved])
+    a, b, psi = _differentiated(forms, len(involved), t)
     back = {_ARGUMENT[j]: q[i] for j, i in enumerate(involved)}
     back.update({_ARGUMENT[len(involved) + j]: qd[i] for j, i in enumerate(involved)})
     back.update({_NUMBER[j]: x for j, x in enumerate(numbers)})
@@ -138,18 +133,6 @@ def differentiated(exprs, q, qd, t=T_SYMBOL, constants=()):
                 entries[r, involved[j]] = entry.xreplace(back)
     return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
             [x.xreplace(back) for x in psi])
-
-
-@functools.lru_cache(maxsize=4096)
-def _put(rows, symbols, values):
-    """(a, b, ψ) of ``_differentiated`` with ``symbols`` replaced by ``values``
-    (placeholder forms: joints alike with equal frames share the result)."""
-    if not symbols:
-        return rows
-    put = dict(zip(symbols, values))
-    a, b, psi = rows
-    return (tuple(tuple(x.xreplace(put) for x in row) for row in a), tuple(x.xreplace(put) for x in b),
-            tuple(x.xreplace(put) for x in psi))
 
 
 _last_positions = ((), (), {})
@@ -192,30 +175,53 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     return a, b, psi
 
 
-def compile_function(args, exprs):
+def compile_function(args, exprs, constants=()):
     """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
-    ``exprs`` (scalars, vectors or matrices), with common subexpressions shared."""
+    ``exprs`` (scalars, vectors or matrices), with common subexpressions shared.
+
+    ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
+    values (numbers or expressions of ``args``) are put in at each evaluation, so that
+    expressions shared by many instances (connectors.joints) are compiled once."""
     shapes = [sp.Matrix(e).shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
     flat = [sp.sympify(x) for e in exprs for x in (e if isinstance(e, sp.MatrixBase) else [e])]
     if not flat:
         def empty(*_):
             return tuple(np.zeros(s) for s in shapes)
         return empty
-    symbols = _flat(args)
-    forms, numbers = canonical(flat, symbols)
-    slots = _placed(args, iter(_ARGUMENT[i] for i in range(len(symbols))))
-    raw = _lambdify(slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms)
-    constants = np.array([_as_double(x) for x in numbers], dtype=float)
+    frozen = _frozen(args)
+    raw, numbers = _compiled(frozen, tuple(flat), tuple(c[0] for c in constants))
+    fixed = np.array([_as_double(x) for x in numbers], dtype=float)
+    values = _values(frozen, tuple(sp.sympify(c[1]) for c in constants))
     sizes = [int(np.prod(s)) for s in shapes]
     splits = np.cumsum(sizes)[:-1]
 
-    def evaluate(*values):
-        values = [np.float64(v) if isinstance(v, (int, float)) else v for v in values]
+    def evaluate(*given):
+        given = [np.float64(v) if isinstance(v, (int, float)) else v for v in given]
         with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
-            out = np.asarray(raw(*values, constants), dtype=float)
+            out = np.asarray(raw(*given, values(*given), fixed), dtype=float)
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
 
     return evaluate
+
+
+@functools.lru_cache(maxsize=4096)
+def _compiled(args, flat, placeholders):
+    """(numpy function of (args, placeholder values, numbers), the numbers): the
+    expressions in ``canonical`` form, compiled once per structure."""
+    symbols = _flat(args) + list(placeholders)
+    forms, numbers = canonical(flat, symbols)
+    slots = _placed(args + (placeholders,), iter(_ARGUMENT[i] for i in range(len(symbols))))
+    return _lambdify(slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms), numbers
+
+
+@functools.lru_cache(maxsize=4096)
+def _values(args, values):
+    """A function of ``args`` giving the array of ``values``: constant when they are numbers."""
+    if all(v.is_Number for v in values):
+        fixed = np.array([_as_double(v) for v in values], dtype=float)
+        return lambda *_: fixed
+    raw = sp.lambdify(args, [_beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"], dummify=True)
+    return lambda *given: np.asarray(raw(*given), dtype=float)
 
 
 @functools.lru_cache(maxsize=4096)
@@ -225,6 +231,11 @@ def _lambdify(args, forms):
     checked then simulated) reuse it."""
     return sp.lambdify(args, [_beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True,
                        dummify=True)
+
+
+def _frozen(args):
+    """``args`` with its lists made tuples (hashable), nested."""
+    return tuple(_frozen(a) if isinstance(a, (list, tuple)) else a for a in args)
 
 
 def _flat(args):

@@ -19,30 +19,76 @@ class Connector:
     """
 
     def __init__(self, name, kind, a, b, C, phi, psi, q, qd, params, row_labels=None):
-        self.name, self.kind = name, kind
         n = len(q)
-        self.a = sp.SparseMatrix(a if isinstance(a, sp.SparseMatrix) else sp.Matrix(a).reshape(len(b), n))
-        self.b, self.C = sp.Matrix(b), sp.SparseMatrix(C)
-        self.phi = None if phi is None else sp.Matrix(phi)
-        self.psi = None if psi is None else sp.Matrix(psi)
-        k = len(b)
-        labels = row_labels or [str(i) for i in range(k)]
-        self.row_names = [name] if k == 1 and row_labels is None else [f"{name}[{x}]" for x in labels]
-        exprs = [self.a, self.b, self.C] + [e for e in (self.phi, self.psi) if e is not None]
+        a = sp.SparseMatrix(a if isinstance(a, sp.SparseMatrix) else sp.Matrix(a).reshape(len(b), n))
+        self._symbolic = (a, sp.Matrix(b), sp.SparseMatrix(C), None if phi is None else sp.Matrix(phi),
+                          None if psi is None else sp.Matrix(psi))
+        self._name_rows(name, kind, len(b), row_labels)
+        exprs = [e for e in self._symbolic if e is not None]
         where = positions(q, qd)
         used = {where[s] for e in exprs for s in e.free_symbols if s in where}
-        used |= {i for _, i in self.a.todok()} | {i for i, _ in self.C.todok()}
+        used |= {i for _, i in a.todok()} | {i for i, _ in self.C.todok()}
         self.indices = np.array(sorted(used), dtype=int)
         local = [int(i) for i in self.indices]
-        zeros = sp.zeros(k, 1)
+        k, zeros = len(b), sp.zeros(len(b), 1)
         self._rows = compile_function(
             (T_SYMBOL, [q[i] for i in local], [qd[i] for i in local], list(params)),
-            [self.a.extract(list(range(k)), local), self.b, self.C.extract(local, [0]),
+            [a.extract(list(range(k)), local), self.b, self.C.extract(local, [0]),
              zeros if self.phi is None else self.phi, zeros if self.psi is None else self.psi])
+
+    def _name_rows(self, name, kind, k, row_labels):
+        self.name, self.kind = name, kind
+        labels = row_labels or [str(i) for i in range(k)]
+        self.row_names = [name] if k == 1 and row_labels is None else [f"{name}[{x}]" for x in labels]
+
+    def _place(self, name, kind, rows, slots, coordinates, constants, q, qd, params, row_labels):
+        """Rows given in placeholder symbols, shared with connectors alike (joints.py):
+        ``rows`` = (a over the slots, b, φ, ψ) with the coordinate slots ``slots`` = (q
+        slots, q̇ slots) standing for the model's coordinates ``coordinates`` (indices),
+        and ``constants`` (placeholder, value) pairs. They are compiled once for all such
+        connectors; their sympy form over the model's symbols is built only when asked."""
+        a, b, phi, psi = rows
+        self._name_rows(name, kind, len(b), row_labels)
+        q_slots, qd_slots = slots
+        free = set().union(*(x.free_symbols for x in (*b, *phi, *psi, *(e for row in a for e in row))))
+        used = sorted({coordinates[j] for j, s in enumerate(q_slots) if s in free}
+                      | {coordinates[j] for j, s in enumerate(qd_slots) if s in free})
+        slot_of = {c: j for j, c in enumerate(coordinates)}
+        local = [slot_of[i] for i in used]
+        self.indices = np.array(used, dtype=int)
+        k = len(b)
+        self._symbolic = None
+        self._placed = (rows, slots, coordinates, dict(constants), q, qd)
+        self._zero_C = sp.SparseMatrix(len(q), 1, {})
+        self._rows = compile_function(
+            (T_SYMBOL, [q_slots[j] for j in local], [qd_slots[j] for j in local], list(params)),
+            [sp.Matrix(k, len(local), [a[r][j] for r in range(k) for j in local]), sp.Matrix(b),
+             sp.zeros(len(local), 1), sp.Matrix(phi), sp.Matrix(psi)], constants=constants)
+
+    def _materialized(self):
+        """(a, b, C, φ, ψ) as sympy expressions of the model's symbols."""
+        if self._symbolic is None:
+            (a, b, phi, psi), (q_slots, qd_slots), coordinates, constants, q, qd = self._placed
+            n, put = len(q), dict(constants)
+            put.update({s: q[c] for s, c in zip(q_slots, coordinates)})
+            put.update({s: qd[c] for s, c in zip(qd_slots, coordinates)})
+            entries = {(r, coordinates[j]): x.xreplace(put) for r, row in enumerate(a) for j, x in enumerate(row)
+                       if x != 0}
+            self._symbolic = (sp.SparseMatrix(len(b), n, entries), sp.Matrix([x.xreplace(put) for x in b]),
+                              self._zero_C, sp.Matrix([x.xreplace(put) for x in phi]),
+                              sp.Matrix([x.xreplace(put) for x in psi]))
+        return self._symbolic
+
+    a = property(lambda self: self._materialized()[0], doc="rows of A over all coordinates (sparse)")
+    b = property(lambda self: self._materialized()[1], doc="right sides b")
+    C = property(lambda self: self._zero_C if self._symbolic is None else self._symbolic[2],
+                 doc="the non-ideal force C (2.6), over all coordinates (zero for placed rows)")
+    phi = property(lambda self: self._materialized()[3], doc="position-level residuals φ (None for none)")
+    psi = property(lambda self: self._materialized()[4], doc="velocity-level residuals φ̇ or ψ (None for none)")
 
     @property
     def size(self):
-        return len(self.b)
+        return len(self.row_names)
 
     @classmethod
     def holonomic(cls, name, phis, q, qd, params, C=None, row_labels=None):

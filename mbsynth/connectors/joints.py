@@ -19,11 +19,13 @@ twice (symbolic.differentiate), exactly — once per kind of joint and kinds of 
 symbolic.differentiated), and the frames' values put in afterwards.
 """
 
+from typing import NamedTuple
+
 import sympy as sp
 
-from ..subsystems import Frame
+from ..subsystems import Frame, Particle, PlanarBody, RigidBody
 from ..symbolic import time_derivative
-from ..symbolic import differentiated, positions
+from ..symbolic import differentiate, differentiated, positions
 from .constraint import Connector
 
 ROTATING = {"revolute", "cylindrical"}
@@ -92,31 +94,112 @@ class Joint(Connector):
     def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None, friction=None):
         """``friction`` (a ``friction.Friction``) puts viscous friction into the joint's C
         (2.6) and keeps Coulomb friction, which needs the joint's load, in ``coulomb``."""
-        where = positions(q, qd)
-        values = _frame_values(frame_a, 0, where) | _frame_values(frame_b, 1, where)
-        pA, RA = _pose(parent, _placeholder(frame_a, 0) if _PLACEHOLDERS[0][0][0] in values else frame_a)
-        pB, RB = _pose(child, _placeholder(frame_b, 1) if _PLACEHOLDERS[1][0][0] in values else frame_b)
-        generic, labels = joint_equations(kind, pA, RA, pB, RB, length)
-        phis = [sp.sympify(phi).xreplace(values) for phi in generic]
-        kept = [i for i, phi in enumerate(phis) if phi != 0]  # e.g. z rows of planar parts
-        phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
-        a, b, psi = differentiated([generic[i] for i in kept], q, qd, constants=list(values.items()))
-        pA, RA, pB, RB = (x.xreplace(values) for x in (pA, RA, pB, RB))
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         self.length = length  # a distance joint's L (sympy), None for the other kinds
-        xa, ya, za = _axes(RA)
-        self.angle = self.angle_rate = self.displacement = self.displacement_rate = None
-        if kind in ROTATING:
-            xb = RB[:, 0]
-            self.angle = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
-            omega_a = parent.angular_velocity() if parent else sp.zeros(3, 1)
-            self.angle_rate = za.dot(child.angular_velocity() - omega_a)
-        if kind in SLIDING:
-            self.displacement = za.dot(pB - pA)
-            self.displacement_rate = time_derivative(self.displacement, q, qd)
+        where = positions(q, qd)
+        values = _frame_values(frame_a, 0, where), _frame_values(frame_b, 1, where)
+        if friction is None and all(values) and all(type(p) in SHARED_PARTS for p in (parent, child) if p):
+            self._place_shared(name, kind, parent, child, values[0] | values[1], q, qd, params, length)
+            return
+        pA, RA = _pose(parent, frame_a)
+        pB, RB = _pose(child, frame_b)
+        phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
+        kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
+        phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
+        a, b, psi = differentiated(phis, q, qd)
+        self._motions = _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd)
         C = sp.SparseMatrix(len(q), 1, {}) if friction is None else friction.viscous_force(self, qd)
         super().__init__(name, "holonomic", a, b, C, phis, psi, q, qd, params, labels)
         self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
+
+    def _place_shared(self, name, kind, parent, child, values, q, qd, params, length):
+        """The rows from the template of joints alike (``_template``), the frames' values
+        and the coordinates of the two parts put in."""
+        template = _template(kind, parent, child, length is not None)
+        constants = dict(values)
+        if length is not None:
+            constants[_LENGTH] = sp.sympify(length)
+        kept = [i for i, phi in enumerate(template.phis) if phi.xreplace(constants) != 0]  # planar parts
+        rows = tuple(tuple(x[i] for i in kept) for x in (template.a, template.b, template.phis, template.psi))
+        where = positions(q, qd)
+        coordinates = [where[s] for s in (parent.q if parent else []) + child.q]
+        self._motions = template.motions
+        self._motion_put = (template.slots, coordinates, constants, q, qd)
+        self.coulomb = None
+        self._place(name, "holonomic", rows, template.slots, coordinates, list(constants.items()), q, qd, params,
+                    [template.labels[i] for i in kept])
+
+    def _motion(self, k):
+        expr = self._motions[k]
+        if expr is None or not hasattr(self, "_motion_put"):
+            return expr
+        (q_slots, qd_slots), coordinates, constants, q, qd = self._motion_put
+        put = dict(constants)
+        put.update({s: q[c] for s, c in zip(q_slots, coordinates)})
+        put.update({s: qd[c] for s, c in zip(qd_slots, coordinates)})
+        return expr.xreplace(put)
+
+    angle = property(lambda self: self._motion(0), doc="the turn about z_A (revolute, cylindrical), else None")
+    angle_rate = property(lambda self: self._motion(1), doc="z_A·(ω_B − ω_A), else None")
+    displacement = property(lambda self: self._motion(2), doc="z_A·(p_B − p_A) (prismatic, cylindrical), else None")
+    displacement_rate = property(lambda self: self._motion(3), doc="its rate, else None")
+
+
+SHARED_PARTS = (RigidBody, Particle, PlanarBody)  # poses that depend on their coordinates alone
+_LENGTH = sp.Dummy("L")
+
+
+def _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd):
+    """(angle, angle rate, displacement, displacement rate) of a joint, None where it has none."""
+    xa, _, za = _axes(RA)
+    motions = [None] * 4
+    if kind in ROTATING:
+        xb = RB[:, 0]
+        omega_a = parent.angular_velocity() if parent else sp.zeros(3, 1)
+        motions[0] = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
+        motions[1] = za.dot(child.angular_velocity() - omega_a)
+    if kind in SLIDING:
+        motions[2] = za.dot(pB - pA)
+        motions[3] = time_derivative(motions[2], q, qd)
+    return motions
+
+
+class _Template(NamedTuple):
+    """A joint's rows in placeholder symbols: frames (``_PLACEHOLDERS``), the distance
+    (``_LENGTH``) and the two parts' coordinates (``slots``: parent's then child's)."""
+
+    slots: tuple
+    phis: tuple
+    labels: tuple
+    a: tuple      # per row, its entries over the slots' coordinates
+    b: tuple
+    psi: tuple
+    motions: tuple
+
+
+_templates = {}
+
+
+def _template(kind, parent, child, has_length):
+    """The template of joints of ``kind`` between parts of the types of ``parent`` and
+    ``child``, derived (once) from these two."""
+    key = (kind, type(parent), len(parent.q) if parent else 0, type(child), len(child.q), has_length)
+    if key not in _templates:
+        q = (list(parent.q) if parent else []) + list(child.q)
+        qd = (list(parent.qd) if parent else []) + list(child.qd)
+        slots = (tuple(sp.Dummy(f"q{i}") for i in range(len(q))), tuple(sp.Dummy(f"qd{i}") for i in range(len(q))))
+        to_slots = dict(zip(q + qd, slots[0] + slots[1]))
+        pA, RA = _pose(parent, _placeholder_frame(0))
+        pB, RB = _pose(child, _placeholder_frame(1))
+        pA, RA, pB, RB = (x.xreplace(to_slots) for x in (pA, RA, pB, RB))
+        phis, labels = joint_equations(kind, pA, RA, pB, RB, _LENGTH if has_length else None)
+        phis = [sp.sympify(phi) for phi in phis]
+        rows = [differentiate(phi, list(slots[0]), list(slots[1])) for phi in phis]
+        motions = _free_motions(kind, parent, child, pA, RA, pB, RB, list(slots[0]), list(slots[1]))
+        motions = tuple(None if m is None else sp.sympify(m).xreplace(to_slots) for m in motions)
+        _templates[key] = _Template(slots, tuple(phis), tuple(labels), tuple(tuple(r[0]) for r in rows),
+                                    tuple(r[1] for r in rows), tuple(r[2] for r in rows), motions)
+    return _templates[key]
 
 
 # the offset (3) and rotation (3 × 3) of frames A and B in their parts, as symbols
@@ -124,9 +207,9 @@ _PLACEHOLDERS = [(sp.Matrix(sp.symbols(f"_s{e}:3", cls=sp.Dummy)), sp.Matrix(3, 
                  for e in "AB"]
 
 
-def _placeholder(frame, end):
-    """``frame`` with placeholder symbols for its offset and rotation."""
-    return Frame(frame.part, frame.name, *_PLACEHOLDERS[end])
+def _placeholder_frame(end):
+    """A frame with placeholder symbols for its offset and rotation."""
+    return Frame("", "", *_PLACEHOLDERS[end])
 
 
 def _frame_values(frame, end, coordinates):

@@ -238,10 +238,11 @@ class _Builder:
             if r:
                 masses.append(self.number(part.mass)[0, 0])
                 inertia.append(self.number(part.inertia))
+                mg.append(self.number(part.mass * part.gravity).ravel())
             else:
                 masses.append(self.number(part.M[0, 0])[0, 0])
                 inertia.append(np.zeros((3, 3)))
-            mg.append(self.number(part.Q[:3, 0]).ravel())  # m g: the first three entries of Q, constant
+                mg.append(self.number(part.Q[:3, 0]).ravel())  # m g: the first three entries of Q, constant
         return masses, mg, inertia
 
     def _joint(self, con):

@@ -36,18 +36,35 @@ class Part:
     kind = "part"
     defaults = {}  # initial coordinate values that are not zero unless the model says otherwise
 
-    def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None):
+    def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None,
+                 shared=None):
+        """``shared``: (q slots, q̇ slots, constants) when M, Q, T, V are a template's,
+        written in those slots and in placeholders with the values ``constants`` ((symbol,
+        value) pairs): compiled once for all parts alike, put in only when asked."""
         self.name = name
         self.coordinates = tuple(coordinates)
         self.q, self.qd = list(q), list(qd)
-        self.M, self.Q = sp.Matrix(M), sp.Matrix(Q)
-        self.T, self.V = sp.sympify(T), sp.sympify(V)
         self.frames = {f.name: f for f in frames}
         self.geometry = tuple(geometry)
         self.initial = dict(initial or {})
-        args = (T_SYMBOL, self.q, self.qd, list(params))
-        self._evaluate = compile_function(args, [self.M, self.Q])
-        self._energy = compile_function(args, [self.T, self.V])
+        template = (sp.Matrix(M), sp.Matrix(Q), sp.sympify(T), sp.sympify(V))
+        q_slots, qd_slots, constants = shared or (self.q, self.qd, ())
+        self._symbolic = None if shared else template
+        self._shared = template, {**dict(constants), **dict(zip(q_slots, self.q)), **dict(zip(qd_slots, self.qd))}
+        args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
+        self._evaluate = compile_function(args, template[:2], constants)
+        self._energy = compile_function(args, template[2:], constants)
+
+    def _materialized(self):
+        if self._symbolic is None:
+            template, put = self._shared
+            self._symbolic = tuple(x.xreplace(put) for x in template)
+        return self._symbolic
+
+    M = property(lambda self: self._materialized()[0], doc="mass matrix (2.1), sympy")
+    Q = property(lambda self: self._materialized()[1], doc="force vector (2.1), sympy")
+    T = property(lambda self: self._materialized()[2], doc="kinetic energy, sympy")
+    V = property(lambda self: self._materialized()[3], doc="potential energy, sympy")
 
     def evaluate(self, t, q, qd, p):
         """(M, Q) of this part at its own coordinates q, velocities qd (2.1)."""

@@ -1,6 +1,8 @@
 """A rigid body in 7 coordinates: its centre of mass r in the world and a unit
 quaternion u (scalar-first) for its orientation."""
 
+import functools
+
 import sympy as sp
 
 from ..kinematics import body_rate_matrix, rotation, world_rate_matrix
@@ -24,16 +26,12 @@ class RigidBody(Part):
     defaults = {"qw": 1.0}  # the identity orientation
 
     def __init__(self, name, q, qd, mass, inertia, gravity, params, frames=(), geometry=(), initial=None):
-        r, u = sp.Matrix(q[:3]), sp.Matrix(q[3:])
-        rd, ud = sp.Matrix(qd[:3]), sp.Matrix(qd[3:])
+        slots, placeholders, (M, Q, T, V) = _template()
         J = sp.Matrix(inertia)
-        E, Ed = body_rate_matrix(u), body_rate_matrix(ud)
-        M = sp.diag(mass * sp.eye(3), 4 * E.T * J * E)
-        Q = sp.Matrix.vstack(mass * sp.Matrix(gravity), -8 * Ed.T * J * E * ud)
-        T = mass * (rd.T * rd)[0] / 2 + 2 * (ud.T * E.T * J * E * ud)[0]
-        V = -mass * (sp.Matrix(gravity).T * r)[0]
         self.mass, self.inertia, self.gravity = mass, J, sp.Matrix(gravity)
-        super().__init__(name, COORDINATES, q, qd, M, Q, T, V, params, frames, geometry, initial)
+        constants = list(zip(placeholders, [mass, *J, *self.gravity]))
+        super().__init__(name, COORDINATES, q, qd, M, Q, T, V, params, frames, geometry, initial,
+                         shared=(*slots, constants))
 
     def own_constraints(self, q, qd, params):
         """uᵀu = 1, differentiated: uᵀü = −u̇ᵀu̇."""
@@ -47,3 +45,19 @@ class RigidBody(Part):
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:]) * sp.Matrix(self.qd[3:])
 
+
+
+@functools.lru_cache(maxsize=1)
+def _template():
+    """(coordinate slots (q, q̇), placeholders (m, J row by row, g), (M, Q, T, V)): the
+    body's equations derived once, for every body (base.Part's ``shared``)."""
+    q, qd = sp.symbols("x y z qw qx qy qz", cls=sp.Dummy), sp.symbols("xd yd zd qwd qxd qyd qzd", cls=sp.Dummy)
+    mass, J, gravity = sp.Dummy("m"), sp.Matrix(3, 3, sp.symbols("J0:9", cls=sp.Dummy)), sp.Matrix(sp.symbols("g0:3", cls=sp.Dummy))
+    r, u = sp.Matrix(q[:3]), sp.Matrix(q[3:])
+    rd, ud = sp.Matrix(qd[:3]), sp.Matrix(qd[3:])
+    E, Ed = body_rate_matrix(u), body_rate_matrix(ud)
+    M = sp.diag(mass * sp.eye(3), 4 * E.T * J * E)
+    Q = sp.Matrix.vstack(mass * gravity, -8 * Ed.T * J * E * ud)
+    T = mass * (rd.T * rd)[0] / 2 + 2 * (ud.T * E.T * J * E * ud)[0]
+    V = -mass * (gravity.T * r)[0]
+    return (list(q), list(qd)), [mass, *J, *gravity], (M, Q, T, V)
