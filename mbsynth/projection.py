@@ -10,6 +10,8 @@ holonomic rows of their bodies, so they are restored like any other constraint.
 """
 
 import numpy as np
+import scipy.sparse
+import scipy.sparse.linalg
 
 from .errors import SolveError
 
@@ -24,9 +26,25 @@ def _free_columns(n, fixed):
     return free
 
 
+SPARSE_ACCEPT = 1e-10  # relative residual under which the sparse least-norm step is taken
+
+
 def _correction(J, r):
-    """Least-norm Δ with J Δ = r (dependent rows allowed)."""
-    return np.linalg.lstsq(J, r, rcond=1e-12)[0]
+    """Least-norm Δ with J Δ = r (J sparse). With independent rows Δ = Jᵀ (J Jᵀ)⁻¹ r,
+    J Jᵀ factored sparse (a tree of joints gives a tree-structured J Jᵀ: linear time);
+    dependent rows (a planar loop in 3D) make J Jᵀ singular, and then, or when that step
+    does not meet J Δ = r to SPARSE_ACCEPT, dense least squares takes over."""
+    if J.shape[0] == 0:
+        return np.zeros(J.shape[1])
+    try:
+        with np.errstate(all="ignore"):
+            y = scipy.sparse.linalg.splu((J @ J.T).tocsc()).solve(r)
+            step = J.T @ y
+        if np.all(np.isfinite(step)) and np.linalg.norm(J @ step - r) <= SPARSE_ACCEPT * (np.linalg.norm(r) + 1e-300):
+            return step
+    except RuntimeError:  # splu: the matrix is exactly singular
+        pass
+    return np.linalg.lstsq(J.toarray(), r, rcond=1e-12)[0]
 
 
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
@@ -39,7 +57,7 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
         rows = np.isfinite(phi)
         if not rows.any() or np.abs(phi[rows]).max() <= tolerance:
             return q
-        A = system.evaluate(t, q, qd).A[rows][:, free]
+        A = system.constraint_rows(t, q, qd)[0][rows][:, free]
         q[free] -= _correction(A, phi[rows])
         if not np.all(np.isfinite(q)):
             break
@@ -56,7 +74,7 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
     rows = np.isfinite(psi)
     if not rows.any() or np.abs(psi[rows]).max() <= tolerance:
         return qd
-    A = system.evaluate(t, q, qd).A[rows][:, free]
+    A = system.constraint_rows(t, q, qd)[0][rows][:, free]
     qd[free] -= _correction(A, psi[rows])  # ψ is affine in q̇ with slope A
     _, psi = system.constraint_residuals(t, q, qd)
     if np.abs(psi[rows]).max() > max(tolerance, 1e-9 * (1 + np.abs(qd).max())):

@@ -8,6 +8,7 @@ assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 from dataclasses import dataclass, replace
 
 import numpy as np
+import scipy.sparse
 import sympy as sp
 
 from . import equations, fast, friction, solvers
@@ -194,6 +195,25 @@ class System:
             C[con.indices] += c
             row += con.size
         return Assembly(M, Q, A, b, C)
+
+    def constraint_rows(self, t, q, qd):
+        """A (m × n, scipy.sparse CSR) and b at (t, q, q̇) — the rows alone, without M:
+        what projection.py needs, in memory proportional to the rows' entries."""
+        q, qd = self._state(q, qd)
+        p = self.parameter_values
+        rows, cols, values, b = [], [], [], []
+        row = 0
+        for con in self.constraints:
+            a, b_con, _ = con.evaluate(t, q, qd, p)
+            r, c = np.meshgrid(np.arange(row, row + con.size), con.indices, indexing="ij")
+            rows.append(r.ravel())
+            cols.append(c.ravel())
+            values.append(np.asarray(a, dtype=float).ravel())
+            b.append(b_con)
+            row += con.size
+        join = lambda parts, kind: np.concatenate([np.zeros(0, kind)] + parts)  # noqa: E731
+        A = scipy.sparse.csr_matrix((join(values, float), (join(rows, int), join(cols, int))), shape=(row, self.n))
+        return A, join(b, float)
 
     def motion(self, t, q, qd, method="fast", baumgarte=None):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,

@@ -24,6 +24,7 @@ class Connector:
         self._symbolic = (a, sp.Matrix(b), sp.SparseMatrix(C), None if phi is None else sp.Matrix(phi),
                           None if psi is None else sp.Matrix(psi))
         self._name_rows(name, kind, len(b), row_labels)
+        self._levels = (phi is not None, psi is not None)  # which residuals the rows have
         exprs = [e for e in self._symbolic if e is not None]
         where = positions(q, qd)
         used = {where[s] for e in exprs for s in e.free_symbols if s in where}
@@ -58,6 +59,7 @@ class Connector:
         self.indices = np.array(used, dtype=int)
         k = len(b)
         self._symbolic = None
+        self._levels = (True, True)
         self._placed = (rows, slots, coordinates, dict(constants), q, qd)
         self._zero_C = sp.SparseMatrix(len(q), 1, {})
         self._rows = compile_function(
@@ -113,7 +115,7 @@ class Connector:
         """(φ, φ̇) per row: position- and velocity-level residuals; NaN where the kind has none."""
         _, _, _, phi, psi = self._rows(t, q[self.indices], qd[self.indices], p)
         nan = np.full(self.size, np.nan)
-        return (nan if self.phi is None else phi.ravel(), nan if self.psi is None else psi.ravel())
+        return (phi.ravel() if self._levels[0] else nan, psi.ravel() if self._levels[1] else nan)
 
 
 def mixed(holonomic, nonholonomic, q, qd):
