@@ -141,7 +141,8 @@ class System:
         changed = replace(self, parameters=new, initial_q=q0, initial_qd=qd0)
         problems = changed.part_problems()
         if problems:
-            raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")
+            given = values if len(values) <= 3 else f"{len(values)} new parameter values"
+            raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
         return changed
 
     def part_problems(self):

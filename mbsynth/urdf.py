@@ -84,6 +84,9 @@ class Description:
         return order
 
 
+INERTIA_RTOL = 1e-12  # a principal moment below −this × the largest is negative (not rounding)
+
+
 def read_urdf(path, package_dirs=()):
     """The Description of the URDF file at ``path``; ``package://`` mesh files are looked
     up in ``package_dirs`` (each holding package folders) and beside the file."""
@@ -156,6 +159,11 @@ def _link(element, path, dirs, materials):
         raise ModelError(f"{path}: link '{name}': bad <inertial>: {err}") from None
     if mass < 0:
         raise ModelError(f"{path}: link '{name}' has a negative mass {mass}")
+    eigenvalues = np.linalg.eigvalsh(inertia)
+    if not np.all(np.isfinite(eigenvalues)) or eigenvalues.min() < -INERTIA_RTOL * max(abs(eigenvalues).max(), 1e-300):
+        raise ModelError(f"{path}: link '{name}': its inertia is not positive semi-definite (principal moments "
+                         f"{', '.join(f'{x:.3g}' for x in eigenvalues)}); no rigid body has it — fix the "
+                         "<inertia> of the file")
     visuals = tuple(v for v in (_visual(x, path, dirs, materials) for x in element.findall("visual")) if v)
     return Link(name, mass, com, inertia, visuals)
 

@@ -250,3 +250,16 @@ def test_validate_command_json_and_the_robot_list(capsys):
     assert robots["ur5"]["pinocchio"] and robots["ur5"]["links"] == 11 and robots["talos"]["movable_joints"] == 32
     assert main(["validate", str(MODELS / "mechanisms" / "four_bar.yaml")]) == 2  # planar bodies: no Pinocchio twin
     assert "no equivalent Pinocchio model" in capsys.readouterr().err
+
+
+def test_an_inertia_no_rigid_body_has_is_refused_naming_file_and_link(tmp_path):
+    """tiago's antenna links have |ixy| > √(ixx iyy): a negative principal moment (−3.5e-8);
+    Pinocchio takes it, mbsynth refuses it by name."""
+    tree = ET.parse(robot_files()["double_pendulum"])
+    inertia = next(link for link in tree.getroot().findall("link") if link.get("name") == "link2").find("inertial/inertia")
+    inertia.attrib.update(ixx="1e-3", iyy="1e-3", ixy="2e-3")  # eigenvalues of the xy block: 3e-3 and −1e-3
+    path = tmp_path / "bad_inertia.urdf"
+    tree.write(path)
+    with pytest.raises(mb.ModelError, match=r"bad_inertia\.urdf: link 'link2': its inertia is not positive semi-definite"
+                                            r".*-0\.001"):
+        mb.from_robot(path)

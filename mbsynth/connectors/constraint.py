@@ -70,10 +70,8 @@ class Connector:
     def _materialized(self):
         """(a, b, C, φ, ψ) as sympy expressions of the model's symbols."""
         if self._symbolic is None:
-            (a, b, phi, psi), (q_slots, qd_slots), coordinates, constants, q, qd = self._placed
-            n, put = len(q), dict(constants)
-            put.update({s: q[c] for s, c in zip(q_slots, coordinates)})
-            put.update({s: qd[c] for s, c in zip(qd_slots, coordinates)})
+            (a, b, phi, psi), slots, coordinates, constants, q, qd = self._placed
+            n, put = len(q), placed_values(slots, coordinates, constants, q, qd)
             entries = {(r, coordinates[j]): x.xreplace(put) for r, row in enumerate(a) for j, x in enumerate(row)
                        if x != 0}
             self._symbolic = (sp.SparseMatrix(len(b), n, entries), sp.Matrix([x.xreplace(put) for x in b]),
@@ -116,6 +114,15 @@ class Connector:
         _, _, _, phi, psi = self._rows(t, q[self.indices], qd[self.indices], p)
         nan = np.full(self.size, np.nan)
         return (phi.ravel() if self._levels[0] else nan, psi.ravel() if self._levels[1] else nan)
+
+
+def placed_values(slots, coordinates, constants, q, qd):
+    """{placeholder: what it stands for}: the constants, and the model's coordinate and
+    velocity symbols at ``coordinates`` for the slots (q slots, q̇ slots)."""
+    put = dict(constants)
+    put.update({s: q[c] for s, c in zip(slots[0], coordinates)})
+    put.update({s: qd[c] for s, c in zip(slots[1], coordinates)})
+    return put
 
 
 def mixed(holonomic, nonholonomic, q, qd):

@@ -13,10 +13,12 @@ frame origins and x, y, z their axes in the world:
 
 The orientation lock is x_A·y_B = y_A·z_B = z_A·x_B = 0: independent near aligned
 frames, so assemble the frames aligned. Rows of A and b follow by differentiating φ
-twice (symbolic.differentiate), exactly — once per kind of joint and kinds of parts:
-φ is derived with the frames' offsets and rotations as placeholder symbols
-(``_PLACEHOLDERS``), differentiated (shared between joints alike,
-symbolic.differentiated), and the frames' values put in afterwards.
+twice (symbolic.differentiate), exactly — once per kind of joint and types of parts
+(``_template``): φ is derived with the frames' offsets and rotations as placeholder
+symbols (``_PLACEHOLDERS``) and the parts' coordinates as slots, compiled once, and each
+joint passes its frames' values and coordinates (Connector._place); its sympy rows are
+built only when asked. Joints on parts whose frames move with their coordinates, or with
+friction, are derived directly.
 """
 
 from typing import NamedTuple
@@ -24,9 +26,8 @@ from typing import NamedTuple
 import sympy as sp
 
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
-from ..symbolic import time_derivative
-from ..symbolic import differentiate, differentiated, positions
-from .constraint import Connector
+from ..symbolic import differentiate, differentiated, positions, time_derivative
+from .constraint import Connector, placed_values
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}
@@ -107,7 +108,7 @@ class Joint(Connector):
         kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
         phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
         a, b, psi = differentiated(phis, q, qd)
-        self._motions = _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd)
+        self._motions, self._motion_put = _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd), None
         C = sp.SparseMatrix(len(q), 1, {}) if friction is None else friction.viscous_force(self, qd)
         super().__init__(name, "holonomic", a, b, C, phis, psi, q, qd, params, labels)
         self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
@@ -131,13 +132,9 @@ class Joint(Connector):
 
     def _motion(self, k):
         expr = self._motions[k]
-        if expr is None or not hasattr(self, "_motion_put"):
+        if expr is None or self._motion_put is None:
             return expr
-        (q_slots, qd_slots), coordinates, constants, q, qd = self._motion_put
-        put = dict(constants)
-        put.update({s: q[c] for s, c in zip(q_slots, coordinates)})
-        put.update({s: qd[c] for s, c in zip(qd_slots, coordinates)})
-        return expr.xreplace(put)
+        return expr.xreplace(placed_values(*self._motion_put))
 
     angle = property(lambda self: self._motion(0), doc="the turn about z_A (revolute, cylindrical), else None")
     angle_rate = property(lambda self: self._motion(1), doc="z_A·(ω_B − ω_A), else None")
