@@ -84,7 +84,9 @@ class Description:
         return order
 
 
-INERTIA_RTOL = 1e-12  # a principal moment below −this × the largest is negative (not rounding)
+# a principal moment below −max(INERTIA_RTOL × the largest, INERTIA_ATOL) is negative, not rounding
+# (icub's head has moments of ±2.4e-35 kg m²: zero, printed with noise; URDF units are SI)
+INERTIA_RTOL, INERTIA_ATOL = 1e-12, 1e-15
 
 
 def read_urdf(path, package_dirs=()):
@@ -160,7 +162,8 @@ def _link(element, path, dirs, materials):
     if mass < 0:
         raise ModelError(f"{path}: link '{name}' has a negative mass {mass}")
     eigenvalues = np.linalg.eigvalsh(inertia)
-    if not np.all(np.isfinite(eigenvalues)) or eigenvalues.min() < -INERTIA_RTOL * max(abs(eigenvalues).max(), 1e-300):
+    if not np.all(np.isfinite(eigenvalues)) or eigenvalues.min() < -max(INERTIA_RTOL * abs(eigenvalues).max(),
+                                                                        INERTIA_ATOL):
         raise ModelError(f"{path}: link '{name}': its inertia is not positive semi-definite (principal moments "
                          f"{', '.join(f'{x:.3g}' for x in eigenvalues)}); no rigid body has it — fix the "
                          "<inertia> of the file")

@@ -16,6 +16,7 @@ import contextlib
 import os
 import sys
 import time
+import xml.etree.ElementTree as ET
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -196,8 +197,10 @@ def robot_table():
         try:
             d = describe(path)
             rows.append((name, path, len(d.links), sum(j.kind != "fixed" for j in d.joints), loads))
-        except ModelError:
-            rows.append((name, path, 0, 0, False))
+        except ModelError:  # mbsynth refuses the file (validate_robot says why); Pinocchio may not
+            root = ET.parse(path).getroot()
+            movable = sum(j.get("type") not in ("fixed", None) for j in root.findall("joint"))
+            rows.append((name, path, len(root.findall("link")), movable, loads))
     return rows
 
 

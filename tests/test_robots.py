@@ -263,3 +263,13 @@ def test_an_inertia_no_rigid_body_has_is_refused_naming_file_and_link(tmp_path):
     with pytest.raises(mb.ModelError, match=r"bad_inertia\.urdf: link 'link2': its inertia is not positive semi-definite"
                                             r".*-0\.001"):
         mb.from_robot(path)
+
+
+def test_an_inertia_of_rounding_noise_is_zero_not_refused(tmp_path):
+    """icub's head: moments of ±2.4e-35 kg m² (a zero inertia printed with noise) are kept."""
+    tree = ET.parse(robot_files()["double_pendulum"])
+    inertia = next(link for link in tree.getroot().findall("link") if link.get("name") == "link2").find("inertial/inertia")
+    inertia.attrib.update(ixx="0", iyy="0", izz="0", ixy="2.4e-35", ixz="0", iyz="0")
+    path = tmp_path / "noise.urdf"
+    tree.write(path)
+    assert mb.from_robot(path).n == 21  # three links, seven coordinates each
