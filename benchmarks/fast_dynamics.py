@@ -178,7 +178,7 @@ class Case:
         qm, qdm = self.to_maximal(q, v)
         motion = system.motion(0.0, qm, qdm)
         assert motion.method == "tree (Baraff)", motion.method
-        row = dict(label=self.label, bodies=len(engine.L.node_kind), n=system.n, nv=len(q), loaded_s=self.loaded_s,
+        row = dict(label=self.label, bodies=len(engine.L.node_kind), n=system.n, nv=len(v), loaded_s=self.loaded_s,
                    build_s=build_s, fast=best(lambda: system.motion(0.0, qm, qdm)), aba=float("nan"),
                    error=float("nan"))
         if self.model is not None:
