@@ -135,6 +135,15 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
             [x.xreplace(back) for x in psi])
 
 
+def placed_values(slots, coordinates, constants, q, qd):
+    """{placeholder: what it stands for}: the constants, and the model's coordinate and
+    velocity symbols at ``coordinates`` for the slots (q slots, q̇ slots)."""
+    put = dict(constants)
+    put.update({s: q[c] for s, c in zip(slots[0], coordinates)})
+    put.update({s: qd[c] for s, c in zip(slots[1], coordinates)})
+    return put
+
+
 _last_positions = ((), (), {})
 
 

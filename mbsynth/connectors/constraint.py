@@ -3,7 +3,7 @@
 import numpy as np
 import sympy as sp
 
-from ..symbolic import T_SYMBOL, compile_function, differentiated, positions
+from ..symbolic import T_SYMBOL, compile_function, differentiated, placed_values, positions
 
 
 class Connector:
@@ -114,15 +114,6 @@ class Connector:
         _, _, _, phi, psi = self._rows(t, q[self.indices], qd[self.indices], p)
         nan = np.full(self.size, np.nan)
         return (phi.ravel() if self._levels[0] else nan, psi.ravel() if self._levels[1] else nan)
-
-
-def placed_values(slots, coordinates, constants, q, qd):
-    """{placeholder: what it stands for}: the constants, and the model's coordinate and
-    velocity symbols at ``coordinates`` for the slots (q slots, q̇ slots)."""
-    put = dict(constants)
-    put.update({s: q[c] for s, c in zip(slots[0], coordinates)})
-    put.update({s: qd[c] for s, c in zip(slots[1], coordinates)})
-    return put
 
 
 def mixed(holonomic, nonholonomic, q, qd):

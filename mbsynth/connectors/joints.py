@@ -26,8 +26,8 @@ from typing import NamedTuple
 import sympy as sp
 
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
-from ..symbolic import differentiate, differentiated, positions, time_derivative
-from .constraint import Connector, placed_values
+from ..symbolic import differentiate, differentiated, placed_values, positions, time_derivative
+from .constraint import Connector
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}

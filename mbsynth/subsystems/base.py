@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..symbolic import T_SYMBOL, compile_function
+from ..symbolic import T_SYMBOL, compile_function, placed_values
 
 
 @dataclass(frozen=True)
@@ -50,14 +50,15 @@ class Part:
         template = (sp.Matrix(M), sp.Matrix(Q), sp.sympify(T), sp.sympify(V))
         q_slots, qd_slots, constants = shared or (self.q, self.qd, ())
         self._symbolic = None if shared else template
-        self._shared = template, {**dict(constants), **dict(zip(q_slots, self.q)), **dict(zip(qd_slots, self.qd))}
+        self._shared = shared and (template, (q_slots, qd_slots), constants)
         args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
         self._evaluate = compile_function(args, template[:2], constants)
         self._energy = compile_function(args, template[2:], constants)
 
     def _materialized(self):
         if self._symbolic is None:
-            template, put = self._shared
+            template, slots, constants = self._shared
+            put = placed_values(slots, range(len(self.q)), constants, self.q, self.qd)
             self._symbolic = tuple(x.xreplace(put) for x in template)
         return self._symbolic
 
