@@ -19,7 +19,10 @@ from mbsynth.fast import engine_for
 from mbsynth.fast.bodies import body_force, rate_transpose
 from mbsynth.fast.joints import vector_work
 from mbsynth.fast.joints import joint_rows as kernel_rows
+from mbsynth.fast.assembly import nodes
 from mbsynth.fast.layout import build as build_layout
+from mbsynth.fast.rate_rows import rate_rows
+from mbsynth import kinematics
 from mbsynth.kinematics import body_rate_matrix
 from mbsynth.subsystems import RigidBody
 
@@ -111,6 +114,50 @@ def test_joint_rows_equal_the_sympy_rows(all_joints):
             expected[:, con.indices] = a_ref
             assert np.abs(full - expected).max() <= 1e-12 * max(1.0, np.abs(expected).max()), con.joint_kind
             assert np.abs(b[:k] - b_ref).max() <= 1e-12 * max(1.0, np.abs(b_ref).max()), con.joint_kind
+
+
+def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
+    """rate_rows.rate_rows (rows on (r̈, α) of the bodies) against Joint.evaluate (sympy)
+    mapped through q̈ = (r̈, (u s + EᵀBᵀα)/ν), B = R(u)/(2ν), s = −u̇·u̇/ν, for every joint
+    without a particle, quaternions of any length."""
+    system = all_joints
+    L, _ = build_layout(system)
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
+    V, rho = vector_work()[0], np.zeros((2, 3))
+    A, b = np.zeros((6, 14)), np.zeros(6)
+    Rs = np.zeros((len(L.node_kind), 4, 3, 3))
+    rng = np.random.default_rng(4)
+    for trial in range(4):
+        q, qd = random_state(system, rng, unit=trial % 2 == 0)
+        mu = nodes(q, qd, np.zeros(0), L.node_kind, L.node_q, L.node_mass, L.node_mg, L.node_J, L.quat_row,
+                   np.zeros(system.n), np.zeros(system.n), np.zeros((len(L.node_kind), 6, 6)),
+                   np.zeros((len(L.node_kind), 6)), np.zeros(len(L.node_kind)), np.zeros(len(L.node_kind)),
+                   np.zeros(7), Rs)
+        assert mu > 0
+        for j, con in enumerate(kernel_joints):
+            if 2 in L.joint_kinds[j]:  # a particle end: joints.py
+                continue
+            a_ref, b_ref, _ = con.evaluate(0.0, q, qd, system.parameter_values)
+            k = int(L.joint_k[j])
+            rate_rows(L.joint_program[j], k, L.joint_kinds[j], L.joint_node[j], L.joint_start[j], L.joint_s[j],
+                      L.joint_R[j], L.joint_length[j], q, qd, Rs, V, rho, A, b)
+            full = np.zeros((k, system.n))
+            full[:, con.indices] = a_ref
+            expected_b = b_ref.astype(float).copy()
+            for e in range(2):
+                if L.joint_kinds[j, e] == 0:
+                    continue
+                o = L.joint_start[j, e]
+                u, ud = q[o + 3:o + 7], qd[o + 3:o + 7]
+                nu = np.linalg.norm(u)
+                B = np.array(kinematics.rotation(u), dtype=float) / (2 * nu)
+                E = np.array(kinematics.body_rate_matrix(u), dtype=float)
+                c_r, c_u = full[:, o:o + 3], full[:, o + 3:o + 7]
+                expected_a = c_u @ E.T @ B.T / nu  # (E c_u / ν)·Bᵀα
+                assert np.abs(A[:k, 6 * e:6 * e + 3] - c_r).max() <= 1e-12, con.joint_kind
+                assert np.abs(A[:k, 6 * e + 3:6 * e + 6] - expected_a).max() <= 1e-12, con.joint_kind
+                expected_b -= c_u @ u * (-(ud @ ud) / nu) / nu
+            assert np.abs(b[:k] - expected_b).max() <= 1e-12 * max(1.0, np.abs(expected_b).max()), con.joint_kind
 
 
 def test_body_blocks_equal_the_sympy_blocks(all_joints):

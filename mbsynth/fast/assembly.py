@@ -18,10 +18,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .bodies import OPTIONS, body_force, rate, reduce_row
-from .joints import MAX_ROWS, RIGID, joint_rows, vector_work
-
-MAX_BLOCK = 6 + MAX_ROWS
+from .bodies import INLINE, OPTIONS, body_force, rate, reduce_row, rotation, rotation_rate
+from .joints import MAX_ROWS, PARTICLE, RIGID, joint_rows, vector_work
+from .rate_rows import rate_rows
+from .tree import GENERAL, RIGID_INVARIANT
 
 
 class Work(NamedTuple):
@@ -32,13 +32,22 @@ class Work(NamedTuple):
     H: np.ndarray      # (N, 6, 6) node masses / μ
     F: np.ndarray      # (N, 6) node forces / μ
     s: np.ndarray      # (N,) quaternion norm accelerations (bodies.py)
+    Rs: np.ndarray     # (N, 4, 3, 3) per body R(u), d/dt R(u), Rb and B (nodes; rate_rows.py)
+    zeta: np.ndarray   # (N, 3) each node's rigid transport (transports)
     nu: np.ndarray     # (N,) quaternion lengths
-    acc: np.ndarray    # (N, 6, 6) children's contributions (tree.factor)
-    perm: np.ndarray   # (MAX_BLOCK,) pivot rows
+    HA: np.ndarray     # (N, 6, 6) articulated masses (tree.factor)
+    Sn: np.ndarray     # (N, 6, 6) null-space bases of the parent-joint rows
+    Jr: np.ndarray     # (N, 6, 6) right inverses of those rows
+    X: np.ndarray      # (N, 6, 6) X = −Jr P
+    U: np.ndarray      # (N, 6, 6) H^A S
+    Ninv: np.ndarray   # (N, 6, 6) (Sᵀ H^A S)⁻¹
+    c: np.ndarray      # (N, 6) tree.solve work
+    x0: np.ndarray     # (N, 6) tree.solve work
+    G: np.ndarray      # (12, 12) tree.factor work
+    pivot: np.ndarray  # (12,) tree.factor's pivots
     J: np.ndarray      # (tree rows, 6) parent-joint rows on the node
     P: np.ndarray      # (tree rows, 6) the same rows on the parent
     rb: np.ndarray     # (tree rows,) their right sides
-    Dinv: np.ndarray   # flat inverse blocks
     ry: np.ndarray     # (tree unknowns,) right side of the tree system
     y: np.ndarray      # (tree unknowns,) work
     z: np.ndarray      # (tree unknowns,) solution
@@ -48,6 +57,7 @@ class Work(NamedTuple):
     R: np.ndarray
     Jt: np.ndarray
     A: np.ndarray      # (MAX_ROWS, 14) one joint's rows
+    rho: np.ndarray    # (2, 3) its frames' offsets (rate_rows.py)
     b: np.ndarray      # (MAX_ROWS,)
     q7: np.ndarray     # (7,) one body's Q
     seg7: np.ndarray   # (S, 7) extra rows' coefficients per node
@@ -67,32 +77,42 @@ class Work(NamedTuple):
 
 def make_work(L):
     """A Work for the Layout L (numpy; one per thread)."""
-    n, nz, dsize, rows = (int(x) for x in L.sizes[[0, 2, 3, 4]])
+    n, nz, rows = (int(x) for x in L.sizes[[0, 2, 3]])
     N, S = L.node_kind.shape[0], L.xseg_node.shape[0]
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
-    shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, acc=(N, 6, 6), J=(rows, 6), P=(rows, 6), rb=rows,
-                  Dinv=dsize, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
+    shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
+                  Ninv=(N, 6, 6), c=(N, 6), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), rho=(2, 3), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
                   rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
     V, R, Jt = vector_work()
-    return Work(perm=np.zeros(MAX_BLOCK, np.int64), V=V, R=R, Jt=Jt, **arrays)
+    return Work(pivot=np.zeros(12, np.int64), V=V, R=R, Jt=Jt, **arrays)
 
 
 @njit(**OPTIONS)
 def _joint(j, q, qd, joints, scratch):
     """Rows of kernel joint j into scratch's A, b; returns their number."""
-    program, k, kinds, start, offset, rotation, length = joints
-    V, R, Jt, A, b = scratch
+    program, k, kinds, start, offset, rotation, length, _ = joints
+    V, R, Jt, A, b, _ = scratch
     joint_rows(program[j], k[j], kinds[j], start[j], offset[j], rotation[j], length[j], q, qd, V, R, Jt, A, b)
     return k[j]
 
 
-@njit(**OPTIONS)
-def _reduce(c7, rigid, q, o, nu, s, out):
-    """A row segment on a node in its reduced unknowns; returns the right-side shift."""
+@njit(**INLINE)
+def _turn(B, x, o):
+    """x[o:o + 3] ← B x[o:o + 3]: a row's coefficients on a from those on α (a = Bᵀα)."""
+    a, b, c = x[o], x[o + 1], x[o + 2]
+    for r in range(3):
+        x[o + r] = B[r, 0] * a + B[r, 1] * b + B[r, 2] * c
+
+
+@njit(**INLINE)
+def _reduce(c7, rigid, q, o, nu, s, B, out):
+    """A row segment on a node in its reduced unknowns (r̈, α); returns the right-side shift."""
     if rigid:
-        return reduce_row(c7, q[o + 3:o + 7], nu, s, out)
+        shift = reduce_row(c7, q[o + 3:o + 7], nu, s, out)
+        _turn(B, out, 3)
+        return shift
     for a in range(3):
         out[a] = c7[a]
         out[3 + a] = 0.0
@@ -100,8 +120,10 @@ def _reduce(c7, rigid, q, o, nu, s, out):
 
 
 @njit(**OPTIONS)
-def nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu, q7):
-    """Masses, forces and quaternion norm accelerations of the nodes; returns μ."""
+def nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu, q7, Rs):
+    """Masses, forces and quaternion norm accelerations of the nodes, a rigid body's in
+    (r̈, α) (module docstring of bodies.py): H_αα = R J Rᵀ, F_α = B F_a with B = R/(2ν);
+    and per body Rs = (R(u), d/dt R(u), Rb = 2R(u̇) + (2s/ν) R, B). Returns μ."""
     mu = 0.0
     for i in range(kind.shape[0]):
         c, m = start[i], mass[i]
@@ -123,16 +145,28 @@ def nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F,
         for a in range(7):
             Qf[c + a] += q7[a]
         e = rate(u, (Qf[c + 3] + Cf[c + 3], Qf[c + 4] + Cf[c + 4], Qf[c + 5] + Cf[c + 5], Qf[c + 6] + Cf[c + 6]))
+        R, Rb, B = Rs[i, 0], Rs[i, 2], Rs[i, 3]
+        rotation(u, R)
+        rotation_rate(u, ud, Rs[i, 1])
+        rotation(ud, Rb)
+        for a in range(3):
+            for b in range(3):
+                Rb[a, b] = 2 * Rb[a, b] + 2 * s[i] / length * R[a, b]
+                B[a, b] = R[a, b] / (2 * length)
         for a in range(3):
             F[i, a] = Qf[c + a] + Cf[c + a]
-            F[i, 3 + a] = e[a] / length
-            for b in range(3):
-                H[i, 3 + a, 3 + b] = 4 * length * length * inertia[i, a, b]
-                mu = max(mu, abs(H[i, 3 + a, 3 + b]))
+            F[i, 3 + a] = (B[a, 0] * e[0] + B[a, 1] * e[1] + B[a, 2] * e[2]) / length
+            for b in range(3):  # (R J Rᵀ)[a, b]
+                t = 0.0
+                for x in range(3):
+                    t += R[a, x] * (inertia[i, x, 0] * R[b, 0] + inertia[i, x, 1] * R[b, 1]
+                                    + inertia[i, x, 2] * R[b, 2])
+                H[i, 3 + a, 3 + b] = t
+                mu = max(mu, abs(t))
     return mu
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _normalize(row, count):
     """1 / the 2-norm of row[:count] (1 for a zero row)."""
     total = 0.0
@@ -142,22 +176,37 @@ def _normalize(row, count):
 
 
 @njit(**OPTIONS)
-def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, joints, joint_row, scratch,
-               J, P, rb):
-    """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated."""
-    A, b = scratch[3], scratch[4]
+def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, Rs, joints, joint_row, scratch,
+              J, P, rb):
+    """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated.
+    Joints between rigid bodies or the world: rate_rows.py; others: joints.py, reduced."""
+    program, count, kinds, starts, offset, rotation, length, ends = joints
+    V, A, b, rho = scratch[0], scratch[3], scratch[4], scratch[5]
     for i in range(kind.shape[0]):
         j = node_joint[i]
         if j < 0:
             continue
-        k = _joint(j, q, qd, joints, scratch)
         me, p, r0 = node_end[i], parent[i], rows[i]
+        if kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE:
+            k = count[j]
+            rate_rows(program[j], k, kinds[j], ends[j], starts[j], offset[j], rotation[j], length[j], q, qd, Rs, V,
+                      rho, A, b)
+            for r in range(k):
+                scale = _normalize(A[r], 12)
+                rhs = b[r] + (bshift[joint_row[j] + r] if bshift.shape[0] else 0.0)
+                for a in range(6):
+                    J[r0 + r, a] = A[r, 6 * me + a] * scale
+                    P[r0 + r, a] = A[r, 6 - 6 * me + a] * scale if p >= 0 else 0.0
+                rb[r0 + r] = rhs * scale
+            continue
+        k = _joint(j, q, qd, joints, scratch)
         for r in range(k):
             scale = _normalize(A[r], 14)
             rhs = b[r] + (bshift[joint_row[j] + r] if bshift.shape[0] else 0.0)
-            rhs += _reduce(A[r, 7 * me:7 * me + 7], kind[i] == RIGID, q, start[i], nu[i], s[i], J[r0 + r])
+            rhs += _reduce(A[r, 7 * me:7 * me + 7], kind[i] == RIGID, q, start[i], nu[i], s[i], Rs[i, 3], J[r0 + r])
             if p >= 0:
-                rhs += _reduce(A[r, 7 - 7 * me:14 - 7 * me], kind[p] == RIGID, q, start[p], nu[p], s[p], P[r0 + r])
+                rhs += _reduce(A[r, 7 - 7 * me:14 - 7 * me], kind[p] == RIGID, q, start[p], nu[p], s[p], Rs[p, 3],
+                               P[r0 + r])
             else:
                 P[r0 + r, :] = 0.0
             for a in range(6):
@@ -167,7 +216,7 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
 
 
 @njit(**OPTIONS)
-def extra_rows(q, qd, gen, bshift, kind, start, nu, s, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
+def extra_rows(q, qd, gen, bshift, kind, start, nu, s, Rs, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
                 xseg_node, gen_rows, scratch, seg7, seg6, xb, Ax):
     """Loop-joint rows and the generated rows (gen: their entries, then their b), as
     segments and Ax entries; equilibrated."""
@@ -207,7 +256,7 @@ def extra_rows(q, qd, gen, bshift, kind, start, nu, s, joints, joint_xrow, joint
         rhs = xb[x] + (bshift[xrow_row[x]] if bshift.shape[0] else 0.0)
         for seg in range(xseg_ptr[x], xseg_ptr[x + 1]):
             i = xseg_node[seg]
-            rhs += _reduce(seg7[seg], kind[i] == RIGID, q, start[i], nu[i], s[i], seg6[seg])
+            rhs += _reduce(seg7[seg], kind[i] == RIGID, q, start[i], nu[i], s[i], Rs[i, 3], seg6[seg])
             for a in range(6):
                 seg6[seg, a] *= scale
         for c in range(nx):
@@ -247,6 +296,27 @@ def divide_masses(mu, H, F, Mx, Fx):
         Fx[x] *= inv
         for c in range(Fx.shape[0]):
             Mx[x, c] *= inv
+
+
+@njit(**OPTIONS)
+def transports(q, start, parent, node_joint, node_end, transport, joint_s, Rs, zeta):
+    """ζ of each rigid node on a rigid parent: X = [[I, [ζ]×], [0, I]] maps the parent's
+    (r̈, α) to the node's when the joint is locked, and J X = −P holds exactly for its rows
+    (tree.py): ζ = r_p − r_i for rows invariant under rotation, ζ = R_i s_i − R_p s_p
+    (the two frames' offsets) for rows that are world components of d."""
+    for i in range(transport.shape[0]):
+        if transport[i] == GENERAL:
+            continue
+        p, j, e = parent[i], node_joint[i], node_end[i]
+        if transport[i] == RIGID_INVARIANT:
+            for a in range(3):
+                zeta[i, a] = q[start[p] + a] - q[start[i] + a]
+            continue
+        si, sp = joint_s[j, e], joint_s[j, 1 - e]
+        for a in range(3):
+            Ri, Rp = Rs[i, 0], Rs[p, 0]
+            zeta[i, a] = (Ri[a, 0] * si[0] + Ri[a, 1] * si[1] + Ri[a, 2] * si[2]
+                          - Rp[a, 0] * sp[0] - Rp[a, 1] * sp[1] - Rp[a, 2] * sp[2])
 
 
 @njit(**OPTIONS)

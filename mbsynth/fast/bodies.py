@@ -20,9 +20,10 @@ the row and its multiplier leave the system exactly (an orthogonal change of var
 from numba import njit
 
 OPTIONS = dict(cache=True, error_model="numpy")
+INLINE = dict(OPTIONS, inline="always")  # small helpers: numba inlines them (a call costs as much)
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def rotation(u, R):
     """R(u) into R (3 × 3)."""
     w, x, y, z = u[0], u[1], u[2], u[3]
@@ -36,6 +37,23 @@ def rotation(u, R):
     R[2, 0] = 2 * (x * z - w * y)
     R[1, 2] = 2 * (y * z - w * x)
     R[2, 1] = 2 * (y * z + w * x)
+
+
+@njit(**INLINE)
+def rotation_rate(u, ud, Rd):
+    """d/dt R(u) into Rd: 2(wẇ − v·v̇) I + 2(v̇vᵀ + v v̇ᵀ) + 2ẇ[v]× + 2w[v̇]×."""
+    w, x, y, z = u[0], u[1], u[2], u[3]
+    wd, xd, yd, zd = ud[0], ud[1], ud[2], ud[3]
+    d = 2 * (w * wd - x * xd - y * yd - z * zd)
+    Rd[0, 0] = d + 4 * x * xd
+    Rd[1, 1] = d + 4 * y * yd
+    Rd[2, 2] = d + 4 * z * zd
+    Rd[0, 1] = 2 * (xd * y + x * yd - wd * z - w * zd)
+    Rd[1, 0] = 2 * (xd * y + x * yd + wd * z + w * zd)
+    Rd[0, 2] = 2 * (xd * z + x * zd + wd * y + w * yd)
+    Rd[2, 0] = 2 * (xd * z + x * zd - wd * y - w * yd)
+    Rd[1, 2] = 2 * (yd * z + y * zd - wd * x - w * xd)
+    Rd[2, 1] = 2 * (yd * z + y * zd + wd * x + w * xd)
 
 
 @njit(**OPTIONS)
@@ -63,7 +81,7 @@ def rotation_jacobian(u, c, J):
     J[2, 2] -= 2 * w * cx
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def rate(u, x):
     """E(u) x for a 4-vector x: −x_w v + w x_v − v × x_v (a 3-tuple)."""
     w, a, b, c = u[0], u[1], u[2], u[3]
@@ -72,7 +90,7 @@ def rate(u, x):
             -x[0] * c + w * x[3] - (a * x[2] - b * x[1]))
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def rate_transpose(u, g):
     """E(u)ᵀ g for a 3-vector g: (−v·g, w g + v × g) (a 4-tuple)."""
     w, a, b, c = u[0], u[1], u[2], u[3]
@@ -82,7 +100,7 @@ def rate_transpose(u, g):
             w * g[2] + a * g[1] - b * g[0])
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def body_force(mg, J, u, ud, Q):
     """Q of a rigid body into Q (7): [m g; −8 E(u̇)ᵀ J E(u) u̇]."""
     o = rate(u, ud)
@@ -96,7 +114,7 @@ def body_force(mg, J, u, ud, Q):
         Q[3 + k] = -8 * f[k]
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def reduce_row(c, u, nu, s, out):
     """(c_r, E c_u/ν) of a 7-coefficient row segment c into out (6); returns the right-side
     shift −(c_u·u) s/ν (module docstring)."""

@@ -2,11 +2,14 @@
 
 ``MBSYNTH_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/mbsynth``, else ``~/.cache/mbsynth``;
 when none of them can be written, a directory under the system's temporary directory.
-numba's on-disk cache (``cache=True``) goes to ``<cache>/numba`` unless NUMBA_CACHE_DIR is
-already set; the generated source of each model's force/constraint function (codegen.py)
+numba's on-disk cache (``cache=True``) goes to ``<cache>/numba/<hash of this package's
+sources>`` unless NUMBA_CACHE_DIR is already set: numba checks only the file of the function
+it loads, so a kernel compiled against an older version of a module it calls would be
+loaded stale; the generated source of each model's force/constraint function (codegen.py)
 goes to ``<cache>/generated``. Call ``configure()`` before numba is imported.
 """
 
+import hashlib
 import os
 import tempfile
 from pathlib import Path
@@ -37,10 +40,18 @@ def cache_dir():
     raise OSError(f"no writable cache directory among {[str(p) for p in candidates]}")
 
 
+def sources_hash():
+    """A digest of the fast path's sources (the kernels and everything they call)."""
+    digest = hashlib.sha256()
+    for path in sorted(Path(__file__).resolve().parent.glob("*.py")):
+        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
 def configure():
-    """Point numba's cache at ``<cache>/numba`` unless NUMBA_CACHE_DIR is set already."""
+    """Point numba's cache at ``<cache>/numba/<sources_hash()>`` unless NUMBA_CACHE_DIR is set."""
     if not os.environ.get("NUMBA_CACHE_DIR"):
-        os.environ["NUMBA_CACHE_DIR"] = str(cache_dir() / "numba")
+        os.environ["NUMBA_CACHE_DIR"] = str(cache_dir() / "numba" / sources_hash())
     import sys
     config = sys.modules.get("numba.core.config")
     if config is not None and not config.CACHE_DIR:  # numba imported before us: tell it directly

@@ -8,7 +8,10 @@ tree system K z = r as a bordered system. With G the extra rows on the tree unkn
 
 the tree is factored once and each extra row costs one tree solve. The small symmetric
 Schur matrix is solved by its eigendecomposition, dropping eigenvalues below
-``EIG_RTOL`` of the largest (redundant rows, as a planar loop's in 3D). A dropped
+``EIG_RTOL`` of the largest, or of 1 (redundant rows, as a planar loop's in 3D; the
+masses are divided by the largest and the rows have unit norm, so a row that acts has an
+eigenvalue of the order of an inverse mass, ≥ about 1/N, and rows that repeat tree rows
+give a Schur matrix of rounding noise). A dropped
 direction must leave the right side alone (else the rows contradict: INCONSISTENT) and
 must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 
@@ -24,8 +27,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .assembly import Work, divide_masses, extra_rows, generated, nodes, tree_rhs, tree_rows
-from .bodies import OPTIONS, rate_transpose
+from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
+from .bodies import INLINE, OPTIONS, rate_transpose
 from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
@@ -33,21 +36,21 @@ from .packing import fields, view1, view2, view3, view4
 from .tree import factor, solve
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
-EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of the largest count as zero
-CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions
+EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of max(the largest, 1) count as zero
+CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions, relative to b's
 NULL_RTOL = 1e-8  # largest acceleration a dropped (unit) direction may move
 RESIDUAL_MAX = 1e-9
 LAYOUT, WORK = fields(Layout), fields(Work)
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _copy(a, b):
     """b ← a (a loop: numba's slice assignment compiles slowly)."""
     for i in range(a.shape[0]):
         b[i] = a[i]
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _scatter(x, weight, segs, seg6, y):
     """y += weight · (extra row x on the tree unknowns). segs: (xseg_ptr, xseg_node, v, yoff)."""
     ptr, node, v, yoff = segs
@@ -57,7 +60,7 @@ def _scatter(x, weight, segs, seg6, y):
             y[yoff[i] + a] += weight * seg6[seg, a]
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _row_dot(x, segs, seg6, z):
     """(extra row x on the tree unknowns) · z."""
     ptr, node, v, yoff = segs
@@ -70,12 +73,12 @@ def _row_dot(x, segs, seg6, z):
 
 
 @njit(**OPTIONS)
-def _moves(vec, nx, topology, segs, seg6, P, Dinv, y, w):
+def _moves(vec, nx, topology, segs, seg6, factored, y, w):
     """The acceleration a unit Schur direction (u_x, μ) moves: (u_x, −(K⁻¹Gᵀμ) on accelerations)."""
     y[:] = 0.0
     for x in range(vec.shape[0] - nx):
         _scatter(x, -vec[nx + x], segs, seg6, y)
-    solve(topology, P, Dinv, y, w)
+    solve(topology, factored, y, w)
     total = 0.0
     for x in range(nx):
         total += vec[x] * vec[x]
@@ -87,7 +90,7 @@ def _moves(vec, nx, topology, segs, seg6, P, Dinv, y, w):
 
 
 @njit(**OPTIONS)
-def _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam):
+def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam):
     """Solve the Schur system of the extra rows and coordinates into lam (extra
     accelerations, then extra multipliers), then the tree into z. Returns a status."""
     mx, nx = Ax.shape[0], Ax.shape[1]
@@ -104,16 +107,18 @@ def _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, ve
     for x in range(mx):
         y[:] = 0.0
         _scatter(x, 1.0, segs, seg6, y)
-        solve(topology, P, Dinv, y, w)
+        solve(topology, factored, y, w)
         for r in range(mx):
             S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
     values = np.zeros(mx + nx)
     symmetric_eigen(S, vectors, values)
-    top = np.abs(values).max() if values.shape[0] else 0.0
+    top = max(np.abs(values).max(), 1.0) if values.shape[0] else 1.0
     lam[:] = 0.0
     dropped = size = 0.0
-    for e in range(values.shape[0]):
+    for e in range(values.shape[0]):  # the right side's scale: before the tree's part cancels
         size += rhs[e] * rhs[e]
+    for x in range(mx):
+        size += xb[x] * xb[x]
     for e in range(values.shape[0]):
         coef = 0.0
         for c in range(values.shape[0]):
@@ -123,20 +128,20 @@ def _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, ve
                 lam[c] += coef / values[e] * vectors[c, e]
         else:
             dropped += coef * coef
-            if _moves(vectors[:, e], nx, topology, segs, seg6, P, Dinv, y, w) > NULL_RTOL:
+            if _moves(vectors[:, e], nx, topology, segs, seg6, factored, y, w) > NULL_RTOL:
                 return NOT_UNIQUE
     if math.sqrt(dropped) > CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
         return INCONSISTENT
     _copy(ry, y)
     for x in range(mx):
         _scatter(x, -lam[nx + x], segs, seg6, y)
-    solve(topology, P, Dinv, y, z)
+    solve(topology, factored, y, z)
     return OK
 
 
 @njit(**OPTIONS)
-def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, z, Qf, Mx, lam, mu, qdd, Qc):
-    """q̈ (bodies.py: ü = (u s + Eᵀa)/ν) and Qc = M q̈ − Q from the solution."""
+def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc):
+    """q̈ (bodies.py: ü = (u s + Eᵀa)/ν, a = Bᵀα) and Qc = M q̈ − Q from the solution."""
     for i in range(kind.shape[0]):
         c, o, m = start[i], yoff[i], mass[i]
         for a in range(3):
@@ -144,12 +149,14 @@ def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, z, Qf, Mx, lam
             Qc[c + a] = m * z[o + a] - Qf[c + a]
         if kind[i] != RIGID:
             continue
-        u, J = q[c + 3:c + 7], inertia[i]
-        alpha = (z[o + 3], z[o + 4], z[o + 5])
-        et = rate_transpose(u, alpha)
-        f = rate_transpose(u, (J[0, 0] * alpha[0] + J[0, 1] * alpha[1] + J[0, 2] * alpha[2],
-                               J[1, 0] * alpha[0] + J[1, 1] * alpha[1] + J[1, 2] * alpha[2],
-                               J[2, 0] * alpha[0] + J[2, 1] * alpha[1] + J[2, 2] * alpha[2]))
+        u, J, Bi = q[c + 3:c + 7], inertia[i], Rs[i, 3]
+        a_rates = (Bi[0, 0] * z[o + 3] + Bi[1, 0] * z[o + 4] + Bi[2, 0] * z[o + 5],
+                 Bi[0, 1] * z[o + 3] + Bi[1, 1] * z[o + 4] + Bi[2, 1] * z[o + 5],
+                 Bi[0, 2] * z[o + 3] + Bi[1, 2] * z[o + 4] + Bi[2, 2] * z[o + 5])
+        et = rate_transpose(u, a_rates)
+        f = rate_transpose(u, (J[0, 0] * a_rates[0] + J[0, 1] * a_rates[1] + J[0, 2] * a_rates[2],
+                               J[1, 0] * a_rates[0] + J[1, 1] * a_rates[1] + J[1, 2] * a_rates[2],
+                               J[2, 0] * a_rates[0] + J[2, 1] * a_rates[1] + J[2, 2] * a_rates[2]))
         for a in range(4):
             qdd[c + 3 + a] = (u[a] * s[i] + et[a]) / nu[i]
             Qc[c + 3 + a] = 4 * nu[i] * f[a] - Qf[c + 3 + a]
@@ -165,7 +172,7 @@ def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, z, Qf, Mx, lam
 @njit(**OPTIONS)
 def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn):
     """Relative residual of the equilibrated KKT equations at the solution (module docstring)."""
-    _, parent, v, k, _, yoff, rows = topology
+    _, parent, v, k, yoff, rows, _ = topology
     ptr, node = segs[0], segs[1]
     mx, nx = Ax.shape[0], Ax.shape[1]
     res = norm_M = norm_A = norm_x = norm_r = 0.0
@@ -238,29 +245,33 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
     v, k, yoff, rows = (view1(LI, LX, LAYOUT.node_v), view1(LI, LX, LAYOUT.node_k), view1(LI, LX, LAYOUT.node_yoff),
                         view1(LI, LX, LAYOUT.node_rows))
     parent, x_coord = view1(LI, LX, LAYOUT.node_parent), view1(LI, LX, LAYOUT.x_coord)
-    topology = (view1(LI, LX, LAYOUT.order), parent, v, k, view1(LI, LX, LAYOUT.node_doff), yoff, rows)
+    transport = view1(LI, LX, LAYOUT.node_transport)
+    topology = (view1(LI, LX, LAYOUT.order), parent, v, k, yoff, rows, transport)
     joints = (view3(LI, LX, LAYOUT.joint_program), view1(LI, LX, LAYOUT.joint_k), view2(LI, LX, LAYOUT.joint_kinds),
               view2(LI, LX, LAYOUT.joint_start), view3(LF, LX, LAYOUT.joint_s), view4(LF, LX, LAYOUT.joint_R),
-              view1(LF, LX, LAYOUT.joint_length))
+              view1(LF, LX, LAYOUT.joint_length), view2(LI, LX, LAYOUT.joint_node))
     xseg_ptr, xseg_node = view1(LI, LX, LAYOUT.xseg_ptr), view1(LI, LX, LAYOUT.xseg_node)
     segs = (xseg_ptr, xseg_node, v, yoff)
     gen_rows = (view1(LI, LX, LAYOUT.gen_arow), view1(LI, LX, LAYOUT.gen_aseg), view1(LI, LX, LAYOUT.gen_acol),
                 view1(LI, LX, LAYOUT.gen_brow))
     Qf, Cf, qdd, Qc = view1(WF, WX, WORK.Qf), view1(WF, WX, WORK.Cf), view1(WF, WX, WORK.qdd), view1(WF, WX, WORK.Qc)
-    H, F, acc, dyn = view3(WF, WX, WORK.H), view2(WF, WX, WORK.F), view3(WF, WX, WORK.acc), view2(WF, WX, WORK.dyn)
-    s, nu = view1(WF, WX, WORK.s), view1(WF, WX, WORK.nu)
-    J, P, rb, Dinv = view2(WF, WX, WORK.J), view2(WF, WX, WORK.P), view1(WF, WX, WORK.rb), view1(WF, WX, WORK.Dinv)
+    H, F, dyn = view3(WF, WX, WORK.H), view2(WF, WX, WORK.F), view2(WF, WX, WORK.dyn)
+    factored = (view3(WF, WX, WORK.HA), view3(WF, WX, WORK.Sn), view3(WF, WX, WORK.Jr), view3(WF, WX, WORK.X),
+                view3(WF, WX, WORK.U), view3(WF, WX, WORK.Ninv), view2(WF, WX, WORK.c), view2(WF, WX, WORK.x0),
+                view2(WF, WX, WORK.zeta))
+    s, nu, Rs = view1(WF, WX, WORK.s), view1(WF, WX, WORK.nu), view4(WF, WX, WORK.Rs)
+    J, P, rb = view2(WF, WX, WORK.J), view2(WF, WX, WORK.P), view1(WF, WX, WORK.rb)
     ry, y, z, z0, w = (view1(WF, WX, WORK.ry), view1(WF, WX, WORK.y), view1(WF, WX, WORK.z), view1(WF, WX, WORK.z0),
                        view1(WF, WX, WORK.w))
     scratch = (view3(WF, WX, WORK.V), view3(WF, WX, WORK.R), view2(WF, WX, WORK.Jt), view2(WF, WX, WORK.A),
-               view1(WF, WX, WORK.b))
+               view1(WF, WX, WORK.b), view2(WF, WX, WORK.rho))
     seg7, seg6, xb, Ax = view2(WF, WX, WORK.seg7), view2(WF, WX, WORK.seg6), view1(WF, WX, WORK.xb), view2(WF, WX, WORK.Ax)
     Mx, Fx, lam = view2(WF, WX, WORK.Mx), view1(WF, WX, WORK.Fx), view1(WF, WX, WORK.lam)
 
     o = generated(gen, view1(LI, LX, LAYOUT.gen_q), view1(LI, LX, LAYOUT.gen_c), view1(LI, LX, LAYOUT.gen_mi),
                   view1(LI, LX, LAYOUT.gen_mj), Qf, Cf, Mx)
     mu = nodes(q, qd, bshift, kind, start, mass, mg, inertia, view1(LI, LX, LAYOUT.quat_row), Qf, Cf, H, F, s, nu,
-               view1(WF, WX, WORK.q7))
+               view1(WF, WX, WORK.q7), Rs)
     for x in range(x_coord.shape[0]):
         Fx[x] = Qf[x_coord[x]] + Cf[x_coord[x]]
         for c in range(x_coord.shape[0]):
@@ -268,24 +279,26 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
     mu = mu if mu > 0 else 1.0
     divide_masses(mu, H, F, Mx, Fx)
     tree_rows(q, qd, bshift, kind, start, view1(LI, LX, LAYOUT.node_joint), view1(LI, LX, LAYOUT.node_end), parent,
-              rows, nu, s, joints, view1(LI, LX, LAYOUT.joint_row), scratch, J, P, rb)
+              rows, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_row), scratch, J, P, rb)
     if xb.shape[0]:
-        extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, joints, view1(LI, LX, LAYOUT.joint_xrow),
+        extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_xrow),
                    view2(LI, LX, LAYOUT.joint_xseg), view1(LI, LX, LAYOUT.xrow_row), xseg_ptr, xseg_node, gen_rows,
                    scratch, seg7, seg6, xb, Ax)
+    transports(q, start, parent, view1(LI, LX, LAYOUT.node_joint), view1(LI, LX, LAYOUT.node_end), transport,
+               joints[4], Rs, factored[8])
     tree_rhs(v, k, yoff, rows, F, rb, ry)
 
-    if factor(topology, H, J, P, Dinv, acc, view1(WI, WX, WORK.perm)) >= 0:
+    if factor(topology, H, J, P, factored, view2(WF, WX, WORK.G), view1(WI, WX, WORK.pivot)) >= 0:
         return SINGULAR, 0.0
     _copy(ry, y)
-    solve(topology, P, Dinv, y, z0)
+    solve(topology, factored, y, z0)
     _copy(z0, z)
     if x_coord.shape[0] + xb.shape[0] > 0:
-        status = _close(topology, segs, seg6, P, Dinv, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
+        status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
                         view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam)
         if status != OK:
             return status, 0.0
-    _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, z, Qf, Mx, lam, mu, qdd, Qc)
+    _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc)
     residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn)
     for c in range(qdd.shape[0]):
         if not (math.isfinite(qdd[c]) and math.isfinite(Qc[c])):

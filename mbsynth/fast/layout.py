@@ -26,7 +26,8 @@ import sympy as sp
 from ..connectors.joints import Joint
 from ..subsystems.particle import Particle
 from ..subsystems.rigid_body import RigidBody
-from .joints import MAX_ROWS, PARTICLE, PROGRAMS, RIGID, WORLD
+from .joints import COMPONENT, MAX_ROWS, PARTICLE, PROGRAMS, RIGID, WORLD
+from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
 
 
 class Layout(NamedTuple):
@@ -40,14 +41,15 @@ class Layout(NamedTuple):
     node_v: np.ndarray       # (N,) unknowns per node: 6 (rigid, bodies.py) or 3
     node_k: np.ndarray       # (N,) rows of the joint to its parent (0 for a free root)
     node_yoff: np.ndarray    # (N,) offset of the node's block in tree vectors
-    node_doff: np.ndarray    # (N,) offset of the node's inverse block in the flat Dinv
     node_rows: np.ndarray    # (N,) first tree row of its parent joint
     node_parent: np.ndarray  # (N,) parent node, −1 for a root
     node_joint: np.ndarray   # (N,) kernel joint to its parent, −1 for a free root
     node_end: np.ndarray     # (N,) which end (0 = A, 1 = B) of that joint the node is
+    node_transport: np.ndarray  # (N,) tree.GENERAL, RIGID_INVARIANT or RIGID_COMPONENTS
     order: np.ndarray        # (N,) parents before children
     joint_kinds: np.ndarray  # (K, 2) WORLD, RIGID or PARTICLE per end
     joint_start: np.ndarray  # (K, 2) first coordinate of each end's part
+    joint_node: np.ndarray   # (K, 2) each end's node, −1 for the world
     joint_s: np.ndarray      # (K, 2, 3) frame offset in its part (world position for a world end)
     joint_R: np.ndarray      # (K, 2, 3, 3) frame rotation in its part
     joint_length: np.ndarray  # (K,) a distance joint's L (1 otherwise)
@@ -69,7 +71,7 @@ class Layout(NamedTuple):
     gen_acol: np.ndarray     # its extra coordinate, or −1
     gen_brow: np.ndarray     # extra row of each b
     quat_row: np.ndarray     # (N,) the System's row of a body's unit-norm row (−1 for particles)
-    sizes: np.ndarray        # n, m, tree unknowns, flat Dinv size, tree rows
+    sizes: np.ndarray        # n, m, tree unknowns, tree rows
 
 
 def _ints(values, shape=None):
@@ -184,7 +186,6 @@ class _Builder:
         k = [joints[j][0].size if j >= 0 else 0 for j in self.pjoint]
         d = [a + b for a, b in zip(v, k)]
         yoff = np.cumsum([0] + d)
-        doff = np.cumsum([0] + [x * x for x in d])
         rows = np.cumsum([0] + k)
         end = [self._end_of(i, j) for i, j in enumerate(self.pjoint)]
         masses, mg, inertia = self._bodies(rigid)
@@ -204,15 +205,18 @@ class _Builder:
         exprs, gen = self._generated(xrow_row, segs)
         seg_ptr = np.cumsum([0] + [len(s) for s in segs])
         kernel = [self._joint(con) for con, _ in joints]
-        sizes = [self.system.n, sum(c.size for c in self.system.constraints), int(yoff[-1]), int(doff[-1]),
+        sizes = [self.system.n, sum(c.size for c in self.system.constraints), int(yoff[-1]),
                  int(rows[-1])]
         layout = Layout(
             node_kind=_ints([RIGID if r else PARTICLE for r in rigid]), node_q=_ints([s for _, s in nodes]),
             node_mass=np.array(masses), node_mg=np.array(mg).reshape(N, 3), node_J=np.array(inertia).reshape(N, 3, 3),
-            node_v=_ints(v), node_k=_ints(k), node_yoff=_ints(yoff[:-1]), node_doff=_ints(doff[:-1]),
+            node_v=_ints(v), node_k=_ints(k), node_yoff=_ints(yoff[:-1]),
             node_rows=_ints(rows[:-1]), node_parent=_ints(self.parent), node_joint=_ints(self.pjoint),
-            node_end=_ints(end), order=_ints(self.order),
+            node_end=_ints(end), node_transport=_ints([self._transport(i, j, rigid) for i, j in enumerate(self.pjoint)]),
+            order=_ints(self.order),
             joint_kinds=_ints([x[0] for x in kernel], (-1, 2)), joint_start=_ints([x[1] for x in kernel], (-1, 2)),
+            joint_node=_ints([[-1 if p is None else self.node_of[p.name] for p in con.parts] for con, _ in joints],
+                             (-1, 2)),
             joint_s=np.array([x[2] for x in kernel], dtype=float).reshape(-1, 2, 3),
             joint_R=np.array([x[3] for x in kernel], dtype=float).reshape(-1, 2, 3, 3),
             joint_length=np.array([x[4] for x in kernel], dtype=float),
@@ -231,6 +235,16 @@ class _Builder:
             return 0
         parts = self.joints[j][0].parts
         return 0 if parts[0] is not None and self.node_of[parts[0].name] == i else 1
+
+    def _transport(self, i, j, rigid):
+        """How node i's accelerations follow its parent's when its joint is locked (tree.py):
+        by the rigid transport between two rigid bodies, with the joint's offset d when
+        its rows are world components of d (these are not invariant under rotation)."""
+        p = self.parent[i]
+        if p < 0 or not (rigid[i] and rigid[p]):
+            return GENERAL
+        operations = {op for op, *_ in PROGRAMS[self.joints[j][0].joint_kind]}
+        return RIGID_COMPONENTS if COMPONENT in operations else RIGID_INVARIANT
 
     def _bodies(self, rigid):
         masses, mg, inertia = [], [], []

@@ -1,146 +1,322 @@
-"""Linear-time block elimination of a tree-structured KKT system (Baraff 1996).
+"""Linear-time elimination of a tree-structured KKT system (Baraff 1996), in articulated
+form (Featherstone's ABA, here over maximal coordinates and any joint rows).
 
-Each node i (a body) owns a block of unknowns: its v_i accelerations (6 for a rigid body
-after bodies.py's change of variables, 3 for a particle) followed by the k_i multipliers
-of the joint that hangs it from its parent. Only those joint rows touch the parent, so
-the KKT matrix is a tree of blocks
+Each node i (a body) owns a block of unknowns: its v_i accelerations y_i (6 for a rigid
+body after bodies.py's change of variables, 3 for a particle) followed by the k_i
+multipliers λ_i of the joint that hangs it from its parent. Only those joint rows touch
+the parent:
 
-    D_i = [[H_i, J_iᵀ], [J_i, 0]]          J_i: the joint's rows on node i (k_i × v_i)
-    K_pi = [[0, P_iᵀ], [0, 0]]             P_i: the same rows on the parent (k_i × v_p)
+    H_i y_i + J_iᵀ λ_i + Σ_children P_cᵀ λ_c = f_i,      J_i y_i + P_i y_p = g_i.
 
-and eliminating from the leaves to the roots causes no fill-in:
+``factor`` finds, per joint, a basis S_i of J_i's null space and a right inverse Jr_i
+(J_i Jr_i = I) by Gauss–Jordan with full pivoting, and X_i = −Jr_i P_i, so that
+J_i X_i = −P_i. The rows then say y_i = X_i y_p + Jr_i g_i + S_i x_i (x_i: the joint's
+free accelerations), and eliminating from the leaves to the roots causes no fill-in:
 
-    D_p ← D_p − K_pi D_i⁻¹ K_ip,  i.e.  H_p ← H_p − P_iᵀ (D_i⁻¹)_λλ P_i.
+    H^A_i = H_i + Σ_children X_cᵀ I^a_c X_c,     N_i = (S_iᵀ H^A_i S_i)⁻¹,
+    I^a_i = H^A_i − U_i N_i U_iᵀ,  U_i = H^A_i S_i       (the articulated mass).
 
-A block alone may be singular (a massless body, a rank-3 inertia); with its joint rows and
-its children's contributions it is invertible exactly when its subtree is determinate.
-``factor`` inverts each eliminated block by Gauss–Jordan with partial pivoting and
-reports a pivot below ``PIVOT_RTOL`` of the block's largest entry as singular: the caller
-then hands the problem to the exact treatment.
+A block alone may be singular (a massless body, a rank-3 inertia); S_iᵀ H^A_i S_i is
+positive definite exactly when the subtree is determinate. A pivot of its Cholesky
+factor below ``PIVOT_RTOL`` of ‖H^A_i‖ ‖s‖², or joint rows that are dependent to that
+tolerance, make ``factor`` report the node: the caller then hands the problem to the
+exact treatment. ``solve`` returns the λ_i too (λ_i = Jr_iᵀ (f^A_i − H^A_i y_i)).
 """
+
+import math
 
 from numba import njit
 
-from .bodies import OPTIONS
+from .bodies import INLINE, OPTIONS
 
-PIVOT_RTOL = 1e-9  # a pivot below this fraction of the block's largest entry counts as zero
+PIVOT_RTOL = 1e-9  # a pivot below this fraction of its scale counts as zero
+GENERAL, RIGID_INVARIANT, RIGID_COMPONENTS = 0, 1, 2  # a node's transport X (layout.node_transport)
 
 
-@njit(**OPTIONS)
-def invert(D, d, perm):
-    """D[:d, :d] ← its inverse, in place (Gauss–Jordan, row pivoting). False when a pivot is
-    below PIVOT_RTOL · max |D|."""
+@njit(**INLINE)
+def _null_space(J, r0, k, v, S, Jr, G, pivot):
+    """S[:v, :v − k] a basis of the null space and Jr[:v, :k] a right inverse of the node's
+    rows J[r0:r0 + k, :v] (Gauss–Jordan with full pivoting on G = [J | I]). False when
+    the rows are dependent."""
     scale = 0.0
-    for i in range(d):
-        for j in range(d):
-            scale = max(scale, abs(D[i, j]))
-    for k in range(d):
-        p, best = k, abs(D[k, k])
-        for i in range(k + 1, d):
-            if abs(D[i, k]) > best:
-                p, best = i, abs(D[i, k])
+    for r in range(k):
+        for c in range(v):
+            G[r, c] = J[r0 + r, c]
+            scale = max(scale, abs(G[r, c]))
+        for c in range(k):
+            G[r, v + c] = 1.0 if r == c else 0.0
+    for c in range(v):
+        pivot[6 + c] = 0  # column c taken
+    for step in range(k):
+        best, pr, pc = 0.0, step, 0
+        for r in range(step, k):
+            for c in range(v):
+                if pivot[6 + c] == 0 and abs(G[r, c]) > best:
+                    best, pr, pc = abs(G[r, c]), r, c
         if not best > PIVOT_RTOL * scale:
             return False
-        perm[k] = p
-        if p != k:
-            for j in range(d):
-                D[k, j], D[p, j] = D[p, j], D[k, j]
-        pivot = 1.0 / D[k, k]
-        D[k, k] = 1.0
-        for j in range(d):
-            D[k, j] *= pivot
-        for i in range(d):
-            if i != k:
-                f = D[i, k]
-                if f != 0.0:
-                    D[i, k] = 0.0
-                    for j in range(d):
-                        D[i, j] -= f * D[k, j]
-    for k in range(d - 1, -1, -1):
-        p = perm[k]
-        if p != k:
-            for i in range(d):
-                D[i, k], D[i, p] = D[i, p], D[i, k]
+        if pr != step:
+            for c in range(v + k):
+                G[step, c], G[pr, c] = G[pr, c], G[step, c]
+        inv = 1.0 / G[step, pc]
+        for c in range(v + k):
+            G[step, c] *= inv
+        for r in range(k):
+            f = G[r, pc]
+            if r != step and f != 0.0:
+                for c in range(v + k):
+                    G[r, c] -= f * G[step, c]
+        pivot[step], pivot[6 + pc] = pc, 1
+    m = 0
+    for c in range(v):
+        for a in range(v):
+            S[a, c] = 0.0
+        for r in range(k):
+            Jr[c, r] = 0.0
+    for c in range(v):
+        if pivot[6 + c] == 0:
+            S[c, m] = 1.0
+            for step in range(k):
+                S[pivot[step], m] = -G[step, c]
+            m += 1
+    for step in range(k):
+        for r in range(k):
+            Jr[pivot[step], r] = G[step, v + r]
     return True
 
 
-@njit(**OPTIONS)
-def factor(topology, H, J, P, Dinv, acc, perm):
-    """Eliminate leaves to roots; Dinv (flat) receives each block's inverse at doff[i].
+@njit(**INLINE)
+def _spd_inverse(A, m, scale, L):
+    """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
+    PIVOT_RTOL · scale[j] (scale: per column)."""
+    for j in range(m):
+        d = A[j, j]
+        for c in range(j):
+            d -= L[j, c] * L[j, c]
+        if not d > PIVOT_RTOL * scale[j]:
+            return False
+        L[j, j] = math.sqrt(d)
+        for r in range(j + 1, m):
+            t = A[r, j]
+            for c in range(j):
+                t -= L[r, c] * L[j, c]
+            L[r, j] = t / L[j, j]
+    for j in range(m):  # L ← L⁻¹ (lower triangular)
+        L[j, j] = 1.0 / L[j, j]
+        for r in range(j + 1, m):
+            t = 0.0
+            for c in range(j, r):
+                t -= L[r, c] * L[c, j]
+            L[r, j] = t / L[r, r]
+    for r in range(m):  # A⁻¹ = L⁻ᵀ L⁻¹
+        for c in range(r + 1):
+            t = 0.0
+            for e in range(r, m):
+                t += L[e, r] * L[e, c]
+            A[r, c] = t
+            A[c, r] = t
+    return True
 
-    topology: (order, parent, v, k, doff, yoff, rows) of the nodes (layout.Layout); H:
-    (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on itself / on its
-    parent, node i's starting at rows[i]; acc: (N, 6, 6) work for the children's
-    contributions. Returns the first node whose block is singular, or −1."""
-    order, parent, v, k, doff, _, rows = topology
+
+@njit(**INLINE)
+def _cross_into(x, z, out, o):
+    """out[o:o + 3] += x × z."""
+    out[o] += x[1] * z[2] - x[2] * z[1]
+    out[o + 1] += x[2] * z[0] - x[0] * z[2]
+    out[o + 2] += x[0] * z[1] - x[1] * z[0]
+
+
+@njit(**INLINE)
+def _add_rigid_transport(Ia, z, Hp):
+    """Hp += Xᵀ Ia X for X = [[I, [ζ]×], [0, I]]: with Ia = [[A, B], [Bᵀ, D]] and
+    M = A [ζ]× + B, Xᵀ Ia X = [[A, M], [Mᵀ, [ζ]×ᵀ M + Bᵀ [ζ]× + D]] (rows of A [ζ]× and
+    Bᵀ[ζ]×: a row × ζ; columns of [ζ]×ᵀ M: a column × ζ)."""
+    M = Ia[6:9, 0:3]
+    for a in range(3):
+        for c in range(3):
+            M[a, c] = Ia[a, 3 + c]
+        _cross_into(Ia[a, 0:3], z, M[a], 0)
+    for a in range(3):
+        for c in range(3):
+            Hp[a, c] += Ia[a, c]
+            Hp[a, 3 + c] += M[a, c]
+            Hp[3 + c, a] += M[a, c]
+            Hp[3 + a, 3 + c] += Ia[3 + a, 3 + c]
+        _cross_into(Ia[0:3, 3 + a], z, Hp[3 + a], 3)  # row a of Bᵀ[ζ]×
+    col = Ia[9, 0:3]
+    for c in range(3):  # column c of [ζ]×ᵀ M
+        col[0], col[1], col[2] = M[1, c] * z[2] - M[2, c] * z[1], M[2, c] * z[0] - M[0, c] * z[2], \
+            M[0, c] * z[1] - M[1, c] * z[0]
+        for a in range(3):
+            Hp[3 + a, 3 + c] += col[a]
+
+
+@njit(**OPTIONS)
+def factor(topology, H, J, P, factored, G, pivot):
+    """Eliminate leaves to roots into ``factored`` = (H^A, S, Jr, X, U, N, c, x0), each
+    (nodes, 6, 6) or (nodes, 6). topology: (order, parent, v, k, yoff, rows) of the nodes
+    (layout.Layout); H: (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on
+    itself / on its parent, node i's starting at rows[i]. Returns the first node whose
+    block is singular, or −1."""
+    order, parent, v, k, _, rows, transport = topology
+    HA, S, Jr, X, U, N, zeta = factored[0], factored[1], factored[2], factored[3], factored[4], factored[5], factored[8]
     for idx in range(order.shape[0]):
-        acc[order[idx]] = 0.0
+        HA[order[idx]] = 0.0
     for idx in range(order.shape[0] - 1, -1, -1):
         i = order[idx]
         vi, ki = v[i], k[i]
-        d = vi + ki
-        D = Dinv[doff[i]:doff[i] + d * d].reshape((d, d))
-        r0 = rows[i]
+        m = vi - ki
+        if not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
+            return i
+        Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
+        top = 0.0
         for a in range(vi):
             for c in range(vi):
-                D[a, c] = H[i, a, c] + acc[i, a, c]
-            for r in range(ki):
-                D[a, vi + r] = J[r0 + r, a]
-                D[vi + r, a] = J[r0 + r, a]
-        for r in range(ki):
-            for c in range(ki):
-                D[vi + r, vi + c] = 0.0
-        if not invert(D, d, perm):
+                Ha[a, c] += H[i, a, c]
+                top = max(top, abs(Ha[a, c]))
+        for a in range(vi):
+            for e in range(m):
+                t = 0.0
+                for c in range(vi):
+                    t += Ha[a, c] * Si[c, e]
+                Ui[a, e] = t
+        for e in range(m):
+            norm = 0.0
+            for a in range(vi):
+                norm += Si[a, e] * Si[a, e]
+            G[0, e] = top * norm
+            for f in range(e + 1):
+                t = 0.0
+                for a in range(vi):
+                    t += Si[a, e] * Ui[a, f]
+                Ni[e, f] = t
+                Ni[f, e] = t
+        if not _spd_inverse(Ni, m, G[0], G[1:7]):
             return i
+        for a in range(vi):  # G ← I^a = H^A − U N Uᵀ
+            for c in range(a + 1):
+                t = Ha[a, c]
+                for e in range(m):
+                    w = 0.0
+                    for f in range(m):
+                        w += Ni[e, f] * Ui[c, f]
+                    t -= Ui[a, e] * w
+                G[a, c] = t
+                G[c, a] = t
         p = parent[i]
-        if p >= 0:  # acc_p −= Pᵀ (D⁻¹)_λλ P
-            vp = v[p]
-            for r in range(ki):
-                for c in range(vp):
-                    t = 0.0
-                    for s in range(ki):
-                        t += D[vi + r, vi + s] * P[r0 + s, c]
-                    for a in range(vp):
-                        acc[p, a, c] -= P[r0 + r, a] * t
+        if p < 0:
+            continue
+        if transport[i] != GENERAL:
+            _add_rigid_transport(G, zeta[i], HA[p])
+            continue
+        vp, r0, Xi = v[p], rows[i], X[i]
+        for a in range(vi):
+            for c in range(vp):
+                t = 0.0
+                for r in range(ki):
+                    t -= Jr[i, a, r] * P[r0 + r, c]
+                Xi[a, c] = t
+        for a in range(vi):  # G[6:] ← I^a X
+            for c in range(vp):
+                t = 0.0
+                for e in range(vi):
+                    t += G[a, e] * Xi[e, c]
+                G[6 + a, c] = t
+        Hp = HA[p]
+        for a in range(vp):  # H^A_p += Xᵀ I^a X
+            for c in range(vp):
+                t = 0.0
+                for e in range(vi):
+                    t += Xi[e, a] * G[6 + e, c]
+                Hp[a, c] += t
     return -1
 
 
 @njit(**OPTIONS)
-def solve(topology, P, Dinv, y, x):
-    """x = K⁻¹ y for the factored tree (y is overwritten)."""
-    order, parent, v, k, doff, yoff, rows = topology
+def solve(topology, factored, y, x):
+    """x = K⁻¹ y for the factored tree (y is overwritten): per node, the accelerations,
+    then the multipliers of its parent joint."""
+    order, parent, v, k, yoff, _, transport = topology
+    HA, S, Jr, X, U, N, cs, xs, zeta = factored
     n = order.shape[0]
-    for idx in range(n - 1, -1, -1):  # leaves to roots: x_i = D_i⁻¹ y_i, passed up through P
+    for idx in range(n - 1, -1, -1):  # leaves to roots: c = Jr g, x0 = N Sᵀ (f − H^A c)
         i = order[idx]
         vi, ki = v[i], k[i]
-        d = vi + ki
-        D = Dinv[doff[i]:doff[i] + d * d].reshape((d, d))
-        o = yoff[i]
-        for a in range(d):
+        m, o = vi - ki, yoff[i]
+        c, x0 = cs[i], xs[i]
+        for a in range(vi):
             t = 0.0
-            for c in range(d):
-                t += D[a, c] * y[o + c]
-            x[o + a] = t
-        p = parent[i]
-        if p >= 0:
-            op, r0 = yoff[p], rows[i]
             for r in range(ki):
-                lam = x[o + vi + r]
-                for c in range(v[p]):
-                    y[op + c] -= P[r0 + r, c] * lam
-    for idx in range(n):  # roots to leaves: x_i −= D_i⁻¹[:, λ] P x_p
-        i = order[idx]
-        p = parent[i]
-        if p < 0:
-            continue
-        vi, ki = v[i], k[i]
-        d = vi + ki
-        D = Dinv[doff[i]:doff[i] + d * d].reshape((d, d))
-        o, op, r0 = yoff[i], yoff[p], rows[i]
-        for r in range(ki):
+                t += Jr[i, a, r] * y[o + vi + r]
+            c[a] = t
+        for a in range(vi):  # x[o:o+v] ← t = f − H^A c (work)
+            t = y[o + a]
+            for e in range(vi):
+                t -= HA[i, a, e] * c[e]
+            x[o + a] = t
+        for e in range(m):
             w = 0.0
-            for c in range(v[p]):
-                w += P[r0 + r, c] * x[op + c]
-            if w != 0.0:
-                for a in range(d):
-                    x[o + a] -= D[a, vi + r] * w
+            for f in range(m):
+                s = 0.0
+                for a in range(vi):
+                    s += S[i, a, f] * x[o + a]
+                w += N[i, e, f] * s
+            x0[e] = w
+        p = parent[i]
+        if p >= 0:  # f^A_p += Xᵀ (t − U x0)
+            op = yoff[p]
+            for a in range(vi):
+                t = x[o + a]
+                for e in range(m):
+                    t -= U[i, a, e] * x0[e]
+                x[o + a] = t
+            if transport[i] != GENERAL:  # Xᵀβ = (β_r, β_α + β_r × ζ)
+                for a in range(6):
+                    y[op + a] += x[o + a]
+                _cross_into(x[o:o + 3], zeta[i], y, op + 3)
+                continue
+            for c2 in range(v[p]):
+                t = 0.0
+                for a in range(vi):
+                    t += X[i, a, c2] * x[o + a]
+                y[op + c2] += t
+    for idx in range(n):  # roots to leaves: y_i = c + X y_p + S (x0 − N Uᵀ X y_p)
+        i = order[idx]
+        vi, ki = v[i], k[i]
+        m, o, p = vi - ki, yoff[i], parent[i]
+        c, x0 = cs[i], xs[i]
+        for a in range(vi):
+            x[o + a] = c[a]
+        if p >= 0:
+            op = yoff[p]
+            if transport[i] != GENERAL:  # X y_p = (r̈_p + ζ × α_p, α_p)
+                for a in range(6):
+                    x[o + a] += x[op + a]
+                _cross_into(zeta[i], x[op + 3:op + 6], x, o)
+            else:
+                for a in range(vi):
+                    t = 0.0
+                    for c2 in range(v[p]):
+                        t += X[i, a, c2] * x[op + c2]
+                    x[o + a] += t
+            for e in range(m):
+                t = 0.0
+                for f in range(m):
+                    w = 0.0
+                    for a in range(vi):
+                        w += U[i, a, f] * (x[o + a] - c[a])
+                    t += N[i, e, f] * w
+                x0[e] -= t
+        for a in range(vi):
+            t = 0.0
+            for e in range(m):
+                t += S[i, a, e] * x0[e]
+            x[o + a] += t
+        for r in range(ki):  # λ = Jrᵀ (f^A − H^A y)
+            t = 0.0
+            for a in range(vi):
+                w = y[o + a]
+                for e in range(vi):
+                    w -= HA[i, a, e] * x[o + e]
+                t += Jr[i, a, r] * w
+            x[o + vi + r] = t
