@@ -41,7 +41,7 @@ class Work(NamedTuple):
     X: np.ndarray      # (N, 6, 6) X = −Jr P
     U: np.ndarray      # (N, 6, 6) H^A S
     Ninv: np.ndarray   # (N, 6, 6) (Sᵀ H^A S)⁻¹
-    c: np.ndarray      # (N, 6) tree.solve work
+    c: np.ndarray      # (N, 12) tree.solve work
     x0: np.ndarray     # (N, 6) tree.solve work
     G: np.ndarray      # (12, 12) tree.factor work
     pivot: np.ndarray  # (12,) tree.factor's pivots
@@ -82,7 +82,7 @@ def make_work(L):
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
     shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
-                  Ninv=(N, 6, 6), c=(N, 6), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), rho=(2, 3), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
+                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), rho=(2, 3), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
                   rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
     V, R, Jt = vector_work()
@@ -305,9 +305,9 @@ def transports(q, start, parent, node_joint, node_end, transport, joint_s, Rs, z
     (tree.py): ζ = r_p − r_i for rows invariant under rotation, ζ = R_i s_i − R_p s_p
     (the two frames' offsets) for rows that are world components of d."""
     for i in range(transport.shape[0]):
-        if transport[i] == GENERAL:
-            continue
         p, j, e = parent[i], node_joint[i], node_end[i]
+        if transport[i] == GENERAL or p < 0:
+            continue
         if transport[i] == RIGID_INVARIANT:
             for a in range(3):
                 zeta[i, a] = q[start[p] + a] - q[start[i] + a]

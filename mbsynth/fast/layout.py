@@ -239,12 +239,15 @@ class _Builder:
     def _transport(self, i, j, rigid):
         """How node i's accelerations follow its parent's when its joint is locked (tree.py):
         by the rigid transport between two rigid bodies, with the joint's offset d when
-        its rows are world components of d (these are not invariant under rotation)."""
+        its rows are world components of d (these are not invariant under rotation). A
+        rigid root on such a joint to the world is marked too (tree.py's null space)."""
         p = self.parent[i]
-        if p < 0 or not (rigid[i] and rigid[p]):
+        if j < 0 or not rigid[i] or (p >= 0 and not rigid[p]):
             return GENERAL
         operations = {op for op, *_ in PROGRAMS[self.joints[j][0].joint_kind]}
-        return RIGID_COMPONENTS if COMPONENT in operations else RIGID_INVARIANT
+        if COMPONENT in operations:
+            return RIGID_COMPONENTS
+        return GENERAL if p < 0 else RIGID_INVARIANT
 
     def _bodies(self, rigid):
         masses, mg, inertia = [], [], []

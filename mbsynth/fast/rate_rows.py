@@ -39,8 +39,9 @@ def _vector(Rs, node, s, Rf, e, col, V, rec):
 
 
 @njit(**INLINE)
-def _end(e, kind, node, s, Rf, q, qd, start, Rs, V, rho):
-    """The origin and axes of end e into V (value, velocity, bias) and its offset ρ."""
+def _end(e, kind, node, s, Rf, q, qd, start, Rs, V, rho, used):
+    """The origin and the axes of end e that the rows use (bit 1 + 3e + x of ``used``) into
+    V (value, velocity, bias), and its offset ρ."""
     origin = ORIGIN_A + e
     if kind == WORLD:
         for a in range(3):
@@ -56,7 +57,8 @@ def _end(e, kind, node, s, Rf, q, qd, start, Rs, V, rho):
         V[origin, a, VALUE] += q[start + a]
         V[origin, a, VELOCITY] += qd[start + a]
     for x in range(3):
-        _vector(Rs, node, s, Rf, e, x, V, 1 + 3 * e + x)
+        if used >> (1 + 3 * e + x) & 1:
+            _vector(Rs, node, s, Rf, e, x, V, 1 + 3 * e + x)
 
 
 @njit(**INLINE)
@@ -94,8 +96,12 @@ def rate_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs, V, rho
     """Rows A[:k, :12] on (r̈_A, α_A, r̈_B, α_B) and b[:k] of one joint whose ends are rigid
     bodies (nodes) or the world. s, Rf, length: as joints.joint_rows; Rs: the bodies'
     matrices (module docstring); V, rho: work."""
+    used = 0
+    for r in range(k):
+        if program[r, 0] == DOT:
+            used |= (1 << program[r, 1]) | (1 << program[r, 2])
     for e in range(2):
-        _end(e, kinds[e], nodes[e], s, Rf, q, qd, starts[e], Rs, V, rho)
+        _end(e, kinds[e], nodes[e], s, Rf, q, qd, starts[e], Rs, V, rho, used)
     for a in range(3):
         for col in range(3):
             V[D, a, col] = V[ORIGIN_B, a, col] - V[ORIGIN_A, a, col]

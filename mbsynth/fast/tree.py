@@ -86,6 +86,69 @@ def _null_space(J, r0, k, v, S, Jr, G, pivot):
 
 
 @njit(**INLINE)
+def _null_space_components(J, r0, k, S, Jr, G):
+    """_null_space for rows of a rigid transport with components (layout): three rows
+    d_a r̈_a + C_a·α (a component of d) and k − 3 rows N_b·α (dots of axes). The null
+    space is α = T x with T a basis of N's null space, r̈ = −D⁻¹C α; a right inverse
+    takes α = Nᵀ(NNᵀ)⁻¹ g_N and r̈ = D⁻¹(g_D − C α). G: work. False when rows are dependent."""
+    n = k - 3
+    top = 0.0
+    for a in range(3):
+        top = max(top, abs(J[r0 + a, a]))
+    for a in range(3):
+        if not abs(J[r0 + a, a]) > PIVOT_RTOL * top:
+            return False
+    for b in range(n):  # G[8] ← ‖N_b‖², G[0:3, 0:3] ← N Nᵀ
+        for c in range(n):
+            t = 0.0
+            for e in range(3):
+                t += J[r0 + 3 + b, 3 + e] * J[r0 + 3 + c, 3 + e]
+            G[b, c] = t
+        G[8, b] = G[b, b]
+    if not _spd_inverse(G, n, G[8], G[3:6]):
+        return False
+    for e in range(3):  # T into S[3:6, :6 − k]
+        for x in range(3):
+            S[3 + e, x] = 1.0 if (n == 0 and e == x) else 0.0
+    if n == 1:
+        e = 0  # the axis least along N_0, then t1 = N_0 × axis, t2 = N_0 × t1
+        for x in range(3):
+            if abs(J[r0 + 3, 3 + x]) < abs(J[r0 + 3, 3 + e]):
+                e = x
+        n0, n1, n2 = J[r0 + 3, 3], J[r0 + 3, 4], J[r0 + 3, 5]
+        u0, u1, u2 = (0.0, n2, -n1) if e == 0 else ((-n2, 0.0, n0) if e == 1 else (n1, -n0, 0.0))
+        S[3, 0], S[4, 0], S[5, 0] = u0, u1, u2
+        S[3, 1], S[4, 1], S[5, 1] = n1 * u2 - n2 * u1, n2 * u0 - n0 * u2, n0 * u1 - n1 * u0
+    elif n == 2:
+        a0, a1, a2 = J[r0 + 3, 3], J[r0 + 3, 4], J[r0 + 3, 5]
+        b0, b1, b2 = J[r0 + 4, 3], J[r0 + 4, 4], J[r0 + 4, 5]
+        S[3, 0], S[4, 0], S[5, 0] = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    for a in range(3):  # r̈ part of S: −D⁻¹ C T
+        inv = 1.0 / J[r0 + a, a]
+        for x in range(3 - n):
+            t = 0.0
+            for e in range(3):
+                t += J[r0 + a, 3 + e] * S[3 + e, x]
+            S[a, x] = -inv * t
+    for e in range(3):  # Jr: the N columns α = Nᵀ (NNᵀ)⁻¹, the D columns 0
+        for c in range(3):
+            Jr[3 + e, c] = 0.0
+        for c in range(n):
+            t = 0.0
+            for b in range(n):
+                t += J[r0 + 3 + b, 3 + e] * G[b, c]
+            Jr[3 + e, 3 + c] = t
+    for a in range(3):  # r̈ = D⁻¹ (g_D − C α)
+        inv = 1.0 / J[r0 + a, a]
+        for c in range(k):
+            t = 1.0 if c == a else 0.0
+            for e in range(3):
+                t -= J[r0 + a, 3 + e] * Jr[3 + e, c]
+            Jr[a, c] = inv * t
+    return True
+
+
+@njit(**INLINE)
 def _spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
@@ -166,7 +229,10 @@ def factor(topology, H, J, P, factored, G, pivot):
         i = order[idx]
         vi, ki = v[i], k[i]
         m = vi - ki
-        if not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
+        if transport[i] == RIGID_COMPONENTS:
+            if not _null_space_components(J, rows[i], ki, S[i], Jr[i], G):
+                return i
+        elif not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
             return i
         Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
         top = 0.0
@@ -232,91 +298,120 @@ def factor(topology, H, J, P, factored, G, pivot):
     return -1
 
 
+@njit(**INLINE)
+def _backward(i, vi, ki, topology, factored, y, x):
+    """Node i of the leaves-to-roots pass of ``solve`` (vi: its unknowns, a literal 6 for a
+    rigid body so that the loops unroll): c = Jr g, x0 = N Sᵀ t with t = f − H^A c, and
+    f^A_p += Xᵀ (t − U x0)."""
+    parent, v, yoff, transport = topology[1], topology[2], topology[4], topology[6]
+    HA, S, Jr, X, U, N, c, x0, zeta = factored
+    m, o = vi - ki, yoff[i]
+    for a in range(vi):
+        t = 0.0
+        for r in range(ki):
+            t += Jr[i, a, r] * y[o + vi + r]
+        c[i, a] = t
+    for a in range(vi):  # x[o:o+v] ← t (work)
+        t = y[o + a]
+        for e in range(vi):
+            t -= HA[i, a, e] * c[i, e]
+        x[o + a] = t
+    for f in range(m):  # x0 ← Sᵀ t, then N x0
+        t = 0.0
+        for a in range(vi):
+            t += S[i, a, f] * x[o + a]
+        x0[i, f] = t
+    for e in range(m):
+        t = 0.0
+        for f in range(m):
+            t += N[i, e, f] * x0[i, f]
+        c[i, vi + e] = t  # c[i, 6:] is free: N Sᵀ t, copied back below
+    for e in range(m):
+        x0[i, e] = c[i, vi + e]
+    p = parent[i]
+    if p < 0:
+        return
+    op = yoff[p]
+    for a in range(vi):
+        t = x[o + a]
+        for e in range(m):
+            t -= U[i, a, e] * x0[i, e]
+        x[o + a] = t
+    if transport[i] != GENERAL:  # Xᵀβ = (β_r, β_α + β_r × ζ)
+        for a in range(6):
+            y[op + a] += x[o + a]
+        _cross_into(x[o:o + 3], zeta[i], y, op + 3)
+        return
+    for c2 in range(v[p]):
+        t = 0.0
+        for a in range(vi):
+            t += X[i, a, c2] * x[o + a]
+        y[op + c2] += t
+
+
+@njit(**INLINE)
+def _forward(i, vi, ki, topology, factored, y, x):
+    """Node i of the roots-to-leaves pass of ``solve``: y_i = c + X y_p + S (x0 − N Uᵀ X y_p),
+    then λ_i = Jrᵀ (f^A − H^A y_i)."""
+    parent, v, yoff, transport = topology[1], topology[2], topology[4], topology[6]
+    HA, S, Jr, X, U, N, c, x0, zeta = factored
+    m, o, p = vi - ki, yoff[i], parent[i]
+    for a in range(vi):
+        x[o + a] = c[i, a]
+    if p >= 0:
+        op = yoff[p]
+        if transport[i] != GENERAL:  # X y_p = (r̈_p + ζ × α_p, α_p)
+            for a in range(6):
+                x[o + a] += x[op + a]
+            _cross_into(zeta[i], x[op + 3:op + 6], x, o)
+        else:
+            for a in range(vi):
+                t = 0.0
+                for c2 in range(v[p]):
+                    t += X[i, a, c2] * x[op + c2]
+                x[o + a] += t
+        for f in range(m):  # c[i, 6 + f] ← (Uᵀ X y_p)_f
+            t = 0.0
+            for a in range(vi):
+                t += U[i, a, f] * (x[o + a] - c[i, a])
+            c[i, vi + f] = t
+        for e in range(m):
+            t = 0.0
+            for f in range(m):
+                t += N[i, e, f] * c[i, vi + f]
+            x0[i, e] -= t
+    for a in range(vi):
+        t = 0.0
+        for e in range(m):
+            t += S[i, a, e] * x0[i, e]
+        x[o + a] += t
+    for a in range(vi):  # c ← f^A − H^A y, then λ = Jrᵀ c
+        t = y[o + a]
+        for e in range(vi):
+            t -= HA[i, a, e] * x[o + e]
+        c[i, a] = t
+    for r in range(ki):
+        t = 0.0
+        for a in range(vi):
+            t += Jr[i, a, r] * c[i, a]
+        x[o + vi + r] = t
+
+
 @njit(**OPTIONS)
 def solve(topology, factored, y, x):
     """x = K⁻¹ y for the factored tree (y is overwritten): per node, the accelerations,
     then the multipliers of its parent joint."""
-    order, parent, v, k, yoff, _, transport = topology
-    HA, S, Jr, X, U, N, cs, xs, zeta = factored
+    order, v, k = topology[0], topology[2], topology[3]
     n = order.shape[0]
-    for idx in range(n - 1, -1, -1):  # leaves to roots: c = Jr g, x0 = N Sᵀ (f − H^A c)
+    for idx in range(n - 1, -1, -1):
         i = order[idx]
-        vi, ki = v[i], k[i]
-        m, o = vi - ki, yoff[i]
-        c, x0 = cs[i], xs[i]
-        for a in range(vi):
-            t = 0.0
-            for r in range(ki):
-                t += Jr[i, a, r] * y[o + vi + r]
-            c[a] = t
-        for a in range(vi):  # x[o:o+v] ← t = f − H^A c (work)
-            t = y[o + a]
-            for e in range(vi):
-                t -= HA[i, a, e] * c[e]
-            x[o + a] = t
-        for e in range(m):
-            w = 0.0
-            for f in range(m):
-                s = 0.0
-                for a in range(vi):
-                    s += S[i, a, f] * x[o + a]
-                w += N[i, e, f] * s
-            x0[e] = w
-        p = parent[i]
-        if p >= 0:  # f^A_p += Xᵀ (t − U x0)
-            op = yoff[p]
-            for a in range(vi):
-                t = x[o + a]
-                for e in range(m):
-                    t -= U[i, a, e] * x0[e]
-                x[o + a] = t
-            if transport[i] != GENERAL:  # Xᵀβ = (β_r, β_α + β_r × ζ)
-                for a in range(6):
-                    y[op + a] += x[o + a]
-                _cross_into(x[o:o + 3], zeta[i], y, op + 3)
-                continue
-            for c2 in range(v[p]):
-                t = 0.0
-                for a in range(vi):
-                    t += X[i, a, c2] * x[o + a]
-                y[op + c2] += t
-    for idx in range(n):  # roots to leaves: y_i = c + X y_p + S (x0 − N Uᵀ X y_p)
+        if v[i] == 6:
+            _backward(i, 6, k[i], topology, factored, y, x)
+        else:
+            _backward(i, v[i], k[i], topology, factored, y, x)
+    for idx in range(n):
         i = order[idx]
-        vi, ki = v[i], k[i]
-        m, o, p = vi - ki, yoff[i], parent[i]
-        c, x0 = cs[i], xs[i]
-        for a in range(vi):
-            x[o + a] = c[a]
-        if p >= 0:
-            op = yoff[p]
-            if transport[i] != GENERAL:  # X y_p = (r̈_p + ζ × α_p, α_p)
-                for a in range(6):
-                    x[o + a] += x[op + a]
-                _cross_into(zeta[i], x[op + 3:op + 6], x, o)
-            else:
-                for a in range(vi):
-                    t = 0.0
-                    for c2 in range(v[p]):
-                        t += X[i, a, c2] * x[op + c2]
-                    x[o + a] += t
-            for e in range(m):
-                t = 0.0
-                for f in range(m):
-                    w = 0.0
-                    for a in range(vi):
-                        w += U[i, a, f] * (x[o + a] - c[a])
-                    t += N[i, e, f] * w
-                x0[e] -= t
-        for a in range(vi):
-            t = 0.0
-            for e in range(m):
-                t += S[i, a, e] * x0[e]
-            x[o + a] += t
-        for r in range(ki):  # λ = Jrᵀ (f^A − H^A y)
-            t = 0.0
-            for a in range(vi):
-                w = y[o + a]
-                for e in range(vi):
-                    w -= HA[i, a, e] * x[o + e]
-                t += Jr[i, a, r] * w
-            x[o + vi + r] = t
+        if v[i] == 6:
+            _forward(i, 6, k[i], topology, factored, y, x)
+        else:
+            _forward(i, v[i], k[i], topology, factored, y, x)
