@@ -106,7 +106,7 @@ def _turn(B, x, o):
         x[o + r] = B[r, 0] * a + B[r, 1] * b + B[r, 2] * c
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _reduce(c7, rigid, q, o, nu, s, B, out):
     """A row segment on a node in its reduced unknowns (r̈, α); returns the right-side shift."""
     if rigid:

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
-from .bodies import INLINE, OPTIONS, rate_transpose
+from .bodies import OPTIONS, rate_transpose
 from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
@@ -43,14 +43,14 @@ RESIDUAL_MAX = 1e-9
 LAYOUT, WORK = fields(Layout), fields(Work)
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _copy(a, b):
     """b ← a (a loop: numba's slice assignment compiles slowly)."""
     for i in range(a.shape[0]):
         b[i] = a[i]
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _scatter(x, weight, segs, seg6, y):
     """y += weight · (extra row x on the tree unknowns). segs: (xseg_ptr, xseg_node, v, yoff)."""
     ptr, node, v, yoff = segs
@@ -60,7 +60,7 @@ def _scatter(x, weight, segs, seg6, y):
             y[yoff[i] + a] += weight * seg6[seg, a]
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _row_dot(x, segs, seg6, z):
     """(extra row x on the tree unknowns) · z."""
     ptr, node, v, yoff = segs

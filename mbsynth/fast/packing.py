@@ -14,7 +14,7 @@ import enum
 import numpy as np
 from numba import njit
 
-from .bodies import INLINE
+from .bodies import OPTIONS
 
 MAX_NDIM = 4
 
@@ -48,21 +48,21 @@ def views(cls, arrays, ints, floats, index):
     return cls(*out)
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view1(buf, index, k):
     return buf[index[k, 0]:index[k, 0] + index[k, 1]]
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view2(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4]))
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view3(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5]))
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view4(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5], index[k, 6]))

@@ -38,7 +38,7 @@ def _vector(Rs, node, s, Rf, e, col, V, rec):
             V[rec, a, m] = t
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _end(e, kind, node, s, Rf, q, qd, start, Rs, V, rho, used):
     """The origin and the axes of end e that the rows use (bit 1 + 3e + x of ``used``) into
     V (value, velocity, bias), and its offset ρ."""

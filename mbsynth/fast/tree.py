@@ -33,7 +33,7 @@ PIVOT_RTOL = 1e-9  # a pivot below this fraction of its scale counts as zero
 GENERAL, RIGID_INVARIANT, RIGID_COMPONENTS = 0, 1, 2  # a node's transport X (layout.node_transport)
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _null_space(J, r0, k, v, S, Jr, G, pivot):
     """S[:v, :v − k] a basis of the null space and Jr[:v, :k] a right inverse of the node's
     rows J[r0:r0 + k, :v] (Gauss–Jordan with full pivoting on G = [J | I]). False when
@@ -85,7 +85,7 @@ def _null_space(J, r0, k, v, S, Jr, G, pivot):
     return True
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _null_space_components(J, r0, k, S, Jr, G):
     """_null_space for rows of a rigid transport with components (layout): three rows
     d_a r̈_a + C_a·α (a component of d) and k − 3 rows N_b·α (dots of axes). The null
@@ -148,7 +148,7 @@ def _null_space_components(J, r0, k, S, Jr, G):
     return True
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
@@ -300,9 +300,8 @@ def factor(topology, H, J, P, factored, G, pivot):
 
 @njit(**INLINE)
 def _backward(i, vi, ki, topology, factored, y, x):
-    """Node i of the leaves-to-roots pass of ``solve`` (vi: its unknowns, a literal 6 for a
-    rigid body so that the loops unroll): c = Jr g, x0 = N Sᵀ t with t = f − H^A c, and
-    f^A_p += Xᵀ (t − U x0)."""
+    """Node i (vi unknowns, ki rows) of the leaves-to-roots pass of ``solve``: c = Jr g,
+    x0 = N Sᵀ t with t = f − H^A c, and f^A_p += Xᵀ (t − U x0)."""
     parent, v, yoff, transport = topology[1], topology[2], topology[4], topology[6]
     HA, S, Jr, X, U, N, c, x0, zeta = factored
     m, o = vi - ki, yoff[i]
@@ -405,13 +404,7 @@ def solve(topology, factored, y, x):
     n = order.shape[0]
     for idx in range(n - 1, -1, -1):
         i = order[idx]
-        if v[i] == 6:
-            _backward(i, 6, k[i], topology, factored, y, x)
-        else:
-            _backward(i, v[i], k[i], topology, factored, y, x)
+        _backward(i, v[i], k[i], topology, factored, y, x)
     for idx in range(n):
         i = order[idx]
-        if v[i] == 6:
-            _forward(i, 6, k[i], topology, factored, y, x)
-        else:
-            _forward(i, v[i], k[i], topology, factored, y, x)
+        _forward(i, v[i], k[i], topology, factored, y, x)
