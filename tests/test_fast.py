@@ -200,6 +200,28 @@ def assert_same_motion(system, t, q, qd, *, rtol=1e-10):
     return fast
 
 
+def test_rigid_transport_carries_the_parent_rows(all_joints):
+    """For a body on a rigid parent, X = [[I, [ζ]×], [0, I]] (assembly.transports) satisfies
+    J X = −P for its joint rows at any state, on or off the constraint manifold (tree.py
+    relies on it): random states of the model with every joint kind."""
+    engine = engine_for(all_joints, wait=True)
+    L, W = engine.L, engine.W
+    rng = np.random.default_rng(5)
+    checked = set()
+    for trial in range(4):
+        q, qd = random_state(all_joints, rng, unit=trial % 2 == 0)
+        engine.motion(0.0, q, qd)
+        for i in np.flatnonzero((L.node_transport != 0) & (L.node_parent >= 0)):
+            r0, k = L.node_rows[i], L.node_k[i]
+            zeta = W.zeta[i]
+            X = np.eye(6)
+            X[:3, 3:] = [[0, -zeta[2], zeta[1]], [zeta[2], 0, -zeta[0]], [-zeta[1], zeta[0], 0]]
+            J, P = W.J[r0:r0 + k], W.P[r0:r0 + k]
+            assert np.abs(J @ X + P).max() <= 1e-12 * max(1.0, np.abs(P).max())
+            checked.add(int(L.node_transport[i]))
+    assert checked == {1, 2}  # rows invariant under rotation, and world components of d
+
+
 def test_all_joints_and_a_loop_agree_with_the_reference(all_joints):
     rng = np.random.default_rng(11)
     for _ in range(4):
@@ -369,3 +391,19 @@ def test_baumgarte_and_parameters(all_joints):
     heavier = all_joints.with_parameters(m=4.0)
     assert_same_motion(heavier, 0.0, q, qd)
     assert rel(engine_for(heavier).motion(0.0, q, qd).qdd, fast.qdd) > 1e-3
+
+
+def test_compiled_code_is_kept_per_version_of_the_sources(tmp_path):
+    """numba checks only the file of the function it loads from its cache, so a kernel built
+    against an older module it calls would come back stale: the cache directory is named by
+    a digest of all the fast path's sources, which any edit changes."""
+    import shutil
+
+    from mbsynth.fast import cache
+
+    copy = tmp_path / "fast"
+    shutil.copytree(Path(cache.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    before = cache.sources_hash(copy)
+    assert before == cache.sources_hash()
+    (copy / "tree.py").write_text((copy / "tree.py").read_text() + "\n# edited\n")
+    assert cache.sources_hash(copy) != before

@@ -2,10 +2,11 @@
 
     layout.py      a System as index and number arrays (tree of bodies, loops, the rest)
     codegen.py     one compiled function for every expression the kernels do not cover
-    bodies.py      rigid-body blocks and the quaternion change of variables
-    joints.py      joint rows of A and b, differentiated by hand
+    bodies.py      rigid-body blocks and the change of variables to (r̈, α)
+    rate_rows.py   rows of joints between rigid bodies, directly in (r̈, α)
+    joints.py      joint rows of A and b over q̈, differentiated by hand (particles, loops)
     assembly.py    one state's blocks
-    tree.py        Baraff's block elimination over the tree of bodies
+    tree.py        the tree's elimination in articulated form (null spaces, rigid transports)
     eigen.py       small symmetric eigendecomposition (the loops' Schur system)
     kernel.py      the whole evaluation and its checks
     engine.py      an Engine per System: motion, motion_batch

@@ -10,11 +10,18 @@ With ν = |u|, U = [uᵀ; E(u)]/ν is orthogonal (E u = 0, E Eᵀ = ν² I), so
 
     ü = Uᵀ [s; a] = (u s + Eᵀ a)/ν,     U (4 EᵀJE) Uᵀ = blockdiag(0, 4 ν² J),
 
-and the unit-norm row uᵀü = −u̇ᵀu̇ fixes s = −u̇ᵀu̇/ν before any solve. The body's unknowns
-become y = (r̈, a) ∈ R⁶ with mass H = blockdiag(m I₃, 4 ν² J) and force (Q_r, E Q_u/ν); a
-row c = (c_r, c_u) of A becomes (c_r, E c_u/ν), with (c_u·u) s/ν moved to its right side.
-The norm row's multiplier only balances the s component, which no other unknown sees, so
-the row and its multiplier leave the system exactly (an orthogonal change of variables).
+and the unit-norm row uᵀü = −u̇ᵀu̇ fixes s = −u̇ᵀu̇/ν before any solve. The norm row's
+multiplier only balances the s component, which no other unknown sees, so the row and its
+multiplier leave the system exactly (an orthogonal change of variables). A second change,
+a = Bᵀα with B = R(u)/(2ν), makes the body's unknowns y = (r̈, α) — for a unit quaternion α
+is the world angular acceleration — with mass H = blockdiag(m I₃, R J Rᵀ) and force
+(Q_r, B E Q_u/ν); a row c = (c_r, c_u) of A becomes (c_r, B E c_u/ν), with (c_u·u) s/ν moved
+to its right side. In these unknowns a vector e = R(u)c fixed in the body has, for any u,
+
+    ë = α × e + (2s/ν) e + 2R(u̇)c,
+
+so the rows of a joint between two bodies take the same form on both (rate_rows.py), and a
+rigid transport carries one body's unknowns to the other's (tree.py).
 """
 
 from numba import njit

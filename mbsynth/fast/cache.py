@@ -40,10 +40,11 @@ def cache_dir():
     raise OSError(f"no writable cache directory among {[str(p) for p in candidates]}")
 
 
-def sources_hash():
-    """A digest of the fast path's sources (the kernels and everything they call)."""
+def sources_hash(folder=None):
+    """A digest of the fast path's sources (the kernels and everything they call): the .py
+    files of ``folder``, this package by default."""
     digest = hashlib.sha256()
-    for path in sorted(Path(__file__).resolve().parent.glob("*.py")):
+    for path in sorted(Path(folder or Path(__file__).resolve().parent).glob("*.py")):
         digest.update(path.name.encode() + b"\0" + path.read_bytes())
     return digest.hexdigest()[:16]
 

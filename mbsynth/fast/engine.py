@@ -38,6 +38,9 @@ class Engine:
         self.gen = np.zeros(self.outputs)
         self.packed = pack(L)
         self.work, self.W = self.new_work()
+        self.buffers = (*self.packed, *self.work)  # kernel.motion's last six arguments
+        self.no_freedom = np.zeros((self.n, 0))  # the nullspace of a unique motion (read-only)
+        self.no_freedom.flags.writeable = False
         self.lock = threading.Lock()
 
     def new_work(self):
@@ -63,11 +66,10 @@ class Engine:
         with self.lock:
             if self.module is not None:
                 self.module.evaluate(t, q, qd, self.p, self.gen)
-            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.packed,
-                                             *self.work)
+            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.buffers)
             if status != kernel.OK:
                 return None
-            return Motion(qdd=self.W.qdd.copy(), unique=True, nullspace=np.zeros((self.n, 0)), Qc=self.W.Qc.copy(),
+            return Motion(qdd=self.W.qdd.copy(), unique=True, nullspace=self.no_freedom, Qc=self.W.Qc.copy(),
                           residual=residual, method="tree (Baraff)")
 
     def motion_batch(self, t, q, qd):

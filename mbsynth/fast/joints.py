@@ -1,4 +1,6 @@
-"""The rows of A and b of the holonomic joints (connectors/joints.py), differentiated by hand.
+"""The rows of A and b of the holonomic joints (connectors/joints.py) over q̈, differentiated
+by hand: used for joints with a particle end and for loop rows (rate_rows.py writes the
+rows of joints between rigid bodies directly in the bodies' (r̈, α)).
 
 Every joint row φ is built from a few world vectors of the two frames: the offset
 d = p_B − p_A and the frames' axes x_A, y_A, z_A, x_B, y_B, z_B. Each vector v(q) has a

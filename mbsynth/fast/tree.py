@@ -9,8 +9,10 @@ the parent:
     H_i y_i + J_iᵀ λ_i + Σ_children P_cᵀ λ_c = f_i,      J_i y_i + P_i y_p = g_i.
 
 ``factor`` finds, per joint, a basis S_i of J_i's null space and a right inverse Jr_i
-(J_i Jr_i = I) by Gauss–Jordan with full pivoting, and X_i = −Jr_i P_i, so that
-J_i X_i = −P_i. The rows then say y_i = X_i y_p + Jr_i g_i + S_i x_i (x_i: the joint's
+(J_i Jr_i = I) — in closed form for joints whose rows are components of d and dots of
+axes, else by Gauss–Jordan with full pivoting — and X_i with J_i X_i = −P_i: for a rigid
+body on a rigid parent the rigid transport X = [[I, [ζ]×], [0, I]] (assembly.transports),
+exact for the rows of rate_rows.py, else X_i = −Jr_i P_i. The rows then say y_i = X_i y_p + Jr_i g_i + S_i x_i (x_i: the joint's
 free accelerations), and eliminating from the leaves to the roots causes no fill-in:
 
     H^A_i = H_i + Σ_children X_cᵀ I^a_c X_c,     N_i = (S_iᵀ H^A_i S_i)⁻¹,
