@@ -51,6 +51,27 @@ def test_joint_accelerations_equal_pinocchio_aba(name, request):
         assert result.passed and result.max_rel_error <= TOLERANCE, result
 
 
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_tree_path_equals_pinocchio_aba(name, request):
+    """The compiled tree path (mbsynth.fast) itself, floating and fixed base, against aba:
+    panda's fingers are prismatic joints (a rigid transport of rows invariant under
+    rotation), its hand a weld, ur5's joints revolute. (Every robot:
+    benchmarks/fast_all_robots.py.)"""
+    from mbsynth.fast import engine_for
+
+    system = request.getfixturevalue(name)
+    rng = np.random.default_rng(7)
+    for variant in (system, fix_base(system)):
+        engine, twin = engine_for(variant, wait=True), Twin(variant)
+        for _ in range(SAMPLES):
+            q, v = sample_pinocchio_state(twin, rng)
+            qm, qdm = twin.to_maximal(q, v)
+            fast = engine.motion(0.0, qm, qdm)
+            exact = twin.accelerations(q, v, np.zeros(twin.model.nv))
+            assert fast is not None
+            assert np.abs(twin.to_pinocchio(qm, qdm, fast.qdd)[2] - exact).max() <= 1e-10 * np.abs(exact).max()
+
+
 def test_parts_are_the_links_with_their_masses(ur5):
     """One rigid body per URDF link, massless links included (a zero block of M); the
     masses add up to Pinocchio's total mass of the floating robot."""
