@@ -312,9 +312,8 @@ def transports(q, start, parent, node_joint, node_end, transport, joint_s, Rs, z
             for a in range(3):
                 zeta[i, a] = q[start[p] + a] - q[start[i] + a]
             continue
-        si, sp = joint_s[j, e], joint_s[j, 1 - e]
+        si, sp, Ri, Rp = joint_s[j, e], joint_s[j, 1 - e], Rs[i, 0], Rs[p, 0]
         for a in range(3):
-            Ri, Rp = Rs[i, 0], Rs[p, 0]
             zeta[i, a] = (Ri[a, 0] * si[0] + Ri[a, 1] * si[1] + Ri[a, 2] * si[2]
                           - Rp[a, 0] * sp[0] - Rp[a, 1] * sp[1] - Rp[a, 2] * sp[2])
 

@@ -151,8 +151,8 @@ def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx,
             continue
         u, J, Bi = q[c + 3:c + 7], inertia[i], Rs[i, 3]
         a_rates = (Bi[0, 0] * z[o + 3] + Bi[1, 0] * z[o + 4] + Bi[2, 0] * z[o + 5],
-                 Bi[0, 1] * z[o + 3] + Bi[1, 1] * z[o + 4] + Bi[2, 1] * z[o + 5],
-                 Bi[0, 2] * z[o + 3] + Bi[1, 2] * z[o + 4] + Bi[2, 2] * z[o + 5])
+                   Bi[0, 1] * z[o + 3] + Bi[1, 1] * z[o + 4] + Bi[2, 1] * z[o + 5],
+                   Bi[0, 2] * z[o + 3] + Bi[1, 2] * z[o + 4] + Bi[2, 2] * z[o + 5])
         et = rate_transpose(u, a_rates)
         f = rate_transpose(u, (J[0, 0] * a_rates[0] + J[0, 1] * a_rates[1] + J[0, 2] * a_rates[2],
                                J[1, 0] * a_rates[0] + J[1, 1] * a_rates[1] + J[1, 2] * a_rates[2],

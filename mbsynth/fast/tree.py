@@ -218,9 +218,9 @@ def _add_rigid_transport(Ia, z, Hp):
 
 @njit(**OPTIONS)
 def factor(topology, H, J, P, factored, G, pivot):
-    """Eliminate leaves to roots into ``factored`` = (H^A, S, Jr, X, U, N, c, x0), each
-    (nodes, 6, 6) or (nodes, 6). topology: (order, parent, v, k, yoff, rows) of the nodes
-    (layout.Layout); H: (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on
+    """Eliminate leaves to roots into ``factored`` = (H^A, S, Jr, X, U, N, c, x0, ζ): per
+    node 6 × 6 matrices, then solve's work and the rigid transports (assembly.transports).
+    topology: (order, parent, v, k, yoff, rows, transport) of the nodes (layout.Layout); H: (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on
     itself / on its parent, node i's starting at rows[i]. Returns the first node whose
     block is singular, or −1."""
     order, parent, v, k, _, rows, transport = topology
@@ -261,6 +261,9 @@ def factor(topology, H, J, P, factored, G, pivot):
                 Ni[f, e] = t
         if not _spd_inverse(Ni, m, G[0], G[1:7]):
             return i
+        p = parent[i]
+        if p < 0:  # a root passes nothing on
+            continue
         for a in range(vi):  # G ← I^a = H^A − U N Uᵀ
             for c in range(a + 1):
                 t = Ha[a, c]
@@ -271,9 +274,6 @@ def factor(topology, H, J, P, factored, G, pivot):
                     t -= Ui[a, e] * w
                 G[a, c] = t
                 G[c, a] = t
-        p = parent[i]
-        if p < 0:
-            continue
         if transport[i] != GENERAL:
             _add_rigid_transport(G, zeta[i], HA[p])
             continue
@@ -317,18 +317,16 @@ def _backward(i, vi, ki, topology, factored, y, x):
         for e in range(vi):
             t -= HA[i, a, e] * c[i, e]
         x[o + a] = t
-    for f in range(m):  # x0 ← Sᵀ t, then N x0
+    for f in range(m):  # c[i, v:] ← Sᵀ t (the spare part of c), then x0 ← N Sᵀ t
         t = 0.0
         for a in range(vi):
             t += S[i, a, f] * x[o + a]
-        x0[i, f] = t
+        c[i, vi + f] = t
     for e in range(m):
         t = 0.0
         for f in range(m):
-            t += N[i, e, f] * x0[i, f]
-        c[i, vi + e] = t  # c[i, 6:] is free: N Sᵀ t, copied back below
-    for e in range(m):
-        x0[i, e] = c[i, vi + e]
+            t += N[i, e, f] * c[i, vi + f]
+        x0[i, e] = t
     p = parent[i]
     if p < 0:
         return
