@@ -6,6 +6,9 @@ The kernels compile once per machine (numba's cache); ``engine_for(..., wait=Tru
 builds an Engine synchronously, so each test knows the tree path answered.
 """
 
+import os
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -407,3 +410,17 @@ def test_compiled_code_is_kept_per_version_of_the_sources(tmp_path):
     assert before == cache.sources_hash()
     (copy / "tree.py").write_text((copy / "tree.py").read_text() + "\n# edited\n")
     assert cache.sources_hash(copy) != before
+
+
+def test_kernels_imported_first_still_cache_per_version(tmp_path):
+    """Importing a kernel module directly (not through the Engine) must not put its compiled
+    code in numba's default place beside the sources, where it would come back stale."""
+    script = ("from mbsynth.fast import kernel, cache, tree\n"
+              "print(kernel.motion._cache._cache_path)\nprint(tree.factor._cache._cache_path)\n"
+              "print(cache.sources_hash())")
+    env = dict(os.environ, MBSYNTH_CACHE_DIR=str(tmp_path))
+    env.pop("NUMBA_CACHE_DIR", None)
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    kernel_path, tree_path, digest = out.stdout.split()
+    for path in (kernel_path, tree_path):
+        assert Path(path).is_relative_to(tmp_path / "numba" / digest)

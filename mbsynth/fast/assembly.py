@@ -175,12 +175,27 @@ def _normalize(row, count):
     return 1.0 / math.sqrt(total) if total > 0 else 1.0
 
 
+@njit(**INLINE)
+def _rigid_rows(j, k, me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb):
+    """The k rows of joint j between rigid bodies (rate_rows.py) into J, P, rb from row r0,
+    equilibrated; me: the node's end of the joint, p its parent (−1: the world)."""
+    program, _, kinds, starts, offset, rotation, length, ends = joints
+    rate_rows(program[j], k, kinds[j], ends[j], starts[j], offset[j], rotation[j], length[j], q, qd, Rs, V, rho, A, b)
+    for r in range(k):
+        scale = _normalize(A[r], 12)
+        rhs = b[r] + (bshift[joint_row[j] + r] if bshift.shape[0] else 0.0)
+        for a in range(6):
+            J[r0 + r, a] = A[r, 6 * me + a] * scale
+            P[r0 + r, a] = A[r, 6 - 6 * me + a] * scale if p >= 0 else 0.0
+        rb[r0 + r] = rhs * scale
+
+
 @njit(**OPTIONS)
 def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, Rs, joints, joint_row, scratch,
               J, P, rb):
     """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated.
     Joints between rigid bodies or the world: rate_rows.py; others: joints.py, reduced."""
-    program, count, kinds, starts, offset, rotation, length, ends = joints
+    count, kinds = joints[1], joints[2]
     V, A, b, rho = scratch[0], scratch[3], scratch[4], scratch[5]
     for i in range(kind.shape[0]):
         j = node_joint[i]
@@ -188,16 +203,12 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
             continue
         me, p, r0 = node_end[i], parent[i], rows[i]
         if kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE:
-            k = count[j]
-            rate_rows(program[j], k, kinds[j], ends[j], starts[j], offset[j], rotation[j], length[j], q, qd, Rs, V,
-                      rho, A, b)
-            for r in range(k):
-                scale = _normalize(A[r], 12)
-                rhs = b[r] + (bshift[joint_row[j] + r] if bshift.shape[0] else 0.0)
-                for a in range(6):
-                    J[r0 + r, a] = A[r, 6 * me + a] * scale
-                    P[r0 + r, a] = A[r, 6 - 6 * me + a] * scale if p >= 0 else 0.0
-                rb[r0 + r] = rhs * scale
+            if count[j] == 5:  # revolute: constant sizes, which numba unrolls
+                _rigid_rows(j, 5, me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
+            elif count[j] == 6:  # fixed
+                _rigid_rows(j, 6, me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
+            else:
+                _rigid_rows(j, count[j], me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
             continue
         k = _joint(j, q, qd, joints, scratch)
         for r in range(k):

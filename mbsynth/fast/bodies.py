@@ -24,7 +24,11 @@ so the rows of a joint between two bodies take the same form on both (rate_rows.
 rigid transport carries one body's unknowns to the other's (tree.py).
 """
 
-from numba import njit
+from . import cache
+
+cache.configure()  # every kernel module imports this one before it compiles: numba must see the cache first
+
+from numba import njit  # noqa: E402
 
 OPTIONS = dict(cache=True, error_model="numpy")
 INLINE = dict(OPTIONS, inline="always")  # small helpers: numba inlines them (a call costs as much)

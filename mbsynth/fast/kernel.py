@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
-from .bodies import OPTIONS, rate_transpose
+from .bodies import INLINE, OPTIONS, rate_transpose
 from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
@@ -169,43 +169,80 @@ def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx,
         Qc[x_coord[x]] = mu * total - Qf[x_coord[x]]
 
 
+@njit(**INLINE)
+def _node_dynamics(i, vi, ki, yoff, rows, H, F, J, z, dyn):
+    """dyn_i ← H_i y_i + J_iᵀ λ_i − F_i (the children's rows are added later); returns its
+    contributions to (‖M‖², ‖x‖², ‖r‖²)."""
+    o, r0 = yoff[i], rows[i]
+    norm_M = norm_x = norm_r = 0.0
+    for a in range(vi):
+        t = -F[i, a]
+        for c in range(vi):
+            t += H[i, a, c] * z[o + c]
+            norm_M += H[i, a, c] ** 2
+        for r in range(ki):
+            t += J[r0 + r, a] * z[o + vi + r]
+        dyn[i, a] = t
+        norm_x += z[o + a] ** 2
+        norm_r += F[i, a] ** 2
+    return norm_M, norm_x, norm_r
+
+
+@njit(**INLINE)
+def _node_rows(i, vi, ki, vp, p, yoff, rows, J, P, rb, z, dyn):
+    """The residual of node i's parent-joint rows, their multipliers added to the parent's
+    dyn; returns (Σ residual², ‖A‖², ‖b‖²) of those rows."""
+    o, r0 = yoff[i], rows[i]
+    res = norm_A = norm_r = 0.0
+    for r in range(ki):
+        lam_r, t = z[o + vi + r], -rb[r0 + r]
+        for a in range(vi):
+            t += J[r0 + r, a] * z[o + a]
+            norm_A += J[r0 + r, a] ** 2
+        if p >= 0:
+            for a in range(vp):
+                dyn[p, a] += P[r0 + r, a] * lam_r
+                t += P[r0 + r, a] * z[yoff[p] + a]
+                norm_A += P[r0 + r, a] ** 2
+        res += t * t
+        norm_r += rb[r0 + r] ** 2
+    return res, norm_A, norm_r
+
+
 @njit(**OPTIONS)
 def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn):
-    """Relative residual of the equilibrated KKT equations at the solution (module docstring)."""
+    """Relative residual of the equilibrated KKT equations at the solution (module docstring).
+    Rigid nodes on revolute or fixed joints run with constant sizes (numba unrolls them)."""
     _, parent, v, k, yoff, rows, _ = topology
     ptr, node = segs[0], segs[1]
     mx, nx = Ax.shape[0], Ax.shape[1]
     res = norm_M = norm_A = norm_x = norm_r = 0.0
     for i in range(kind.shape[0]):
-        o, r0 = yoff[i], rows[i]
-        for a in range(v[i]):
-            t = -F[i, a]
-            for c in range(v[i]):
-                t += H[i, a, c] * z[o + c]
-                norm_M += H[i, a, c] ** 2
-            for r in range(k[i]):
-                t += J[r0 + r, a] * z[o + v[i] + r]
-            dyn[i, a] = t
-            norm_x += z[o + a] ** 2
-            norm_r += F[i, a] ** 2
+        if v[i] == 6 and k[i] == 5:
+            m2, x2, r2 = _node_dynamics(i, 6, 5, yoff, rows, H, F, J, z, dyn)
+        elif v[i] == 6 and k[i] == 6:
+            m2, x2, r2 = _node_dynamics(i, 6, 6, yoff, rows, H, F, J, z, dyn)
+        else:
+            m2, x2, r2 = _node_dynamics(i, v[i], k[i], yoff, rows, H, F, J, z, dyn)
+        norm_M += m2
+        norm_x += x2
+        norm_r += r2
         if kind[i] == RIGID:  # the unit-norm row, exact by construction
             norm_x += s[i] ** 2
             norm_r += s[i] ** 2
             norm_A += 1.0
     for i in range(kind.shape[0]):
-        p, o, r0 = parent[i], yoff[i], rows[i]
-        for r in range(k[i]):
-            lam_r, t = z[o + v[i] + r], -rb[r0 + r]
-            for a in range(v[i]):
-                t += J[r0 + r, a] * z[o + a]
-                norm_A += J[r0 + r, a] ** 2
-            if p >= 0:
-                for a in range(v[p]):
-                    dyn[p, a] += P[r0 + r, a] * lam_r
-                    t += P[r0 + r, a] * z[yoff[p] + a]
-                    norm_A += P[r0 + r, a] ** 2
-            res += t * t
-            norm_r += rb[r0 + r] ** 2
+        p = parent[i]
+        vp = v[p] if p >= 0 else 0
+        if v[i] == 6 and vp == 6 and k[i] == 5:
+            t2, a2, r2 = _node_rows(i, 6, 5, 6, p, yoff, rows, J, P, rb, z, dyn)
+        elif v[i] == 6 and vp == 6 and k[i] == 6:
+            t2, a2, r2 = _node_rows(i, 6, 6, 6, p, yoff, rows, J, P, rb, z, dyn)
+        else:
+            t2, a2, r2 = _node_rows(i, v[i], k[i], vp, p, yoff, rows, J, P, rb, z, dyn)
+        res += t2
+        norm_A += a2
+        norm_r += r2
     for x in range(mx):
         t = _row_dot(x, segs, seg6, z) - xb[x]
         for seg in range(ptr[x], ptr[x + 1]):

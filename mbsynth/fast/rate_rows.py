@@ -20,7 +20,7 @@ and b = −(the bias terms + 2 ẋ·ẇ) as in joints.py.
 
 from numba import njit
 
-from .bodies import INLINE, OPTIONS
+from .bodies import INLINE
 from .joints import COMPONENT, DOT, WORLD
 
 D, ORIGIN_A, ORIGIN_B = 0, 7, 8  # records of ``vectors``: d, the axes (1 + 3e + a), the origins
@@ -30,15 +30,17 @@ VALUE, VELOCITY, BIAS = 0, 1, 2
 @njit(**INLINE)
 def _vector(Rs, node, s, Rf, e, col, V, rec):
     """V[rec] ← (value, velocity, bias) of c = s[e] (col < 0) or Rf[e, :, col] on the body."""
-    for a in range(3):
-        for m in range(3):
-            t = 0.0
-            for x in range(3):
-                t += Rs[node, m, a, x] * (s[e, x] if col < 0 else Rf[e, x, col])
-            V[rec, a, m] = t
+    if col < 0:
+        c0, c1, c2 = s[e, 0], s[e, 1], s[e, 2]
+    else:
+        c0, c1, c2 = Rf[e, 0, col], Rf[e, 1, col], Rf[e, 2, col]
+    for m in range(3):
+        M = Rs[node, m]
+        for a in range(3):
+            V[rec, a, m] = M[a, 0] * c0 + M[a, 1] * c1 + M[a, 2] * c2
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _end(e, kind, node, s, Rf, q, qd, start, Rs, V, rho, used):
     """The origin and the axes of end e that the rows use (bit 1 + 3e + x of ``used``) into
     V (value, velocity, bias), and its offset ρ."""
@@ -91,7 +93,7 @@ def _along(x, w, kinds, V, rho, A, r):
             _cross_add(V, x, w0, w1, w2, 1.0, A, r, 6 * e + 3)
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def rate_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs, V, rho, A, b):
     """Rows A[:k, :12] on (r̈_A, α_A, r̈_B, α_B) and b[:k] of one joint whose ends are rigid
     bodies (nodes) or the world. s, Rf, length: as joints.joint_rows; Rs: the bodies'

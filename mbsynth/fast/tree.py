@@ -87,7 +87,7 @@ def _null_space(J, r0, k, v, S, Jr, G, pivot):
     return True
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _null_space_components(J, r0, k, S, Jr, G):
     """_null_space for rows of a rigid transport with components (layout): three rows
     d_a r̈_a + C_a·α (a component of d) and k − 3 rows N_b·α (dots of axes). The null
@@ -150,7 +150,7 @@ def _null_space_components(J, r0, k, S, Jr, G):
     return True
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
@@ -216,87 +216,104 @@ def _add_rigid_transport(Ia, z, Hp):
             Hp[3 + a, 3 + c] += col[a]
 
 
+@njit(**INLINE)
+def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
+    """Node i (vi unknowns, ki rows) of ``factor``: its S, Jr, N and U, and its articulated
+    mass carried into its parent's H^A. False when its block is singular."""
+    parent, v, rows, transport = topology[1], topology[2], topology[5], topology[6]
+    HA, S, Jr, X, U, N, zeta = factored[0], factored[1], factored[2], factored[3], factored[4], factored[5], factored[8]
+    m = vi - ki
+    if transport[i] == RIGID_COMPONENTS:
+        if not _null_space_components(J, rows[i], ki, S[i], Jr[i], G):
+            return False
+    elif not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
+        return False
+    Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
+    top = 0.0
+    for a in range(vi):
+        for c in range(vi):
+            Ha[a, c] += H[i, a, c]
+            top = max(top, abs(Ha[a, c]))
+    for a in range(vi):
+        for e in range(m):
+            t = 0.0
+            for c in range(vi):
+                t += Ha[a, c] * Si[c, e]
+            Ui[a, e] = t
+    for e in range(m):
+        norm = 0.0
+        for a in range(vi):
+            norm += Si[a, e] * Si[a, e]
+        G[0, e] = top * norm
+        for f in range(e + 1):
+            t = 0.0
+            for a in range(vi):
+                t += Si[a, e] * Ui[a, f]
+            Ni[e, f] = t
+            Ni[f, e] = t
+    if not _spd_inverse(Ni, m, G[0], G[1:7]):
+        return False
+    p = parent[i]
+    if p < 0:  # a root passes nothing on
+        return True
+    for a in range(vi):  # G ← I^a = H^A − U N Uᵀ
+        for c in range(a + 1):
+            t = Ha[a, c]
+            for e in range(m):
+                w = 0.0
+                for f in range(m):
+                    w += Ni[e, f] * Ui[c, f]
+                t -= Ui[a, e] * w
+            G[a, c] = t
+            G[c, a] = t
+    if transport[i] != GENERAL:
+        _add_rigid_transport(G, zeta[i], HA[p])
+        return True
+    vp, r0, Xi = v[p], rows[i], X[i]
+    for a in range(vi):
+        for c in range(vp):
+            t = 0.0
+            for r in range(ki):
+                t -= Jr[i, a, r] * P[r0 + r, c]
+            Xi[a, c] = t
+    for a in range(vi):  # G[6:] ← I^a X
+        for c in range(vp):
+            t = 0.0
+            for e in range(vi):
+                t += G[a, e] * Xi[e, c]
+            G[6 + a, c] = t
+    Hp = HA[p]
+    for a in range(vp):  # H^A_p += Xᵀ I^a X
+        for c in range(vp):
+            t = 0.0
+            for e in range(vi):
+                t += Xi[e, a] * G[6 + e, c]
+            Hp[a, c] += t
+    return True
+
+
 @njit(**OPTIONS)
 def factor(topology, H, J, P, factored, G, pivot):
     """Eliminate leaves to roots into ``factored`` = (H^A, S, Jr, X, U, N, c, x0, ζ): per
     node 6 × 6 matrices, then solve's work and the rigid transports (assembly.transports).
     topology: (order, parent, v, k, yoff, rows, transport) of the nodes (layout.Layout); H: (N, 6, 6) node masses; J, P: (rows, 6) each node's joint rows on
     itself / on its parent, node i's starting at rows[i]. Returns the first node whose
-    block is singular, or −1."""
-    order, parent, v, k, _, rows, transport = topology
-    HA, S, Jr, X, U, N, zeta = factored[0], factored[1], factored[2], factored[3], factored[4], factored[5], factored[8]
+    block is singular, or −1. The common sizes (a rigid body on a revolute or a fixed
+    joint) are compiled with constant sizes, which numba unrolls."""
+    order, v, k = topology[0], topology[2], topology[3]
+    HA = factored[0]
     for idx in range(order.shape[0]):
         HA[order[idx]] = 0.0
     for idx in range(order.shape[0] - 1, -1, -1):
         i = order[idx]
-        vi, ki = v[i], k[i]
-        m = vi - ki
-        if transport[i] == RIGID_COMPONENTS:
-            if not _null_space_components(J, rows[i], ki, S[i], Jr[i], G):
-                return i
-        elif not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
+        if v[i] == 6 and k[i] == 5:
+            done = _factor_node(i, 6, 5, topology, H, J, P, factored, G, pivot)
+        elif v[i] == 6 and k[i] == 6:
+            done = _factor_node(i, 6, 6, topology, H, J, P, factored, G, pivot)
+        else:
+            done = _factor_node(i, v[i], k[i], topology, H, J, P, factored, G, pivot)
+        if not done:
             return i
-        Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
-        top = 0.0
-        for a in range(vi):
-            for c in range(vi):
-                Ha[a, c] += H[i, a, c]
-                top = max(top, abs(Ha[a, c]))
-        for a in range(vi):
-            for e in range(m):
-                t = 0.0
-                for c in range(vi):
-                    t += Ha[a, c] * Si[c, e]
-                Ui[a, e] = t
-        for e in range(m):
-            norm = 0.0
-            for a in range(vi):
-                norm += Si[a, e] * Si[a, e]
-            G[0, e] = top * norm
-            for f in range(e + 1):
-                t = 0.0
-                for a in range(vi):
-                    t += Si[a, e] * Ui[a, f]
-                Ni[e, f] = t
-                Ni[f, e] = t
-        if not _spd_inverse(Ni, m, G[0], G[1:7]):
-            return i
-        p = parent[i]
-        if p < 0:  # a root passes nothing on
-            continue
-        for a in range(vi):  # G ← I^a = H^A − U N Uᵀ
-            for c in range(a + 1):
-                t = Ha[a, c]
-                for e in range(m):
-                    w = 0.0
-                    for f in range(m):
-                        w += Ni[e, f] * Ui[c, f]
-                    t -= Ui[a, e] * w
-                G[a, c] = t
-                G[c, a] = t
-        if transport[i] != GENERAL:
-            _add_rigid_transport(G, zeta[i], HA[p])
-            continue
-        vp, r0, Xi = v[p], rows[i], X[i]
-        for a in range(vi):
-            for c in range(vp):
-                t = 0.0
-                for r in range(ki):
-                    t -= Jr[i, a, r] * P[r0 + r, c]
-                Xi[a, c] = t
-        for a in range(vi):  # G[6:] ← I^a X
-            for c in range(vp):
-                t = 0.0
-                for e in range(vi):
-                    t += G[a, e] * Xi[e, c]
-                G[6 + a, c] = t
-        Hp = HA[p]
-        for a in range(vp):  # H^A_p += Xᵀ I^a X
-            for c in range(vp):
-                t = 0.0
-                for e in range(vi):
-                    t += Xi[e, a] * G[6 + e, c]
-                Hp[a, c] += t
     return -1
 
 
@@ -404,7 +421,17 @@ def solve(topology, factored, y, x):
     n = order.shape[0]
     for idx in range(n - 1, -1, -1):
         i = order[idx]
-        _backward(i, v[i], k[i], topology, factored, y, x)
+        if v[i] == 6 and k[i] == 6:
+            _backward(i, 6, 6, topology, factored, y, x)
+        elif v[i] == 6 and k[i] == 5:
+            _backward(i, 6, 5, topology, factored, y, x)
+        else:
+            _backward(i, v[i], k[i], topology, factored, y, x)
     for idx in range(n):
         i = order[idx]
-        _forward(i, v[i], k[i], topology, factored, y, x)
+        if v[i] == 6 and k[i] == 6:
+            _forward(i, 6, 6, topology, factored, y, x)
+        elif v[i] == 6 and k[i] == 5:
+            _forward(i, 6, 5, topology, factored, y, x)
+        else:
+            _forward(i, v[i], k[i], topology, factored, y, x)
