@@ -424,3 +424,23 @@ def test_kernels_imported_first_still_cache_per_version(tmp_path):
     kernel_path, tree_path, digest = out.stdout.split()
     for path in (kernel_path, tree_path):
         assert Path(path).is_relative_to(tmp_path / "numba" / digest)
+
+
+def test_borrowed_arrays_share_the_callers_memory():
+    """packing.borrowed drops only the reference count: its views read and write the
+    caller's buffer, which numpy sees afterwards."""
+    from numba import njit
+
+    from mbsynth.fast.packing import borrowed, view2
+
+    @njit
+    def fill(buf, index):
+        view = view2(borrowed(buf), index, 0)
+        view[1, :] = 7.0
+        return view.sum()
+
+    buf, index = np.arange(12.0), np.array([[2, 6, 2, 2, 3, 0, 0]])
+    expected = buf[2:8].reshape(2, 3).copy()
+    expected[1, :] = 7.0
+    assert fill(buf, index) == expected.sum()
+    assert np.array_equal(buf[2:8].reshape(2, 3), expected) and buf[1] == 1.0 and buf[8] == 8.0

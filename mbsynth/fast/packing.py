@@ -12,7 +12,8 @@ views in local variables, since numba compiles tuples of many arrays very slowly
 import enum
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import intrinsic
 
 from .bodies import OPTIONS
 
@@ -66,3 +67,17 @@ def view3(buf, index, k):
 @njit(**OPTIONS)
 def view4(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5], index[k, 6]))
+
+
+@intrinsic
+def borrowed(typingctx, array):
+    """The same array without its reference count (a null meminfo): views of it cost no
+    atomic increments. Only for arrays that outlive the call, as the kernel's arguments."""
+    def codegen(context, builder, signature, args):
+        source = context.make_array(signature.args[0])(context, builder, args[0])
+        out = context.make_array(signature.return_type)(context, builder)
+        for field in ("parent", "nitems", "itemsize", "data", "shape", "strides"):
+            setattr(out, field, getattr(source, field))
+        out.meminfo = context.get_constant_null(types.MemInfoPointer(types.voidptr))
+        return out._getvalue()
+    return array(array), codegen
