@@ -92,7 +92,7 @@ def rotation_jacobian(u, c, J):
     J[2, 2] -= 2 * w * cx
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def rate(u, x):
     """E(u) x for a 4-vector x: −x_w v + w x_v − v × x_v (a 3-tuple)."""
     w, a, b, c = u[0], u[1], u[2], u[3]
@@ -101,7 +101,7 @@ def rate(u, x):
             -x[0] * c + w * x[3] - (a * x[2] - b * x[1]))
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def rate_transpose(u, g):
     """E(u)ᵀ g for a 3-vector g: (−v·g, w g + v × g) (a 4-tuple)."""
     w, a, b, c = u[0], u[1], u[2], u[3]
@@ -111,7 +111,7 @@ def rate_transpose(u, g):
             w * g[2] + a * g[1] - b * g[0])
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def body_force(mg, J, u, ud, Q):
     """Q of a rigid body into Q (7): [m g; −8 E(u̇)ᵀ J E(u) u̇]."""
     o = rate(u, ud)

@@ -42,6 +42,8 @@ class Engine:
         self.no_freedom = np.zeros((self.n, 0))  # the nullspace of a unique motion (read-only)
         self.no_freedom.flags.writeable = False
         self.lock = threading.Lock()
+        self.batch_lock = threading.Lock()
+        self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
 
     def new_work(self):
         """(packed buffers, Work of views into them)."""
@@ -80,15 +82,18 @@ class Engine:
         gen = np.zeros((count, self.outputs))
         bounds = np.linspace(0, count, min(count, THREADS) + 1).astype(int)
 
-        def block(a, b):
+        def block(a, b, work):
             if self.module is not None:
                 self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
-            kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *self.new_work()[0], qdd[a:b], status[a:b])
+            kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *work, qdd[a:b], status[a:b])
 
-        if len(bounds) > 2:
-            list(_pool().map(block, bounds[:-1], bounds[1:]))
-        elif count:
-            block(0, count)
+        with self.batch_lock:
+            while len(self.batch_works) < len(bounds) - 1:
+                self.batch_works.append(self.new_work()[0])
+            if len(bounds) > 2:
+                list(_pool().map(block, bounds[:-1], bounds[1:], self.batch_works))
+            elif count:
+                block(0, count, self.batch_works[0])
         return qdd, status
 
 

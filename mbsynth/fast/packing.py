@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import intrinsic
 
-from .bodies import OPTIONS
+from .bodies import INLINE
 
 MAX_NDIM = 4
 
@@ -49,22 +49,22 @@ def views(cls, arrays, ints, floats, index):
     return cls(*out)
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def view1(buf, index, k):
     return buf[index[k, 0]:index[k, 0] + index[k, 1]]
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def view2(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4]))
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def view3(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5]))
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def view4(buf, index, k):
     return view1(buf, index, k).reshape((index[k, 3], index[k, 4], index[k, 5], index[k, 6]))
 
