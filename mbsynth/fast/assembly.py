@@ -203,12 +203,7 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
             continue
         me, p, r0 = node_end[i], parent[i], rows[i]
         if kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE:
-            if count[j] == 5:  # revolute: constant sizes, which numba unrolls
-                _rigid_rows(j, 5, me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
-            elif count[j] == 6:  # fixed
-                _rigid_rows(j, 6, me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
-            else:
-                _rigid_rows(j, count[j], me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
+            _rigid_rows(j, count[j], me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
             continue
         k = _joint(j, q, qd, joints, scratch)
         for r in range(k):
