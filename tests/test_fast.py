@@ -444,3 +444,20 @@ def test_borrowed_arrays_share_the_callers_memory():
     expected[1, :] = 7.0
     assert fill(buf, index) == expected.sum()
     assert np.array_equal(buf[2:8].reshape(2, 3), expected) and buf[1] == 1.0 and buf[8] == 8.0
+
+
+def test_motion_made_is_the_frozen_dataclass():
+    """Motion.made (the fast path's constructor) gives the same fields as Motion(...) and
+    the same frozen object."""
+    import dataclasses
+
+    from mbsynth.equations import Motion
+
+    fields = dict(qdd=np.arange(3.0), unique=True, nullspace=np.zeros((3, 0)), Qc=np.ones(3), residual=1e-16,
+                  method="tree (Baraff)")
+    made, built = Motion.made(**fields), Motion(**fields)
+    assert [f.name for f in dataclasses.fields(made)] == list(fields)
+    for name, value in fields.items():
+        assert np.array_equal(getattr(made, name), getattr(built, name))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        made.qdd = np.zeros(3)

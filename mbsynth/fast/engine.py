@@ -71,8 +71,7 @@ class Engine:
             status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.buffers)
             if status != kernel.OK:
                 return None
-            return Motion(qdd=self.W.qdd.copy(), unique=True, nullspace=self.no_freedom, Qc=self.W.Qc.copy(),
-                          residual=residual, method="tree (Baraff)")
+            return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
 
     def motion_batch(self, t, q, qd):
         """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): blocks of
