@@ -412,6 +412,18 @@ def test_compiled_code_is_kept_per_version_of_the_sources(tmp_path):
     assert cache.sources_hash(copy) != before
 
 
+def test_cache_configuration_tolerates_numba_half_imported(tmp_path):
+    """A background build configures the cache while the caller's thread may be importing
+    numba: its config module is then in sys.modules without its settings yet."""
+    script = ("import sys, types\nsys.modules['numba.core.config'] = types.ModuleType('numba.core.config')\n"
+              "from mbsynth.fast import cache\ncache.configure()\nimport os\nprint(os.environ['NUMBA_CACHE_DIR'])")
+    env = dict(os.environ, MBSYNTH_CACHE_DIR=str(tmp_path))
+    env.pop("NUMBA_CACHE_DIR", None)
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert Path(out.stdout.strip()).is_relative_to(tmp_path / "numba")
+
+
 def test_kernels_imported_first_still_cache_per_version(tmp_path):
     """Importing a kernel module directly (not through the Engine) must not put its compiled
     code in numba's default place beside the sources, where it would come back stale."""

@@ -55,7 +55,9 @@ def configure():
         os.environ["NUMBA_CACHE_DIR"] = str(cache_dir() / "numba" / sources_hash())
     import sys
     config = sys.modules.get("numba.core.config")
-    if config is not None and not config.CACHE_DIR:  # numba imported before us: tell it directly
+    # numba imported before us: tell it directly (while another thread is still importing it,
+    # it has no CACHE_DIR yet and reads the variable itself when done)
+    if config is not None and hasattr(config, "CACHE_DIR") and not config.CACHE_DIR:
         config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
 
 

@@ -7,6 +7,8 @@ of field k. ``views(cls, arrays, ints, floats, index)`` rebuilds the NamedTuple 
 buffers (numpy). In numba, ``view1`` … ``view4`` give one field by its number, named by
 ``fields(cls)`` (an IntEnum, which numba reads as a constant); the kernel keeps the
 views in local variables, since numba compiles tuples of many arrays very slowly.
+``borrowed`` drops a buffer's reference count for the length of a kernel call: every view
+and slice of a counted array costs two atomic operations, a fifth of the kernel's time.
 """
 
 import enum
