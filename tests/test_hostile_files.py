@@ -160,6 +160,14 @@ def test_the_model_to_break_loads():
     assert system.n == 7 and system.constraint_names == ["c1", "rod[length]"]
 
 
+def test_an_empty_constraint_entry_is_refused_by_line():
+    """A list item with nothing after its dash (YAML null), found by the mutation fuzzer."""
+    text = ("name: empty_entry\nsubsystems:\n  body: {type: lagrangian, coordinates: [x], T: x_dot**2/2}\n"
+            "constraints:\n  - holonomic: body.x - 1\n  -\n")
+    with pytest.raises(ModelError, match=r":6: at constraints\[1\]: .*needs exactly one of holonomic"):
+        loads(text)
+
+
 # ------------------------------------------------------------------ junk and random documents
 
 

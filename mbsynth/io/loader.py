@@ -245,7 +245,7 @@ class _Builder:
         constraints, names = [], set()
         for i, spec in enumerate(node):
             path = ("constraints", i)
-            self.mapping(spec, path, {"name", "description", "C", *kinds})
+            spec = self.mapping(spec, path, {"name", "description", "C", *kinds})
             name = spec.get("name", f"constraint_{i + 1}")
             if not isinstance(name, str) or not name.strip():
                 self.fail(path + ("name",), f"constraint name must be a string, got {_kind(name)}")
