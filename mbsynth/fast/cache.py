@@ -6,7 +6,8 @@ numba's on-disk cache (``cache=True``) goes to ``<cache>/numba/<hash of this pac
 sources>`` unless NUMBA_CACHE_DIR is already set: numba checks only the file of the function
 it loads, so a kernel compiled against an older version of a module it calls would be
 loaded stale; the generated source of each model's force/constraint function (codegen.py)
-goes to ``<cache>/generated``. Call ``configure()`` before numba is imported.
+goes to ``<cache>/generated``. bodies.py, which every kernel module imports first, calls
+``configure()`` before anything compiles.
 """
 
 import hashlib

@@ -12,14 +12,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from . import cache
-
-cache.configure()
-
-from ..equations import Motion  # noqa: E402  (numba must see the cache directory first)
-from . import codegen, kernel, layout  # noqa: E402
-from .assembly import Work, make_work  # noqa: E402
-from .packing import pack, views  # noqa: E402
+from ..equations import Motion
+from . import codegen, kernel, layout
+from .assembly import Work, make_work
+from .packing import pack, views
 
 EMPTY = np.zeros(0)
 THREADS = os.cpu_count() or 1

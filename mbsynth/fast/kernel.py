@@ -330,9 +330,9 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
     if factor(topology, H, J, P, factored, view2(WF, WX, WORK.G), view1(WI, WX, WORK.pivot)) >= 0:
         return SINGULAR, 0.0
     _copy(ry, y)
-    solve(topology, factored, y, z0)
-    _copy(z0, z)
-    if x_coord.shape[0] + xb.shape[0] > 0:
+    bordered = x_coord.shape[0] + xb.shape[0] > 0
+    solve(topology, factored, y, z0 if bordered else z)  # _close solves again into z
+    if bordered:
         status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
                         view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam)
         if status != OK:
