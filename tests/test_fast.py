@@ -458,6 +458,35 @@ def test_borrowed_arrays_share_the_callers_memory():
     assert np.array_equal(buf[2:8].reshape(2, 3), expected) and buf[1] == 1.0 and buf[8] == 8.0
 
 
+def test_kernel_views_are_the_packed_fields():
+    """packing.view1 … view4 (built without numba's slicing) see each packed field with
+    numpy's shape and strides, int and float buffers alike, and write into the buffer."""
+    from collections import namedtuple
+
+    from numba import njit
+
+    from mbsynth.fast.packing import pack, view1, view2, view3, view4, views
+
+    Fields = namedtuple("Fields", "a b c d e")
+    arrays = Fields(np.arange(5.0), np.arange(6.0).reshape(2, 3), np.arange(24.0).reshape(2, 3, 4),
+                    np.arange(3, dtype=np.int64), np.arange(120.0).reshape(2, 3, 4, 5))
+    ints, floats, index = pack(arrays)
+
+    @njit
+    def read(ints, floats, index):
+        a, b, c = view1(floats, index, 0), view2(floats, index, 1), view3(floats, index, 2)
+        d, e = view1(ints, index, 3), view4(floats, index, 4)
+        b[1, 2] = -1.0
+        return a.copy(), b.copy(), c.copy(), d.copy(), e.copy(), (b.strides, c.strides, e.strides)
+
+    *got, strides = read(ints, floats, index)
+    expected = arrays._replace(b=np.array([[0.0, 1.0, 2.0], [3.0, 4.0, -1.0]]))
+    for mine, theirs in zip(got, expected):
+        assert mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
+    assert strides == (arrays.b.strides, arrays.c.strides, arrays.e.strides)
+    assert views(Fields, arrays, ints, floats, index).b[1, 2] == -1.0  # written through
+
+
 def test_motion_made_is_the_frozen_dataclass():
     """Motion.made (the fast path's constructor) gives the same fields as Motion(...) and
     the same frozen object."""

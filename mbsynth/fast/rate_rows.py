@@ -88,7 +88,7 @@ def _along(x, w, kinds, V, rho, A, r):
                 A[r, 6 * e + 4] += sign * (r2 * w0 - r0 * w2)
                 A[r, 6 * e + 5] += sign * (r0 * w1 - r1 * w0)
     else:
-        e = (x - 1) // 3
+        e = 0 if x <= 3 else 1  # records 1–3: end A's axes, 4–6: end B's
         if kinds[e] != WORLD:
             _cross_add(V, x, w0, w1, w2, 1.0, A, r, 6 * e + 3)
 
@@ -112,12 +112,13 @@ def rate_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs, V, rho
         for col in range(12):
             A[r, col] = 0.0
         if op == COMPONENT:  # d_w: e_w on r̈_B, ρ_B × e_w on α_B, the negatives on A
+            w1, w2 = (w + 1 if w < 2 else 0), (w + 2 if w < 1 else w - 1)  # (w + 1, w + 2) mod 3
             for e in range(2):
                 if kinds[e] != WORLD:
                     sign = 1.0 if e == 1 else -1.0
                     A[r, 6 * e + w] = sign
-                    A[r, 6 * e + 3 + (w + 1) % 3] = sign * rho[e, (w + 2) % 3]
-                    A[r, 6 * e + 3 + (w + 2) % 3] = -sign * rho[e, (w + 1) % 3]
+                    A[r, 6 * e + 3 + w1] = sign * rho[e, w2]
+                    A[r, 6 * e + 3 + w2] = -sign * rho[e, w1]
             b[r] = -V[D, w, BIAS]
             continue
         if op == DOT:
