@@ -19,6 +19,7 @@ from .packing import pack, views
 
 EMPTY = np.zeros(0)
 THREADS = os.cpu_count() or 1
+CHUNK = 16  # fewest rows a thread takes at a time
 
 
 class Engine:
@@ -70,25 +71,31 @@ class Engine:
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
 
     def motion_batch(self, t, q, qd):
-        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): blocks of
-        rows in threads, the kernels running without the GIL, each block with its own Work."""
+        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): chunks of
+        rows taken in turn by one thread per core, the kernels running without the GIL,
+        each thread with its own Work (taken in turn, a thread slowed by other load on
+        the machine does fewer chunks)."""
         count = q.shape[0]
         qdd, status = np.zeros((count, self.n)), np.zeros(count, dtype=np.int64)
         gen = np.zeros((count, self.outputs))
-        bounds = np.linspace(0, count, min(count, THREADS) + 1).astype(int)
+        size = max(CHUNK, -(-count // (THREADS * 8)))
+        chunks = iter(range(0, count, size))  # next() on it is atomic under the GIL
 
-        def block(a, b, work):
-            if self.module is not None:
-                self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
-            kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *work, qdd[a:b], status[a:b])
+        def worker(work):
+            for a in chunks:
+                b = min(a + size, count)
+                if self.module is not None:
+                    self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
+                kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *work, qdd[a:b], status[a:b])
 
+        threads = max(1, min(THREADS, -(-count // size)))
         with self.batch_lock:
-            while len(self.batch_works) < len(bounds) - 1:
+            while len(self.batch_works) < threads:
                 self.batch_works.append(self.new_work()[0])
-            if len(bounds) > 2:
-                list(_pool().map(block, bounds[:-1], bounds[1:], self.batch_works))
-            elif count:
-                block(0, count, self.batch_works[0])
+            if threads > 1:
+                list(_pool().map(worker, self.batch_works[:threads]))
+            else:
+                worker(self.batch_works[0])
         return qdd, status
 
 
