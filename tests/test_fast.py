@@ -10,6 +10,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -422,6 +423,30 @@ def test_cache_configuration_tolerates_numba_half_imported(tmp_path):
     out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert Path(out.stdout.strip()).is_relative_to(tmp_path / "numba")
+
+
+def test_stale_versions_of_the_numba_cache_are_pruned(tmp_path):
+    """configure() marks its version's directory and removes the versions unused for
+    STALE_DAYS (by their mark, or the directory's own time when unmarked); recent ones stay."""
+    from mbsynth.fast import cache
+
+    root = tmp_path / "numba"
+    days = 86400
+    for name, age, marked in (("old", 40, True), ("recent", 2, True), ("unmarked_old", 40, False)):
+        folder = root / name
+        folder.mkdir(parents=True)
+        (folder / "kernel.nbi").write_text("")
+        stamped = folder / cache.MARK if marked else folder
+        if marked:
+            stamped.write_text("")
+        os.utime(stamped, (time.time() - age * days,) * 2)
+    script = "from mbsynth.fast import cache; cache.configure(); print(cache.sources_hash())"
+    env = dict(os.environ, MBSYNTH_CACHE_DIR=str(tmp_path))
+    env.pop("NUMBA_CACHE_DIR", None)
+    digest = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True,
+                            check=True).stdout.strip()
+    assert sorted(p.name for p in root.iterdir()) == sorted(["recent", digest])
+    assert time.time() - (root / digest / cache.MARK).stat().st_mtime < 600
 
 
 def test_kernels_imported_first_still_cache_per_version(tmp_path):

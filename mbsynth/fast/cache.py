@@ -7,13 +7,19 @@ sources>`` unless NUMBA_CACHE_DIR is already set: numba checks only the file of 
 it loads, so a kernel compiled against an older version of a module it calls would be
 loaded stale; the generated source of each model's force/constraint function (codegen.py)
 goes to ``<cache>/generated``. bodies.py, which every kernel module imports first, calls
-``configure()`` before anything compiles.
+``configure()`` before anything compiles. Each use marks its version's directory; the
+directories of versions unused for ``STALE_DAYS`` are removed (each holds tens of MB).
 """
 
 import hashlib
 import os
+import shutil
 import tempfile
+import time
 from pathlib import Path
+
+STALE_DAYS = 30  # a version's numba directory unused this long is removed
+MARK = ".last-used"
 
 
 def _writable(path):
@@ -51,15 +57,35 @@ def sources_hash(folder=None):
 
 
 def configure():
-    """Point numba's cache at ``<cache>/numba/<sources_hash()>`` unless NUMBA_CACHE_DIR is set."""
+    """Point numba's cache at ``<cache>/numba/<sources_hash()>`` unless NUMBA_CACHE_DIR is set
+    (then mark it used and prune the stale versions)."""
     if not os.environ.get("NUMBA_CACHE_DIR"):
-        os.environ["NUMBA_CACHE_DIR"] = str(cache_dir() / "numba" / sources_hash())
+        version = cache_dir() / "numba" / sources_hash()
+        os.environ["NUMBA_CACHE_DIR"] = str(version)
+        _mark_and_prune(version)
     import sys
     config = sys.modules.get("numba.core.config")
     # numba imported before us: tell it directly (while another thread is still importing it,
     # it has no CACHE_DIR yet and reads the variable itself when done)
     if config is not None and hasattr(config, "CACHE_DIR") and not config.CACHE_DIR:
         config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
+
+
+def _mark_and_prune(version):
+    """Touch ``version``'s mark, then remove its siblings whose mark (or, unmarked, whose
+    directory) is older than STALE_DAYS. A cache that cannot be written is left alone."""
+    try:
+        version.mkdir(parents=True, exist_ok=True)
+        (version / MARK).touch()
+        cutoff = time.time() - STALE_DAYS * 86400
+        for other in version.parent.iterdir():
+            if other == version or not other.is_dir():
+                continue
+            mark = other / MARK
+            if (mark if mark.exists() else other).stat().st_mtime < cutoff:
+                shutil.rmtree(other, ignore_errors=True)
+    except OSError:
+        pass
 
 
 def generated_dir():
