@@ -20,6 +20,7 @@ same fields): else the script says so and stops.
 import argparse
 import importlib
 import io
+import shutil
 import subprocess
 import sys
 import tarfile
@@ -43,6 +44,7 @@ def package_at(rev):
     name = f"mbsynth_{commit}"
     home = cache.cache_dir() / "ab" / commit
     if not (home / name).exists():
+        shutil.rmtree(home / "partial", ignore_errors=True)  # left by an interrupted run
         archive = subprocess.run(["git", "archive", commit, "mbsynth"], cwd=ROOT, capture_output=True,
                                  check=True).stdout
         with tarfile.open(fileobj=io.BytesIO(archive)) as tar:

@@ -71,10 +71,9 @@ class Engine:
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
 
     def motion_batch(self, t, q, qd):
-        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): chunks of
-        rows taken in turn by one thread per core, the kernels running without the GIL,
-        each thread with its own Work (taken in turn, a thread slowed by other load on
-        the machine does fewer chunks)."""
+        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread
+        per core, each with its own Work, taking chunks of rows in turn (a thread slowed by
+        other load does fewer), the kernels running without the GIL."""
         count = q.shape[0]
         qdd, status = np.zeros((count, self.n)), np.zeros(count, dtype=np.int64)
         gen = np.zeros((count, self.outputs))

@@ -277,8 +277,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
     gen: the generated function's outputs at (t, q, q̇) — time enters only there; bshift:
     added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
     Layout and the Work packed (packing.py)."""
-    LI, LF, WI, WF = borrowed(LI), borrowed(LF), borrowed(WI), borrowed(WF)
-    q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)
+    q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
     mass, mg, inertia = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), view3(LF, LX, LAYOUT.node_J)
     v, k, yoff, rows = (view1(LI, LX, LAYOUT.node_v), view1(LI, LX, LAYOUT.node_k), view1(LI, LX, LAYOUT.node_yoff),
