@@ -23,7 +23,7 @@ from mbsynth.fast import engine_for
 from mbsynth.fast.bodies import body_force, rate_transpose
 from mbsynth.fast.joints import vector_work
 from mbsynth.fast.joints import joint_rows as kernel_rows
-from mbsynth.fast.assembly import nodes
+from mbsynth.fast.assembly import make_work, nodes
 from mbsynth.fast.layout import build as build_layout
 from mbsynth.fast.rate_rows import rate_rows
 from mbsynth import kinematics
@@ -127,9 +127,8 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
     system = all_joints
     L, _ = build_layout(system)
     kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
-    V, rho = vector_work()[0], np.zeros((2, 3))
     A, b = np.zeros((6, 14)), np.zeros(6)
-    Rs = np.zeros((len(L.node_kind), 4, 3, 3))
+    Rs = make_work(L).Rs  # with the world's slot
     rng = np.random.default_rng(4)
     for trial in range(4):
         q, qd = random_state(system, rng, unit=trial % 2 == 0)
@@ -144,7 +143,7 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
             a_ref, b_ref, _ = con.evaluate(0.0, q, qd, system.parameter_values)
             k = int(L.joint_k[j])
             rate_rows(L.joint_program[j], k, L.joint_kinds[j], L.joint_node[j], L.joint_start[j], L.joint_s[j],
-                      L.joint_R[j], L.joint_length[j], q, qd, Rs, V, rho, A, b)
+                      L.joint_R[j], L.joint_length[j], q, qd, Rs, A, b)
             full = np.zeros((k, system.n))
             full[:, con.indices] = a_ref
             expected_b = b_ref.astype(float).copy()

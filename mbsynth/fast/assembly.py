@@ -20,7 +20,7 @@ from numba import njit
 
 from .bodies import INLINE, OPTIONS, body_force, rate, reduce_row, rotation, rotation_rate
 from .joints import MAX_ROWS, PARTICLE, RIGID, joint_rows, vector_work
-from .rate_rows import rate_rows
+from .rate_rows import equilibrated_rows
 from .tree import GENERAL, RIGID_INVARIANT
 
 
@@ -32,7 +32,7 @@ class Work(NamedTuple):
     H: np.ndarray      # (N, 6, 6) node masses / μ
     F: np.ndarray      # (N, 6) node forces / μ
     s: np.ndarray      # (N,) quaternion norm accelerations (bodies.py)
-    Rs: np.ndarray     # (N, 4, 3, 3) per body R(u), d/dt R(u), Rb and B (nodes; rate_rows.py)
+    Rs: np.ndarray     # (N + 1, 4, 3, 3) per body R(u), d/dt R(u), Rb and B (nodes; rate_rows.py), then the world's (I, 0, 0, 0)
     zeta: np.ndarray   # (N, 3) each node's rigid transport (transports)
     nu: np.ndarray     # (N,) quaternion lengths
     HA: np.ndarray     # (N, 6, 6) articulated masses (tree.factor)
@@ -57,7 +57,6 @@ class Work(NamedTuple):
     R: np.ndarray
     Jt: np.ndarray
     A: np.ndarray      # (MAX_ROWS, 14) one joint's rows
-    rho: np.ndarray    # (2, 3) its frames' offsets (rate_rows.py)
     b: np.ndarray      # (MAX_ROWS,)
     q7: np.ndarray     # (7,) one body's Q
     seg7: np.ndarray   # (S, 7) extra rows' coefficients per node
@@ -81,10 +80,11 @@ def make_work(L):
     N, S = L.node_kind.shape[0], L.xseg_node.shape[0]
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
-    shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
-                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), rho=(2, 3), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
+    shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N + 1, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
+                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
                   rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
+    arrays["Rs"][N, 0] = np.eye(3)  # the world, as a body at rest in its own frame (rate_rows.py)
     V, R, Jt = vector_work()
     return Work(pivot=np.zeros(12, np.int64), V=V, R=R, Jt=Jt, **arrays)
 
@@ -93,7 +93,7 @@ def make_work(L):
 def _joint(j, q, qd, joints, scratch):
     """Rows of kernel joint j into scratch's A, b; returns their number."""
     program, k, kinds, start, offset, rotation, length, _ = joints
-    V, R, Jt, A, b, _ = scratch
+    V, R, Jt, A, b = scratch
     joint_rows(program[j], k[j], kinds[j], start[j], offset[j], rotation[j], length[j], q, qd, V, R, Jt, A, b)
     return k[j]
 
@@ -175,35 +175,21 @@ def _normalize(row, count):
     return 1.0 / math.sqrt(total) if total > 0 else 1.0
 
 
-@njit(**INLINE)
-def _rigid_rows(j, k, me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb):
-    """The k rows of joint j between rigid bodies (rate_rows.py) into J, P, rb from row r0,
-    equilibrated; me: the node's end of the joint, p its parent (−1: the world)."""
-    program, _, kinds, starts, offset, rotation, length, ends = joints
-    rate_rows(program[j], k, kinds[j], ends[j], starts[j], offset[j], rotation[j], length[j], q, qd, Rs, V, rho, A, b)
-    for r in range(k):
-        scale = _normalize(A[r], 12)
-        rhs = b[r] + (bshift[joint_row[j] + r] if bshift.shape[0] else 0.0)
-        for a in range(6):
-            J[r0 + r, a] = A[r, 6 * me + a] * scale
-            P[r0 + r, a] = A[r, 6 - 6 * me + a] * scale if p >= 0 else 0.0
-        rb[r0 + r] = rhs * scale
-
-
 @njit(**OPTIONS)
 def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, Rs, joints, joint_row, scratch,
               J, P, rb):
     """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated.
     Joints between rigid bodies or the world: rate_rows.py; others: joints.py, reduced."""
-    count, kinds = joints[1], joints[2]
-    V, A, b, rho = scratch[0], scratch[3], scratch[4], scratch[5]
+    program, count, kinds, starts, offset, frame, length, ends = joints
+    A, b = scratch[3], scratch[4]
     for i in range(kind.shape[0]):
         j = node_joint[i]
         if j < 0:
             continue
         me, p, r0 = node_end[i], parent[i], rows[i]
         if kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE:
-            _rigid_rows(j, count[j], me, p, r0, q, qd, bshift, Rs, joints, joint_row, V, rho, A, b, J, P, rb)
+            equilibrated_rows(program[j], count[j], kinds[j], ends[j], starts[j], offset[j], frame[j], length[j], q,
+                              qd, Rs, me, bshift, joint_row[j], J, P, rb, r0)
             continue
         k = _joint(j, q, qd, joints, scratch)
         for r in range(k):

@@ -302,7 +302,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
     ry, y, z, z0, w = (view1(WF, WX, WORK.ry), view1(WF, WX, WORK.y), view1(WF, WX, WORK.z), view1(WF, WX, WORK.z0),
                        view1(WF, WX, WORK.w))
     scratch = (view3(WF, WX, WORK.V), view3(WF, WX, WORK.R), view2(WF, WX, WORK.Jt), view2(WF, WX, WORK.A),
-               view1(WF, WX, WORK.b), view2(WF, WX, WORK.rho))
+               view1(WF, WX, WORK.b))
     seg7, seg6, xb, Ax = view2(WF, WX, WORK.seg7), view2(WF, WX, WORK.seg6), view1(WF, WX, WORK.xb), view2(WF, WX, WORK.Ax)
     Mx, Fx, lam = view2(WF, WX, WORK.Mx), view1(WF, WX, WORK.Fx), view1(WF, WX, WORK.lam)
 

@@ -49,7 +49,7 @@ class Layout(NamedTuple):
     order: np.ndarray        # (N,) parents before children
     joint_kinds: np.ndarray  # (K, 2) WORLD, RIGID or PARTICLE per end
     joint_start: np.ndarray  # (K, 2) first coordinate of each end's part
-    joint_node: np.ndarray   # (K, 2) each end's node, −1 for the world
+    joint_node: np.ndarray   # (K, 2) each end's node; the world's: N, its slot of Work.Rs
     joint_s: np.ndarray      # (K, 2, 3) frame offset in its part (world position for a world end)
     joint_R: np.ndarray      # (K, 2, 3, 3) frame rotation in its part
     joint_length: np.ndarray  # (K,) a distance joint's L (1 otherwise)
@@ -215,7 +215,7 @@ class _Builder:
             node_end=_ints(end), node_transport=_ints([self._transport(i, j, rigid) for i, j in enumerate(self.pjoint)]),
             order=_ints(self.order),
             joint_kinds=_ints([x[0] for x in kernel], (-1, 2)), joint_start=_ints([x[1] for x in kernel], (-1, 2)),
-            joint_node=_ints([[-1 if p is None else self.node_of[p.name] for p in con.parts] for con, _ in joints],
+            joint_node=_ints([[len(self.nodes) if p is None else self.node_of[p.name] for p in con.parts] for con, _ in joints],
                              (-1, 2)),
             joint_s=np.array([x[2] for x in kernel], dtype=float).reshape(-1, 2, 3),
             joint_R=np.array([x[3] for x in kernel], dtype=float).reshape(-1, 2, 3, 3),
