@@ -19,7 +19,8 @@ and b = −(the bias terms + 2 ẋ·ẇ) as in joints.py. A world end has no unk
 coefficients are dropped.
 
 Each row is computed on its own, its vectors as 3-tuples (``_row``), so that they stay in
-registers: about three times faster than filling a table of the joint's vectors first.
+registers: the joint rows take half the time they took when a table of the joint's
+vectors was filled first (talos: 14 → 7.6 µs of the kernel's).
 """
 
 import math
@@ -78,8 +79,8 @@ def _axis(x, nodes, Rf, Rs):
 def _row(op, x, w, kinds, nodes, Rf, length, Rs, A, B):
     """One row: (coefficients on r̈_A, α_A, r̈_B, α_B; b), a world end's zero. A, B: the
     ends' origins. Each kind of row returns on its own and no branch picks tuples per
-    end: numba then keeps the tuples in registers (merging the branches' tuples, or a
-    branch on the world end, costs half the time)."""
+    end: numba then keeps the tuples in registers (with the kinds' tuples merged after
+    the branches, or a branch on the world end, the rows took twice as long)."""
     fA, fB = 0.0 if kinds[0] == WORLD else 1.0, 0.0 if kinds[1] == WORLD else 1.0
     if op == COMPONENT:  # e_w on r̈_B, ρ_B × e_w on α_B, the negatives on A
         rhoA, rhoB = A[0], B[0]
