@@ -26,6 +26,7 @@ from mbsynth.fast.joints import joint_rows as kernel_rows
 from mbsynth.fast.assembly import make_work, nodes
 from mbsynth.fast.layout import build as build_layout
 from mbsynth.fast.rate_rows import rate_rows
+from mbsynth.fast.tree import _components_closed, _null_space_components
 from mbsynth import kinematics
 from mbsynth.kinematics import body_rate_matrix
 from mbsynth.subsystems import RigidBody
@@ -161,6 +162,32 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
                 assert np.abs(A[:k, 6 * e + 3:6 * e + 6] - expected_a).max() <= 1e-12, con.joint_kind
                 expected_b -= c_u @ u * (-(ud @ ud) / nu) / nu
             assert np.abs(b[:k] - expected_b).max() <= 1e-12 * max(1.0, np.abs(expected_b).max()), con.joint_kind
+
+
+def test_closed_form_null_spaces_of_revolute_and_fixed_rows():
+    """tree._components_closed (revolute and fixed rows in closed form) gives J S = 0,
+    J Jr = I and the same S, Jr as the Cholesky-based _null_space_components, and
+    refuses dependent dot rows as it does."""
+    rng = np.random.default_rng(8)
+    for k in (5, 6):
+        for trial in range(20):
+            J = np.zeros((k, 6))
+            J[:3, :3] = np.diag(rng.uniform(0.2, 1.0, 3) * rng.choice([-1, 1], 3))
+            J[:3, 3:] = rng.normal(size=(3, 3))
+            J[3:, 3:] = rng.normal(size=(k - 3, 3))
+            dependent = trial % 4 == 3
+            if dependent:
+                J[4, 3:] = 2.0 * J[3, 3:]
+            S, Jr, S_ref, Jr_ref = np.zeros((6, 6)), np.zeros((6, 6)), np.zeros((6, 6)), np.zeros((6, 6))
+            closed = _components_closed(J, 0, k, S, Jr)
+            general = _null_space_components(J, 0, k, S_ref, Jr_ref, np.zeros((12, 12)))
+            assert closed == general == (not dependent)
+            if dependent:
+                continue
+            m = 6 - k
+            assert np.abs(J @ S[:, :m]).max(initial=0.0) <= 1e-12 and np.abs(J @ Jr[:, :k] - np.eye(k)).max() <= 1e-11
+            assert np.abs(S[:, :m] - S_ref[:, :m]).max(initial=0.0) <= 1e-12
+            assert np.abs(Jr[:, :k] - Jr_ref[:, :k]).max() <= 1e-11 * np.abs(Jr_ref).max()
 
 
 def test_body_blocks_equal_the_sympy_blocks(all_joints):

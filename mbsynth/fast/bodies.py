@@ -35,6 +35,17 @@ INLINE = dict(OPTIONS, inline="always")  # small helpers: numba inlines them (a 
 
 
 @njit(**INLINE)
+def cross3(x, w):
+    """x × w of two 3-tuples (or arrays), as a 3-tuple."""
+    return (x[1] * w[2] - x[2] * w[1], x[2] * w[0] - x[0] * w[2], x[0] * w[1] - x[1] * w[0])
+
+
+@njit(**INLINE)
+def dot3(x, w):
+    return x[0] * w[0] + x[1] * w[1] + x[2] * w[2]
+
+
+@njit(**INLINE)
 def rotation(u, R):
     """R(u) into R (3 × 3)."""
     w, x, y, z = u[0], u[1], u[2], u[3]

@@ -27,7 +27,7 @@ import math
 
 from numba import njit
 
-from .bodies import INLINE
+from .bodies import INLINE, cross3, dot3
 from .joints import COMPONENT, D, DOT, WORLD
 
 ZERO = (0.0, 0.0, 0.0)
@@ -38,16 +38,6 @@ def _times(M, c):
     """M c for a 3 × 3 M and a 3-tuple c."""
     return (M[0, 0] * c[0] + M[0, 1] * c[1] + M[0, 2] * c[2], M[1, 0] * c[0] + M[1, 1] * c[1] + M[1, 2] * c[2],
             M[2, 0] * c[0] + M[2, 1] * c[1] + M[2, 2] * c[2])
-
-
-@njit(**INLINE)
-def _cross(x, w):
-    return (x[1] * w[2] - x[2] * w[1], x[2] * w[0] - x[0] * w[2], x[0] * w[1] - x[1] * w[0])
-
-
-@njit(**INLINE)
-def _dot(x, w):
-    return x[0] * w[0] + x[1] * w[1] + x[2] * w[2]
 
 
 @njit(**INLINE)
@@ -95,9 +85,9 @@ def _row(op, x, w, kinds, nodes, Rf, length, Rs, A, B):
         xv, xd, xb = _axis(x, nodes, Rf, Rs)
         wv, wd, wb = _axis(w, nodes, Rf, Rs)
         f = (1.0 if x <= 3 else 0.0) - (1.0 if w <= 3 else 0.0)  # on α_A; −f on α_B
-        c = _cross(xv, wv)
+        c = cross3(xv, wv)
         return ZERO, _axpy(fA * f, c, ZERO), ZERO, _axpy(-fB * f, c, ZERO), \
-            -(_dot(xb, wv) + _dot(xv, wb) + 2 * _dot(xd, wd))
+            -(dot3(xb, wv) + dot3(xv, wb) + 2 * dot3(xd, wd))
     # d·w for an axis w, or the distance: d·d scaled by 1/2L
     xv, xd, xb = _axpy(-1.0, A[1], B[1]), _axpy(-1.0, A[2], B[2]), _axpy(-1.0, A[3], B[3])
     distance = op != DOT
@@ -106,11 +96,11 @@ def _row(op, x, w, kinds, nodes, Rf, length, Rs, A, B):
     fd = 1.0 if distance else 0.0
     fa = 0.0 if distance or w > 3 else 1.0
     t = _axpy(fd, xv, wv)  # the coefficients of d̈·w and, for the distance, of ẅ·d = d̈·d
-    c = _cross(wv, xv)
-    aA = _axpy(fa * scale, c, _axpy(-scale, _cross(A[0], t), ZERO))
-    aB = _axpy((1.0 - fd - fa) * scale, c, _axpy(scale, _cross(B[0], t), ZERO))
+    c = cross3(wv, xv)
+    aA = _axpy(fa * scale, c, _axpy(-scale, cross3(A[0], t), ZERO))
+    aB = _axpy((1.0 - fd - fa) * scale, c, _axpy(scale, cross3(B[0], t), ZERO))
     return (_axpy(-fA * scale, t, ZERO), _axpy(fA, aA, ZERO), _axpy(fB * scale, t, ZERO), _axpy(fB, aB, ZERO),
-            -scale * (_dot(xb, wv) + _dot(xv, wb) + 2 * _dot(xd, wd)))
+            -scale * (dot3(xb, wv) + dot3(xv, wb) + 2 * dot3(xd, wd)))
 
 
 @njit(**INLINE)
@@ -134,7 +124,7 @@ def equilibrated_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs
     B0 = _origin(kinds[1], nodes[1], starts[1], s[1], q, qd, Rs)
     for r in range(k):
         rA, aA, rB, aB, beta = _row(program[r, 0], program[r, 1], program[r, 2], kinds, nodes, Rf, length, Rs, A0, B0)
-        total = _dot(rA, rA) + _dot(aA, aA) + _dot(rB, rB) + _dot(aB, aB)
+        total = dot3(rA, rA) + dot3(aA, aA) + dot3(rB, rB) + dot3(aB, aB)
         scale = 1.0 / math.sqrt(total) if total > 0 else 1.0
         mr, ma, orr, oa = (rA, aA, rB, aB) if me == 0 else (rB, aB, rA, aA)
         for a in range(3):

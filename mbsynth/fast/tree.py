@@ -33,7 +33,7 @@ import math
 
 from numba import njit
 
-from .bodies import INLINE, OPTIONS
+from .bodies import INLINE, OPTIONS, cross3, dot3
 
 PIVOT_RTOL = 1e-9  # a pivot below this fraction of its scale counts as zero
 GENERAL, RIGID_INVARIANT, RIGID_COMPONENTS = 0, 1, 2  # a node's transport X (layout.node_transport)
@@ -155,6 +155,60 @@ def _null_space_components(J, r0, k, S, Jr, G):
 
 
 @njit(**INLINE)
+def _row3(J, r, o):
+    """J[r, o:o + 3] as a 3-tuple."""
+    return (J[r, o], J[r, o + 1], J[r, o + 2])
+
+
+@njit(**INLINE)
+def _components_closed(J, r0, k, S, Jr):
+    """_null_space_components in closed form for a revolute (k = 5: two dot rows N_0, N_1,
+    T = N_0 × N_1) or a fixed joint (k = 6: N invertible, Nᵀ(NNᵀ)⁻¹ = N⁻¹ by cross
+    products); the same pivot tests as the Cholesky factor of NNᵀ."""
+    D = (J[r0, 0], J[r0 + 1, 1], J[r0 + 2, 2])
+    top = max(abs(D[0]), max(abs(D[1]), abs(D[2])))
+    for a in range(3):
+        if not abs(D[a]) > PIVOT_RTOL * top:
+            return False
+    N0, N1 = _row3(J, r0 + 3, 3), _row3(J, r0 + 4, 3)
+    g00, g11, T = dot3(N0, N0), dot3(N1, N1), cross3(N0, N1)
+    t2 = dot3(T, T)  # |N_0 × N_1|², the determinant of N Nᵀ (k = 5)
+    if not (g00 > PIVOT_RTOL * g00 and t2 > PIVOT_RTOL * g11 * g00):
+        return False
+    if k == 5:
+        g01 = dot3(N0, N1)
+        j0 = ((g11 * N0[0] - g01 * N1[0]) / t2, (g11 * N0[1] - g01 * N1[1]) / t2, (g11 * N0[2] - g01 * N1[2]) / t2)
+        j1 = ((g00 * N1[0] - g01 * N0[0]) / t2, (g00 * N1[1] - g01 * N0[1]) / t2, (g00 * N1[2] - g01 * N0[2]) / t2)
+        for e in range(3):
+            S[3 + e, 0] = T[e]
+            Jr[3 + e, 0] = Jr[3 + e, 1] = Jr[3 + e, 2] = 0.0
+            Jr[3 + e, 3], Jr[3 + e, 4] = j0[e], j1[e]
+        for a in range(3):
+            C = _row3(J, r0 + a, 3)
+            inv = 1.0 / D[a]
+            S[a, 0] = -inv * dot3(C, T)
+            for c in range(3):
+                Jr[a, c] = inv if c == a else 0.0
+            Jr[a, 3], Jr[a, 4] = -inv * dot3(C, j0), -inv * dot3(C, j1)
+        return True
+    N2 = _row3(J, r0 + 5, 3)
+    det = dot3(N2, T)
+    if not det * det > PIVOT_RTOL * dot3(N2, N2) * t2:
+        return False
+    c0, c1 = cross3(N1, N2), cross3(N2, N0)  # N⁻¹'s columns: (N1×N2, N2×N0, N0×N1)/det
+    for e in range(3):
+        Jr[3 + e, 0] = Jr[3 + e, 1] = Jr[3 + e, 2] = 0.0
+        Jr[3 + e, 3], Jr[3 + e, 4], Jr[3 + e, 5] = c0[e] / det, c1[e] / det, T[e] / det
+    for a in range(3):
+        C = _row3(J, r0 + a, 3)
+        inv = 1.0 / D[a]
+        for c in range(3):
+            Jr[a, c] = inv if c == a else 0.0
+        Jr[a, 3], Jr[a, 4], Jr[a, 5] = -inv * dot3(C, c0) / det, -inv * dot3(C, c1) / det, -inv * dot3(C, T) / det
+    return True
+
+
+@njit(**INLINE)
 def _spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
@@ -228,7 +282,10 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
     HA, S, Jr, X, U, N, zeta = factored[0], factored[1], factored[2], factored[3], factored[4], factored[5], factored[8]
     m = vi - ki
     if transport[i] == RIGID_COMPONENTS:
-        if not _null_space_components(J, rows[i], ki, S[i], Jr[i], G):
+        if ki == 5 or ki == 6:
+            if not _components_closed(J, rows[i], ki, S[i], Jr[i]):
+                return False
+        elif not _null_space_components(J, rows[i], ki, S[i], Jr[i], G):
             return False
     elif not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
         return False
