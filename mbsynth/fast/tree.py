@@ -91,7 +91,7 @@ def _null_space(J, r0, k, v, S, Jr, G, pivot):
     return True
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _null_space_components(J, r0, k, S, Jr, G):
     """_null_space for rows of a rigid transport with components (layout): three rows
     d_a r̈_a + C_a·α (a component of d) and k − 3 rows N_b·α (dots of axes). The null
