@@ -21,5 +21,5 @@ __version__ = "0.1.0"
 __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
     "ModelError", "SolveError", "SimulationError", "load", "loads", "System",
-    "simulate", "sweep", "Trajectory", "load_trajectory", "from_robot",
+    "simulate", "sweep", "Trajectory", "load_trajectory", "from_robot", "viewer",
 ]
