@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
-from .connectors import Connector
+from .constraint import Connector
 from .equations import rank_report
 from .errors import ModelError
 from .symbolic import T_SYMBOL, tidy

@@ -25,9 +25,9 @@ from typing import NamedTuple
 
 import sympy as sp
 
+from ..constraint import Connector
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
 from ..symbolic import differentiate, differentiated, placed_values, positions, time_derivative
-from .constraint import Connector
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}

@@ -22,8 +22,8 @@ frame's y axis:  ψ = y_f · v_p = 0 (one non-holonomic row).
 
 import sympy as sp
 
+from ..constraint import Connector, mixed
 from ..symbolic import time_derivative
-from .constraint import Connector, mixed
 
 
 def _velocity(position, q, qd):

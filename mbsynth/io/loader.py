@@ -12,7 +12,7 @@ import numpy as np
 import sympy as sp
 
 from ..closure import close
-from ..connectors import Connector
+from ..constraint import Connector
 from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
 from ..symbolic import T_SYMBOL

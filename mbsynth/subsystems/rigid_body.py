@@ -5,8 +5,8 @@ import functools
 
 import sympy as sp
 
+from ..constraint import Connector
 from ..kinematics import body_rate_matrix, rotation, world_rate_matrix
-from ..connectors import Connector
 from .base import Part
 
 COORDINATES = ("x", "y", "z", "qw", "qx", "qy", "qz")

@@ -3,7 +3,7 @@
 import numpy as np
 import sympy as sp
 
-from ..symbolic import T_SYMBOL, compile_function, differentiated, placed_values, positions
+from .symbolic import T_SYMBOL, compile_function, differentiated, placed_values, positions
 
 
 class Connector:
