@@ -29,8 +29,14 @@ PLOT_FORMATS = (".png", ".pdf", ".svg")
 
 
 def main(argv=None):
-    parser = _parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        args = _parser().parse_args(argv)
+    except _UsageError as err:
+        if "--json" not in argv:
+            argparse.ArgumentParser.error(err.parser, err.message)  # usage on stderr, exit 2
+        print(json.dumps({"error": f"{err.parser.prog}: {err.message}"}))
+        return 2
     try:
         return args.run(args)
     except (ModelError, SolveError, OSError) as err:
@@ -73,8 +79,24 @@ def _check_flags(args, positive=(), outputs=()):
             raise ModelError(f"{flag} {value}: the folder {Path(value).parent} does not exist")
 
 
+class _UsageError(Exception):
+    """A command line argparse cannot read (``parser``: the command's, for its usage)."""
+
+    def __init__(self, parser, message):
+        super().__init__(message)
+        self.parser, self.message = parser, message
+
+
+class _ArgumentParser(argparse.ArgumentParser):
+    """argparse that raises _UsageError instead of exiting, so that main can answer
+    with --json's {"error": ...} object."""
+
+    def error(self, message):
+        raise _UsageError(self, message)
+
+
 def _parser():
-    parser = argparse.ArgumentParser(prog="mbsynth", description=__doc__.splitlines()[0])
+    parser = _ArgumentParser(prog="mbsynth", description=__doc__.splitlines()[0])
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     check = commands.add_parser(

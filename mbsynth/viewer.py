@@ -52,7 +52,7 @@ def show(system, trajectory, *, axes=False, joints=False, fps=FPS, block=True):
     """Serve the animation of ``trajectory`` in a live meshcat viewer on this machine.
 
     block=True prints the URL and serves until interrupted (Ctrl-C or SIGTERM), then
-    stops the server. block=False returns the running ``MeshcatView`` (``.url``;
+    stops the server and raises KeyboardInterrupt (the command exits 130). block=False returns the running ``MeshcatView`` (``.url``;
     ``close()`` it, or use it in a ``with`` block).
     """
     scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps)
@@ -64,13 +64,10 @@ def show(system, trajectory, *, axes=False, joints=False, fps=FPS, block=True):
             view.close()
             raise
         return view
-    try:
-        with _sigterm_interrupts(), MeshcatView() as view:
-            view.draw(scene)
-            print(f"meshcat viewer of {system.name}: {view.url}  (Ctrl-C stops it)", flush=True)
-            view.serve()
-    except KeyboardInterrupt:
-        pass
+    with _sigterm_interrupts(), MeshcatView() as view:
+        view.draw(scene)
+        print(f"meshcat viewer of {system.name}: {view.url}  (Ctrl-C stops it)", flush=True)
+        view.serve()
     return None
 
 

@@ -3,6 +3,7 @@ on stderr (a traceback only with --debug); with --json, stdout is one JSON objec
 {"error": ...} even then. Argparse's own usage errors keep exit 2."""
 
 import json
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -109,6 +110,14 @@ def test_usage_errors_stay_argparse_exit_2(capsys):
         assert "usage:" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("line", ["simulate {m} --t-end abc", "sweep {m} --param m1=1:2:2 --t-end 1 --out o.csv "
+                                  "--workers two", "check {m} --nosuch", "check"])
+def test_usage_errors_with_json_are_one_json_object(capsys, line):
+    code, out, err = run(capsys, line.format(m=MODEL) + " --json")
+    assert_json_error(code, out, err)
+    assert "usage:" not in err and json.loads(out)["error"].startswith("mbsynth")
+
+
 def test_ctrl_c_keeps_the_output_and_exits_130(capsys, tmp_path, monkeypatch):
     """Ctrl-C in the middle of a run: one line, exit 130 (128 + SIGINT), the rows computed
     so far in --out, JSON with --json."""
@@ -128,6 +137,20 @@ def test_ctrl_c_keeps_the_output_and_exits_130(capsys, tmp_path, monkeypatch):
     assert 0.5 < saved.t[-1] < 0.51 and np.all(np.diff(saved.t) > 0)
     code, stdout, err = run(capsys, f"simulate {MODEL} --t-end 1 --out {out} --json")
     assert code == 130 and "interrupted" in json.loads(stdout)["error"]
+
+
+def test_ctrl_c_stops_the_live_viewer_and_exits_130():
+    """SIGINT to ``mbsynth view`` serving a model: the server stops, exit 130, one line."""
+    process = subprocess.Popen([sys.executable, "-m", "mbsynth.cli", "view", MODEL, "--t-end", "0.2"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert "meshcat viewer of" in process.stdout.readline()  # serving now
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+        process.wait()
+    assert process.returncode == 130 and err.strip() == "error: interrupted", err
 
 
 def test_the_installed_command_prints_one_line_without_traceback(files):
