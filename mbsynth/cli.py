@@ -21,7 +21,7 @@ from .errors import ModelError, SimulationError, SolveError
 from .io import load
 from .plot import plot_trajectory
 from .simulate import STABILIZATIONS, simulate
-from .trajectory import load_trajectory
+from .trajectory import load_trajectory, output_file
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # scipy solve_ivp's methods
@@ -42,11 +42,17 @@ def main(argv=None):
     except (ModelError, SolveError, OSError) as err:
         return _fail(args, err, 2)
     except KeyboardInterrupt:
-        kept = f"; the output so far is in {args.out}" if getattr(args, "out", None) else ""
+        kept = f"; the output so far is in {_kept_output(args)}" if getattr(args, "out", None) else ""
         return _fail(args, f"interrupted{kept}", 130)
     except Exception as err:  # noqa: BLE001  (a bug: say so in one line, not a traceback)
         return _fail(args, f"internal error, a bug in mbsynth ({type(err).__name__}: {err}); "
                            "--debug shows where", 3)
+
+
+def _kept_output(args):
+    """Where an interrupted command left its --out: a sweep's table in place, a run's
+    trajectory in ``output_file`` (FILE.partial for a CSV)."""
+    return output_file(args.out, completed=False) if args.command == "simulate" else args.out
 
 
 def _fail(args, error, code):
@@ -221,7 +227,8 @@ def run_simulate(args):
                "steps": traj.stats.get("steps"), "evaluations": traj.stats.get("evaluations"),
                "wall_time_s": round(time.perf_counter() - started, 3), "max_residual": traj.max_residual,
                "energy_drift": traj.energy_drift, "initial_changes": traj.stats.get("initial_changes", {}),
-               "out": args.out, "plot": args.plot, "status": "completed" if error is None else "failed"}
+               "out": args.out and str(output_file(args.out, completed=error is None)), "plot": args.plot,
+               "status": "completed" if error is None else "failed"}
     if error:
         summary["error"] = error
     if args.plot and traj.t.size:

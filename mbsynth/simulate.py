@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 
 from .errors import SimulationError, SolveError
 from .projection import consistent_initial_state, project
-from .trajectory import Trajectory, TrajectoryWriter
+from .trajectory import COMPLETED, Trajectory, TrajectoryWriter
 
 log = logging.getLogger(__name__)
 
@@ -66,7 +66,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
             run.record(t_next, q, qd, writer)
             if progress is not None:
                 progress(t_next)
-        status = "completed"
+        status = COMPLETED
     except SolveError as err:
         status = f"failed at t = {run.t_failed:.9g}: {err}"
         raise SimulationError(f"run stopped at t = {run.t_failed:.9g} (last good state saved at "

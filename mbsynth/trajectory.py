@@ -9,10 +9,11 @@ position and velocity constraint residuals, and the total energy. Files:
 
 ``TrajectoryWriter`` writes while a run goes on, so an interrupted or failed run keeps
 everything computed so far, and never leaves half a file under the final name: CSV
-rows are appended to ``FILE.partial`` (cut back to its last complete row and renamed to
-FILE when the run ends, however it ends; a killed run leaves only FILE.partial); NPZ is
-checkpointed to a temporary file that replaces FILE atomically (and is removed if
-writing it fails).
+rows are appended to ``FILE.partial``, cut back to its last complete row when the run
+ends and renamed to FILE only when the run completed (a CSV has no place for the
+status: an interrupted, failed or killed run leaves its rows in FILE.partial, and no
+FILE of an earlier run); NPZ is checkpointed to a temporary file that replaces FILE
+atomically (and is removed if writing it fails), with the run's status inside.
 """
 
 import csv
@@ -26,6 +27,7 @@ import numpy as np
 from .errors import ModelError
 
 FORMATS = (".npz", ".csv")
+COMPLETED = "completed"
 
 
 @dataclass
@@ -38,7 +40,7 @@ class Trajectory:
     kinetic: np.ndarray
     residual_position: np.ndarray
     residual_velocity: np.ndarray
-    status: str = "completed"
+    status: str = COMPLETED
     stats: dict = field(default_factory=dict)
 
     @property
@@ -66,14 +68,29 @@ class Trajectory:
         raise KeyError(f"no coordinate '{name}'; coordinates: {', '.join(self.coordinates)}")
 
     def save(self, path):
-        """Write the whole trajectory to ``path`` (.npz or .csv), atomically."""
+        """Write the whole trajectory to ``path`` (.npz or .csv), atomically; the CSV of a
+        run that did not complete goes to ``path``.partial (see the module docstring)."""
         with TrajectoryWriter(path, self.coordinates) as writer:
             writer.append(self)
             writer.status = self.status
 
 
+def partial_file(path):
+    """FILE.partial: where a CSV run's rows go until the run completes."""
+    path = Path(path)
+    return path.with_name(path.name + ".partial")
+
+
+def output_file(path, completed):
+    """The file that holds a run's output written to ``path``: ``path`` itself, or for a
+    CSV run that did not complete, ``partial_file(path)``."""
+    path = Path(path)
+    return path if completed or path.suffix != ".csv" else partial_file(path)
+
+
 def load_trajectory(path):
-    """Read a trajectory written by ``Trajectory.save`` or a run (.npz or .csv)."""
+    """Read a trajectory written by ``Trajectory.save`` or a run (.npz, .csv or the
+    .csv.partial of a run that did not complete)."""
     path = Path(path)
     if path.suffix == ".npz":
         with np.load(path, allow_pickle=False) as data:
@@ -83,8 +100,8 @@ def load_trajectory(path):
         nan = np.full(n_rows, np.nan)
         return Trajectory(coordinates, get["t"], get["q"], get["qd"], get.get("energy", nan),
                           get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
-                          str(get.get("status", "completed")))
-    if path.suffix == ".csv":
+                          str(get.get("status", COMPLETED)))
+    if path.suffix == ".csv" or path.name.endswith(".csv.partial"):
         with path.open(newline="") as f:
             header = next(csv.reader(f))
         data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
@@ -110,9 +127,10 @@ class TrajectoryWriter:
         self._chunks = []
         self._last_checkpoint = time.monotonic()
         if self.path.suffix == ".csv":
-            self._partial = self.path.with_name(self.path.name + ".partial")
+            self._partial = partial_file(self.path)
             try:
                 self._csv_file = self._partial.open("w", newline="")
+                self.path.unlink(missing_ok=True)  # an earlier run's file: not this run's output
             except OSError as err:
                 raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
             self._csv = csv.writer(self._csv_file)
@@ -142,11 +160,13 @@ class TrajectoryWriter:
                 self._write_npz()
 
     def close(self):
-        """Finish the file under its final name, whatever the state of the run."""
+        """Finish the file: under its final name if the run completed (NPZ: whatever the
+        state of the run, which it records)."""
         if self.path.suffix == ".csv":
             self._csv_file.close()
             os.truncate(self._partial, self._complete)  # drop a row cut short by a failed write
-            os.replace(self._partial, self.path)
+            if self.status == COMPLETED:
+                os.replace(self._partial, self.path)
         else:
             self._write_npz()
 

@@ -137,6 +137,10 @@ def test_ctrl_c_keeps_the_output_and_exits_130(capsys, tmp_path, monkeypatch):
     assert 0.5 < saved.t[-1] < 0.51 and np.all(np.diff(saved.t) > 0)
     code, stdout, err = run(capsys, f"simulate {MODEL} --t-end 1 --out {out} --json")
     assert code == 130 and "interrupted" in json.loads(stdout)["error"]
+    out = tmp_path / "run.csv"  # an interrupted CSV run keeps its rows in FILE.partial, and says so
+    code, stdout, err = run(capsys, f"simulate {MODEL} --t-end 1 --out {out}")
+    assert code == 130 and err.strip().endswith(f"the output so far is in {out}.partial") and not out.exists()
+    assert 0.5 < load_trajectory(f"{out}.partial").t[-1] < 0.51
 
 
 def test_ctrl_c_stops_the_live_viewer_and_exits_130():

@@ -150,11 +150,31 @@ def test_interrupted_run_keeps_a_readable_partial_output(tmp_path, suffix):
 
     with pytest.raises(KeyboardInterrupt):
         simulate(system, 10.0, out=out, progress=interrupt)
-    saved = load_trajectory(out)
+    kept = out if suffix == ".npz" else tmp_path / "run.csv.partial"  # a CSV keeps its final name for complete runs
+    assert sorted(tmp_path.iterdir()) == [kept]
+    saved = load_trajectory(kept)
     assert 5.0 < saved.t[-1] < 5.1 and saved.q.shape == (saved.t.size, 3)
     full = simulate(system, 10.0)
     np.testing.assert_allclose(saved.q, full.q[:saved.t.size], atol=1e-12)
-    assert not list(tmp_path.glob("*.partial")) and not list(tmp_path.glob("*.tmp*"))
+    if suffix == ".npz":
+        assert saved.status.startswith("interrupted at t = 5.")
+
+
+def test_a_failed_csv_run_leaves_no_file_under_the_final_name(tmp_path):
+    """The README: the final name holds a complete file or nothing. A run that fails (a
+    force NaN after t = 1) over an earlier complete run.csv: its rows are in run.csv.partial
+    and the earlier run's file is gone (it is not this run's output)."""
+    out = tmp_path / "run.csv"
+    out.write_text("t,p.x,p.x_dot,energy\n0.0,0.0,0.0,0.0\n")
+    system = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
+                      "forces: {x: sqrt(1 - t)}}\n")
+    with pytest.raises(mb.SimulationError):
+        simulate(system, 2.0, out=out, dt=0.01)
+    assert not out.exists()
+    saved = load_trajectory(tmp_path / "run.csv.partial")
+    assert saved.t[-1] == pytest.approx(1.0) and saved.q[-1, 0] == pytest.approx(0.4, rel=1e-8)
+    simulate(system, 0.5, out=out, dt=0.01)
+    assert sorted(tmp_path.iterdir()) == [out] and load_trajectory(out).t[-1] == 0.5
 
 
 def test_a_state_that_becomes_nan_stops_with_the_last_good_state_saved(tmp_path):
