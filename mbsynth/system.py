@@ -58,6 +58,7 @@ class System:
     definitions: dict = None  # parameter name -> sympy expression of earlier parameters
     initial_definitions: dict = None  # initial value name -> sympy expression of parameters
     source: str = ""  # the model file's text, for workers that rebuild the System
+    source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
 
     @classmethod

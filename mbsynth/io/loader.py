@@ -33,9 +33,10 @@ def load(path):
     return build(read_document(path))
 
 
-def loads(text, name="<string>"):
-    """Build a ``System`` from model text (``name`` is used in error messages)."""
-    return build(Document(name, text))
+def loads(text, name="<string>", folder=None):
+    """Build a ``System`` from model text (``name`` is used in error messages); file names
+    in it (meshes, URDFs) are relative to ``folder`` (default: the working folder)."""
+    return build(Document(name, text, folder))
 
 
 def build(doc):
@@ -164,7 +165,8 @@ class _Builder:
                               initial_fixed=self.read_initial_fixed(initial),
                               forces=[*robot_forces, *read_forces(self), *joint_forces])
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
-                         source=self.doc.text, robots=tuple(entry.robot for entry in self.robots.values()))
+                         source=self.doc.text, source_folder=str(self.doc.folder),
+                         robots=tuple(entry.robot for entry in self.robots.values()))
         self.check_parts(system)
         closure = root.get("closure", "none")
         if closure not in ("auto", "none"):

@@ -245,14 +245,12 @@ def read_line_end(builder, item, frames, path):
 
 
 def read_mesh_file(builder, text, path):
-    """The absolute path of a mesh file named relative to the model file's folder (the
-    working folder for a model given as text)."""
+    """The absolute path of a mesh file named relative to the model's folder (``Document.folder``)."""
     if not isinstance(text, str) or not text:
         builder.fail(path, "mesh must be a file path")
     file = Path(text).expanduser()
     if not file.is_absolute():
-        model = Path(builder.doc.name)
-        file = (model.parent if model.is_file() else Path.cwd()) / file
+        file = builder.doc.folder / file
     if file.suffix.lower() not in MESH_FORMATS:
         builder.fail(path, f"mesh {text!r}: the viewer reads {', '.join(MESH_FORMATS)} files")
     if not file.is_file():

@@ -38,7 +38,7 @@ class RobotEntry:
         source = spec["robot"]
         if not isinstance(source, str) or not source:
             builder.fail(path + ("robot",), "expected a robot name (see 'mbsynth robots') or a URDF file")
-        here = os.path.dirname(builder.doc.name)
+        here = builder.doc.folder
         if source.endswith(".urdf") and not os.path.isabs(source) and os.path.isfile(os.path.join(here, source)):
             source = os.path.join(here, source)
         try:

@@ -114,11 +114,14 @@ _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _constr
 
 
 class Document:
-    """A parsed model file: ``root`` (a LineDict) and ``error(path, message)``."""
+    """A parsed model file: ``root`` (a LineDict) and ``error(path, message)``; ``folder``:
+    where file names in it are relative to (the model file's folder; default the working
+    folder)."""
 
-    def __init__(self, name, text):
+    def __init__(self, name, text, folder=None):
         self.name = str(name)
         self.text = text
+        self.folder = Path.cwd() if folder is None else Path(folder).resolve()
         loader = None
         try:
             loader = _Loader(text, self.name)
@@ -177,4 +180,4 @@ def read_document(path):
         line = data.count(b"\n", 0, err.start) + 1
         raise ModelError(f"{path}:{line}: not UTF-8 text (byte {data[err.start]:#04x}); "
                          "a model file is YAML") from None
-    return Document(path, text)
+    return Document(path, text, folder=path.resolve().parent)
