@@ -149,8 +149,9 @@ def _parser():
                     help="energy_drift, max_residual, or AGG:expression with AGG final|max|min|mean "
                          "(repeatable; default energy_drift and max_residual)")
     sw.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (default: a local cluster)")
-    sw.add_argument("--workers", type=int, help="local workers (default: one per core)")
-    sw.add_argument("--trajectories", metavar="DIR", help="also save each run's trajectory as DIR/<run_id>.npz")
+    sw.add_argument("--workers", type=int, help="local workers (default: one per core; not with --scheduler)")
+    sw.add_argument("--trajectories", metavar="DIR",
+                    help="also save each run's trajectory as DIR/<run_id>.npz (on this machine)")
     sw.add_argument("--dt", type=float, help="output interval of each run [s]")
     sw.add_argument("--json", action="store_true", help="print a summary as one JSON object")
     sw.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)

@@ -3,13 +3,17 @@
 Every combination of the swept parameters (or every row of a samples table) is one
 run: the model with those parameter values simulated to ``t_end``, reduced to the
 metrics asked for. Runs go to a Dask cluster — a local one that mbsynth starts
-(one single-threaded worker process per core) or the user's (``scheduler``). Each
-worker builds the model from its text once and reuses it for every run it gets
+(one single-threaded worker process per core, everything bound to 127.0.0.1) or the
+user's (``scheduler``). Each worker builds the model from its text once (file names in
+it relative to the model file's folder) and reuses it for every run it gets
 (``System.with_parameters`` only changes numbers). Results are one table row per
 run, failures included with their error; the table is written to ``out`` (.parquet or
 .csv) atomically as runs finish, and a sweep restarted with the same ``out`` skips
 the runs already in it. Runs are keyed by a hash of their parameter values, so a run
-that Dask repeats (a worker lost mid-run) still appears exactly once.
+that Dask repeats (a worker lost mid-run) still appears exactly once; every row records
+the sweep's settings (model, t_end, simulation options, metrics), and a restart with
+other settings is refused rather than mixing the two. Trajectories come back from the
+workers and are written by the client, so ``trajectories`` is a folder on this machine.
 """
 
 import hashlib
@@ -36,6 +40,7 @@ log = logging.getLogger(__name__)
 AGGREGATES = ("final", "max", "min", "mean")
 SUMMARIES = ("energy_drift", "max_residual")
 CHECKPOINT_SECONDS = 1.0
+LOCALHOST = "127.0.0.1"  # where the local cluster listens: its scheduler, workers and dashboard
 
 
 @dataclass(frozen=True)
@@ -122,37 +127,65 @@ def read_samples(path):
 
 def run_id(values):
     """A stable key of one run's parameter values."""
-    text = json.dumps({k: repr(float(v)) for k, v in sorted(values.items())})
+    return _digest(json.dumps({k: repr(float(v)) for k, v in sorted(values.items())}))
+
+
+def _digest(text):
+    """16 hex digits of the SHA-1 of ``text``."""
     return hashlib.sha1(text.encode()).hexdigest()[:16]
 
 
-_SYSTEMS = {}  # per worker process: model text hash -> System
+@dataclass(frozen=True)
+class ModelText:
+    """What a worker needs to rebuild a System: its file's text, the name errors give,
+    and the folder its file names (meshes, URDFs) are relative to."""
+
+    source: str
+    name: str
+    folder: str
+
+    @classmethod
+    def of(cls, system):
+        return cls(system.source, system.name, system.source_folder)
+
+    def system(self):
+        """The System, built once per process."""
+        key = (self.source, self.folder)
+        if key not in _SYSTEMS:
+            _SYSTEMS[key] = loads(self.source, name=self.name, folder=self.folder or None)
+        return _SYSTEMS[key]
 
 
-def _system(source, name):
-    key = hashlib.sha1(source.encode()).hexdigest()
-    if key not in _SYSTEMS:
-        _SYSTEMS[key] = loads(source, name=name)
-    return _SYSTEMS[key]
+_SYSTEMS = {}  # per worker process: (model text, folder) -> System
 
 
-def run_one(source, name, values, t_end, metrics, options, trajectory_dir=None):
-    """One simulation of the model (built once per process) with ``values``: a result row."""
+def run_one(model, values, t_end, metrics, options, keep_trajectory=False):
+    """One simulation of ``model`` (a ModelText) with ``values``: (a result row, the
+    trajectory when ``keep_trajectory`` and the run got one, else None)."""
     row = {"run_id": run_id(values), **values, "status": "ok", "error": ""}
     started = time.perf_counter()
+    traj = None
     try:
-        system = _system(source, name).with_parameters(**values)
-        out = None if trajectory_dir is None else Path(trajectory_dir) / f"{row['run_id']}.npz"
-        traj = simulate(system, t_end, out=out, **options)
+        system = model.system().with_parameters(**values)
+        traj = simulate(system, t_end, **options)
         for metric in metrics:
             row[metric.name] = metric.evaluate(system, traj)
-    except (SolveError, ModelError, ValueError) as err:
-        row.update(status="failed", error=str(err))
+    except Exception as err:  # noqa: BLE001  (every failure is the run's row; the sweep goes on)
+        traj = getattr(err, "trajectory", traj)  # a SimulationError's run up to the failure
+        row.update(status="failed", error=error_text(err))
         for metric in metrics:
             row[metric.name] = np.nan
     row["wall_time_s"] = time.perf_counter() - started
     row["worker_pid"] = os.getpid()
-    return row
+    return row, traj if keep_trajectory else None
+
+
+def error_text(err):
+    """A failed run's error: the message of a model or solve error (they name the part and
+    time), the type and message of any other."""
+    if isinstance(err, (SolveError, ModelError, ValueError)):
+        return str(err)
+    return f"{type(err).__name__}: {err}"
 
 
 def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift", "max_residual"), out=None,
@@ -161,18 +194,24 @@ def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift
     row of ``samples`` (a CSV path or a list of dicts); return the results as a DataFrame.
 
     model: a model path or a System loaded from a file. options: passed to ``simulate``
-    (dt, method, rtol, atol, stabilization). progress: callable(done, failed, total, eta_s).
+    (dt, method, rtol, atol, stabilization). workers: the size of the local cluster (not
+    with ``scheduler``). trajectories: a folder here, where each run's trajectory is saved
+    as <run_id>.npz. progress: callable(done, failed, total, eta_s).
     """
     system = model if hasattr(model, "with_parameters") else load(model)
     if not system.source:
         raise ModelError(f"model '{system.name}': a sweep needs a model read from a file (mbsynth.load)")
+    if scheduler and workers is not None:
+        raise ModelError(f"workers={workers} (--workers) sizes the local cluster mbsynth starts; with the "
+                         f"scheduler {scheduler} its own workers run the sweep: give one or the other")
     runs = _runs(system, params, samples)
     if out is not None and Path(out).suffix not in (".parquet", ".csv"):
         raise ModelError(f"{out}: results must be .parquet or .csv")
     metric_list = [Metric(m) for m in metrics]
     for metric in metric_list:
         metric.parse(system)
-    done = _read_results(out)
+    settings = sweep_settings(system, t_end, metric_list, options)
+    done = _read_results(out, settings)
     todo = [v for v in runs if run_id(v) not in done]
     results = dict(done)
     log.info("sweep of %d runs: %d already in %s, %d to go", len(runs), len(done), out, len(todo))
@@ -180,8 +219,8 @@ def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift
         if trajectories is not None:
             Path(trajectories).mkdir(parents=True, exist_ok=True)
         with _client(scheduler, workers) as client:
-            _execute(client, system, todo, t_end, metric_list, options, trajectories, results, out, progress,
-                     len(runs))
+            _execute(client, ModelText.of(system), todo, (t_end, metric_list, options, settings), trajectories,
+                     results, out, progress, len(runs))
     table = _table(results, runs)
     if out is not None:
         _write_results(out, table)
@@ -213,7 +252,8 @@ class _client:
             self.client = Client(self.scheduler)
         else:
             self.cluster = LocalCluster(n_workers=self.workers or os.cpu_count(), threads_per_worker=1,
-                                        processes=True, dashboard_address=":0", silence_logs=logging.ERROR)
+                                        processes=True, host=LOCALHOST, dashboard_address=f"{LOCALHOST}:0",
+                                        silence_logs=logging.ERROR)
             self.client = Client(self.cluster)
         return self.client
 
@@ -223,21 +263,22 @@ class _client:
             self.cluster.close()
 
 
-def _execute(client, system, todo, t_end, metrics, options, trajectories, results, out, progress, total):
+def _execute(client, model, todo, job, trajectories, results, out, progress, total):
+    """Submit the runs ``todo`` (job: t_end, metrics, options, settings) and gather their
+    rows into ``results`` as they finish, saving trajectories and checkpoints of ``out``."""
     from distributed import as_completed
 
-    futures = {client.submit(run_one, system.source, system.name, values, t_end, metrics, options,
-                             None if trajectories is None else str(trajectories), key=f"mbsynth-run-{run_id(values)}",
-                             pure=False, retries=2): values
+    t_end, metrics, options, settings = job
+    futures = {client.submit(run_one, model, values, t_end, metrics, options, trajectories is not None,
+                             key=f"mbsynth-run-{run_id(values)}", pure=False, retries=2): values
                for values in todo}
     started, last_write = time.perf_counter(), 0.0
     finished = 0
     for future in as_completed(futures):
-        try:
-            row = future.result()
-        except Exception as err:  # a worker lost for good: the run is recorded as failed
-            values = futures[future]
-            row = {"run_id": run_id(values), **values, "status": "failed", "error": f"worker lost: {err}"}
+        row, traj = _outcome(future, futures.pop(future))
+        if traj is not None:
+            traj.save(Path(trajectories) / f"{row['run_id']}.npz")
+        row["settings"] = settings
         results[row["run_id"]] = row
         finished += 1
         if out is not None and time.perf_counter() - last_write > CHECKPOINT_SECONDS:
@@ -249,17 +290,54 @@ def _execute(client, system, todo, t_end, metrics, options, trajectories, result
             progress(len(results), failed, total, (total - len(results)) / rate)
 
 
+def _outcome(future, values):
+    """A finished run's (row, trajectory or None); a row of its error when the run never
+    returned (a worker lost for good, Dask's own failure)."""
+    from distributed import KilledWorker
+
+    try:
+        return future.result()
+    except KilledWorker as err:
+        error = f"worker lost: {err}"
+    except Exception as err:  # noqa: BLE001  (the run is recorded as failed, the sweep goes on)
+        error = error_text(err)
+    return {"run_id": run_id(values), **values, "status": "failed", "error": error}, None
+
+
+def sweep_settings(system, t_end, metrics, options):
+    """What the runs' results depend on besides their parameter values, as JSON text: the
+    model (its text's hash and folder), t_end, the simulation options and the metrics."""
+    return json.dumps({"model_sha1": _digest(system.source), "folder": system.source_folder, "t_end": float(t_end),
+                       "options": options, "metrics": [m.spec for m in metrics]}, sort_keys=True, default=list)
+
+
 def _table(results, runs):
     order = [run_id(v) for v in runs]
     return pd.DataFrame([results[k] for k in order if k in results])
 
 
-def _read_results(out):
+def _read_results(out, settings):
+    """The finished runs of an earlier sweep with the same ``settings`` in ``out`` (by run
+    id); a ModelError when ``out`` holds another sweep's runs."""
     if out is None or not Path(out).exists():
         return {}
     table = _read_table(out)
-    return {row["run_id"]: row for row in table.to_dict("records") if row.get("status") == "ok"} \
-        if "run_id" in table else {}
+    if "run_id" not in table:
+        return {}
+    _check_settings(out, set(table["settings"]) if "settings" in table else {""}, settings)
+    return {row["run_id"]: row for row in table.to_dict("records") if row.get("status") == "ok"}
+
+
+def _check_settings(out, found, settings):
+    """ModelError unless every row of ``out`` was run with ``settings``, saying what differs."""
+    if found <= {settings}:
+        return
+    now = json.loads(settings)
+    before = [json.loads(text) if text else {} for text in sorted(found - {settings})][0]
+    changes = [f"{key} {before.get(key, 'not recorded')!r} there, {now[key]!r} now" for key in sorted(now)
+               if before.get(key) != now[key]]
+    raise ModelError(f"{out}: holds runs of another sweep ({'; '.join(changes)}); resuming would mix them. "
+                     f"Give another --out, or remove {out} to start over")
 
 
 def _read_table(path):

@@ -1,10 +1,15 @@
 """Parameter studies on a local two-worker Dask cluster: the natural frequencies of the
 paper's example 3 recovered from every run against the exact eigenvalues; a worker
-killed mid-sweep; resuming an interrupted sweep."""
+killed mid-sweep; resuming an interrupted sweep, refused when its settings changed;
+workers that see other folders than the client; the cluster mbsynth starts listens
+on 127.0.0.1 only."""
 
+import importlib
+import json
 import os
 import signal
 from pathlib import Path
+from urllib.parse import urlparse
 
 import numpy as np
 import pandas as pd
@@ -13,7 +18,8 @@ import scipy.linalg
 
 import mbsynth as mb
 from mbsynth.cli import main
-from mbsynth.sweep import grid, run_id, sweep
+from mbsynth.sweep import _client, grid, run_id, sweep
+from mbsynth.trajectory import load_trajectory
 
 MODEL = Path(__file__).resolve().parent.parent / "models" / "paper" / "example3_two_masses.yaml"
 FAST = dict(dt=0.02, rtol=1e-10, atol=1e-12)
@@ -22,7 +28,8 @@ FAST = dict(dt=0.02, rtol=1e-10, atol=1e-12)
 @pytest.fixture(scope="module")
 def cluster():
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as c:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address="127.0.0.1:0") as c:
         yield c
 
 
@@ -126,3 +133,102 @@ def test_derived_parameters_and_initial_values_follow_with_parameters():
     changed = system.with_parameters(m=4.0)
     assert changed.parameters["Ic"] == pytest.approx(0.5) and changed.initial_state()[1][0] == pytest.approx(2.0)
     assert system.parameters["Ic"] == pytest.approx(0.25)  # the original is unchanged
+
+
+def test_file_names_in_the_model_are_relative_to_its_folder_on_the_workers(cluster, tmp_path, monkeypatch):
+    """The workers run in another folder than the model's: its mesh is still found."""
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "body.stl").write_text("solid body\nendsolid body\n")
+    model = tmp_path / "body.yaml"
+    model.write_text("parameters: {m: 1.0}\nsubsystems:\n  body:\n    type: rigid_body\n    mass: m\n"
+                     "    inertia: [1, 1, 1]\n    geometry: {mesh: meshes/body.stl}\n"
+                     "initial: {body.x_dot: 1.0}\n")
+    monkeypatch.chdir(Path(__file__).parent)
+    table = sweep(model, {"m": [1.0, 2.0]}, 0.2, scheduler=cluster.scheduler_address, metrics=["final:body.x"],
+                  dt=0.1)
+    assert list(table["status"]) == ["ok", "ok"], list(table["error"])
+    np.testing.assert_allclose(table["final:body.x"], [0.2, 0.2], rtol=1e-9)  # x = t ẋ(0), no force
+
+
+@pytest.mark.parametrize("change", ["t_end", "dt", "metric", "model"])
+def test_resuming_with_other_settings_is_refused(cluster, tmp_path, change):
+    """Rows of a sweep with another t_end, dt, metric list or model file are not mixed in."""
+    out = tmp_path / "runs.csv"
+    first = dict(t_end=0.5, dt=0.05, metrics=["final:body1.x1"], model=MODEL)
+    sweep(first["model"], {"k1": [40.0, 80.0]}, first["t_end"], out=out, metrics=first["metrics"], dt=first["dt"],
+          scheduler=cluster.scheduler_address)
+    other = tmp_path / "other.yaml"
+    other.write_text(MODEL.read_text().replace("k1: 100", "k1: 101"))
+    second = dict(first, **{"t_end": dict(t_end=0.4), "dt": dict(dt=0.1), "metric": dict(metrics=["max:body1.x1"]),
+                            "model": dict(model=other)}[change])
+    with pytest.raises(mb.ModelError, match="holds runs of another sweep.*remove"):
+        sweep(second["model"], {"k1": [40.0, 80.0]}, second["t_end"], out=out, metrics=second["metrics"],
+              dt=second["dt"], scheduler=cluster.scheduler_address)
+    assert len(pd.read_csv(out)) == 2  # the earlier results are untouched
+
+
+def test_a_changed_setting_is_named_in_the_refusal(cluster, tmp_path):
+    out = tmp_path / "runs.parquet"
+    sweep(MODEL, {"k1": [40.0]}, 0.5, out=out, scheduler=cluster.scheduler_address, **FAST)
+    with pytest.raises(mb.ModelError, match=r"t_end 0\.5 there, 0\.25 now"):
+        sweep(MODEL, {"k1": [40.0]}, 0.25, out=out, scheduler=cluster.scheduler_address, **FAST)
+
+
+def test_a_run_failing_with_another_exception_reports_that_error(monkeypatch):
+    """A run that raises something other than a model or solve error (here a RuntimeError
+    injected into one run on an in-process worker) is its own failed row, not 'worker lost'."""
+    distributed = pytest.importorskip("distributed")
+    module = importlib.import_module("mbsynth.sweep")
+    real = module.simulate
+
+    def broken_for_k1_80(system, t_end, **options):
+        if system.parameters["k1"] == 80.0:
+            raise RuntimeError("integrator state corrupted")
+        return real(system, t_end, **options)
+
+    monkeypatch.setattr(module, "simulate", broken_for_k1_80)
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as c:
+        table = sweep(MODEL, {"k1": [40.0, 80.0]}, 0.2, scheduler=c.scheduler_address, **FAST)
+    assert list(table["status"]) == ["ok", "failed"]
+    assert table["error"].iloc[1] == "RuntimeError: integrator state corrupted"
+
+
+def test_trajectories_are_written_by_the_client_in_its_folder(cluster, tmp_path, monkeypatch):
+    """--trajectories traj (a relative folder) with a scheduler whose workers run elsewhere:
+    every trajectory lands in the client's traj/, the same as the run's metric says."""
+    monkeypatch.chdir(tmp_path)
+    table = sweep(MODEL, {"k1": [40.0, 80.0]}, 0.5, scheduler=cluster.scheduler_address, trajectories="traj",
+                  metrics=["final:body1.x1"], **FAST)
+    assert (table["status"] == "ok").all(), list(table["error"])
+    for row in table.to_dict("records"):
+        saved = load_trajectory(tmp_path / "traj" / f"{row['run_id']}.npz")
+        assert saved.status == "completed" and saved.t[-1] == 0.5
+        assert saved.column("body1.x1")[-1] == pytest.approx(row["final:body1.x1"], rel=1e-12)
+
+
+def test_workers_with_a_scheduler_is_an_error(cluster, tmp_path, capsys):
+    with pytest.raises(mb.ModelError, match="give one or the other"):
+        sweep(MODEL, {"k1": [40.0]}, 0.2, scheduler=cluster.scheduler_address, workers=4)
+    code = main(["sweep", str(MODEL), "--param", "k1=40:80:2", "--t-end", "0.2", "--out", str(tmp_path / "o.csv"),
+                 "--scheduler", cluster.scheduler_address, "--workers", "4", "--json"])
+    assert code == 2 and "--workers" in json.loads(capsys.readouterr().out)["error"]
+
+
+def listening(psutil):
+    """(ip, port) of every socket this process and its children listen on."""
+    me = psutil.Process()
+    return {(c.laddr.ip, c.laddr.port) for p in (me, *me.children(recursive=True))
+            for c in p.net_connections("inet") if c.status == psutil.CONN_LISTEN}
+
+
+def test_the_local_cluster_listens_on_127_0_0_1_only():
+    """The scheduler, the worker and the dashboard of the cluster mbsynth starts: no socket
+    on another interface (0.0.0.0 would be every one)."""
+    psutil = pytest.importorskip("psutil")
+    before = listening(psutil)
+    with _client(None, 1) as client:
+        opened = listening(psutil) - before
+        dashboard = urlparse(client.dashboard_link).port
+        scheduler = urlparse(client.scheduler.address).port
+    assert {dashboard, scheduler} <= {port for _, port in opened}
+    assert {ip for ip, _ in opened} == {"127.0.0.1"}, opened
