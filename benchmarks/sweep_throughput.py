@@ -24,7 +24,8 @@ MODEL = HERE.parent / "models" / "paper" / "example3_two_masses.yaml"
 
 def measure(workers, runs):
     started = time.perf_counter()
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address="127.0.0.1:0") as cluster:
         startup = time.perf_counter() - started
         warm = sweep(MODEL, {"k1": [100.0], "k2": np.linspace(40, 80, workers)}, 0.1,
                      scheduler=cluster.scheduler_address, dt=0.02)  # each worker compiles the model once
