@@ -333,7 +333,8 @@ def _check_settings(out, found, settings):
     if found <= {settings}:
         return
     now = json.loads(settings)
-    before = [json.loads(text) if text else {} for text in sorted(found - {settings})][0]
+    other = sorted(found - {settings})[0]
+    before = json.loads(other) if other else {}  # "": a table written before settings were recorded
     changes = [f"{key} {before.get(key, 'not recorded')!r} there, {now[key]!r} now" for key in sorted(now)
                if before.get(key) != now[key]]
     raise ModelError(f"{out}: holds runs of another sweep ({'; '.join(changes)}); resuming would mix them. "
