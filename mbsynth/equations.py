@@ -24,19 +24,39 @@ means a rounding error or a slightly different parameter could change the rank.
 
 Consistency rule. (2.12) has a solution iff (a) b ∈ range(A) and (b) wᵀ(Q + C) = 0 for
 every w ∈ null([M; A]) (proof in ``constrained_acceleration``). Either failure raises
-``SolveError``; no least-squares vector is ever returned. A violation counts when the
+``SolveError`` at a state on the constraint manifold. A violation counts when the
 offending component exceeds ``tol`` times a scale of the data, with
 tol = max(CONSISTENCY_RTOL, 8 k ε σ₁/σ_r): the second term is the rounding error of the
 computed null space (its angle error is about ε σ₁/σ_r, σ_r the smallest kept singular
 value), so a consistent problem is never rejected for the inaccuracy of its own basis.
-The scales: for (a), ‖b_e‖ + ‖q̈‖ (b_e the equilibrated b, whose rows of A have unit norm);
-for (b), ‖Q + C‖ + ‖M q̈‖ (the applied and the inertial forces). Both components are
-projections, so they never exceed their scale: the test is a pure ratio.
+The scales are the sizes of the terms, not of their sum, since rounding grows with the
+terms even where they cancel: for (a), ‖b_e‖ + ‖q̈‖ (b_e the equilibrated b, whose rows
+of A have unit norm, so ‖A_e q̈‖ ≤ √m ‖q̈‖); for (b), ‖Q‖ + ‖C‖ + ‖M q̈‖ (the applied,
+the non-ideal and the inertial forces).
+
+Drift rule (``drift`` given: a state that may lie off the constraint manifold, such as an
+integrator's stage or a projection's iterate). There b is only as accurate as the state
+is close to φ = 0, φ̇ = 0, so (a) is not judged: the constraints are replaced by their
+trusted part and (2.14) gives the least-squares, minimum-norm acceleration, which is what
+M̄⁺ yields anyway; drift control then brings the state back, and the contradiction test
+(a) is made at the projected state. With A_e = U Σ Vᵀ and c = Uᵀ b_e, a direction is
+trusted when σ_i is above the rank cut and, if it is nearly dependent
+(σ_i < ``NEAR_SINGULAR`` σ₁, a configuration near a singular position or dependent rows
+whose dependency moves with the configuration), when (1) σ_i exceeds what the drift
+itself can make of a dependent direction, ``DRIFT_RANK`` δ σ₁, with δ = max |φ_i|/‖A_i‖
+over the rows, relative to the size of the positions (the state's distance from the
+manifold: A moves by about that much over it), and (2) the acceleration it asks for,
+|c_i|/σ_i, is at most ``DRIFT_GAIN`` times that of the rest of the motion. On the
+manifold c_i = σ_i v_iᵀq̈, so a trusted direction changes nothing; off it, the drift's
+share of c_i is amplified by 1/σ_i → ∞ at the singular position, and a direction that
+fails (1) or (2) is treated as dependent (its rows are named in ``Motion.singular``
+when it failed (2)). Through a singular position the motion keeps its velocity and so
+the branch it came from.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,6 +66,9 @@ RANK_RTOL = 1e-12  # singular values below RANK_RTOL · σ_max of the equilibrat
 CONSISTENCY_RTOL = 1e-9  # least relative size of b ∉ range(A) or of wᵀ(Q + C) that is an error
 SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
 NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
+NEAR_SINGULAR = 1e-5  # σ_i below this fraction of σ₁ (of the equilibrated A): a nearly dependent direction
+DRIFT_RANK = 1e3  # a nearly dependent σ_i below this times the relative drift δ (× σ₁) counts as dependent
+DRIFT_GAIN = 10.0  # a nearly dependent direction asking more than this times the rest's acceleration is drift
 VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off makes the verdict uncertain
 # (a mass ratio of 1e-9, 1e3 times the cut-off, is a legitimate model and is not flagged)
 
@@ -109,7 +132,9 @@ class Motion:
     ``qdd``: the minimum-norm solution of (2.12), (2.14) with η = 0; ``nullspace``: n × r
     orthonormal basis of the directions it leaves free (n × 0 when ``unique``); ``Qc``:
     the constraint force M q̈ − Q of (2.5); ``residual``: relative residual of the
-    row-equilibrated (2.12) at q̈; ``method``: the formula that produced q̈.
+    row-equilibrated (2.12) at q̈; ``method``: the formula that produced q̈;
+    ``singular``: the constraint rows of the nearly dependent directions that the drift
+    rule set aside (a singular position; empty elsewhere).
     """
 
     qdd: np.ndarray
@@ -118,6 +143,7 @@ class Motion:
     Qc: np.ndarray
     residual: float
     method: str
+    singular: tuple = ()
 
     @classmethod
     def made(cls, qdd, unique, nullspace, Qc, residual, method):
@@ -134,6 +160,7 @@ class _Data:
 
     M: np.ndarray
     Q: np.ndarray
+    C: np.ndarray
     F: np.ndarray  # Q + C
     A: np.ndarray
     b: np.ndarray
@@ -162,7 +189,7 @@ def rank_report(M, A, *, rtol=RANK_RTOL) -> RankReport:
 
 
 def constrained_acceleration(M, Q, A, b, C=None, *, rtol=RANK_RTOL,
-                             coordinates=None, constraints=None) -> Motion:
+                             coordinates=None, constraints=None, drift=None) -> Motion:
     """The acceleration of (2.14) with η = 0: q̈ = M̄⁺ [Q + C; b], M̄ = [(I − A⁺A)M; A].
 
     M may be singular (symmetric positive semi-definite). M̄⁺ keeps exactly rank M̂
@@ -178,19 +205,66 @@ def constrained_acceleration(M, Q, A, b, C=None, *, rtol=RANK_RTOL,
     wᵀ(Q + C) − (M w)ᵀA⁺b = wᵀ(Q + C) = 0. Hence (a) b ∈ range(A) and (b) wᵀ(Q + C) = 0
     for all w ∈ null([M; A]) are necessary and sufficient; a violation raises
     ``SolveError`` naming the constraints (a) or coordinates (b) involved, as does
-    NaN/inf input. Shape errors raise ``ValueError``.
+    NaN/inf input. Shape errors raise ``ValueError``. ``drift``: None for a state on the
+    constraint manifold; for a state that may be off it, a callable returning (φ per row
+    of A, NaN where a row has none; the size of the positions), called only near a
+    singular position: (a) gives way to the drift rule of the module docstring.
     """
     d = _prepare(M, Q, A, b, C, coordinates, constraints)
+    singular = ()
+    if drift is not None and d.m:
+        d, singular = _trusted(d, rtol, drift)
+    report, s_hat, Ua, sa, Vk, qdd = _solve(d, rtol)
+    if drift is None:
+        _check_constraints(d, Ua, sa, Vk.shape[1], qdd)
+    _check_forces(d, report.nullspace, s_hat, report.rank_Mhat, qdd)
+    return _motion(d, qdd, Vk, "pseudoinverse (2.14)", report.nullspace, singular)
+
+
+def _solve(d: "_Data", rtol):
+    """(2.14) with η = 0 on equilibrated data: (rank report, σ of M̂, SVD of A_e as
+    (U, s, V_k), q̈)."""
     report, s_hat = _rank_report(d, rtol)
     Ua, sa, Vk = _row_space(d.Ae, rtol)
     r = report.rank_Mhat
     Mbar = np.vstack([(d.M - Vk @ (Vk.T @ d.M)) / d.mu, d.Ae])  # (2.13), rows equilibrated
     U, s, Vt = np.linalg.svd(Mbar, full_matrices=False)
     rhs = np.concatenate([d.F / d.mu, d.be])
-    qdd = Vt[:r].T @ ((U[:, :r].T @ rhs) / s[:r])  # (2.14), η = 0
-    _check_constraints(d, Ua, sa, Vk.shape[1], qdd)
-    _check_forces(d, report.nullspace, s_hat, r, qdd)
-    return _motion(d, qdd, Vk, "pseudoinverse (2.14)", report.nullspace)
+    return report, s_hat, Ua, sa, Vk, Vt[:r].T @ ((U[:, :r].T @ rhs) / s[:r])
+
+
+def _trusted(d: "_Data", rtol, drift):
+    """The drift rule (module docstring): d with A_e, b_e replaced by their trusted part
+    (same rows, consistent by construction) and the names of the rows of the nearly
+    dependent directions whose right side the drift dominates."""
+    U, s, Vt = np.linalg.svd(d.Ae, full_matrices=False)
+    c = U.T @ d.be
+    keep = s > rtol * s[0] if s[0] > 0 else np.zeros(s.size, dtype=bool)
+    near = keep & (s < NEAR_SINGULAR * s[0])
+    singular = ()
+    if near.any():
+        keep &= s > DRIFT_RANK * _relative_drift(d, drift) * s[0]
+        near &= keep
+        rest = _solve(_restricted(d, U, s, Vt, c, keep & ~near), rtol)[-1]
+        asks = np.abs(c[near]) / s[near]
+        drifted = np.flatnonzero(near)[asks > DRIFT_GAIN * np.linalg.norm(rest)]
+        keep[drifted] = False
+        if drifted.size:
+            singular = tuple(d.constraints[i] for i in _named(np.abs(U[:, drifted]).max(axis=1)))
+    return _restricted(d, U, s, Vt, c, keep), singular
+
+
+def _relative_drift(d: "_Data", drift):
+    """δ = max |φ_i|/‖A_i‖ over the rows, divided by the size of the positions."""
+    phi, size = drift()
+    phi_e = np.abs(np.asarray(phi, dtype=float)) / np.linalg.norm(d.A, axis=1).clip(_TINY)
+    finite = phi_e[np.isfinite(phi_e)]
+    return float(finite.max()) / max(size, _TINY) if finite.size else 0.0
+
+
+def _restricted(d: "_Data", U, s, Vt, c, keep):
+    """d with A_e = U Σ Vᵀ and b_e = U c kept on the singular directions ``keep`` only."""
+    return replace(d, Ae=(U[:, keep] * s[keep]) @ Vt[keep], be=U[:, keep] @ c[keep])
 
 
 def udwadia_kalaba(M, Q, A, b, C=None, *, coordinates=None, constraints=None) -> Motion:
@@ -220,10 +294,8 @@ def udwadia_kalaba(M, Q, A, b, C=None, *, coordinates=None, constraints=None) ->
             "handles singular mass matrices.", coordinates=names)
     Mih = (V / np.sqrt(lam)) @ V.T  # M^-1/2
     a = V @ ((V.T @ d.Q) / lam)  # M⁻¹Q
-    B = d.A @ Mih  # (4.3)
-    norms = np.linalg.norm(B, axis=1)
-    norms[norms == 0] = 1.0
-    Ub, sb, Vb = _row_space(B / norms[:, None], RANK_RTOL)
+    Be, norms = equilibrate_rows(d.A @ Mih)  # B of (4.3), rows scaled to unit norm
+    Ub, sb, Vb = _row_space(Be, RANK_RTOL)
     k = Vb.shape[1]
     Bplus_e = Vb @ (Ub[:, :k].T / sb[:k, None])  # B⁺ of the row-equilibrated B
     x = Mih @ (d.F - d.Q)  # M^-½ C
@@ -266,10 +338,18 @@ def _prepare(M, Q, A, b, C, coordinates=None, constraints=None) -> _Data:
             f"M is not symmetric: M[{coordinates[i]}, {coordinates[j]}] = {M[i, j]:.6g} but "
             f"M[{coordinates[j]}, {coordinates[i]}] = {M[j, i]:.6g}",
             coordinates=(coordinates[i], coordinates[j]))
-    norms = np.linalg.norm(A, axis=1)
-    norms[norms == 0] = 1.0
-    return _Data(M=M, Q=Q, F=Q + C, A=A, b=b, Ae=A / norms[:, None], be=b / norms,
+    Ae, norms = equilibrate_rows(A)
+    return _Data(M=M, Q=Q, C=C, F=Q + C, A=A, b=b, Ae=Ae, be=b / norms,
                  mu=mu if mu > 0 else 1.0, coordinates=coordinates, constraints=constraints)
+
+
+def equilibrate_rows(X):
+    """(X with each row divided by its 2-norm, the norms used): zero rows stay zero
+    (their norm counts as 1). Row scaling keeps null spaces, ranks and, for consistent
+    data, the minimum-norm solution (module docstring)."""
+    norms = np.linalg.norm(X, axis=1)
+    norms[norms == 0] = 1.0
+    return X / norms[:, None], norms
 
 
 def _names(names, count, label, pattern):
@@ -359,7 +439,7 @@ def _check_forces(d: _Data, N, s_hat, r, qdd):
         return
     g = N.T @ d.F
     imbalance = float(np.linalg.norm(g))
-    scale = np.linalg.norm(d.F) + np.linalg.norm(d.M @ qdd) + _TINY
+    scale = np.linalg.norm(d.Q) + np.linalg.norm(d.C) + np.linalg.norm(d.M @ qdd) + _TINY
     if imbalance <= _tol(s_hat, r, d.n) * scale:
         return
     w = N @ g / imbalance
@@ -373,7 +453,7 @@ def _check_forces(d: _Data, N, s_hat, r, qdd):
         "constraint (as (5.40), (5.49) do) or give them mass.", coordinates=names)
 
 
-def _motion(d: _Data, qdd, Vk, method, nullspace) -> Motion:
+def _motion(d: _Data, qdd, Vk, method, nullspace, singular=()) -> Motion:
     """Motion with Qc = M q̈ − Q (2.5) and the relative residual of the equilibrated (2.12);
     Vk spans the row space of A, so P x = x − V_k V_kᵀ x."""
     def P(x):
@@ -384,4 +464,5 @@ def _motion(d: _Data, qdd, Vk, method, nullspace) -> Motion:
     scale = ((np.linalg.norm(d.M) / d.mu + np.linalg.norm(d.Ae)) * np.linalg.norm(qdd)
              + np.linalg.norm(rhs) + _TINY)
     return Motion(qdd=qdd, unique=nullspace.shape[1] == 0, nullspace=nullspace,
-                  Qc=force - d.Q, residual=float(np.linalg.norm(res) / scale), method=method)
+                  Qc=force - d.Q, residual=float(np.linalg.norm(res) / scale), method=method,
+                  singular=singular)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .equations import RANK_RTOL
+from .equations import RANK_RTOL, equilibrate_rows
 from .errors import SolveError
 from .symbolic import T_SYMBOL, compile_function
 
@@ -108,11 +108,9 @@ def coulomb_motion(constraints, arrays, solve, t, q, qd, p):
         start += con.size
     if not sliding:
         return solve(arrays.C)
-    A = arrays.A
-    norms = np.linalg.norm(A, axis=1)
-    norms[norms == 0] = 1.0
+    Ae, norms = equilibrate_rows(arrays.A)
     # λ of the load rows from Aᵀλ = Q + C − M q̈, solved on the rows of A scaled to unit norm
-    L = (np.linalg.pinv((A / norms[:, None]).T, rcond=RANK_RTOL) / norms[:, None])[rows]
+    L = (np.linalg.pinv(Ae.T, rcond=RANK_RTOL) / norms[:, None])[rows]
     noise = 16 * np.finfo(float).eps * np.array([np.linalg.norm(L[s]) for _, _, s in sliding])
     N = np.zeros(len(sliding))
     for _ in range(MAX_ITERATIONS):

@@ -6,6 +6,14 @@ integrators between output times and, with the default ``stabilization="projecti
 projects (q, q̇) back onto the constraints at every output time (projection.py); the
 integrator restarts there with its last step size. ``"baumgarte"`` instead replaces
 b by b − 2α φ̇ − β² φ (Baumgarte 1972) with no restart; ``"none"`` does neither.
+
+Consistency is judged where it means something. The integrator's stages lie off the
+manifold by the integration error, so the motion there follows the drift rule of
+``equations`` (least squares where the drift explains an inconsistency of b, as with
+dependent rows whose dependency changes with the configuration — Bricard's mechanism —
+and nearly dependent directions near a singular position set aside). At each projected
+output state the constraints are judged strictly: a real contradiction raises
+SolveError there. The singular positions crossed are in ``stats["singular_positions"]``.
 """
 
 import logging
@@ -107,6 +115,8 @@ class _Run:
         self.t_failed = float("nan")
         self.non_unique = False
         self.calls, self.t_mark, self.span = 0, 0.0, 0.0
+        self.singular = []  # (t, rows) of the stages where the drift rule set directions aside
+        self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
 
     @property
     def t(self):
@@ -120,8 +130,10 @@ class _Run:
                 raise self._collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
         q, qd = y[:self.n], y[self.n:]
-        motion = self.system.motion(t, q, qd, baumgarte=self.baumgarte)
+        motion = self.system.motion(t, q, qd, baumgarte=self.baumgarte, drift=True)
         self.non_unique |= not motion.unique
+        if motion.singular:
+            self.singular.append((t, motion.singular))
         return np.concatenate([qd, motion.qdd])
 
     def advance(self, t_next, q, qd):
@@ -141,15 +153,27 @@ class _Run:
         y = sol.y[:, -1]
         self._check(t_next, y)
         q, qd = y[:self.n], y[self.n:]
+        self._note_singular()
         if self.stabilization == "projection":
             self.t_failed = t_next
             q, qd = project(self.system, t_next, q, qd)
+            self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
         return q, qd
+
+    def _note_singular(self):
+        """One entry of ``singular_positions`` for the stages of the interval just done."""
+        if self.singular:
+            times = [t for t, _ in self.singular]
+            rows = sorted({r for _, names in self.singular for r in names})
+            self.singular_positions.append(dict(t_from=min(times), t_to=max(times), rows=rows))
+            log.info("singular position crossed near t = %.6g (nearly dependent rows %s set aside)",
+                     min(times), ", ".join(rows))
+            self.singular = []
 
     def _collapse(self, t, y, why):
         """The SolveError of a step-size collapse at (t, y), naming the coordinates of the
         largest accelerations (within a factor 10 of the largest): what the steps chase."""
-        qdd = np.abs(self.system.motion(t, y[:self.n], y[self.n:], baumgarte=self.baumgarte).qdd)
+        qdd = np.abs(self.system.motion(t, y[:self.n], y[self.n:], baumgarte=self.baumgarte, drift=True).qdd)
         fastest = [(c, a) for c, a in zip(self.system.coordinates, qdd) if a >= qdd.max() / 10]
         return SolveError(f"step-size collapse, the integrator gave up ({why}); fastest changing: "
                           f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}",
@@ -179,7 +203,8 @@ class _Run:
         traj = Trajectory(tuple(self.system.coordinates), np.array(r["t"]), np.array(r["q"]).reshape(-1, self.n),
                           np.array(r["qd"]).reshape(-1, self.n), np.array(r["energy"]), np.array(r["kinetic"]),
                           np.array(r["residual_position"]), np.array(r["residual_velocity"]), status)
-        traj.stats.update(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique)
+        traj.stats.update(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique,
+                          singular_positions=self.singular_positions)
         if self.non_unique:
             log.warning("the motion was not unique somewhere on this run; the free directions got zero "
                         "acceleration (η = 0 in (2.14))")

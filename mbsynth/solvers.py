@@ -13,8 +13,12 @@ from . import equations
 from .equations import Motion
 
 
+RCOND_MIN = 1e-8  # KKT systems less well conditioned than this go to the reference (2.14)
+RESIDUAL_MAX = 1e-9  # a KKT solution whose relative residual of (2.12) exceeds this goes too
+
+
 def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
-                     rcond_min=1e-12) -> Motion:
+                     rcond_min=RCOND_MIN, drift=None) -> Motion:
     """q̈ from the augmented (KKT) system [[M, Aᵀ], [A, 0]] [q̈; λ] = [Q + C; b].
 
     Why it gives (2.14): by (2.10), P Qc = P C with P = I − A⁺A, so Qc − C lies in
@@ -26,12 +30,14 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
     The system is equilibrated as in ``equations`` (rows of A and b by the row norms of A,
     M and Q + C by max |M|), LU-factored (LAPACK getrf) and its reciprocal condition
     number in the 1-norm estimated (gecon); one step of iterative refinement restores
-    accuracy on moderately ill-conditioned systems. When rcond is below ``rcond_min``, or
-    anything is not finite, the reference ``equations.constrained_acceleration`` decides
-    instead: non-unique motion, dependent constraints, or ``SolveError`` for inconsistent
-    data. In the sampled problems rcond stayed below σ_min/σ_max of the equilibrated
-    [M; A], so the default 1e-12 (= RANK_RTOL) sends every problem the reference calls
-    non-unique to the reference.
+    accuracy on moderately ill-conditioned systems. When rcond is below ``rcond_min``, when
+    the solution's relative residual of the equilibrated (2.12) exceeds ``RESIDUAL_MAX``,
+    or when anything is not finite, the reference ``equations.constrained_acceleration``
+    decides instead (with ``drift`` passed on): non-unique motion, dependent constraints,
+    near-singular positions, or ``SolveError`` for inconsistent data. One verdict: rcond
+    stays below σ_min/σ_max of the equilibrated [M; A] in the sampled problems, so the
+    default 1e-8, four orders above the reference's rank cut (RANK_RTOL), leaves every
+    problem near that cut to the reference, and so every "not unique" to its rule.
     """
     d = equations._prepare(M, Q, A, b, C, coordinates, constraints)
     n, m = d.n, d.m
@@ -49,6 +55,8 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
             qdd = x[:n, 0]
             if np.isfinite(x).all():
                 Vk = np.linalg.qr(d.Ae.T)[0]  # A has full row rank: a basis of its row space
-                return equations._motion(d, qdd, Vk, "kkt", np.zeros((n, 0)))
+                motion = equations._motion(d, qdd, Vk, "kkt", np.zeros((n, 0)))
+                if motion.residual <= RESIDUAL_MAX:
+                    return motion
     return equations.constrained_acceleration(M, Q, A, b, C, coordinates=coordinates,
-                                              constraints=constraints)
+                                              constraints=constraints, drift=drift)

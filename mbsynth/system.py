@@ -217,7 +217,7 @@ class System:
         A = scipy.sparse.csr_matrix((join(values, float), (join(rows, int), join(cols, int))), shape=(row, self.n))
         return A, join(b, float)
 
-    def motion(self, t, q, qd, method="fast", baumgarte=None):
+    def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
         Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
         (2.14)). "fast" is the linear-time tree path (``mbsynth.fast``) once its compiled
@@ -227,7 +227,11 @@ class System:
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
         residuals (drift control during integration; b itself when they are zero).
         Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``
-        iterates, and Qc includes the friction."""
+        iterates, and Qc includes the friction.
+        ``drift=True``: the state may lie off the constraint manifold (an integrator's
+        stage): b is judged by the drift rule of ``equations`` (least squares where the
+        drift explains an inconsistency, near-singular directions the drift dominates set
+        aside) instead of raising SolveError for contradictory constraints."""
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
@@ -237,13 +241,19 @@ class System:
                 return motion
         arrays = self.evaluate(t, q, qd)
         b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
+        off_manifold = self._off_manifold(t, q, qd) if drift else None
 
         def solve(C):
-            return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C,
-                                   coordinates=self.coordinates, constraints=self.constraint_names)
+            return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=self.coordinates,
+                                   constraints=self.constraint_names, drift=off_manifold)
         if any(getattr(con, "coulomb", None) for con in self.constraints):  # C depends on q̈ (friction.py)
             return friction.coulomb_motion(self.constraints, arrays, solve, t, q, qd, self.parameter_values)
         return solve(arrays.C)
+
+    def _off_manifold(self, t, q, qd):
+        """The drift measure of ``equations.constrained_acceleration``: a callable giving φ
+        per row and the size of the positions, evaluated only when its rule needs them."""
+        return lambda: (self.constraint_residuals(t, q, qd)[0], float(np.abs(q).max(initial=0.0)))
 
     def _tree_motion(self, t, q, qd, baumgarte):
         """The Motion from mbsynth.fast, or None: kernels not ready, model not covered (no
