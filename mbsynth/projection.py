@@ -7,6 +7,11 @@ change: positions by Gauss–Newton on the position-level rows, q ← q − Φ_q
 velocity-level row (holonomic and non-holonomic, both linear in q̇),
 q̇ ← q̇ − A_v⁺ ψ. Coordinates marked fixed are not changed. Unit quaternions are
 holonomic rows of their bodies, so they are restored like any other constraint.
+
+Tolerances are relative, so a mechanism projects alike in millimetres or kilometres: a
+row's residual is judged against the size of its terms, estimated from the row of A as
+‖A_i‖₁ ‖q‖∞ for φ_i (x² + y² − L² at x, y ≈ L: 2L · L, where rounding is ε L²) and
+‖A_i‖₁ ‖q̇‖∞ for ψ_i, times ``TOLERANCE``.
 """
 
 import numpy as np
@@ -15,7 +20,7 @@ import scipy.sparse.linalg
 
 from .errors import SolveError
 
-TOLERANCE = 1e-12  # largest residual accepted after projection (in each row's own units)
+TOLERANCE = 1e-12  # largest residual accepted after projection, relative to the row's terms
 MAX_ITERATIONS = 50
 
 
@@ -27,6 +32,7 @@ def _free_columns(n, fixed):
 
 
 SPARSE_ACCEPT = 1e-10  # relative residual under which the sparse least-norm step is taken
+VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity step
 
 
 def _correction(J, r):
@@ -47,6 +53,11 @@ def _correction(J, r):
     return np.linalg.lstsq(J.toarray(), r, rcond=1e-12)[0]
 
 
+def _row_scales(A, x):
+    """The size of each row's terms at x (module docstring): ‖A_i‖₁ ‖x‖∞."""
+    return np.asarray(abs(A).sum(axis=1)).ravel() * np.abs(x).max(initial=0.0)
+
+
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
     """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices)."""
     q = np.array(q, dtype=float)
@@ -55,15 +66,18 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
     for _ in range(MAX_ITERATIONS):
         phi, _ = system.constraint_residuals(t, q, qd)
         rows = np.isfinite(phi)
-        if not rows.any() or np.abs(phi[rows]).max() <= tolerance:
+        A = system.constraint_rows(t, q, qd)[0][rows]
+        unmet = np.abs(phi[rows]) > tolerance * _row_scales(A, q)
+        if not unmet.any():
             return q
-        A = system.constraint_rows(t, q, qd)[0][rows][:, free]
-        q[free] -= _correction(A, phi[rows])
+        q[free] -= _correction(A[:, free], phi[rows])
         if not np.all(np.isfinite(q)):
             break
     phi, _ = system.constraint_residuals(t, q, qd)
+    A = system.constraint_rows(t, q, qd)[0]
     raise SolveError(_unmet(system, phi, "positions", free),
-                     constraints=[n for n, r in zip(system.constraint_names, phi) if abs(r) > tolerance])
+                     constraints=[n for n, r, s in zip(system.constraint_names, phi, _row_scales(A, q))
+                                  if abs(r) > tolerance * s])
 
 
 def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
@@ -72,14 +86,15 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
     free = _free_columns(qd.size, fixed)
     _, psi = system.constraint_residuals(t, q, qd)
     rows = np.isfinite(psi)
-    if not rows.any() or np.abs(psi[rows]).max() <= tolerance:
+    A = system.constraint_rows(t, q, qd)[0][rows]
+    if not (np.abs(psi[rows]) > tolerance * _row_scales(A, qd)).any():
         return qd
-    A = system.constraint_rows(t, q, qd)[0][rows][:, free]
-    qd[free] -= _correction(A, psi[rows])  # ψ is affine in q̇ with slope A
+    qd[free] -= _correction(A[:, free], psi[rows])  # ψ is affine in q̇ with slope A
     _, psi = system.constraint_residuals(t, q, qd)
-    if np.abs(psi[rows]).max() > max(tolerance, 1e-9 * (1 + np.abs(qd).max())):
+    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * _row_scales(A, qd)
+    if unmet.any():
         raise SolveError(_unmet(system, psi, "velocities", free),
-                         constraints=[n for n, r in zip(system.constraint_names, psi) if abs(r) > tolerance])
+                         constraints=[n for n, u in zip(np.array(system.constraint_names)[rows], unmet) if u])
     return qd
 
 
@@ -109,10 +124,11 @@ def consistent_initial_state(system, t=0.0):
                              constraints=err.constraints) from None
     names = list(system.coordinates)
     changes = {}
+    q_size, qd_size = np.abs(q).max(initial=0.0), np.abs(qd).max(initial=0.0)
     for i, c in enumerate(names):
-        if abs(q[i] - q0[i]) > 1e-12:
+        if abs(q[i] - q0[i]) > TOLERANCE * q_size:
             changes[c] = (float(q0[i]), float(q[i]))
-        if abs(qd[i] - qd0[i]) > 1e-12:
+        if abs(qd[i] - qd0[i]) > TOLERANCE * qd_size:
             changes[c + "_dot"] = (float(qd0[i]), float(qd[i]))
     return q, qd, changes
 
