@@ -69,8 +69,8 @@ def n_four_bar_yaml(N, L=1.0, m=1.0, g=9.81, v0=1.0):
     3 (2N + 1) coordinates, 2 (3N + 1) independent joint rows (each planar revolute
     joint has 5 rows of which 3 vanish identically in the plane): one degree of freedom,
     N + 1 when the bars are horizontal (the singular positions). Initial state: bars
-    vertical, v0's rate -v0/L about z (B0 moving at v0 along +x); the other velocities
-    are completed from the constraints when the run starts."""
+    vertical, every vertical bar turning at -v0/L about z (B0 moving at v0 along +x),
+    the horizontal bars translating at v0 along +x: consistent as written."""
     if N < 1:
         raise ValueError("N must be at least 1")
     lines = [
@@ -78,10 +78,10 @@ def n_four_bar_yaml(N, L=1.0, m=1.0, g=9.81, v0=1.0):
         "# benchmarks/iftomm_reference.py; see its comments for the benchmark's statement).",
         f"# {N + 1} vertical bars on ground pivots L apart, their tops joined by {N} horizontal",
         "# bars; every bar a uniform slender rod of length L and mass m; gravity g along -y;",
-        "# all bars vertical at the start, the first bar's top B0 moving at v0 along +x.",
+        "# all bars vertical at the start, the first bar's top B0 moving at `speed` along +x.",
         "# Reference: the exact one-degree-of-freedom motion (n_four_bar_reference).",
         f"name: n_four_bar_{N}",
-        f"parameters: {{L: {L!r}, m: {m!r}, g: {g!r}, v0: {v0!r}}}",
+        f"parameters: {{L: {L!r}, m: {m!r}, g: {g!r}, speed: {v0!r}}}",
         "gravity: [0, -g, 0]",
         "world:",
         "  frames:",
@@ -90,14 +90,14 @@ def n_four_bar_yaml(N, L=1.0, m=1.0, g=9.81, v0=1.0):
         lines.append(f"    p{i}: {{position: [{i}*L, 0, 0]}}")
     lines.append("subsystems:")
     for i in range(N + 1):
-        extra = ", angular_velocity: -v0/L" if i == 0 else ""
         lines.append(f"  v{i}: {{type: planar_body, mass: m, inertia: m*L**2/12, "
                      f"frames: {{bottom: {{position: [0, -L/2, 0]}}, top: {{position: [0, L/2, 0]}}}}, "
-                     f"initial: {{position: [{i}*L, L/2], theta: 0{extra}}}}}")
+                     f"initial: {{position: [{i}*L, L/2], theta: 0, velocity: [speed/2, 0], "
+                     f"angular_velocity: -speed/L}}}}")
     for i in range(N):
         lines.append(f"  h{i}: {{type: planar_body, mass: m, inertia: m*L**2/12, "
                      f"frames: {{left: {{position: [-L/2, 0, 0]}}, right: {{position: [L/2, 0, 0]}}}}, "
-                     f"initial: {{position: [{i}*L + L/2, L], theta: 0}}}}")
+                     f"initial: {{position: [{i}*L + L/2, L], theta: 0, velocity: [speed, 0]}}}}")
     lines.append("joints:")
     for i in range(N + 1):
         lines.append(f"  - {{name: ground{i}, type: revolute, parent: world.p{i}, child: v{i}.bottom}}")
