@@ -227,6 +227,8 @@ def run(problem, quick=False, log=print):
     except mb.SimulationError as err:
         result.status = f"stopped: {err}"
         traj = err.trajectory
+    except mb.SolveError as err:   # e.g. no consistent initial state
+        result.status = f"failed: SolveError: {err}"
     except Exception as err:
         result.status = f"failed: {type(err).__name__}: {err}"
         log(traceback.format_exc())
@@ -259,12 +261,13 @@ def table(results):
     return "\n".join(lines) + ("\n\nNotes:\n\n" + "\n".join(notes) if notes else "") + "\n"
 
 
-def header(quick):
+def header(argv):
     cores = os.cpu_count()
+    quick = " " + " ".join(argv) if argv else ""
     return (f"# mbsynth on the IFToMM/LIM benchmark problems and the IVP test set's `andrews` (issue 18)\n\n"
             f"{datetime.date.today().isoformat()}, {platform.platform()}, {platform.machine()}, {cores} cores, "
             f"Python {platform.python_version()}, mbsynth {getattr(mb, '__version__', '?')}; written by "
-            f"`PYTHONPATH=. .venv/bin/python benchmarks/iftomm.py{' --quick' if quick else ''}`.\n\n"
+            f"`PYTHONPATH=. .venv/bin/python benchmarks/iftomm.py{quick}`.\n\n"
             "References (benchmarks/iftomm_reference.py, no mbsynth inside): the pendulum's exact motion (Jacobi's "
             "sn), the N-four-bar's exact one-degree-of-freedom motion (scipy DOP853 at 1e-13), the IVP test set's "
             "Andrews angles at 0.03 s (andrews.f, SOLN), and for the over-constrained loops energy conservation "
@@ -280,6 +283,7 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="shortened runs; print, no file unless --out")
     parser.add_argument("--only", default="", help="comma-separated problem names (default: all)")
     parser.add_argument("--out", default=None, help="the results file (default benchmarks/iftomm_results.md)")
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
     chosen = [p for p in problems() if not args.only or p.name in args.only.split(",")]
     if not chosen:
@@ -291,7 +295,8 @@ def main(argv=None):
         print(f"  {r.status[:300]}; error {r.error:.2e}, drift {r.drift:.2e}, residual {r.residual:.2e}, "
               f"{r.wall:.3g} s", flush=True)
         results.append(r)
-    text = header(args.quick) + table(results)
+    shown = [a for i, a in enumerate(argv) if a != "--out" and (i == 0 or argv[i - 1] != "--out")]
+    text = header(shown) + table(results)
     print(text)
     out = args.out or (None if args.quick else HERE / "iftomm_results.md")
     if out is not None:
