@@ -43,9 +43,9 @@ M̄⁺ yields anyway; drift control then brings the state back, and the contradi
 trusted when σ_i is above the rank cut and, if it is nearly dependent
 (σ_i < ``NEAR_SINGULAR`` σ₁, a configuration near a singular position or dependent rows
 whose dependency moves with the configuration), when (1) σ_i exceeds what the drift
-itself can make of a dependent direction, ``DRIFT_RANK`` δ σ₁, with δ = max |φ_i|/‖A_i‖
-over the rows, relative to the size of the positions (the state's distance from the
-manifold: A moves by about that much over it), and (2) the acceleration it asks for,
+itself can make of a dependent direction, ``DRIFT_RANK`` δ σ₁, with δ = max |φ_i| over
+the rows relative to the size of their terms (``term_scales``: the state's relative
+distance from the manifold; A moves by about that much over it), and (2) the acceleration it asks for,
 |c_i|/σ_i, is at most ``DRIFT_GAIN`` times that of the rest of the motion. On the
 manifold c_i = σ_i v_iᵀq̈, so a trusted direction changes nothing; off it, the drift's
 share of c_i is amplified by 1/σ_i → ∞ at the singular position, and a direction that
@@ -68,6 +68,7 @@ SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
 NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
 NEAR_SINGULAR = 1e-5  # σ_i below this fraction of σ₁ (of the equilibrated A): a nearly dependent direction
 DRIFT_RANK = 1e3  # a nearly dependent σ_i below this times the relative drift δ (× σ₁) counts as dependent
+TERM_FLOOR = 1e-3  # term_scales: the share of ‖A_i‖₁ ‖x‖∞ that a row with coordinates near zero keeps
 DRIFT_GAIN = 10.0  # a nearly dependent direction asking more than this times the rest's acceleration is drift
 VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off makes the verdict uncertain
 # (a mass ratio of 1e-9, 1e3 times the cut-off, is a legitimate model and is not flagged)
@@ -207,7 +208,7 @@ def constrained_acceleration(M, Q, A, b, C=None, *, rtol=RANK_RTOL,
     ``SolveError`` naming the constraints (a) or coordinates (b) involved, as does
     NaN/inf input. Shape errors raise ``ValueError``. ``drift``: None for a state on the
     constraint manifold; for a state that may be off it, a callable returning (φ per row
-    of A, NaN where a row has none; the size of the positions), called only near a
+    of A, NaN where a row has none; the positions q), called only near a
     singular position: (a) gives way to the drift rule of the module docstring.
     """
     d = _prepare(M, Q, A, b, C, coordinates, constraints)
@@ -255,11 +256,22 @@ def _trusted(d: "_Data", rtol, drift):
 
 
 def _relative_drift(d: "_Data", drift):
-    """δ = max |φ_i|/‖A_i‖ over the rows, divided by the size of the positions."""
-    phi, size = drift()
-    phi_e = np.abs(np.asarray(phi, dtype=float)) / np.linalg.norm(d.A, axis=1).clip(_TINY)
-    finite = phi_e[np.isfinite(phi_e)]
-    return float(finite.max()) / max(size, _TINY) if finite.size else 0.0
+    """δ = max |φ_i| / (the size of row i's terms, ``term_scales``) over the rows."""
+    phi, q = drift()
+    relative = np.abs(np.asarray(phi, dtype=float)) / np.maximum(term_scales(d.A, q), _TINY)
+    finite = relative[np.isfinite(relative)]
+    return float(finite.max(initial=0.0))
+
+
+def term_scales(A, x):
+    """The size of the terms of each row's residual at x, estimated from its row of A:
+    Σ_j |A_ij x_j| (x² + y² − L² at x, y ≈ L: 2L², where rounding is ε L²; each
+    coordinate counts in its own units, so angles and millimetres mix), plus a thousandth
+    of ‖A_i‖₁ ‖x‖∞ for rows whose coordinates are near zero. A dense or scipy.sparse A."""
+    x = np.abs(np.asarray(x, dtype=float))
+    weights = abs(A)
+    return (np.asarray(weights @ x).ravel()
+            + TERM_FLOOR * np.asarray(weights.sum(axis=1)).ravel() * x.max(initial=0.0))
 
 
 def _restricted(d: "_Data", U, s, Vt, c, keep):

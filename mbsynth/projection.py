@@ -9,15 +9,16 @@ q̇ ← q̇ − A_v⁺ ψ. Coordinates marked fixed are not changed. Unit quater
 holonomic rows of their bodies, so they are restored like any other constraint.
 
 Tolerances are relative, so a mechanism projects alike in millimetres or kilometres: a
-row's residual is judged against the size of its terms, estimated from the row of A as
-‖A_i‖₁ ‖q‖∞ for φ_i (x² + y² − L² at x, y ≈ L: 2L · L, where rounding is ε L²) and
-‖A_i‖₁ ‖q̇‖∞ for ψ_i, times ``TOLERANCE``.
+row's residual is judged against the size of its terms, estimated from the row of A
+(``equations.term_scales``: Σ_j |A_ij q_j| for φ_i, Σ_j |A_ij q̇_j| for ψ_i), times
+``TOLERANCE``.
 """
 
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
+from .equations import term_scales
 from .errors import SolveError
 
 TOLERANCE = 1e-12  # largest residual accepted after projection, relative to the row's terms
@@ -53,11 +54,6 @@ def _correction(J, r):
     return np.linalg.lstsq(J.toarray(), r, rcond=1e-12)[0]
 
 
-def _row_scales(A, x):
-    """The size of each row's terms at x (module docstring): ‖A_i‖₁ ‖x‖∞."""
-    return np.asarray(abs(A).sum(axis=1)).ravel() * np.abs(x).max(initial=0.0)
-
-
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
     """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices)."""
     q = np.array(q, dtype=float)
@@ -67,7 +63,7 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
         phi, _ = system.constraint_residuals(t, q, qd)
         rows = np.isfinite(phi)
         A = system.constraint_rows(t, q, qd)[0][rows]
-        unmet = np.abs(phi[rows]) > tolerance * _row_scales(A, q)
+        unmet = np.abs(phi[rows]) > tolerance * term_scales(A, q)
         if not unmet.any():
             return q
         q[free] -= _correction(A[:, free], phi[rows])
@@ -76,7 +72,7 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
     phi, _ = system.constraint_residuals(t, q, qd)
     A = system.constraint_rows(t, q, qd)[0]
     raise SolveError(_unmet(system, phi, "positions", free),
-                     constraints=[n for n, r, s in zip(system.constraint_names, phi, _row_scales(A, q))
+                     constraints=[n for n, r, s in zip(system.constraint_names, phi, term_scales(A, q))
                                   if abs(r) > tolerance * s])
 
 
@@ -87,15 +83,28 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
     _, psi = system.constraint_residuals(t, q, qd)
     rows = np.isfinite(psi)
     A = system.constraint_rows(t, q, qd)[0][rows]
-    if not (np.abs(psi[rows]) > tolerance * _row_scales(A, qd)).any():
+    if not (np.abs(psi[rows]) > tolerance * term_scales(A, qd)).any():
         return qd
     qd[free] -= _correction(A[:, free], psi[rows])  # ψ is affine in q̇ with slope A
     _, psi = system.constraint_residuals(t, q, qd)
-    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * _row_scales(A, qd)
+    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
     if unmet.any():
         raise SolveError(_unmet(system, psi, "velocities", free),
                          constraints=[n for n, u in zip(np.array(system.constraint_names)[rows], unmet) if u])
     return qd
+
+
+def relative_drift(system, t, q, qd):
+    """The largest residual of φ or ψ relative to its row's terms (module docstring): how far
+    the state lies off the manifold, alike at every scale."""
+    phi, psi = system.constraint_residuals(t, q, qd)
+    A = system.constraint_rows(t, q, qd)[0]
+    worst = 0.0
+    for residual, x in ((phi, q), (psi, qd)):
+        rows = np.isfinite(residual)
+        relative = np.abs(residual[rows]) / np.maximum(term_scales(A[rows], x), np.finfo(float).tiny)
+        worst = max(worst, float(relative.max(initial=0.0)))
+    return worst
 
 
 def project(system, t, q, qd, fixed_q=None, fixed_qd=None):

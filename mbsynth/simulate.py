@@ -3,8 +3,9 @@
 The accelerations satisfy the constraints only at the acceleration level (2.4), so
 positions and velocities drift. ``simulate`` integrates with scipy's adaptive
 integrators between output times and, with the default ``stabilization="projection"``,
-projects (q, q̇) back onto the constraints at every output time (projection.py); the
-integrator restarts there with its last step size. ``"baumgarte"`` instead replaces
+projects (q, q̇) back onto the constraints at every output time (projection.py), and
+between output times as often as keeps the drift below DRIFT_TARGET; the integrator
+restarts there with its last step size. ``"baumgarte"`` instead replaces
 b by b − 2α φ̇ − β² φ (Baumgarte 1972) with no restart; ``"none"`` does neither.
 
 Consistency is judged where it means something. The integrator's stages lie off the
@@ -23,7 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .errors import SimulationError, SolveError
-from .projection import consistent_initial_state, project
+from .projection import consistent_initial_state, project, relative_drift
 from .trajectory import COMPLETED, Trajectory, TrajectoryWriter
 
 log = logging.getLogger(__name__)
@@ -36,6 +37,7 @@ MAX_STATE = 1e12  # a coordinate or velocity beyond this counts as an exploding 
 # scipy would crawl on for minutes at that step size before it gives up by itself
 COLLAPSE_CALLS = 1000
 COLLAPSE_SPAN = 1e-8
+DRIFT_TARGET = 1e-9  # largest relative drift off the manifold between two projections
 
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
@@ -115,6 +117,7 @@ class _Run:
         self.t_failed = float("nan")
         self.non_unique = False
         self.calls, self.t_mark, self.span = 0, 0.0, 0.0
+        self.drift_span = None  # the span between projections, when shorter than the output interval
         self.singular = []  # (t, rows) of the stages where the drift rule set directions aside
         self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
 
@@ -137,8 +140,32 @@ class _Run:
         return np.concatenate([qd, motion.qdd])
 
     def advance(self, t_next, q, qd):
-        """Integrate to t_next, check the state, project it if asked."""
+        """Integrate to t_next, check the state, project it if asked. With projection the
+        interval is cut into spans short enough that the state drifts off the manifold by
+        at most DRIFT_TARGET (relative, projection.relative_drift) between projections: the
+        span halves after a larger drift and doubles after one below a hundredth of it."""
         t = self.t[-1]
+        while t < t_next:
+            t_to = t_next if self.drift_span is None or t + 1.5 * self.drift_span >= t_next else t + self.drift_span
+            q, qd = self._integrate(t, t_to, q, qd)
+            if self.stabilization == "projection":
+                self.t_failed = t_to
+                self._adapt_span(relative_drift(self.system, t_to, q, qd), t_to - t, t_next - self.t[-1])
+                q, qd = project(self.system, t_to, q, qd)
+            t = t_to
+        self._note_singular()
+        if self.stabilization == "projection":
+            self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
+        return q, qd
+
+    def _adapt_span(self, drift, span, interval):
+        if drift > DRIFT_TARGET:
+            self.drift_span = span / 2
+        elif drift < DRIFT_TARGET / 100 and self.drift_span is not None:
+            self.drift_span = None if 2 * self.drift_span >= interval else 2 * self.drift_span
+
+    def _integrate(self, t, t_next, q, qd):
+        """solve_ivp from (t, q, q̇) to t_next; the state at t_next, checked."""
         self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
         first_step = min(self.first_step, t_next - t) if self.first_step else None
         sol = solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=self.rtol,
@@ -152,13 +179,7 @@ class _Run:
         self.first_step = steps[-2] if steps.size > 1 else self.first_step  # the last step was cut short
         y = sol.y[:, -1]
         self._check(t_next, y)
-        q, qd = y[:self.n], y[self.n:]
-        self._note_singular()
-        if self.stabilization == "projection":
-            self.t_failed = t_next
-            q, qd = project(self.system, t_next, q, qd)
-            self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
-        return q, qd
+        return y[:self.n], y[self.n:]
 
     def _note_singular(self):
         """One entry of ``singular_positions`` for the stages of the interval just done."""

@@ -252,8 +252,8 @@ class System:
 
     def _off_manifold(self, t, q, qd):
         """The drift measure of ``equations.constrained_acceleration``: a callable giving φ
-        per row and the size of the positions, evaluated only when its rule needs them."""
-        return lambda: (self.constraint_residuals(t, q, qd)[0], float(np.abs(q).max(initial=0.0)))
+        per row and q, evaluated only when its rule needs them."""
+        return lambda: (self.constraint_residuals(t, q, qd)[0], q)
 
     def _tree_motion(self, t, q, qd, baumgarte):
         """The Motion from mbsynth.fast, or None: kernels not ready, model not covered (no
