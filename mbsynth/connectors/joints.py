@@ -149,8 +149,9 @@ class Joint(Connector):
         (axis rows) — else None."""
         if self.joint_kind not in LOCKED | ROTATING:
             return None
-        RA, RB = (np.array(_pose(part, frame)[1].xreplace(values), dtype=float)
-                  for part, frame in zip(self.parts, self.frames))
+        RA, RB = (_numeric(_pose(part, frame)[1], values) for part, frame in zip(self.parts, self.frames))
+        if RA is None or RB is None:
+            return None
         if self.joint_kind in LOCKED:
             return _turned(self, RA.T @ RB)
         with np.errstate(all="ignore"):
@@ -164,6 +165,14 @@ class Joint(Connector):
 
 SHARED_PARTS = (RigidBody, Particle, PlanarBody)  # poses that depend on their coordinates alone
 _LENGTH = sp.Dummy("L")
+
+
+def _numeric(matrix, values):
+    """``matrix`` at ``values`` as floats, or None where that is no real number."""
+    try:
+        return np.array(matrix.xreplace(values), dtype=float)
+    except TypeError:
+        return None
 
 
 def _turned(joint, relative):
