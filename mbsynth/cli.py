@@ -402,8 +402,7 @@ def format_check(report, path):
             if balance["free"]:
                 lines.append("      free: no force acts along it, its acceleration is arbitrary")
             else:
-                lines.append(f"      balance needed: {balance['equation']}  "
-                             "(add it as a constraint, or set 'closure: auto')")
+                lines += _format_balance(balance)
         if report.state_dependent:
             lines.append("    note: these directions depend on the state; the balances hold only "
                          "where the null space keeps this form")
@@ -422,6 +421,18 @@ def format_check(report, path):
     if violated:
         lines.append(f"  warning: the initial state violates {', '.join(violated)}")
     return "\n".join(lines)
+
+
+def _format_balance(balance):
+    """The lines of a balance that is needed: what it is physically where that is known,
+    and the equation, its numbers rounded (closure.readable)."""
+    effort = balance["effort"]
+    advice = "(add it as a constraint, or set 'closure: auto')"
+    if effort is None:
+        return [f"      balance needed: {balance['readable']}  {advice}"]
+    value = "0 at this state, not at every state" if effort["value"] == 0 else f"{effort['value']:.6g} ≠ 0"
+    return [f"      balance needed: {effort['name']}: {value}; it must vanish:",
+            f"        {balance['readable']}  {advice}"]
 
 
 def _format_direction(direction):

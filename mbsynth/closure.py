@@ -47,6 +47,11 @@ class Balance:
     def equation(self):
         return f"{sp.sstr(self.expression)} = 0"
 
+    @property
+    def readable_equation(self):
+        """``equation`` as a person reads it (``readable``)."""
+        return f"{readable(self.expression)} = 0"
+
 
 def balances(system, t=0.0, q=None, qd=None):
     """The balances of every indeterminate direction of ``system`` (none when unique).
@@ -85,6 +90,53 @@ def balances(system, t=0.0, q=None, qd=None):
             expression = sp.S.Zero if is_free else tidy((w.T * force)[0])
             result.append(Balance(_direction(w, state, system.coordinates), expression, state_dependent))
     return result
+
+
+READABLE_DIGITS = 6  # significant digits of the numbers in a printed balance
+READABLE_DROP = 1e-9  # a term of a sum below this times its largest coefficient is left out of a printed balance
+
+
+def readable(expression):
+    """``expression`` printed for a person: factored (a polynomial that is a product), each sum factor scaled
+    so that its largest coefficient is 1, the terms of a sum below READABLE_DROP times its
+    largest left out, numbers rounded to READABLE_DIGITS significant digits — the rationals
+    of a numeric null vector (state-dependent directions) come out as short decimals."""
+    factored = sp.factor(expression) if expression.is_polynomial() else expression
+    if sum(not factor.is_Number for factor in sp.Mul.make_args(factored)) < 2:  # no product to show
+        factored = expression
+    if factored.is_Add:
+        return sp.sstr(_kept_terms(sp.Add.make_args(factored)), full_prec=False)
+    coefficient, factors = sp.S.One, []
+    for factor in sp.Mul.make_args(factored):
+        base, exponent = factor.as_base_exp()
+        if factor.is_Number:
+            coefficient *= factor
+        elif base.is_Add and exponent.is_Integer:
+            terms = sp.Add.make_args(base)
+            largest = max((term.as_coeff_Mul()[0] for term in terms), key=abs)
+            coefficient *= largest**exponent
+            base = _kept_terms([term / largest for term in terms])
+            factors.append(base if exponent == 1 else sp.Pow(base, exponent, evaluate=False))
+        else:
+            factors.append(_rounded(factor))
+    if coefficient != 1 or not factors:
+        factors.insert(0, _rounded(coefficient))
+    return sp.sstr(sp.Mul(*factors, evaluate=False) if len(factors) > 1 else factors[0], full_prec=False)
+
+
+def _kept_terms(terms):
+    """The sum of ``terms``, rounded, without those whose coefficient is below READABLE_DROP
+    times the largest."""
+    coefficients = [abs(term.as_coeff_Mul()[0]) for term in terms]
+    kept = [_rounded(term) for term, c in zip(terms, coefficients) if c >= READABLE_DROP * max(coefficients)]
+    return sp.Add(*kept, evaluate=False) if len(kept) > 1 else kept[0]
+
+
+def _rounded(expression):
+    """``expression`` with its numbers other than small integers as floats of READABLE_DIGITS digits."""
+    small = 10**READABLE_DIGITS
+    return expression.xreplace({x: sp.Float(x, READABLE_DIGITS) for x in expression.atoms(sp.Number)
+                                if not (x.is_Integer and abs(x) < small)})
 
 
 def _separate(g, values, system, q, qd, t):

@@ -109,6 +109,11 @@ class Connector:
         a, b, C, _, _ = self._rows(t, q[self.indices], qd[self.indices], p)
         return a, b.ravel(), C.ravel()
 
+    def wrong_branch(self, values):
+        """A message when the rows hold at ``values`` in a pose the connector does not
+        mean (joints.py); None for rows without such poses."""
+        return None
+
     def residuals(self, t, q, qd, p):
         """(φ, φ̇) per row: position- and velocity-level residuals; NaN where the kind has none."""
         _, _, _, phi, psi = self._rows(t, q[self.indices], qd[self.indices], p)

@@ -11,11 +11,13 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .closure import balances
+from .closure import ZERO_TOL, balances
 from .equations import VERDICT_MARGIN, rank_report
 from .errors import SolveError
+from .kinematics import body_rate_matrix, quaternion_matrix, rotation_z
 
 COMPONENT_TOL = 1e-12
+AXIS_TOL = 1e-9  # a unit vector within this of a body's or the world's axis is that axis
 
 
 @dataclass(frozen=True)
@@ -69,13 +71,73 @@ def diagnose(system, t=0.0, q=None, qd=None):
         rank_Mhat=report.rank_Mhat, unique=report.unique,
         indeterminate=[_components(w, system.coordinates) for w in report.nullspace.T],
         suggested_constraints=[b.equation for b in found if not b.free],
-        balances=[{"direction": b.direction, "free": b.free,
-                   "equation": None if b.free else b.equation} for b in found],
+        balances=[_balance(system, b, arrays.Q + arrays.C, q) for b in found],
         state_dependent=any(b.state_dependent for b in found),
         closures=[{"constraint": c.constraint, "equation": c.equation, "direction": c.direction,
                    "state_dependent": c.state_dependent} for c in system.closures],
         constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
         rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report))
+
+
+def _balance(system, balance, force, q):
+    """The report of one balance: its direction, whether it is free, its equation (exact,
+    and ``readable``), and what it is physically (``effort``, at the state q)."""
+    if balance.free:
+        return {"direction": balance.direction, "free": True, "equation": None}
+    return {"direction": balance.direction, "free": False, "equation": balance.equation,
+            "readable": balance.readable_equation, "effort": effort(system, balance.direction, force, q)}
+
+
+def effort(system, direction, force, q):
+    """wᵀ(Q + C) along ``direction`` (a Balance's) read physically, when w moves one part
+    alone: {"name": "torque about rod's z axis", "value": 0.3} when it turns a rigid body
+    (body rate 2 E(u) w, kinematics.py) or a planar body, {"name": "force on p1 along the
+    world's x axis", ...} when it moves a body or particle without turning; else None.
+    ``force`` is Q + C at the state q, numbers over all coordinates; a value below ZERO_TOL
+    times its largest entry is 0."""
+    owners = {name.split(".")[0] for name in direction}
+    part = next((p for p in system.subsystems if {p.name} == owners), None)
+    if part is None or part.kind not in ("rigid_body", "planar_body", "particle"):
+        return None
+    index = [system.coordinates.index(f"{part.name}.{c}") for c in part.coordinates]
+    w = np.array([direction.get(f"{part.name}.{c}", 0.0) for c in part.coordinates])
+    shift, turn, rotation = _motion_of(part.kind, w, q[index])
+    if np.any(shift) == np.any(turn):  # both (turning about another point) or neither
+        return None
+    moving = np.any(shift)
+    own, words, length = _axis(shift if moving else turn, part.name, rotation)
+    name = f"{'force' if moving else 'torque'}{'' if own else ' on ' + part.name} {'along' if moving else 'about'}"
+    value = float(w @ force[index]) / length
+    return {"name": f"{name} {words}", "value": 0.0 if abs(value) <= ZERO_TOL * np.abs(force).max() else value}
+
+
+def _motion_of(kind, w, x):
+    """(displacement, turn, both in world axes, and the part's rotation or None) of the
+    step w of a part's coordinates x."""
+    if kind == "particle":
+        return w[:3], np.zeros(3), None
+    if kind == "planar_body":
+        return np.array([w[0], w[1], 0.0]), np.array([0.0, 0.0, w[2]]), np.array(rotation_z(x[2]), dtype=float)
+    R = quaternion_matrix(x[3:])
+    u = x[3:] / np.linalg.norm(x[3:])
+    E = np.array(body_rate_matrix(u), dtype=float)
+    return w[:3], R @ (2 * E @ w[3:]), R
+
+
+def _axis(vector, name, rotation):
+    """(whether it is the part's own axis, words for the axis along ``vector``, the signed
+    length of ``vector`` along it): the part's own x, y or z axis (``rotation``: its axes in
+    the world; None for a particle), else the world's, else the unit vector in world axes."""
+    length = np.linalg.norm(vector)
+    unit = vector / length
+    for axes, owner in ((rotation, f"{name}'s"), (np.eye(3), "the world's")):
+        if axes is None:
+            continue
+        local = axes.T @ unit
+        i = int(np.argmax(np.abs(local)))
+        if abs(local[i]) > 1 - AXIS_TOL:
+            return axes is rotation, f"{owner} {'xyz'[i]} axis", length * np.sign(local[i])
+    return False, "(" + ", ".join(f"{x:.3g}" for x in unit + 0.0) + ") in world axes", length
 
 
 def _warnings(report):

@@ -12,7 +12,8 @@ import scipy.sparse
 import sympy as sp
 
 from . import equations, fast, friction, solvers
-from .errors import ModelError
+from .errors import ModelError, SolveError
+from .symbolic import T_SYMBOL
 
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
 
@@ -163,6 +164,23 @@ class System:
                                             "or a T that is no kinetic energy)"))
             start = stop
         return problems
+
+    def branch_problems(self, q=None, t=0.0):
+        """[(joint name, message)] for each joint whose frames meet its rows at ``q`` (the
+        initial state by default) in a pose it does not mean: a fixed joint's frames turned
+        180° (connectors/joints.py)."""
+        q = self.initial_q if q is None else q
+        values = dict(zip(self.q_symbols, np.asarray(q, dtype=float)))
+        values.update(zip(self.parameter_symbols, self.parameter_values))
+        values[T_SYMBOL] = t
+        return [(c.name, message) for c in self.constraints if (message := c.wrong_branch(values))]
+
+    def check_branches(self, q, t=0.0):
+        """Raise SolveError naming the first joint whose frames, at the state q, are in a
+        pose the joint does not mean (``branch_problems``)."""
+        problems = self.branch_problems(q, t)
+        if problems:
+            raise SolveError(f"model '{self.name}': {problems[0][1]}", constraints=[problems[0][0]])
 
     def with_constraints(self, extra, closures=()):
         """A new System with ``extra`` constraints appended (the original is unchanged)."""

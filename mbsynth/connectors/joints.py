@@ -12,7 +12,10 @@ frame origins and x, y, z their axes in the world:
     distance     (|p_B − p_A|² − L²) / 2L = 0                    1 row  (a massless rod)
 
 The orientation lock is x_A·y_B = y_A·z_B = z_A·x_B = 0: independent near aligned
-frames, so assemble the frames aligned. Rows of A and b follow by differentiating φ
+frames, so assemble the frames aligned. It also holds with B turned 180° about an axis
+of A, or 120° about a diagonal (x → y → z), and the axis rows z_B ⟂ x_A, y_A hold with
+z_B = −z_A: poses the joint does not mean. ``Joint.wrong_branch`` tells them from the
+meant one (frames turned less than 90° apart). Rows of A and b follow by differentiating φ
 twice (symbolic.differentiate), exactly — once per kind of joint and types of parts
 (``_template``): φ is derived with the frames' offsets and rotations as placeholder
 symbols (``_PLACEHOLDERS``) and the parts' coordinates as slots, compiled once, and each
@@ -23,7 +26,9 @@ friction, are derived directly.
 
 from typing import NamedTuple
 
+import numpy as np
 import sympy as sp
+from scipy.spatial.transform import Rotation
 
 from ..constraint import Connector
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
@@ -31,6 +36,7 @@ from ..symbolic import differentiate, differentiated, placed_values, positions, 
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}
+LOCKED = {"fixed", "prismatic"}  # kinds with the orientation lock
 
 
 def _axes(R):
@@ -136,6 +142,21 @@ class Joint(Connector):
             return expr
         return expr.xreplace(placed_values(*self._motion_put))
 
+    def wrong_branch(self, values):
+        """A message when the frames, at ``values`` ({symbol: number} of the coordinates,
+        parameters and time), meet the joint's orientation rows in a pose it does not
+        mean — turned 90° or more from aligned (orientation lock), or z_B against z_A
+        (axis rows) — else None."""
+        if self.joint_kind not in LOCKED | ROTATING:
+            return None
+        RA, RB = (_numeric(_pose(part, frame)[1], values) for part, frame in zip(self.parts, self.frames))
+        if RA is None or RB is None:
+            return None
+        if self.joint_kind in LOCKED:
+            return _turned(self, RA.T @ RB)
+        with np.errstate(all="ignore"):
+            return _reversed(self, RA[:, 2] @ RB[:, 2] / np.linalg.norm(RB[:, 2]) / np.linalg.norm(RA[:, 2]))
+
     angle = property(lambda self: self._motion(0), doc="the turn about z_A (revolute, cylindrical), else None")
     angle_rate = property(lambda self: self._motion(1), doc="z_A·(ω_B − ω_A), else None")
     displacement = property(lambda self: self._motion(2), doc="z_A·(p_B − p_A) (prismatic, cylindrical), else None")
@@ -144,6 +165,44 @@ class Joint(Connector):
 
 SHARED_PARTS = (RigidBody, Particle, PlanarBody)  # poses that depend on their coordinates alone
 _LENGTH = sp.Dummy("L")
+
+
+def _numeric(matrix, values):
+    """``matrix`` at ``values`` as floats, or None where that is no real number."""
+    try:
+        return np.array(matrix.xreplace(values), dtype=float)
+    except TypeError:
+        return None
+
+
+def _turned(joint, relative):
+    """The message for frames turned 90° or more apart (``relative`` = R_Aᵀ R_B), else None
+    (also when ``relative`` is no turn at all: a zero quaternion, left to other checks)."""
+    if not (np.all(np.isfinite(relative)) and np.linalg.det(relative) > 0):
+        return None
+    turn = Rotation.from_matrix(relative).as_rotvec()
+    angle = np.degrees(np.linalg.norm(turn))
+    if angle < 90:
+        return None
+    axis = ", ".join(f"{x:.3g}" for x in np.round(turn / np.linalg.norm(turn), 6) + 0.0)
+    return (f"{joint.joint_kind} joint '{joint.name}': its frames are turned {angle:.3g}° about ({axis}) "
+            "(parent frame axes) from the aligned pose it holds; its rows also hold turned 180° about an "
+            f"axis or 120° about a diagonal, and would keep the wrong pose: fix the initial orientation of "
+            f"{_named(joint.parts)}")
+
+
+def _reversed(joint, cosine):
+    """The message for a z_B against z_A (``cosine`` = z_A·z_B ≤ 0), else None."""
+    if not cosine <= 0:  # NaN too (a zero axis)
+        return None
+    angle = np.degrees(np.arccos(np.clip(cosine, -1, 1)))
+    return (f"{joint.joint_kind} joint '{joint.name}': its child's z axis points {angle:.3g}° away from its "
+            f"parent's (z_A·z_B = {cosine:.3g}); its axis rows also hold with z_B = −z_A, and would keep the "
+            f"wrong pose: fix the initial orientation of {_named(joint.parts)}")
+
+
+def _named(parts):
+    return " or ".join(f"'{p.name}'" for p in parts if p is not None)
 
 
 def _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd):

@@ -26,6 +26,7 @@ from .source import Document, LineDict, LineList, read_document
 TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
             "closure", "initial", "initial_fixed", "forces"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
+ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
 
 def load(path):
@@ -168,6 +169,7 @@ class _Builder:
                          source=self.doc.text, source_folder=str(self.doc.folder),
                          robots=tuple(entry.robot for entry in self.robots.values()))
         self.check_parts(system)
+        self.check_branches(system)
         closure = root.get("closure", "none")
         if closure not in ("auto", "none"):
             self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
@@ -339,17 +341,32 @@ class _Builder:
         seen = set()
         for con in constraints:
             if con.name in seen:
-                places = [(key, i) for key in ("constraints", "joints")
-                          for i, spec in enumerate(self.root.get(key) or ())
-                          if isinstance(spec, dict) and spec.get("name") == con.name]
-                self.fail(places[-1] + ("name",) if places else ("constraints",),
+                place = self.entry_named(con.name)
+                self.fail(place + ("name",) if place else ("constraints",),
                           f"the name '{con.name}' is given to two constraints or joints")
             seen.add(con.name)
+
+    def entry_named(self, name):
+        """The path of the last constraint or joint entry named ``name``, or None."""
+        places = [(key, i) for key in ("constraints", "joints") for i, spec in enumerate(self.root.get(key) or ())
+                  if isinstance(spec, dict) and spec.get("name") == name]
+        return places[-1] if places else None
 
     def check_parts(self, system):
         """Each part's M must be finite and positive semi-definite at the initial state."""
         for part, problem in system.part_problems():
             self.fail(("subsystems", part) + (("T",) if "semi-definite" in problem else ()), problem)
+
+    def check_branches(self, system):
+        """No joint may be assembled at the initial state (its rows hold) in a pose its rows
+        allow but it does not mean (a fixed joint's frames turned 180°): System.branch_problems.
+        A joint whose rows do not hold yet is left to the state made consistent."""
+        q, qd = system.initial_state()
+        phi, _ = system.constraint_residuals(0.0, q, qd)
+        apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED}
+        for joint, problem in system.branch_problems(q):
+            if joint not in apart:
+                self.fail(self.entry_named(joint) or ("initial",), problem)
 
 
 SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,

@@ -1,0 +1,100 @@
+"""Joints whose rows also hold in poses they do not mean (connectors/joints.py): a fixed
+joint's orientation lock x_A·y_B = y_A·z_B = z_A·x_B = 0 holds with the frames turned
+180° about an axis or 120° about a diagonal, a revolute joint's axis rows with
+z_B = −z_A. A model starting there is refused, naming the joint; the meant pose loads."""
+
+import textwrap
+
+import numpy as np
+import pytest
+
+import mbsynth as mb
+from mbsynth.projection import consistent_initial_state
+from mbsynth.kinematics import matrix_quaternion, rpy_matrix
+
+# a block hung from the world by one joint at its frame ``top`` (z up in the block)
+MODEL = """\
+name: one_joint
+gravity: [0, 0, -9.81]
+world:
+  frames:
+    mount: {{position: [0, 0, 1]}}
+subsystems:
+  block:
+    type: rigid_body
+    mass: 1.0
+    inertia: [0.1, 0.2, 0.3]
+    frames:
+      top: {{position: [0, 0, 0.5]}}
+    initial: {{position: {position}, quaternion: {quaternion}}}
+joints:
+  - {{name: hinge, type: {kind}, parent: world.mount, child: block.top}}
+"""
+CYCLIC = np.array([[0, 0, 1], [1, 0, 0], [0, 1, 0]])  # x → y → z: 120° about (1, 1, 1), 0 at (0,1), (1,2), (2,0)
+
+
+def model(kind, rotation):
+    """The model with the block turned by ``rotation`` about its frame ``top``, which
+    stays at the mount: the joint's position rows hold, its orientation rows hold exactly
+    when they hold for ``rotation``."""
+    position = np.array([0, 0, 1]) - rotation @ np.array([0, 0, 0.5])
+    return MODEL.format(kind=kind, position=np.round(position, 15).tolist(),
+                        quaternion=matrix_quaternion(rotation).tolist())
+
+
+@pytest.mark.parametrize("kind, rotation, angle", [
+    ("fixed", rpy_matrix(np.pi, 0, 0), "180°"), ("fixed", rpy_matrix(0, np.pi, 0), "180°"),
+    ("fixed", rpy_matrix(0, 0, np.pi), "180°"), ("fixed", CYCLIC, "120°"),
+    ("prismatic", np.diag([1, -1, -1]) @ CYCLIC, "120°"),
+    ("revolute", rpy_matrix(np.pi, 0, 0), "180°"), ("revolute", rpy_matrix(0, np.pi, 0.7), "180°")])
+def test_a_pose_the_rows_allow_but_the_joint_does_not_mean_is_refused(kind, rotation, angle):
+    text = model(kind, rotation)
+    with pytest.raises(mb.ModelError, match=rf"model\.yaml:15: .*{kind} joint 'hinge'.*{angle}.*'block'"):
+        mb.loads(text, name="model.yaml")
+
+
+@pytest.mark.parametrize("kind, rotation", [
+    ("fixed", rpy_matrix(np.pi, 0, 0)), ("fixed", CYCLIC), ("revolute", rpy_matrix(np.pi, 0, 0))])
+def test_the_refused_poses_meet_every_row_of_the_joint(kind, rotation):
+    """Why they must be refused: nothing else would notice (the rows are met exactly)."""
+    joint = textwrap.dedent(f"""\
+        name: rows_only
+        world: {{frames: {{mount: {{position: [0, 0, 1]}}}}}}
+        subsystems:
+          block: {{type: rigid_body, mass: 1.0, inertia: [0.1, 0.2, 0.3], frames: {{top: {{position: [0, 0, 0.5]}}}}}}
+        joints:
+          - {{name: hinge, type: {kind}, parent: world.mount, child: block.top}}
+        """)
+    system = mb.loads(joint)
+    q = system.initial_q.copy()
+    q[:3] = np.array([0, 0, 1]) - rotation @ np.array([0, 0, 0.5])
+    q[3:] = matrix_quaternion(rotation)
+    phi, _ = system.constraint_residuals(0.0, q, np.zeros(7))
+    assert np.abs(phi).max() < 1e-15
+    with pytest.raises(mb.SolveError, match=f"{kind} joint 'hinge'") as err:
+        system.check_branches(q)
+    assert err.value.constraints == ("hinge",)
+
+
+@pytest.mark.parametrize("kind, rotation", [
+    ("fixed", np.eye(3)), ("fixed", rpy_matrix(0.3, -0.2, 0.1)), ("prismatic", np.eye(3)),
+    ("revolute", rpy_matrix(0, 0, np.pi)), ("revolute", rpy_matrix(0, 0, 2.5))])
+def test_the_meant_pose_loads_and_a_slightly_off_one_is_left_to_projection(kind, rotation):
+    """A revolute joint turns freely about its axis (even 180°); a fixed joint's frames
+    turned 0.3 rad are off, not on another branch: projection brings them back."""
+    system = mb.loads(model(kind, rotation))
+    assert system.branch_problems() == []
+    q, _, _ = consistent_initial_state(system)
+    assert system.branch_problems(q) == []
+
+
+def test_a_pose_where_the_rows_do_not_hold_yet_is_checked_once_consistent():
+    """Turned 170° about x, the fixed joint's rows do not hold: loading leaves the pose to
+    the state made consistent, and projection settles on the 180° flip, where
+    System.check_branches (to run on every consistent initial state) refuses it."""
+    system = mb.loads(model("fixed", rpy_matrix(np.radians(170), 0, 0)))
+    q, _, _ = consistent_initial_state(system)
+    phi, _ = system.constraint_residuals(0.0, q, np.zeros(system.n))
+    assert np.abs(phi).max() < 1e-12  # consistent: every row holds
+    with pytest.raises(mb.SolveError, match=r"fixed joint 'hinge': its frames are turned 180° about \(-?1, 0, 0\)"):
+        system.check_branches(q)
