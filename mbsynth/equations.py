@@ -147,11 +147,12 @@ class Motion:
     singular: tuple = ()
 
     @classmethod
-    def made(cls, qdd, unique, nullspace, Qc, residual, method):
+    def made(cls, qdd, unique, nullspace, Qc, residual, method, singular=()):
         """The same Motion without the frozen dataclass's __init__ (one object.__setattr__
         per field, 1 µs): for the fast path, which makes one per call."""
         motion = object.__new__(cls)
-        motion.__dict__.update(qdd=qdd, unique=unique, nullspace=nullspace, Qc=Qc, residual=residual, method=method)
+        motion.__dict__.update(qdd=qdd, unique=unique, nullspace=nullspace, Qc=Qc, residual=residual, method=method,
+                               singular=singular)
         return motion
 
 

@@ -131,6 +131,7 @@ def consistent_initial_state(system, t=0.0):
             kept = ", ".join(sorted(system.initial_fixed)) or "nothing"
             raise SolveError(f"no consistent initial state exists (keeping {kept}): {err}",
                              constraints=err.constraints) from None
+    system.check_branches(q, t)  # a joint's rows met on a branch it does not mean: a fixed joint flipped
     names = list(system.coordinates)
     changes = {}
     q_size, qd_size = np.abs(q).max(initial=0.0), np.abs(qd).max(initial=0.0)

@@ -291,7 +291,16 @@ def test_every_model_file(path):
             arrays = system.evaluate(0.25, q, qd)
             assert rel(motion.qdd, literal_2_14(arrays.M, arrays.Q, arrays.A, arrays.b, arrays.C)) < 1e-8
             continue
-        assert fast is not None and rel(fast.qdd, ref.qdd) < 1e-10, path.name
+        assert fast is not None and rel(fast.qdd, ref.qdd) < agreement(system, 0.25, q, qd), path.name
+
+
+def agreement(system, t, q, qd):
+    """How closely two backward-stable solves must agree at a state: 1e-10, or 1e3 ε κ
+    where the rows of A are nearly dependent (κ = σ₁/σ_r of the equilibrated A, σ_r its
+    smallest singular value above the rank cut; Bricard's loop off its manifold)."""
+    s = np.linalg.svd(mb.equations.equilibrate_rows(system.evaluate(t, q, qd).A)[0], compute_uv=False)
+    kept = s[s > mb.equations.RANK_RTOL * s[0]]
+    return max(1e-10, 1e3 * np.finfo(float).eps * kept[0] / kept[-1])
 
 
 def numbers(values):
@@ -563,7 +572,7 @@ def test_motion_made_is_the_frozen_dataclass():
     from mbsynth.equations import Motion
 
     fields = dict(qdd=np.arange(3.0), unique=True, nullspace=np.zeros((3, 0)), Qc=np.ones(3), residual=1e-16,
-                  method="tree (Baraff)")
+                  method="tree (Baraff)", singular=())
     made, built = Motion.made(**fields), Motion(**fields)
     assert [f.name for f in dataclasses.fields(made)] == list(fields)
     for name, value in fields.items():

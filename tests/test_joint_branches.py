@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.projection import consistent_initial_state
+from mbsynth.projection import consistent_initial_state, project_positions
 from mbsynth.kinematics import matrix_quaternion, rpy_matrix
 
 # a block hung from the world by one joint at its frame ``top`` (z up in the block)
@@ -91,10 +91,13 @@ def test_the_meant_pose_loads_and_a_slightly_off_one_is_left_to_projection(kind,
 def test_a_pose_where_the_rows_do_not_hold_yet_is_checked_once_consistent():
     """Turned 170° about x, the fixed joint's rows do not hold: loading leaves the pose to
     the state made consistent, and projection settles on the 180° flip, where
-    System.check_branches (to run on every consistent initial state) refuses it."""
+    consistent_initial_state (System.check_branches) refuses it, naming the joint."""
     system = mb.loads(model("fixed", rpy_matrix(np.radians(170), 0, 0)))
-    q, _, _ = consistent_initial_state(system)
+    q = project_positions(system, 0.0, system.initial_state()[0])
     phi, _ = system.constraint_residuals(0.0, q, np.zeros(system.n))
     assert np.abs(phi).max() < 1e-12  # consistent: every row holds
-    with pytest.raises(mb.SolveError, match=r"fixed joint 'hinge': its frames are turned 180° about \(-?1, 0, 0\)"):
-        system.check_branches(q)
+    with pytest.raises(mb.SolveError, match=r"fixed joint 'hinge': its frames are turned 180° about \(-?1, 0, 0\)") as info:
+        consistent_initial_state(system)
+    assert info.value.constraints == ("hinge",)
+    with pytest.raises(mb.SolveError, match="hinge"):
+        mb.simulate(system, 0.1)
