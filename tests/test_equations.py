@@ -391,3 +391,48 @@ def test_rank_tolerance_is_relative():
     assert rank_report(np.diag([1e-20, 1e-29, 1e-29]), A).unique  # all tiny, ratio 1e-9
     assert rank_report(np.zeros((3, 3)), np.eye(3)).unique
     assert rank_report(np.zeros((3, 3)), np.zeros((0, 3))).rank_Mhat == 0
+
+
+def test_forces_that_cancel_are_judged_against_the_terms_not_their_sum():
+    """Q + C = −2⁻⁵² Q on a massless coordinate is rounding of the forces involved (1e3), not
+    a load no mass resists: the consistency scale is ‖Q‖ + ‖C‖ + ‖M q̈‖ (issue 18); an
+    imbalance of 1e-6 of them still is one."""
+    Q = np.array([0.0, 1e3])
+    motion = constrained_acceleration(np.diag([1.0, 0.0]), Q, np.zeros((0, 2)), np.zeros(0), C=-Q * (1 + 2**-52))
+    assert not motion.unique and motion.qdd[0] == 0.0 and motion.nullspace.shape == (2, 1)
+    with pytest.raises(SolveError, match="no mass resists"):
+        constrained_acceleration(np.diag([1.0, 0.0]), Q, np.zeros((0, 2)), np.zeros(0), C=-Q * (1 + 1e-6))
+
+
+def test_drift_rule_takes_dependent_rows_in_the_least_squares_sense():
+    """Off the manifold (drift given), dependent rows whose b disagrees by the drift give the
+    minimum-norm solution of (2.12) with b projected on range(A) in the equilibrated rows
+    (each row of A scaled to unit norm; numpy's lstsq) — while on the manifold the same data
+    is a contradiction."""
+    M, Q = np.diag([2.0, 1.0, 3.0]), np.array([1.0, -2.0, 0.5])
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [2.0, 2.0, 0.0]])
+    b = np.array([1.0, 5.0, 2.0 + 1e-6])
+    with pytest.raises(SolveError, match="contradictory"):
+        constrained_acceleration(M, Q, A, b)
+    motion = constrained_acceleration(M, Q, A, b, drift=lambda: (np.full(3, 1e-12), np.ones(3)))
+    norms = np.linalg.norm(A, axis=1)
+    Ae, be = A / norms[:, None], b / norms
+    consistent = norms * (Ae @ np.linalg.lstsq(Ae, be, rcond=None)[0])
+    np.testing.assert_allclose(motion.qdd, constrained_acceleration(M, Q, A, consistent).qdd, rtol=1e-12)
+    assert motion.singular == ()
+
+
+def test_drift_rule_sets_aside_a_nearly_dependent_direction_that_amplifies_drift():
+    """Rows 1e-9 from dependent (σ ≈ 7e-10) with b off by 1e-7: the minimum-norm solution asks
+    ~140 along the nearly dependent direction, 1e2 times the rest of the motion; the drift rule
+    sets it aside (Motion.singular names the rows) and keeps the rest, which is the motion
+    with the direction removed."""
+    M, Q = np.eye(2), np.array([0.0, 1.0])
+    A, b = np.array([[1.0, 0.0], [1.0, 1e-9]]), np.array([0.0, 1e-7])
+    strict = constrained_acceleration(M, Q, A, b)
+    assert np.abs(strict.qdd).max() > 50
+    motion = constrained_acceleration(M, Q, A, b, drift=lambda: (np.zeros(2), np.ones(2)))
+    assert set(motion.singular) == {"row 0", "row 1"}
+    U, s, Vt = np.linalg.svd(A / np.linalg.norm(A, axis=1)[:, None])
+    kept = Vt[:1]  # the well-conditioned direction: x₁ held, x₂ free under its load
+    np.testing.assert_allclose(motion.qdd, Q - kept.T @ (kept @ Q), atol=1e-6)
