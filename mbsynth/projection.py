@@ -2,7 +2,8 @@
 
 (2.14) enforces the constraints only at the acceleration level (2.4): an integrated
 state drifts off φ(q, t) = 0 and φ̇ = 0. These functions move it back with the least
-change: positions by Gauss–Newton on the position-level rows, q ← q − Φ_q⁺ φ
+change (each coordinate weighed by how strongly it moves the constraints, ``_correction``):
+positions by Gauss–Newton on the position-level rows, q ← q − Φ_q⁺ φ
 (Φ_q = the rows of A of the holonomic constraints), then velocities on every
 velocity-level row (holonomic and non-holonomic, both linear in q̇),
 q̇ ← q̇ − A_v⁺ ψ. Coordinates marked fixed are not changed. Unit quaternions are
@@ -37,21 +38,28 @@ VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity st
 
 
 def _correction(J, r):
-    """Least-norm Δ with J Δ = r (J sparse). With independent rows Δ = Jᵀ (J Jᵀ)⁻¹ r,
-    J Jᵀ factored sparse (a tree of joints gives a tree-structured J Jᵀ: linear time);
-    dependent rows (a planar loop in 3D) make J Jᵀ singular, and then, or when that step
-    does not meet J Δ = r to SPARSE_ACCEPT, dense least squares takes over."""
+    """The smallest Δ with J Δ = r in the metric that weighs each coordinate by how strongly
+    it moves the constraints, ‖diag(c) Δ‖ with c_j = ‖J_:j‖ (column equilibration): a
+    quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
+    moved, not turned, as one 1 m long is. With G = J D (D = diag(1/c)) and independent
+    rows, Δ = D Gᵀ (G Gᵀ)⁻¹ r, G Gᵀ factored sparse (a tree of joints gives a
+    tree-structured G Gᵀ: linear time); dependent rows (a planar loop in 3D) make it
+    singular, and then, or when that step does not meet J Δ = r to SPARSE_ACCEPT, dense
+    least squares takes over."""
     if J.shape[0] == 0:
         return np.zeros(J.shape[1])
+    columns = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
+    D = scipy.sparse.diags(1.0 / np.where(columns > 0, columns, 1.0))
+    G = (J @ D).tocsr()
     try:
         with np.errstate(all="ignore"):
-            y = scipy.sparse.linalg.splu((J @ J.T).tocsc()).solve(r)
-            step = J.T @ y
+            y = scipy.sparse.linalg.splu((G @ G.T).tocsc()).solve(r)
+            step = D @ (G.T @ y)
         if np.all(np.isfinite(step)) and np.linalg.norm(J @ step - r) <= SPARSE_ACCEPT * (np.linalg.norm(r) + 1e-300):
             return step
     except RuntimeError:  # splu: the matrix is exactly singular
         pass
-    return np.linalg.lstsq(J.toarray(), r, rcond=1e-12)[0]
+    return D @ np.linalg.lstsq(G.toarray(), r, rcond=1e-12)[0]
 
 
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):

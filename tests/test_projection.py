@@ -19,12 +19,31 @@ def tree_rows(count, width=5):
     return J.tocsr()
 
 
+def weighted_least_norm(J, r):
+    """numpy's minimum of ‖diag(c) Δ‖ subject to J Δ = r, c_j = ‖J_:j‖ (the metric of
+    projection._correction): Δ = D (J D)⁺ r with D = diag(1/c)."""
+    J = J.toarray()
+    D = 1.0 / np.linalg.norm(J, axis=0)
+    return D * np.linalg.lstsq(J * D, r, rcond=1e-12)[0]
+
+
 def test_independent_rows_give_the_least_norm_step():
     J = tree_rows(40)
+    J = (J @ scipy.sparse.diags(RNG.uniform(1e-3, 1e3, size=J.shape[1]))).tocsr()  # coordinates in mixed units
     r = RNG.normal(size=J.shape[0])
     step = _correction(J, r)
-    expected = np.linalg.lstsq(J.toarray(), r, rcond=None)[0]
+    expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-10 * np.linalg.norm(expected)
+
+
+def test_the_step_does_not_depend_on_the_coordinates_units():
+    """Rescaling a coordinate (metres to millimetres, a quaternion beside lengths of a
+    kilometre) rescales its share of the step and nothing else: the same physical move."""
+    J = tree_rows(10)
+    r = RNG.normal(size=J.shape[0])
+    units = RNG.uniform(1e-3, 1e3, size=J.shape[1])
+    scaled = _correction((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r)  # coordinate j counted in 1/units_j
+    np.testing.assert_allclose(scaled / units, _correction(J, r), rtol=1e-9, atol=1e-12)
 
 
 def test_dependent_rows_still_give_the_least_norm_step():
@@ -32,6 +51,6 @@ def test_dependent_rows_still_give_the_least_norm_step():
     J = scipy.sparse.vstack([J, J[3] + 2 * J[17]]).tocsr()  # a redundant row, as a planar loop in 3D has
     r = J @ RNG.normal(size=J.shape[1])  # consistent right side
     step = _correction(J, r)
-    expected = np.linalg.lstsq(J.toarray(), r, rcond=1e-12)[0]
+    expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-9 * np.linalg.norm(expected)
     assert np.linalg.norm(J @ step - r) < 1e-9 * np.linalg.norm(r)

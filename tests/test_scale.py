@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
+from mbsynth.projection import project_positions
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -46,3 +47,29 @@ def test_n_four_bar_through_its_singular_position_at_any_scale(length, mass):
     by = (traj.column("v0.y") + 0.5 * length * np.cos(theta)) / length
     xr, yr = ref.n_four_bar_reference(traj.t / unit, 1)
     assert np.hypot(bx - xr, by - yr).max() < 1e-5  # of L; the benchmark asks 1e-3
+
+
+@pytest.mark.parametrize("length, mass", [(1e-3, 1e3), (1e3, 1e-3)])
+def test_rigid_double_pendulum_at_any_scale(length, mass):
+    """Rigid bodies with quaternions and revolute joints (the compiled tree path and its
+    fallbacks): the 3D double pendulum scaled in length and mass, released from rest at the
+    1 m model's consistent pose scaled alike (positions × length about the pivot at
+    (0, 0, 2), orientations as they are),
+    moves as the 1 m, 1 kg one after rescaling time, its angles alike to 1e-7 rad."""
+    base = mb.load(ROOT / "models" / "rigid" / "double_pendulum_3d.yaml")
+    p = base.parameters
+    scaled = base.with_parameters(L1=p["L1"] * length, L2=p["L2"] * length, r=p["r"] * length,
+                                  m1=p["m1"] * mass, m2=p["m2"] * mass)
+    unit = math.sqrt(length)
+    at_rest = np.zeros(base.n)
+    q0 = project_positions(base, 0.0, base.initial_q)
+    pivot = np.array([{"x": 0.0, "y": 0.0, "z": 2.0}.get(c.split(".")[1], np.nan) for c in base.coordinates])
+    q0_scaled = np.where(np.isnan(pivot), q0, pivot + (q0 - pivot) * length)
+    reference = mb.simulate(base, 2.0, dt=0.05, q0=q0, qd0=at_rest)
+    traj = mb.simulate(scaled, 2.0 * unit, dt=0.05 * unit, q0=q0_scaled, qd0=at_rest)
+    assert traj.status == reference.status == "completed"
+    for link in ("link1", "link2"):
+        # the angle about the pivot's y axis, from the quaternion (w, 0, y, 0): 2 atan2(y, w)
+        angle = 2 * np.arctan2(traj.column(f"{link}.qy"), traj.column(f"{link}.qw"))
+        expected = 2 * np.arctan2(reference.column(f"{link}.qy"), reference.column(f"{link}.qw"))
+        assert np.abs(np.angle(np.exp(1j * (angle - expected)))).max() < 1e-7
