@@ -7,12 +7,15 @@ against it; where its own method does not apply it falls back to the reference.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse
+import scipy.sparse.linalg
 from scipy.linalg import lapack
 
 from . import equations
 from .equations import Motion
 
 
+SPARSE_SIZE = 200  # KKT systems of this order and larger are factored sparse (SuperLU)
 RCOND_MIN = 1e-8  # KKT systems less well conditioned than this go to the reference (2.14)
 RESIDUAL_MAX = 1e-9  # a KKT solution whose relative residual of (2.12) exceeds this goes too
 
@@ -28,10 +31,12 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
     [M; A] has full column rank (Result 3: q̈ unique) and A has full row rank (λ unique).
 
     The system is equilibrated as in ``equations`` (rows of A and b by the row norms of A,
-    M and Q + C by max |M|), LU-factored (LAPACK getrf) and its reciprocal condition
-    number in the 1-norm estimated (gecon); one step of iterative refinement restores
-    accuracy on moderately ill-conditioned systems. When rcond is below ``rcond_min``, when
-    the solution's relative residual of the equilibrated (2.12) exceeds ``RESIDUAL_MAX``,
+    M and Q + C by max |M|), LU-factored (LAPACK getrf, or SuperLU from order
+    ``SPARSE_SIZE`` on) and its reciprocal condition number in the 1-norm estimated (gecon,
+    or Higham's estimate); one step of iterative refinement restores accuracy on moderately
+    ill-conditioned systems. ``residual`` is the relative residual of the equilibrated KKT
+    equations (its numerator bounds that of (2.12), since P Aᵀ = 0 and ‖P‖ = 1). When
+    rcond is below ``rcond_min``, when that residual exceeds ``RESIDUAL_MAX``,
     or when anything is not finite, the reference ``equations.constrained_acceleration``
     decides instead (with ``drift`` passed on): non-unique motion, dependent constraints,
     near-singular positions, or ``SolveError`` for inconsistent data. One verdict: rcond
@@ -41,22 +46,54 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
     """
     d = equations._prepare(M, Q, A, b, C, coordinates, constraints)
     n, m = d.n, d.m
-    K = np.zeros((n + m, n + m))
-    K[:n, :n] = d.M / d.mu
-    K[:n, n:] = d.Ae.T
-    K[n:, :n] = d.Ae
-    lu, piv, info = lapack.dgetrf(K)
-    if info == 0:
-        rcond, info = lapack.dgecon(lu, np.abs(K).sum(axis=0).max(), norm="1")
-        if info == 0 and rcond >= rcond_min:
-            rhs = np.concatenate([d.F / d.mu, d.be])[:, None]
-            x = lapack.dgetrs(lu, piv, rhs)[0]
-            x += lapack.dgetrs(lu, piv, rhs - K @ x)[0]  # one step of iterative refinement
-            qdd = x[:n, 0]
-            if np.isfinite(x).all():
-                Vk = np.linalg.qr(d.Ae.T)[0]  # A has full row rank: a basis of its row space
-                motion = equations._motion(d, qdd, Vk, "kkt", np.zeros((n, 0)))
-                if motion.residual <= RESIDUAL_MAX:
-                    return motion
+    rhs = np.concatenate([d.F / d.mu, d.be])
+    solve = _sparse_solve if n + m >= SPARSE_SIZE else _dense_solve
+    K, x, rcond = solve(d)
+    if x is not None and rcond >= rcond_min and np.isfinite(x).all():
+        residual = np.linalg.norm(K @ x - rhs) / (_norm(K) * np.linalg.norm(x) + np.linalg.norm(rhs) + 1e-300)
+        if residual <= RESIDUAL_MAX:
+            qdd = x[:n]
+            return Motion(qdd=qdd, unique=True, nullspace=np.zeros((n, 0)), Qc=d.M @ qdd - d.Q,
+                          residual=float(residual), method="kkt")
     return equations.constrained_acceleration(M, Q, A, b, C, coordinates=coordinates,
                                               constraints=constraints, drift=drift)
+
+
+def _dense_solve(d):
+    """(K, x, rcond) by LAPACK: LU (getrf), the 1-norm condition estimate (gecon), one step
+    of iterative refinement; x None when K is singular."""
+    n, m = d.n, d.m
+    K = np.zeros((n + m, n + m))
+    K[:n, :n], K[:n, n:], K[n:, :n] = d.M / d.mu, d.Ae.T, d.Ae
+    lu, piv, info = lapack.dgetrf(K)
+    if info != 0:
+        return K, None, 0.0
+    rcond, info = lapack.dgecon(lu, np.abs(K).sum(axis=0).max(), norm="1")
+    rhs = np.concatenate([d.F / d.mu, d.be])
+    x = lapack.dgetrs(lu, piv, rhs)[0]
+    x += lapack.dgetrs(lu, piv, rhs - K @ x)[0]  # one step of iterative refinement
+    return K, x, rcond if info == 0 else 0.0
+
+
+def _sparse_solve(d):
+    """(K, x, rcond) by SuperLU on the sparse K, the 1-norm of K⁻¹ estimated by Higham's
+    block algorithm (scipy's onenormest, a few solves with K and Kᵀ), one step of
+    iterative refinement; x None when K is singular."""
+    Ae = scipy.sparse.csc_matrix(d.Ae)
+    K = scipy.sparse.bmat([[scipy.sparse.csc_matrix(d.M / d.mu), Ae.T], [Ae, None]], format="csc")
+    try:
+        lu = scipy.sparse.linalg.splu(K)
+    except RuntimeError:  # exactly singular
+        return K, None, 0.0
+    inverse = scipy.sparse.linalg.LinearOperator(K.shape, matvec=lu.solve, rmatvec=lambda y: lu.solve(y, trans="T"),
+                                                 dtype=float)
+    rcond = 1.0 / (scipy.sparse.linalg.norm(K, 1) * scipy.sparse.linalg.onenormest(inverse))
+    rhs = np.concatenate([d.F / d.mu, d.be])
+    x = lu.solve(rhs)
+    x += lu.solve(rhs - K @ x)
+    return K, x, rcond
+
+
+def _norm(K):
+    """The Frobenius norm of a dense or sparse K."""
+    return scipy.sparse.linalg.norm(K) if scipy.sparse.issparse(K) else np.linalg.norm(K)
