@@ -49,8 +49,9 @@ distance from the manifold; A moves by about that much over it), and (2) the acc
 |c_i|/σ_i, is at most ``DRIFT_GAIN`` times that of the rest of the motion. On the
 manifold c_i = σ_i v_iᵀq̈, so a trusted direction changes nothing; off it, the drift's
 share of c_i is amplified by 1/σ_i → ∞ at the singular position, and a direction that
-fails (1) or (2) is treated as dependent (its rows are named in ``Motion.singular``
-when it failed (2)). Through a singular position the motion keeps its velocity and so
+fails (1) or (2) is treated as dependent. A direction that passes (1) is a singular
+position near (not a dependent row off its manifold): its rows are named in
+``Motion.singular``, whether (2) kept it or not. Through a singular position the motion keeps its velocity and so
 the branch it came from.
 """
 
@@ -134,8 +135,8 @@ class Motion:
     orthonormal basis of the directions it leaves free (n × 0 when ``unique``); ``Qc``:
     the constraint force M q̈ − Q of (2.5); ``residual``: relative residual of the
     row-equilibrated (2.12) at q̈; ``method``: the formula that produced q̈;
-    ``singular``: the constraint rows of the nearly dependent directions that the drift
-    rule set aside (a singular position; empty elsewhere).
+    ``singular``: under the drift rule, the constraint rows of the nearly dependent
+    directions at this state (a singular position near; empty elsewhere).
     """
 
     qdd: np.ndarray
@@ -238,7 +239,7 @@ def _solve(d: "_Data", rtol):
 def _trusted(d: "_Data", rtol, drift):
     """The drift rule (module docstring): d with A_e, b_e replaced by their trusted part
     (same rows, consistent by construction) and the names of the rows of the nearly
-    dependent directions whose right side the drift dominates."""
+    dependent directions of a singular position near."""
     U, s, Vt = np.linalg.svd(d.Ae, full_matrices=False)
     c = U.T @ d.be
     keep = s > rtol * s[0] if s[0] > 0 else np.zeros(s.size, dtype=bool)
@@ -251,8 +252,8 @@ def _trusted(d: "_Data", rtol, drift):
         asks = np.abs(c[near]) / s[near]
         drifted = np.flatnonzero(near)[asks > DRIFT_GAIN * np.linalg.norm(rest)]
         keep[drifted] = False
-        if drifted.size:
-            singular = tuple(d.constraints[i] for i in _named(np.abs(U[:, drifted]).max(axis=1)))
+        if near.any():
+            singular = tuple(d.constraints[i] for i in _named(np.abs(U[:, near]).max(axis=1)))
     return _restricted(d, U, s, Vt, c, keep), singular
 
 

@@ -14,7 +14,10 @@ manifold by the integration error, so the motion there follows the drift rule of
 dependent rows whose dependency changes with the configuration — Bricard's mechanism —
 and nearly dependent directions near a singular position set aside). At each projected
 output state the constraints are judged strictly: a real contradiction raises
-SolveError there. The singular positions crossed are in ``stats["singular_positions"]``.
+SolveError there. ``stats["singular_positions"]`` lists the output intervals in which a
+stage came near a singular position (σ < 1e-5 σ₁ of the equilibrated A: the drift rule's
+zone); a crossing whose stages all stay farther from it needs no special treatment and
+may go unlisted.
 """
 
 import logging
@@ -118,7 +121,7 @@ class _Run:
         self.non_unique = False
         self.calls, self.t_mark, self.span = 0, 0.0, 0.0
         self.drift_span = None  # the span between projections, when shorter than the output interval
-        self.singular = []  # (t, rows) of the stages where the drift rule set directions aside
+        self.singular = []  # (t, rows) of the stages near a singular position (Motion.singular)
         self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
 
     @property
@@ -187,7 +190,7 @@ class _Run:
             times = [t for t, _ in self.singular]
             rows = sorted({r for _, names in self.singular for r in names})
             self.singular_positions.append(dict(t_from=min(times), t_to=max(times), rows=rows))
-            log.info("singular position crossed near t = %.6g (nearly dependent rows %s set aside)",
+            log.info("singular position near t = %.6g (nearly dependent rows %s)",
                      min(times), ", ".join(rows))
             self.singular = []
 
