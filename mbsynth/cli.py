@@ -228,6 +228,8 @@ def run_simulate(args):
                "steps": traj.stats.get("steps"), "evaluations": traj.stats.get("evaluations"),
                "wall_time_s": round(time.perf_counter() - started, 3), "max_residual": traj.max_residual,
                "energy_drift": traj.energy_drift, "initial_changes": traj.stats.get("initial_changes", {}),
+               "singular_positions": [{"t_from": float(e["t_from"]), "t_to": float(e["t_to"]), "rows": e["rows"]}
+                                      for e in traj.stats.get("singular_positions", [])],
                "out": args.out and str(output_file(args.out, completed=error is None)), "plot": args.plot,
                "status": "completed" if error is None else "failed"}
     if error:
@@ -359,6 +361,12 @@ def format_summary(s):
              f"  max constraint residual {s['max_residual']:.3g}, relative energy drift {s['energy_drift']:.3g}"]
     for name, (given, new) in s["initial_changes"].items():
         lines.append(f"  initial {name}: {given:.9g} -> {new:.9g} (made consistent)")
+    if s["singular_positions"]:
+        times = ", ".join(f"{e['t_from']:.6g}" for e in s["singular_positions"][:8])
+        more = len(s["singular_positions"]) - 8
+        rows = sorted({r for e in s["singular_positions"] for r in e["rows"]})
+        lines.append(f"  passed near singular positions at t ≈ {times}{f' and {more} more' if more > 0 else ''} "
+                     f"(nearly dependent rows: {', '.join(rows[:6])}{', ...' if len(rows) > 6 else ''})")
     for key in ("out", "plot"):
         if s[key]:
             lines.append(f"  wrote {s[key]}")

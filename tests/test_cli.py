@@ -83,3 +83,24 @@ def test_model_error_is_one_line_and_exit_2(capsys, tmp_path):
     assert err.startswith(f"error: {bad}:2:") and "\n" not in err
     assert main(["check", str(bad), "--json"]) == 2
     assert "error" in json.loads(capsys.readouterr().out)
+
+
+def test_simulate_names_the_singular_position_it_passed(capsys):
+    """The N-four-bar (N = 2) comes horizontal, its rows dependent, when its one-degree-of-
+    freedom motion J ψ̈ = K sin ψ from vertical at 1 m/s reaches ψ = π/2: t = 0.714356 s
+    (benchmarks/iftomm_reference.py, scipy at 1e-13). The summary says so."""
+    root = Path(__file__).resolve().parent.parent
+    sys.path.insert(0, str(root / "benchmarks"))
+    import iftomm_reference as ref
+    import numpy as np
+
+    assert main(["simulate", str(root / "models" / "mechanisms" / "n_four_bar.yaml"), "--t-end", "1", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    first = summary["singular_positions"][0]
+    t = np.linspace(0.70, 0.73, 3001)
+    x, _ = ref.n_four_bar_reference(t, 2)
+    horizontal = t[np.argmax(x)]  # B0 farthest along +x: the bars horizontal
+    assert first["t_from"] <= horizontal + 1e-5 and first["t_to"] >= horizontal - 1e-5
+    assert "ground0[x]" in first["rows"]
+    assert main(["simulate", str(root / "models" / "mechanisms" / "n_four_bar.yaml"), "--t-end", "1"]) == 0
+    assert "passed near singular positions at t ≈ 0.7143" in capsys.readouterr().out
