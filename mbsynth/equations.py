@@ -68,7 +68,7 @@ CONSISTENCY_RTOL = 1e-9  # least relative size of b ∉ range(A) or of wᵀ(Q + 
 SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
 NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
 NEAR_SINGULAR = 1e-5  # σ_i below this fraction of σ₁ (of the equilibrated A): a nearly dependent direction
-DRIFT_RANK = 1e3  # a nearly dependent σ_i below this times the relative drift δ (× σ₁) counts as dependent
+DRIFT_RANK = 10.0  # a nearly dependent σ_i below this times the relative drift δ (× σ₁) counts as dependent
 TERM_FLOOR = 1e-3  # term_scales: the share of ‖A_i‖₁ ‖x‖∞ that a row with coordinates near zero keeps
 DRIFT_GAIN = 10.0  # a nearly dependent direction asking more than this times the rest's acceleration is drift
 VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off makes the verdict uncertain
@@ -246,8 +246,9 @@ def _trusted(d: "_Data", rtol, drift):
     near = keep & (s < NEAR_SINGULAR * s[0])
     singular = ()
     if near.any():
-        keep &= s > DRIFT_RANK * _relative_drift(d, drift) * s[0]
-        near &= keep
+        dependent = near & (s <= DRIFT_RANK * _relative_drift(d, drift) * s[0])  # (1): the drift's own
+        keep &= ~dependent
+        near &= ~dependent
         rest = _solve(_restricted(d, U, s, Vt, c, keep & ~near), rtol)[-1]
         asks = np.abs(c[near]) / s[near]
         drifted = np.flatnonzero(near)[asks > DRIFT_GAIN * np.linalg.norm(rest)]

@@ -254,7 +254,7 @@ class System:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
         if method == "fast":
-            motion = self._tree_motion(t, q, qd, baumgarte)
+            motion = self._tree_motion(t, q, qd, baumgarte, drift)
             if motion is not None:
                 return motion
         arrays = self.evaluate(t, q, qd)
@@ -273,11 +273,13 @@ class System:
         per row and q, evaluated only when its rule needs them."""
         return lambda: (self.constraint_residuals(t, q, qd)[0], q)
 
-    def _tree_motion(self, t, q, qd, baumgarte):
+    def _tree_motion(self, t, q, qd, baumgarte, drift):
         """The Motion from mbsynth.fast, or None: kernels not ready, model not covered (no
-        rigid body or particle, Coulomb friction) or a case for the exact treatment."""
+        rigid body or particle, Coulomb friction), a case for the exact treatment, or a
+        state off the manifold of a model with loops (the kernel's Schur step drops
+        dependent rows by its own rule, not by equations' drift rule)."""
         engine = fast.engine_for(self)
-        if engine is None:
+        if engine is None or (drift and engine.closes_loops):
             return None
         shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
         return engine.motion(t, q, qd, shift)

@@ -33,6 +33,7 @@ class Engine:
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.gen = np.zeros(self.outputs)
+        self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
         self.packed = pack(L)
         self.work, self.W = self.new_work()
         self.buffers = (*self.packed, *self.work)  # kernel.motion's last six arguments
