@@ -34,6 +34,7 @@ def _free_columns(n, fixed):
 
 
 SPARSE_ACCEPT = 1e-10  # relative residual under which the sparse least-norm step is taken
+PROJECTION_RCOND = 1e-8  # directions of J (columns equilibrated) below this × σ₁ count as dependent
 VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity step
 
 
@@ -43,23 +44,27 @@ def _correction(J, r):
     quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
     moved, not turned, as one 1 m long is. With G = J D (D = diag(1/c)) and independent
     rows, Δ = D Gᵀ (G Gᵀ)⁻¹ r, G Gᵀ factored sparse (a tree of joints gives a
-    tree-structured G Gᵀ: linear time); dependent rows (a planar loop in 3D) make it
-    singular, and then, or when that step does not meet J Δ = r to SPARSE_ACCEPT, dense
-    least squares takes over."""
+    tree-structured G Gᵀ: linear time). Rows that are dependent, or dependent to within
+    ``PROJECTION_RCOND`` (a loop whose dependency moves with the configuration, off its
+    manifold: the step along the near-dependent direction would be r's drift over σ), go to
+    dense least squares that drops those directions; so does a sparse step that does not
+    meet J Δ = r to SPARSE_ACCEPT."""
     if J.shape[0] == 0:
         return np.zeros(J.shape[1])
     columns = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
     D = scipy.sparse.diags(1.0 / np.where(columns > 0, columns, 1.0))
     G = (J @ D).tocsr()
+    size = np.linalg.norm(r) + 1e-300
     try:
         with np.errstate(all="ignore"):
-            y = scipy.sparse.linalg.splu((G @ G.T).tocsc()).solve(r)
-            step = D @ (G.T @ y)
-        if np.all(np.isfinite(step)) and np.linalg.norm(J @ step - r) <= SPARSE_ACCEPT * (np.linalg.norm(r) + 1e-300):
-            return step
+            z = G.T @ scipy.sparse.linalg.splu((G @ G.T).tocsc()).solve(r)
+        well_posed = np.linalg.norm(z) * PROJECTION_RCOND * scipy.sparse.linalg.norm(G) <= size
+        if np.all(np.isfinite(z)) and well_posed and np.linalg.norm(G @ z - r) <= SPARSE_ACCEPT * size:
+            return D @ z
     except RuntimeError:  # splu: the matrix is exactly singular
         pass
-    return D @ np.linalg.lstsq(G.toarray(), r, rcond=1e-12)[0]
+    G = G.toarray()
+    return D @ np.linalg.lstsq(G, r, rcond=PROJECTION_RCOND)[0]
 
 
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):

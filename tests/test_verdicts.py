@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import mbsynth as mb
-from mbsynth.equations import constrained_acceleration, rank_report, udwadia_kalaba
+from mbsynth.equations import RANK_RTOL, constrained_acceleration, equilibrate_rows, rank_report, udwadia_kalaba
 from mbsynth.solvers import SPARSE_SIZE, kkt_acceleration
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -29,12 +29,16 @@ def rel(x, y):
 
 
 def agreement(M, A, F, qdd):
-    """1e-9, or the forward error of a backward-stable solve of the equilibrated (2.12):
-    1e3 ε κ, times 1 + ‖Q + C‖/(μ ‖q̈‖) where the loads dwarf the inertia they move
-    (μ = max |M|: a near-massless model's q̈ comes from a cancellation of forces)."""
+    """1e-9, or the forward error of backward-stable solves of the equilibrated (2.12):
+    1e3 ε κ(M̂) κ(A), times 1 + ‖Q + C‖/(μ ‖q̈‖) where the loads dwarf the inertia they
+    move (μ = max |M|: a near-massless model's q̈ comes from a cancellation of forces).
+    κ(A) (σ₁/σ_r of the equilibrated A over its rank) enters through (2.14)'s projector
+    I − A⁺A, κ(M̂) through the solve itself."""
     mu = max(np.abs(M).max(), 1e-300)
-    loads = np.linalg.norm(F) / (mu * max(np.linalg.norm(qdd), 1e-300))
-    return max(1e-9, 1e3 * EPS * rank_report(M, A).condition * (1 + loads))
+    loads = np.linalg.norm(F) / max(mu * np.linalg.norm(qdd), 1e-300)
+    s = np.linalg.svd(equilibrate_rows(np.asarray(A, dtype=float).reshape(-1, M.shape[0]))[0], compute_uv=False)
+    kept = s[s > RANK_RTOL * s[0]] if s.size and s[0] > 0 else np.ones(1)
+    return max(1e-9, 1e3 * EPS * rank_report(M, A).condition * kept[0] / kept[-1] * (1 + loads))
 
 
 @st.composite
