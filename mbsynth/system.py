@@ -11,8 +11,11 @@ import numpy as np
 import scipy.sparse
 import sympy as sp
 
-from . import equations, fast, friction, solvers
+from . import equations, fast, friction, reactions, solvers
+from .connectors import Joint
 from .errors import ModelError, SolveError
+from .joint_values import JointKinematics
+from .subsystems import Frame
 from .symbolic import T_SYMBOL
 
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
@@ -249,10 +252,16 @@ class System:
         ``drift=True``: the state may lie off the constraint manifold (an integrator's
         stage): b is judged by the drift rule of ``equations`` (least squares where the
         drift explains an inconsistency, near-singular directions the drift dominates set
-        aside) instead of raising SolveError for contradictory constraints."""
+        aside) instead of raising SolveError for contradictory constraints.
+        The Motion's ``lam`` (the multipliers, reactions.py) is computed when first read."""
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
+        motion = self._solved(t, q, qd, method, baumgarte, drift)
+        return motion.with_multipliers(lambda: self._multipliers(t, q, qd, motion)[0])
+
+    def _solved(self, t, q, qd, method, baumgarte, drift):
+        """The Motion of ``motion``, without its multipliers."""
         if method == "fast":
             motion = self._tree_motion(t, q, qd, baumgarte, drift)
             if motion is not None:
@@ -324,3 +333,77 @@ class System:
         b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.constraints])
         C = sum((con.C for con in self.constraints), sp.zeros(n, 1))
         return M, Q, A, b, C
+
+    def _multipliers(self, t, q, qd, motion, arrays=None):
+        """(λ, dependent rows) of ``motion`` at (t, q, q̇): Qc − C = Aᵀλ (reactions.py)."""
+        arrays = self.evaluate(t, q, qd) if arrays is None else arrays
+        C = arrays.C if motion.C is None else motion.C
+        return reactions.multipliers(arrays.A, arrays.M @ motion.qdd - arrays.Q - C)
+
+    def joint_kinematics(self):
+        """{name: joint_values.JointKinematics} of every joint (reaction frames; fixed and
+        distance joints have no values) and of each floating robot's root link
+        (``<prefix>root_joint``, a free joint, as Pinocchio names it), compiled on first use."""
+        found = self.__dict__.get("_joint_kinematics")
+        if found is None:
+            from .robots import LINK_FRAME  # robots.py builds on this module
+            found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
+                                             c.report_frame, self)
+                     for c in self.constraints if isinstance(c, Joint)}
+            parts = {p.name: p for p in self.subsystems}
+            for robot in self.robots:
+                if robot.floating:
+                    root = parts[robot.parts[robot.description.root]]
+                    frame = root.frames[LINK_FRAME]
+                    world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
+                    name = f"{robot.prefix}root_joint"
+                    found[name] = JointKinematics(name, "free", None, world, root, frame, frame, self)
+            object.__setattr__(self, "_joint_kinematics", found)
+        return found
+
+    def joint_values(self, t, q, qd, qdd=None):
+        """{joint name: JointValues(position, rate, acceleration)} of every joint that has
+        values (joint_values.py: revolute ``angle``, prismatic ``displacement``, …, a
+        floating robot's ``root_joint``), in model order; acceleration None without q̈."""
+        q, qd = self._state(q, qd)
+        qdd = None if qdd is None else np.asarray(qdd, dtype=float).ravel()
+        p = self.parameter_values
+        return {name: k.values(t, q, qd, qdd, p) for name, k in self.joint_kinematics().items() if k.position_names}
+
+    def reactions(self, t, q, qd, motion=None):
+        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default
+        ``self.motion(t, q, qd)``): the multipliers of each connector's rows, and for each
+        joint the wrench (``force``, ``torque``) the parent exerts on the child through it —
+        its rows, its friction, its actuation and spring — at the child's reaction frame
+        (the frame B of the joint; a robot's child link frame), in that frame's axes."""
+        q, qd = self._state(q, qd)
+        motion = self.motion(t, q, qd) if motion is None else motion
+        arrays = self.evaluate(t, q, qd)
+        lam, dependent = self._multipliers(t, q, qd, motion, arrays)
+        kinematics, p = self.joint_kinematics(), self.parameter_values
+        out, row = {}, 0
+        for con in self.constraints:
+            rows = slice(row, row + con.size)
+            force = torque = None
+            if con.name in kinematics:
+                k = kinematics[con.name]
+                g = self._joint_force(con, lam[rows], t, q, qd, p)
+                force, torque = reactions.wrench(k.frame(t, q, qd, p), con.parts[1].idle_directions(q[k.child_indices]),
+                                                 g[k.child_indices])
+            out[con.name] = reactions.Reaction(lam[rows].copy(), bool(dependent[rows].any()), force, torque)
+            row += con.size
+        return out
+
+    def _joint_force(self, joint, lam, t, q, qd, p):
+        """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the
+        load λ gives, Coulomb friction: friction.py) and its force elements."""
+        g = np.zeros(self.n)
+        a, _, c = joint.evaluate(t, q, qd, p)
+        g[joint.indices] += a.T @ lam + c
+        if joint.coulomb is not None:
+            w, direction = joint.coulomb.evaluate(t, q, qd, p)
+            g[joint.coulomb.indices] -= np.sign(w) * np.linalg.norm(lam[joint.coulomb.load_rows]) * direction
+        for element in self.forces:
+            if element.joint == joint.name:
+                g[element.indices] += element.evaluate(t, q, qd, p)
+        return g

@@ -1,0 +1,168 @@
+"""Joint values: the relative coordinates of a joint's two frames, read off the parts' states.
+
+Frame A is on the parent (or the world), frame B on the child; x, y, z their axes and
+p their origins in the world, ω the parts' angular velocities. Per kind of joint:
+
+    revolute     angle θ = atan2((x_A × x_B)·z_A, x_A·x_B)       rate z_A·(ω_B − ω_A)
+    prismatic    displacement s = z_A·(p_B − p_A)                rate ṡ
+    cylindrical  angle, displacement                             angle_rate, displacement_rate
+    universal    angle1 = atan2(z_B·y_A, z_B·x_A) (about z_A),   rate1 = z_A·(ω_B − ω_A),
+                 angle2 = atan2(−z_A·y_B, z_A·x_B) (about z_B)   rate2 = z_B·(ω_B − ω_A)
+    spherical    rotation vector of R_Aᵀ R_B (rx, ry, rz)        R_Bᵀ(ω_B − ω_A) (wx, wy, wz)
+    free         p_B, quaternion of R_B (x y z qw qx qy qz)      R_Bᵀ ṗ_B, R_Bᵀ ω_B (vx vy vz wx wy wz)
+
+A joint's acceleration is the time derivative of its rates' components,
+(∂w/∂q̇) q̈ + (∂w/∂q) q̇ + ∂w/∂t, compiled with the rates. These are Pinocchio's
+conventions: a revolute joint's (q, v, v̇) are (θ, θ̇, θ̈); a free-flyer's v is the
+spatial velocity in its own axes and v̇ its derivative, Rᵀp̈ − ω × Rᵀṗ (not the classical
+acceleration); Pinocchio's quaternion is (x, y, z, w), mbsynth's (w, x, y, z). Angles
+are atan2 in (−π, π] at one state; ``unwrap`` makes them continuous along a trajectory.
+Fixed and distance joints have no values.
+
+The same compiled function gives the pose of the joint's reaction frame (the child frame
+B, or a robot's child link frame) and its Jacobian, which turn the generalized force a
+joint exerts on its child into a wrench (``System.reactions``).
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+import sympy as sp
+from scipy.spatial.transform import Rotation
+
+from .kinematics import matrix_quaternion
+from .symbolic import T_SYMBOL, compile_function, jacobian, time_derivative
+
+# kind -> (position names, rate names, acceleration names, which positions are angles)
+NAMES = {
+    "revolute": (("angle",), ("rate",), ("acceleration",), (True,)),
+    "prismatic": (("displacement",), ("rate",), ("acceleration",), (False,)),
+    "cylindrical": (("angle", "displacement"), ("angle_rate", "displacement_rate"),
+                    ("angle_acceleration", "displacement_acceleration"), (True, False)),
+    "universal": (("angle1", "angle2"), ("rate1", "rate2"), ("acceleration1", "acceleration2"), (True, True)),
+    "spherical": (("rx", "ry", "rz"), ("wx", "wy", "wz"), ("wx_dot", "wy_dot", "wz_dot"), (False,) * 3),
+    "free": (("x", "y", "z", "qw", "qx", "qy", "qz"), ("vx", "vy", "vz", "wx", "wy", "wz"),
+             ("vx_dot", "vy_dot", "vz_dot", "wx_dot", "wy_dot", "wz_dot"), (False,) * 7),
+}
+MATRIX_POSITIONS = {"spherical", "free"}  # positions computed from the frames' rotations, not compiled
+
+
+class JointValues(NamedTuple):
+    """One joint's ``position``, ``rate`` and ``acceleration`` (None without q̈), arrays
+    with one entry per joint coordinate (``JointKinematics.names``)."""
+
+    position: np.ndarray
+    rate: np.ndarray
+    acceleration: np.ndarray = None
+
+
+class FramePose(NamedTuple):
+    """The reaction frame's world ``origin`` and ``rotation`` (frame → world), and
+    ``jacobian`` (6 × the child's coordinates): [ṗ; ω] = jacobian · q̇_child."""
+
+    origin: np.ndarray
+    rotation: np.ndarray
+    jacobian: np.ndarray
+
+
+class JointKinematics:
+    """The compiled joint values of one joint of ``kind`` between ``frame_a`` on ``parent``
+    (None: the world) and ``frame_b`` on ``child``, and the pose of ``report_frame`` (a
+    frame on the child with B's origin: B itself, or a robot's link frame)."""
+
+    def __init__(self, name, kind, parent, frame_a, child, frame_b, report_frame, system):
+        self.name, self.kind = name, kind
+        self.position_names, self.rate_names, self.acceleration_names, self.angles = NAMES.get(kind, ((), (), (), ()))
+        q, qd = list(system.q_symbols), list(system.qd_symbols)
+        where = {s: i for i, s in enumerate(q)}
+        local = sorted({where[s] for part in (parent, child) if part is not None for s in part.q})
+        self.indices = np.array(local, dtype=int)
+        self.child_indices = np.array([where[s] for s in child.q], dtype=int)
+        ql, qdl = [q[i] for i in local], [qd[i] for i in local]
+        pA, RA = _pose(parent, frame_a)
+        pB, RB = child.pose(frame_b)
+        positions, rates = _relative(kind, parent, child, pA, RA, pB, RB, ql, qdl)
+        rates = sp.Matrix(rates) if rates else sp.zeros(0, 1)
+        rate_a = jacobian(rates, qdl)
+        rate_b = -(jacobian(rates, ql) * sp.Matrix(qdl)) - sp.diff(rates, T_SYMBOL) if rates else sp.zeros(0, 1)
+        pR, RR = child.pose(report_frame)
+        frame_rate = sp.Matrix.vstack(sp.Matrix([time_derivative(x, ql, qdl) for x in pR]), child.angular_velocity())
+        J = jacobian(frame_rate, list(child.qd))
+        exprs = [sp.Matrix(positions) if positions else sp.zeros(0, 1), rates, rate_a, rate_b, sp.Matrix(pR),
+                 sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
+        self._evaluate = compile_function((T_SYMBOL, ql, qdl, list(system.parameter_symbols)), exprs)
+
+    @property
+    def names(self):
+        """The names of its coordinates (``angle``, ``displacement``, ``rx`` …)."""
+        return self.position_names
+
+    def values(self, t, q, qd, qdd, p):
+        """``JointValues`` at the model's state (q, q̇) and, when given, q̈."""
+        i = self.indices
+        scalars, rates, rate_a, rate_b, _, _, RA, RB, _ = self._evaluate(t, q[i], qd[i], p)
+        position = _positions(self.kind, scalars.ravel(), RA, RB, self._origin(t, q, qd, p))
+        acceleration = None if qdd is None else rate_a @ qdd[i] - rate_b.ravel()
+        return JointValues(position, rates.ravel(), acceleration)
+
+    def _origin(self, t, q, qd, p):
+        return self._evaluate(t, q[self.indices], qd[self.indices], p)[4].ravel() if self.kind == "free" else None
+
+    def frame(self, t, q, qd, p):
+        """The ``FramePose`` of the reaction frame."""
+        i = self.indices
+        *_, pR, RR, _, _, J = self._evaluate(t, q[i], qd[i], p)
+        return FramePose(pR.ravel(), RR, J)
+
+
+def _pose(part, frame):
+    if part is None:
+        return sp.Matrix(frame.position), sp.Matrix(frame.rotation)
+    return part.pose(frame)
+
+
+def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):
+    """(scalar position expressions, rate expressions) of a joint of ``kind``."""
+    xa, ya, za = RA[:, 0], RA[:, 1], RA[:, 2]
+    xb, yb, zb = RB[:, 0], RB[:, 1], RB[:, 2]
+    omega = child.angular_velocity() - (parent.angular_velocity() if parent is not None else sp.zeros(3, 1))
+    angle = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
+    displacement = za.dot(pB - pA)
+    if kind == "revolute":
+        return [angle], [za.dot(omega)]
+    if kind == "prismatic":
+        return [displacement], [time_derivative(displacement, q, qd)]
+    if kind == "cylindrical":
+        return [angle, displacement], [za.dot(omega), time_derivative(displacement, q, qd)]
+    if kind == "universal":
+        return [sp.atan2(zb.dot(ya), zb.dot(xa)), sp.atan2(-za.dot(yb), za.dot(xb))], [za.dot(omega), zb.dot(omega)]
+    if kind == "spherical":
+        return [], list(RB.T * omega)
+    if kind == "free":
+        velocity = sp.Matrix([time_derivative(x, q, qd) for x in pB])
+        return [], list(RB.T * velocity) + list(RB.T * child.angular_velocity())
+    return [], []
+
+
+def _positions(kind, scalars, RA, RB, origin):
+    """The position entries: compiled scalars, or from the frames' rotations."""
+    if kind == "spherical":
+        return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
+    if kind == "free":
+        return np.concatenate([origin, matrix_quaternion(RB)])
+    return scalars
+
+
+def _orthonormal(R):
+    """The rotation nearest R (R is exact on the constraint manifold; rounding off it)."""
+    U, _, Vt = np.linalg.svd(R)
+    return U @ Vt
+
+
+def unwrap(kinematics, positions):
+    """``positions`` (T × k, one row per time) of a joint with its angles made continuous."""
+    positions = np.array(positions, dtype=float)
+    for j, is_angle in enumerate(kinematics.angles):
+        if is_angle:
+            positions[:, j] = np.unwrap(positions[:, j])
+    return positions
