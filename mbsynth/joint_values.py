@@ -115,6 +115,27 @@ class JointKinematics:
         return FramePose(pR.ravel(), RR, J)
 
 
+def value_expressions(joint):
+    """{name: sympy expression} of a joint's values that are expressions of the state (the
+    names model files use as ``<joint>.<name>``): its positions except a spherical joint's
+    rotation vector, and its rates."""
+    kind = joint.joint_kind
+    if kind not in NAMES:
+        return {}
+    positions, rates, _, _ = NAMES[kind]
+    if kind in ("revolute", "prismatic", "cylindrical"):  # the joint's own (shared) expressions
+        exprs = {"revolute": [joint.angle, joint.angle_rate], "prismatic": [joint.displacement, joint.displacement_rate],
+                 "cylindrical": [joint.angle, joint.displacement, joint.angle_rate, joint.displacement_rate]}[kind]
+        return dict(zip(positions + rates, exprs))
+    parent, child = joint.parts
+    q = (list(parent.q) if parent is not None else []) + list(child.q)
+    qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+    pA, RA = _pose(parent, joint.frames[0])
+    pB, RB = child.pose(joint.frames[1])
+    scalars, rate_exprs = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
+    return dict(zip(positions[:len(scalars)] + rates, list(scalars) + list(rate_exprs)))
+
+
 def _pose(part, frame):
     if part is None:
         return sp.Matrix(frame.position), sp.Matrix(frame.rotation)

@@ -4,6 +4,7 @@ finite differences."""
 import numpy as np
 import pinocchio as pin
 import pytest
+from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 import mbsynth as mb
@@ -195,3 +196,56 @@ def test_joint_rates_are_derivatives_of_positions():
         else:
             derivative = (after[name].position - before[name].position) / (2 * h)
         assert np.allclose(derivative, value.rate, rtol=0, atol=1e-7 * (1 + np.abs(value.rate).max()))
+
+
+PD_PENDULUM = """
+name: pd_pendulum
+parameters: {m: 1.0, L: 1.0, g: 9.81, kp: 50.0, kd: 10.0, target: 0.5}
+gravity: [0, 0, -g]
+world: {frames: {pivot: {axis: [0, 1, 0]}}}
+subsystems:
+  rod:
+    type: rigid_body
+    mass: m
+    inertia: [m*L**2/12, m*L**2/12, 0.001]
+    frames: {top: {position: [0, 0, L/2], axis: [0, 1, 0]}}
+    initial: {position: [0, 0, -L/2]}
+joints:
+  - name: hinge
+    type: revolute
+    parent: world.pivot
+    child: rod.top
+    actuation: -kp*(hinge.angle - target) - kd*hinge.rate
+"""
+
+
+def test_pd_law_on_joint_values_settles_at_the_static_balance():
+    """A PD law written on ``hinge.angle`` and ``hinge.rate`` holds the rod where the
+    spring torque balances gravity: kp (θ − target) = −m g (L/2) sin θ."""
+    system = mb.loads(PD_PENDULUM)
+    trajectory = mb.simulate(system, 6.0, dt=1.0)
+    (theta,), (rate,), _ = system.joint_values(trajectory.t[-1], trajectory.q[-1], trajectory.qd[-1])["hinge"]
+    balance = brentq(lambda x: 50.0 * (x - 0.5) + 9.81 * 0.5 * np.sin(x), 0.0, 1.0)
+    assert theta == pytest.approx(balance, abs=1e-6)
+    assert abs(rate) < 1e-5
+
+
+def test_prescribed_joint_angle_multiplier_is_the_driving_torque():
+    """``holonomic: hinge.angle − 0.3 sin 2t`` in place of the actuation: the row's
+    multiplier is the torque I θ̈ + m g (L/2) sin θ that makes that motion."""
+    text = PD_PENDULUM.replace("    actuation: -kp*(hinge.angle - target) - kd*hinge.rate\n", "")
+    text += "constraints:\n  - {name: servo, holonomic: hinge.angle - 0.3*sin(2*t)}\n"
+    system = mb.loads(text)
+    trajectory = mb.simulate(system, 1.0, dt=0.5)
+    t, q, qd = trajectory.t[-1], trajectory.q[-1], trajectory.qd[-1]
+    motion = system.motion(t, q, qd)
+    theta, acceleration = 0.3 * np.sin(2 * t), -1.2 * np.sin(2 * t)
+    assert system.joint_values(t, q, qd)["hinge"].position[0] == pytest.approx(theta, abs=1e-9)
+    torque = acceleration / 3 + 9.81 / 2 * np.sin(theta)  # I = m L²/3 about the pivot
+    assert system.reactions(t, q, qd, motion)["servo"].multipliers[0] == pytest.approx(torque, rel=1e-8)
+
+
+def test_joint_named_like_a_part_is_refused():
+    text = PD_PENDULUM.replace("name: hinge", "name: rod").replace("hinge.", "rod.")
+    with pytest.raises(mb.ModelError, match=r"joints\[0\].*joint 'rod' has the name of part 'rod'"):
+        mb.loads(text)

@@ -12,7 +12,9 @@ import numpy as np
 import sympy as sp
 
 from ..closure import close
+from ..connectors import Joint
 from ..constraint import Connector
+from ..joint_values import value_expressions
 from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
 from ..symbolic import T_SYMBOL
@@ -157,8 +159,9 @@ class _Builder:
                 self.global_symbols[f"{part.name}.{c}_dot"] = qds
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
-        joints, joint_forces = read_joints(self)
         robot_joints, robot_forces = connect_robots(self)
+        self.register_joints(robot_joints)
+        joints, joint_forces = read_joints(self)
         constraints += robot_joints + self.read_constraints() + joints
         self.check_names(constraints)
         initial = self.read_initial(parts)
@@ -306,6 +309,19 @@ class _Builder:
         node = self.mapping(spec["C"], path + ("C",), set(coords))
         return [self.expression(node[c], path + ("C", c), self.global_symbols) if c in node
                 else sp.S.Zero for c in coords]
+
+    def register_joints(self, joints):
+        """Put the joints' values (``<joint>.angle``, ``<joint>.rate``, …: joint_values.py)
+        among the names expressions may use; a joint and a part share one namespace."""
+        for joint in joints:
+            if not isinstance(joint, Joint):
+                continue
+            if joint.name in self.parts:
+                self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
+                          f"joint '{joint.name}' has the name of part '{joint.name}': joints and parts share one "
+                          f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
+            for key, expr in value_expressions(joint).items():
+                self.global_symbols[f"{joint.name}.{key}"] = expr
 
     def coordinate_names(self):
         return (str(s) for s in self.q)
