@@ -160,7 +160,7 @@ class _Builder:
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
         robot_joints, robot_forces = connect_robots(self)
-        self.register_joints(robot_joints)
+        self.register_joints(robot_joints, robot=True)
         joints, joint_forces = read_joints(self)
         constraints += robot_joints + self.read_constraints() + joints
         self.check_names(constraints)
@@ -310,11 +310,13 @@ class _Builder:
         return [self.expression(node[c], path + ("C", c), self.global_symbols) if c in node
                 else sp.S.Zero for c in coords]
 
-    def register_joints(self, joints):
+    def register_joints(self, joints, robot=False):
         """Put the joints' values (``<joint>.angle``, ``<joint>.rate``, …: joint_values.py)
-        among the names expressions may use; a joint and a part share one namespace."""
+        among the names expressions may use; a joint and a part share one namespace. A
+        URDF may give a joint its child link's name: such a robot joint has no values in
+        expressions (its part's coordinates keep the name)."""
         for joint in joints:
-            if not isinstance(joint, Joint):
+            if not isinstance(joint, Joint) or (robot and joint.name in self.parts):
                 continue
             if joint.name in self.parts:
                 self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
