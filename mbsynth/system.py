@@ -14,7 +14,7 @@ import sympy as sp
 from . import equations, fast, friction, reactions, solvers
 from .connectors import Joint
 from .errors import ModelError, SolveError
-from .joint_values import JointKinematics
+from .joint_values import JointKinematics, value_expressions
 from .subsystems import Frame
 from .symbolic import T_SYMBOL
 
@@ -64,6 +64,7 @@ class System:
     source: str = ""  # the model file's text, for workers that rebuild the System
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
+    outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
 
     @classmethod
     def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
@@ -407,3 +408,15 @@ class System:
             if element.joint == joint.name:
                 g[element.indices] += element.evaluate(t, q, qd, p)
         return g
+
+    def expression_names(self):
+        """{name: sympy expression} of what expressions about this model may use: t, the
+        parameters, coordinates ``part.c``, velocities ``part.c_dot`` and joint values
+        ``joint.angle``, ``joint.rate``, … (joint_values.value_expressions; a robot joint
+        named like a part has none)."""
+        names = {"t": T_SYMBOL, **{str(s): s for s in (*self.parameter_symbols, *self.q_symbols, *self.qd_symbols)}}
+        parts = {p.name for p in self.subsystems}
+        for con in self.constraints:
+            if isinstance(con, Joint) and con.name not in parts:
+                names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
+        return names

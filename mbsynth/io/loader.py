@@ -21,12 +21,13 @@ from ..symbolic import T_SYMBOL
 from ..system import System
 from .forces import read_forces
 from .joints import read_joints, read_world
+from .outputs import read_outputs
 from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import connect_robots, read_robot, read_robots
 from .source import Document, LineDict, LineList, read_document
 
 TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
-            "closure", "initial", "initial_fixed", "forces"}
+            "closure", "initial", "initial_fixed", "forces", "outputs"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
@@ -170,7 +171,8 @@ class _Builder:
                               forces=[*robot_forces, *read_forces(self), *joint_forces])
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
                          source=self.doc.text, source_folder=str(self.doc.folder),
-                         robots=tuple(entry.robot for entry in self.robots.values()))
+                         robots=tuple(entry.robot for entry in self.robots.values()),
+                         outputs=read_outputs(self, constraints))
         self.check_parts(system)
         self.check_branches(system)
         closure = root.get("closure", "none")
