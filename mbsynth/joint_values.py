@@ -180,8 +180,23 @@ def _orthonormal(R):
     return U @ Vt
 
 
-def unwrap(kinematics, positions):
-    """``positions`` (T × k, one row per time) of a joint with its angles made continuous."""
+def along(system, t, q, qd, qdd=None):
+    """{joint name: JointValues of arrays (one row per time)} along a trajectory (arrays t,
+    q, q̇ and optionally q̈, one row per time), with the angles made continuous (unwrapped):
+    a joint turning past π keeps counting."""
+    rows = [system.joint_values(ti, qi, qdi, None if qdd is None else qdd[i])
+            for i, (ti, qi, qdi) in enumerate(zip(t, q, qd))]
+    kinematics = system.joint_kinematics()
+    out = {}
+    for name in (rows[0] if rows else {}):
+        position, rate, acceleration = (np.array([r[name][k] for r in rows]) if qdd is not None or k < 2 else None
+                                        for k in range(3))
+        out[name] = JointValues(_unwrapped(kinematics[name], position), rate, acceleration)
+    return out
+
+
+def _unwrapped(kinematics, positions):
+    """``positions`` (T × k) of a joint with its angles made continuous."""
     positions = np.array(positions, dtype=float)
     for j, is_angle in enumerate(kinematics.angles):
         if is_angle:

@@ -249,3 +249,63 @@ def test_joint_named_like_a_part_is_refused():
     text = PD_PENDULUM.replace("name: hinge", "name: rod").replace("hinge.", "rod.")
     with pytest.raises(mb.ModelError, match=r"joints\[0\].*joint 'rod' has the name of part 'rod'"):
         mb.loads(text)
+
+
+CART_POLE = """
+name: cart_pole
+parameters: {M: 1.5, m: 0.4, l: 0.3, I: 0.004, g: 9.81}
+gravity: [0, 0, -g]
+world: {frames: {rail: {axis: [1, 0, 0]}}}
+subsystems:
+  cart:
+    type: rigid_body
+    mass: M
+    inertia: [0.01, 0.01, 0.01]
+    frames: {rail: {axis: [1, 0, 0]}, pivot: {axis: [0, 1, 0]}}
+  pole:
+    type: rigid_body
+    mass: m
+    inertia: [I, I, 0.001]
+    frames: {pivot: {position: [0, 0, l], axis: [0, 1, 0]}}
+    initial: {position: [0, 0, -l]}
+joints:
+  - {name: slider, type: prismatic, parent: world.rail, child: cart.rail}
+  - {name: hinge, type: revolute, parent: cart.pivot, child: pole.pivot}
+constraints:
+  - {name: servo, holonomic: slider.displacement - 0.2*sin(3*t)}
+"""
+
+
+def test_under_actuated_cart_pole_servo_force():
+    """A cart-pole whose cart follows x(t) = 0.2 sin 3t by a servo row, the pole free: the
+    pole obeys (I + m l²) θ̈ − m l cos θ ẍ + m g l sin θ = 0 and the servo's multiplier is
+    the force on the cart, (M + m) ẍ − m l cos θ θ̈ + m l sin θ θ̇² (Lagrange's equations)."""
+    system = mb.loads(CART_POLE)
+    P = system.parameters
+    M, m, l, I, g = P["M"], P["m"], P["l"], P["I"], P["g"]
+    trajectory = mb.simulate(system, 1.0, dt=0.5)
+    t, q, qd = trajectory.t[-1], trajectory.q[-1], trajectory.qd[-1]
+    motion = system.motion(t, q, qd)
+    values = system.joint_values(t, q, qd, motion.qdd)
+    x, xdd = values["slider"].position[0], values["slider"].acceleration[0]
+    assert x == pytest.approx(0.2 * np.sin(3 * t), abs=1e-9)
+    assert xdd == pytest.approx(-1.8 * np.sin(3 * t), abs=1e-8)
+    (theta,), (rate,), (thdd,) = values["hinge"]
+    assert (I + m * l**2) * thdd - m * l * np.cos(theta) * xdd + m * g * l * np.sin(theta) == pytest.approx(0, abs=1e-9)
+    force = (M + m) * xdd - m * l * np.cos(theta) * thdd + m * l * np.sin(theta) * rate**2
+    assert system.reactions(t, q, qd, motion)["servo"].multipliers[0] == pytest.approx(force, rel=1e-9)
+
+
+def test_angles_along_a_trajectory_keep_counting():
+    """A free rod spun about its hinge (no gravity) turns at a constant rate: along the
+    trajectory its angle is rate · t, past ±π, not wrapped."""
+    text = PD_PENDULUM.replace("    actuation: -kp*(hinge.angle - target) - kd*hinge.rate\n", "")
+    text = text.replace("gravity: [0, 0, -g]", "gravity: [0, 0, 0]")
+    text = text.replace("initial: {position: [0, 0, -L/2]}", "initial: {position: [0, 0, -L/2], angular_velocity: [0, 4, 0]}")
+    system = mb.loads(text)
+    trajectory = mb.simulate(system, 2.0, dt=0.1)
+    from mbsynth.joint_values import along
+    hinge = along(system, trajectory.t, trajectory.q, trajectory.qd)["hinge"]
+    assert hinge.acceleration is None
+    assert np.allclose(hinge.rate[:, 0], 4.0, rtol=1e-9)
+    assert np.allclose(hinge.position[:, 0], 4.0 * trajectory.t, atol=1e-8)
