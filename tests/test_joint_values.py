@@ -1,6 +1,8 @@
 """Joint values and reactions (issue 19) against Pinocchio, analytic solutions and
 finite differences."""
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -12,6 +14,8 @@ from mbsynth.constraint import Connector
 from mbsynth.symbolic import T_SYMBOL
 from mbsynth.twin import Twin
 from mbsynth.validate import sample_pinocchio_state
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def _pinocchio_positions(coordinate, q):
@@ -198,25 +202,8 @@ def test_joint_rates_are_derivatives_of_positions():
         assert np.allclose(derivative, value.rate, rtol=0, atol=1e-7 * (1 + np.abs(value.rate).max()))
 
 
-PD_PENDULUM = """
-name: pd_pendulum
-parameters: {m: 1.0, L: 1.0, g: 9.81, kp: 50.0, kd: 10.0, target: 0.5}
-gravity: [0, 0, -g]
-world: {frames: {pivot: {axis: [0, 1, 0]}}}
-subsystems:
-  rod:
-    type: rigid_body
-    mass: m
-    inertia: [m*L**2/12, m*L**2/12, 0.001]
-    frames: {top: {position: [0, 0, L/2], axis: [0, 1, 0]}}
-    initial: {position: [0, 0, -L/2]}
-joints:
-  - name: hinge
-    type: revolute
-    parent: world.pivot
-    child: rod.top
-    actuation: -kp*(hinge.angle - target) - kd*hinge.rate
-"""
+PD_PENDULUM = (ROOT / "models" / "joints" / "pd_pendulum.yaml").read_text()
+
 
 
 def test_pd_law_on_joint_values_settles_at_the_static_balance():
@@ -251,29 +238,8 @@ def test_joint_named_like_a_part_is_refused():
         mb.loads(text)
 
 
-CART_POLE = """
-name: cart_pole
-parameters: {M: 1.5, m: 0.4, l: 0.3, I: 0.004, g: 9.81}
-gravity: [0, 0, -g]
-world: {frames: {rail: {axis: [1, 0, 0]}}}
-subsystems:
-  cart:
-    type: rigid_body
-    mass: M
-    inertia: [0.01, 0.01, 0.01]
-    frames: {rail: {axis: [1, 0, 0]}, pivot: {axis: [0, 1, 0]}}
-  pole:
-    type: rigid_body
-    mass: m
-    inertia: [I, I, 0.001]
-    frames: {pivot: {position: [0, 0, l], axis: [0, 1, 0]}}
-    initial: {position: [0, 0, -l]}
-joints:
-  - {name: slider, type: prismatic, parent: world.rail, child: cart.rail}
-  - {name: hinge, type: revolute, parent: cart.pivot, child: pole.pivot}
-constraints:
-  - {name: servo, holonomic: slider.displacement - 0.2*sin(3*t)}
-"""
+CART_POLE = (ROOT / "models" / "joints" / "cart_pole_servo.yaml").read_text()
+
 
 
 def test_under_actuated_cart_pole_servo_force():
