@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from .connectors.joints import SHARED_PARTS
 from .kinematics import matrix_quaternion
 from .subsystems.base import Frame
-from .symbolic import T_SYMBOL, compile_function, jacobian, time_derivative
+from .symbolic import T_SYMBOL, JointValue, compile_function, jacobian, time_derivative
 
 # kind -> (position names, rate names, acceleration names, which positions are angles)
 NAMES = {
@@ -183,6 +183,20 @@ def value_expressions(joint):
     pB, RB = child.pose(joint.frames[1])
     scalars, rate_exprs = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
     return dict(zip(positions[:len(scalars)] + rates, list(scalars) + list(rate_exprs)))
+
+
+def constraint_symbols(joint):
+    """``value_expressions`` for constraints: each angle a ``symbolic.JointValue`` whose
+    derivative is its rate, so that a constraint on it (a servo row ``angle − θ(t)``) is
+    differentiated through the rate, not through the atan2 (exact on the manifold)."""
+    exprs = value_expressions(joint)
+    if not exprs:
+        return exprs
+    positions, rates, _, angles = NAMES[joint.joint_kind]
+    for position, rate, is_angle in zip(positions, rates, angles):
+        if is_angle:
+            exprs[position] = JointValue(f"{joint.name}.{position}", exprs[position], exprs[rate])
+    return exprs
 
 
 def _pose(part, frame):
