@@ -153,22 +153,27 @@ def _submit(system, shared):
 
 def _work():
     while True:
-        system, shared = _tasks.get()
-        name = system.name
-        try:
-            template, engine = _build(system)
-            with _lock:
-                slot = _slot(system)
-                if slot.engine is None and not slot.fixed:
-                    slot.engine = engine  # warmed at this System's initial state
-        except Exception as err:
-            log.warning("model %s: the fast path is unavailable (%s: %s); using the KKT path",
-                        name, type(err).__name__, err)
-            del system
-            shared.future.set_exception(err)
-            continue
-        del system  # before the result wakes anyone: the System may be collected from then on
-        shared.future.set_result(template)
+        _build_task(*_tasks.get())
+
+
+def _build_task(system, shared):
+    """Build ``shared``'s Template from ``system`` and give ``system`` its warmed Engine. The
+    references to both are dropped before the result wakes anyone, who may then let them go."""
+    name = system.name
+    try:
+        template, engine = _build(system)
+        with _lock:
+            slot = _slot(system)
+            if slot.engine is None and not slot.fixed:
+                slot.engine = engine  # warmed at this System's initial state
+    except Exception as err:
+        log.warning("model %s: the fast path is unavailable (%s: %s); using the KKT path",
+                    name, type(err).__name__, err)
+        del system
+        shared.future.set_exception(err.with_traceback(None))  # its frames would hold the System
+        return
+    del system, engine
+    shared.future.set_result(template)
 
 
 def _build(system):
