@@ -3,8 +3,9 @@
     .venv/bin/python benchmarks/startup.py [--runs 5] [--baseline DIR_OR_COMMIT] [--out FILE]
 
 Each command runs --runs times, each in a fresh interpreter, and the median and the fastest
-wall times are reported beside the plain interpreter start (`python -c pass`) and
-`import sympy` (model loading needs sympy; it is the floor of any `mbsynth check`).
+wall times are reported beside the plain interpreter start (`python -c pass`), `import
+numpy` (the floor of `import mbsynth`) and `import sympy` (model loading needs sympy: the
+floor of any `mbsynth check`).
 `mbsynth check` runs as the console script does (`mbsynth.cli.main`). The last column lists
 which of the heavy libraries the command left loaded (one more run, not timed).
 --baseline runs the same commands on other code (a checkout's folder, or a commit of this
@@ -32,6 +33,7 @@ HEAVY = ("pandas", "dask", "matplotlib", "meshcat", "pinocchio", "numba", "sympy
 MAIN = "import sys; from mbsynth.cli import main; sys.exit(main(sys.argv[1:]))"  # the console script
 COMMANDS = [
     ("python -c pass", "pass", []),
+    ("import numpy", "import numpy", []),
     ("import sympy", "import sympy", []),
     ("import mbsynth", "import mbsynth", []),
     ("mbsynth check models/paper/example3_m1_zero.yaml", MAIN, ["check", "models/paper/example3_m1_zero.yaml"]),
