@@ -1,9 +1,14 @@
 """Every module of mbsynth can be the first one imported: no import cycle hidden by the
-order in which ``mbsynth/__init__.py`` happens to import its submodules."""
+order in which ``mbsynth/__init__.py`` happens to import its submodules; and what is
+imported is only what is used (issue 20, a light import)."""
 
+import argparse
+import importlib
 import subprocess
 import sys
 from pathlib import Path
+
+from mbsynth.cli import parser
 
 PACKAGE = Path(__file__).resolve().parent.parent / "mbsynth"
 
@@ -84,3 +89,12 @@ def test_public_names_resolve_after_any_import_order():
                        "assert mb.sweep is sys.modules['mbsynth.sweep'].sweep\n"
                        "print(sorted(set(mb.__all__) - set(dir(mb))))")
     assert out.strip() == "[]"
+
+
+def test_every_command_of_the_parser_has_its_module():
+    """``mbsynth.cli.parser()`` is the whole command line (the CLI reference is generated
+    from it); main runs a command from the module of the same name."""
+    commands = next(a for a in parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert {"check", "simulate", "sweep", "view", "validate", "robots"} <= set(commands)
+    for name in commands:
+        assert callable(importlib.import_module(f"mbsynth.cli.{name}").run), name
