@@ -2,23 +2,24 @@
 
     .venv/bin/python benchmarks/startup.py [--runs 5] [--baseline DIR_OR_COMMIT] [--out FILE]
 
-Each command runs --runs times, each in a fresh interpreter, and the median and the fastest
-wall times are reported beside the plain interpreter start (`python -c pass`), `import
-numpy` (the floor of `import mbsynth`) and `import sympy` (model loading needs sympy: the
-floor of any `mbsynth check`).
-`mbsynth check` runs as the console script does (`mbsynth.cli.main`). The last column lists
-which of the heavy libraries the command left loaded (one more run, not timed).
+Each command runs --runs times, each in a fresh interpreter; the table gives the medians of
+its wall time and of its CPU time (user + system: less sensitive to a shared machine's
+load), and which of the heavy libraries it left loaded (one more run, not timed). Beside
+mbsynth's commands: the interpreter's start (`python -c pass`), `import numpy` (the floor
+of `import mbsynth`) and `import sympy` (model loading needs sympy: the floor of any
+`mbsynth check`). `mbsynth check` runs as the console script does (`mbsynth.cli.main`).
+
 --baseline runs the same commands on other code (a checkout's folder, or a commit of this
-repository, extracted to a temporary folder), first on PYTHONPATH, alternating with this
-checkout's, and adds its medians and the ratio: compare figures within one table, the
-machines are shared and noisy. The table is written to
-benchmarks/startup_results.md unless --out.
+repository extracted to a temporary folder), first on PYTHONPATH, alternating with this
+checkout's, and adds its medians and the ratios: compare figures within one table, the
+machines are shared and noisy. The table goes to benchmarks/startup_results.md unless --out.
 """
 
 import argparse
 import io
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -49,32 +50,54 @@ exec(compile(code, "<string>", "exec"), {{"__name__": "__main__"}})
 
 
 def run(repo, code, args, probe=False):
-    """Wall time [s] of one fresh ``python -c code args`` in ``repo`` (and, with probe, the
-    heavy modules it loaded)."""
+    """Wall and CPU (user + system) time [s] of one fresh ``python -c code args`` in ``repo``,
+    and with probe the heavy modules it loaded."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")])))
     argv = [sys.executable, "-c", PROBE, code, *args] if probe else [sys.executable, "-c", code, *args]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     result = subprocess.run(argv, cwd=repo, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             check=False)
-    elapsed = time.perf_counter() - started
+    wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if result.returncode not in (0, 1):  # check answers 1 for a verdict that needs attention
         raise RuntimeError(f"{code} {' '.join(args)} failed ({result.returncode}): {result.stderr[-2000:]}")
     heavy = [line.split()[1:] for line in result.stderr.splitlines() if line.startswith("HEAVY")]
-    return elapsed, heavy[-1] if heavy else []
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    return wall, cpu, heavy[-1] if heavy else []
 
 
 def measure(repos, label, code, argv, runs):
-    """(label, medians, fastest times, heavy modules), one entry per repo, the runs alternating
-    between the repos so that each sees the same load."""
+    """``label`` and, per repo, (median wall time, median CPU time, heavy modules), the runs
+    alternating between the repos so that each sees the same load."""
     for repo in repos:
         run(repo, code, argv)  # warm the file system and the compiled caches
     times = [[] for _ in repos]
     for _ in range(runs):
         for repo, measured in zip(repos, times):
-            measured.append(run(repo, code, argv)[0])
-    heavy = [run(repo, code, argv, probe=True)[1] for repo in repos]
-    print(f"{label}: medians {', '.join(f'{statistics.median(t):.3f}' for t in times)} s", flush=True)
-    return label, [statistics.median(t) for t in times], [min(t) for t in times], heavy
+            measured.append(run(repo, code, argv)[:2])
+    results = [(statistics.median(w for w, _ in t), statistics.median(c for _, c in t),
+                run(repo, code, argv, probe=True)[2]) for repo, t in zip(repos, times)]
+    print(f"{label}: {results}", flush=True)
+    return label, results
+
+
+def table(rows, baseline):
+    """The markdown table: per repo wall and CPU medians and the heavy modules; with a
+    baseline, its figures and the ratios baseline / this."""
+    head = ["command", "wall [s]", "CPU [s]", "heavy modules loaded"]
+    if baseline:
+        head += ["baseline wall [s]", "baseline CPU [s]", "baseline heavy modules", "baseline / this (wall, CPU)"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "|".join("---:" if "[s]" in h else "---" for h in head) + "|"]
+    for label, results in rows:
+        cells = [f"`{label}`"]
+        for wall, cpu, heavy in results:
+            cells += [f"{wall:.3f}", f"{cpu:.3f}", ", ".join(heavy) or "—"]
+        if baseline:
+            (wall, cpu, _), (base_wall, base_cpu, _) = results
+            cells.append(f"{base_wall / wall:.1f}×, {base_cpu / cpu:.1f}×")
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
 
 
 def main():
@@ -91,17 +114,8 @@ def main():
              f"on {platform.node()} ({platform.processor() or platform.machine()}, {os.cpu_count()} cores), Python "
              f"{platform.python_version()}, {time.strftime('%Y-%m-%d')}: this checkout ({_commit(HERE.parent)})"
              + (f" against {args.baseline}, runs alternating" if args.baseline else "")
-             + ". A fresh process for every run; caches warm.", ""]
-    if args.baseline:
-        lines += ["| command | median [s] | fastest [s] | heavy modules loaded | baseline median [s] | "
-                  "baseline fastest [s] | baseline heavy modules | baseline / this |", "|---|---:|---:|---|---:|---:|---|---:|"]
-        lines += [f"| `{label}` | {median[0]:.3f} | {fastest[0]:.3f} | {', '.join(heavy[0]) or '—'} | {median[1]:.3f} | "
-                  f"{fastest[1]:.3f} | {', '.join(heavy[1]) or '—'} | {median[1] / median[0]:.1f}× |"
-                  for label, median, fastest, heavy in rows]
-    else:
-        lines += ["| command | median [s] | fastest [s] | heavy modules loaded |", "|---|---:|---:|---|"]
-        lines += [f"| `{label}` | {median[0]:.3f} | {fastest[0]:.3f} | {', '.join(heavy[0]) or '—'} |"
-                  for label, median, fastest, heavy in rows]
+             + ". A fresh process for every run, caches warm; medians of the runs.", "",
+             *table(rows, args.baseline)]
     args.out.write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
