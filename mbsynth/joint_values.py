@@ -28,7 +28,6 @@ from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
-from scipy.spatial.transform import Rotation
 
 from .connectors.joints import SHARED_PARTS
 from .kinematics import matrix_quaternion
@@ -231,6 +230,7 @@ def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):
 def _positions(kind, scalars, RA, RB, origin):
     """The position entries: compiled scalars, or from the frames' rotations."""
     if kind == "spherical":
+        from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
         return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
     if kind == "free":
         return np.concatenate([origin, matrix_quaternion(RB)])

@@ -432,3 +432,21 @@ class System:
             if isinstance(con, Joint) and con.name not in parts:
                 names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
         return names
+
+    def working_forces(self):
+        """The names of what can change the total energy T + V: force elements with efforts
+        (actuation, dampers), parts with generalized forces or an explicit t, constraints
+        with a non-ideal C (friction) or an explicit t (a prescribed motion). Empty: the
+        energy is conserved, and its change along a run is drift."""
+        found = [e.name for e in self.forces if not e.conservative]
+        for part in self.subsystems:
+            own = part.__dict__.get("_symbolic")  # parts shared from a template hold neither
+            if any(f != 0 for f in getattr(part, "forces", ())) or (own and any(T_SYMBOL in x.free_symbols
+                                                                                  for x in own[2:])):
+                found.append(part.name)
+        for con in self.constraints:
+            own = con.__dict__.get("_symbolic")  # placed (joint) rows hold neither
+            if getattr(con, "coulomb", None) or (own and (any(x != 0 for x in own[2]) or any(
+                    T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ()))))):
+                found.append(con.name)
+        return found

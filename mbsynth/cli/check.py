@@ -12,12 +12,15 @@ def run(args):
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:
-        print(format_check(report, args.model))
+        print(format_check(report, args.model, args.coordinates))
     return 0 if report.consistent and not report.suggested_constraints else 1
 
 
-def format_check(report, path):
-    """The human-readable ``mbsynth check`` report."""
+def format_check(report, path, coordinates="joints"):
+    """The human-readable ``mbsynth check`` report; ``coordinates``: "joints" reports the
+    accelerations and free directions per joint where the model has joints, "maximal" per
+    coordinate of the parts."""
+    in_joints = coordinates == "joints" and bool(report.joints)
     lines = [f"model {report.model} ({path})",
              f"  coordinates n = {report.n}, constraints m = {report.m}",
              f"  rank M = {report.rank_M}, rank A = {report.rank_A}, "
@@ -28,8 +31,10 @@ def format_check(report, path):
         lines.append("  motion: unique (Result 3)")
     else:
         lines.append(f"  motion: NOT unique, {report.n - report.rank_Mhat} indeterminate direction(s)")
-        for balance in report.balances:
+        for balance, moved in zip(report.balances, report.free_joints or [{}] * len(report.balances)):
             lines.append(f"    direction {_format_direction(balance['direction'])}")
+            if in_joints and moved:
+                lines.append(f"      moves joint(s) {', '.join(moved)}")
             if balance["free"]:
                 lines.append("      free: no force acts along it, its acceleration is arbitrary")
             else:
@@ -44,6 +49,11 @@ def format_check(report, path):
     lines += [f"  warning: {warning}" for warning in report.warnings]
     if report.error:
         lines.append(f"  no motion at the initial state: {report.error}")
+    elif in_joints:
+        accelerations = ", ".join(f"{joint}.{name} = {x:.6g}" for joint, j in report.joints.items()
+                                  for name, x in zip(j["accelerations"], j["acceleration"]))
+        lines.append(f"  joint accelerations at the initial state{'' if report.unique else ' (η = 0)'}: "
+                     f"{accelerations or 'none (no joint moves)'}")
     else:
         accelerations = ", ".join(f"{c} = {x:.6g}" for c, x in report.qdd.items())
         lines.append(f"  accelerations at the initial state{'' if report.unique else ' (η = 0)'}: {accelerations}")

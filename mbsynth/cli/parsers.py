@@ -27,9 +27,16 @@ def _check(commands):
         description="Report the ranks of M, A and [M; A] at the model's initial state, whether the "
                     "motion is unique, each indeterminate direction and the force balance that "
                     "would close it. Exit 0 when the motion is determined or only free directions "
-                    "remain, 1 when a balance is missing or no motion exists, 2 on a model error.")
+                    "remain, 1 when a balance is missing or no motion exists, 2 on a model error. "
+                    "A model with joints gets its accelerations as joint accelerations (a revolute "
+                    "joint's angle, a prismatic joint's displacement, ...: the time derivatives of "
+                    "the joints' rates) and the joints each indeterminate direction moves.")
     check.add_argument("model", help="model file (YAML)")
-    check.add_argument("--json", action="store_true", help="print one JSON object")
+    check.add_argument("--json", action="store_true",
+                       help="print one JSON object (both 'qdd', per coordinate, and 'joints')")
+    check.add_argument("--coordinates", choices=("joints", "maximal"), default="joints",
+                       help="report accelerations per joint (default, where the model has joints) or per "
+                            "coordinate of the parts ('maximal')")
     return check
 
 
@@ -42,7 +49,11 @@ def _simulate(commands):
     sim.add_argument("--t-end", type=float, required=True, help="end time [s]")
     sim.add_argument("--dt", type=float, help="output interval [s] (default t_end/500)")
     sim.add_argument("--out", help="trajectory file (.npz or .csv), written as the run goes")
-    sim.add_argument("--plot", help="figure of coordinates, energy drift and residuals (.png, .pdf, .svg)")
+    sim.add_argument("--plot", help="figure (.png, .pdf, .svg) of the joint coordinates (or the model's outputs, "
+                                    "or --plot-vars), kinetic and potential energy, and the constraint residuals")
+    sim.add_argument("--plot-vars", nargs="+", metavar="NAME",
+                     help="what the figure's top panel draws: coordinates (part.c), velocities (part.c_dot), "
+                          "outputs")
     sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
     sim.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
     sim.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance (default 1e-10)")

@@ -35,7 +35,8 @@ def run(args):
     summary = {"model": system.name, "t_end": float(traj.t[-1]) if traj.t.size else 0.0, "outputs": int(traj.t.size),
                "steps": traj.stats.get("steps"), "evaluations": traj.stats.get("evaluations"),
                "wall_time_s": round(time.perf_counter() - started, 3), "max_residual": traj.max_residual,
-               "energy_drift": traj.energy_drift, "initial_changes": traj.stats.get("initial_changes", {}),
+               "energy_drift": traj.energy_drift, "working_forces": system.working_forces(),
+               "initial_changes": traj.stats.get("initial_changes", {}),
                "singular_positions": [{"t_from": float(e["t_from"]), "t_to": float(e["t_to"]), "rows": e["rows"]}
                                       for e in traj.stats.get("singular_positions", [])],
                "out": args.out and str(output_file(args.out, completed=error is None)), "plot": args.plot,
@@ -45,7 +46,7 @@ def run(args):
     if args.plot and traj.t.size:
         from ..plot import plot_trajectory  # matplotlib: only for --plot
 
-        plot_trajectory(traj, args.plot, title=f"{system.name}")
+        plot_trajectory(traj, args.plot, title=f"{system.name}", system=system, names=args.plot_vars)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -59,7 +60,7 @@ def format_summary(s):
     """The human-readable summary of a run."""
     lines = [f"model {s['model']}: simulated to t = {s['t_end']:.6g} s ({s['status']})",
              f"  {s['steps']} steps, {s['evaluations']} evaluations of (2.14), {s['wall_time_s']:.3g} s wall time",
-             f"  max constraint residual {s['max_residual']:.3g}, relative energy drift {s['energy_drift']:.3g}"]
+             f"  max constraint residual {s['max_residual']:.3g}, " + _energy_line(s)]
     for name, (given, new) in s["initial_changes"].items():
         lines.append(f"  initial {name}: {given:.9g} -> {new:.9g} (made consistent)")
     if s["singular_positions"]:
@@ -72,3 +73,12 @@ def format_summary(s):
         if s[key]:
             lines.append(f"  wrote {s[key]}")
     return "\n".join(lines)
+
+
+def _energy_line(s):
+    """The relative change of T + V: "drift" only where nothing in the model does work."""
+    working = s["working_forces"]
+    if not working:
+        return f"relative energy drift {s['energy_drift']:.3g}"
+    return (f"relative energy change {s['energy_drift']:.3g} (work of {', '.join(working[:4])}"
+            f"{', ...' if len(working) > 4 else ''})")
