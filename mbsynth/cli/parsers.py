@@ -107,7 +107,10 @@ def _validate(commands):
         "validate", help="compare with Pinocchio: a robot (fixed and floating base) or a model file",
         description="Draw random states and joint torques (within the joint limits), compute mbsynth's "
                     "joint accelerations and Pinocchio's (aba, or constraintDynamics where loops are closed) "
-                    "and print the largest differences. ROBOT_OR_MODEL is a robot name (see 'mbsynth robots'), "
+                    "and print the largest differences; in joint space too: the joint values against "
+                    "Pinocchio's (q, v, v̇) and each joint's reaction (the wrench its parent exerts on its child, "
+                    "at the child link frame, in its axes) against data.f of rnea. "
+                    "ROBOT_OR_MODEL is a robot name (see 'mbsynth robots'), "
                     "a URDF file, or a model file (.yaml) of rigid bodies and robots, compared with its "
                     "equivalent Pinocchio model. Exit 0 when every relative error is within the tolerance, "
                     "1 when one is not (or no comparison is possible), 2 on a model error.")
