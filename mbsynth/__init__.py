@@ -9,8 +9,11 @@ Result 3 (full column rank of [M; A]) as the exact test of uniqueness.
 from .equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
 from .errors import ModelError, SimulationError, SolveError
 from .io import load, loads
+from .linearization import Linearization, linearize
+from .modal import Modes, modes
 from .robots import from_robot
 from .simulate import simulate
+from .statics import equilibrium
 from .sweep import sweep
 from .system import System
 from .trajectory import Trajectory, load_trajectory
@@ -22,4 +25,5 @@ __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
     "ModelError", "SolveError", "SimulationError", "load", "loads", "System",
     "simulate", "sweep", "Trajectory", "load_trajectory", "from_robot", "viewer",
+    "equilibrium", "linearize", "Linearization", "modes", "Modes",
 ]
