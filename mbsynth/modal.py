@@ -83,27 +83,36 @@ def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL):
                          "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
     values, vectors = scipy.linalg.eig(lin.A) if k else (np.zeros(0, complex), np.zeros((0, 0), complex))
     scale = np.abs(values).max(initial=0.0)
-    found, free = [], np.abs(values) <= ZERO_RTOL * scale
-    listed_free = 0
-    for s, v, is_free in zip(values, vectors.T, free):
-        if is_free:  # a free direction has a double zero eigenvalue (position and velocity): one mode
-            listed_free += 1
-            if listed_free > (free.sum() + 1) // 2:
-                continue
-        elif s.imag < -ZERO_RTOL * scale:  # the conjugate of a listed pair
-            continue
-        shape = lin.basis @ v[:k]
-        if np.abs(shape).max(initial=0.0) == 0:
-            shape = lin.basis @ v[k:]  # a free mode's eigenvector can be all velocity
-        shape = shape / shape[np.argmax(np.abs(shape))]
-        found.append(Mode(complex(s), float(abs(s) / (2 * np.pi)), _damping(s, scale), _kind(s, scale), shape,
-                          _joint_shape(system, t, q, shape)))
+    free = np.abs(values) <= ZERO_RTOL * scale
+    found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
+    for s, v in zip(values[~free], vectors.T[~free]):
+        if s.imag >= -ZERO_RTOL * scale:  # one of each conjugate pair
+            found.append(_mode(system, t, q, lin, s, v[:k], scale))
     found.sort(key=lambda m: (m.frequency, m.eigenvalue.real))
     return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin)
 
 
+def _free_directions(lin, count):
+    """``count`` directions x of the independent coordinates along which nothing resists:
+    the right singular vectors of the stiffness block K = ∂ü/∂u of A with the smallest
+    singular values (a free direction is a double zero eigenvalue of A, one mode)."""
+    k = lin.k
+    return np.linalg.svd(lin.A[k:, :k])[2][k - count:] if count else []
+
+
+def _mode(system, t, q, lin, s, x, scale):
+    """The Mode of eigenvalue s with the independent coordinates' motion x."""
+    shape = lin.basis @ x
+    shape = shape / shape[np.argmax(np.abs(shape))]
+    return Mode(complex(s), float(abs(s) / (2 * np.pi)), _damping(s, scale), _kind(s, scale), shape,
+                _joint_shape(system, t, q, shape))
+
+
 def _damping(s, scale):
-    return float("nan") if abs(s) <= ZERO_RTOL * scale else float(-s.real / abs(s)) + 0.0  # no −0
+    """−Re s/|s|; NaN for a free mode, 0 where Re s is rounding (below ε times the largest |s|)."""
+    if abs(s) <= ZERO_RTOL * scale:
+        return float("nan")
+    return 0.0 if abs(s.real) <= 8 * np.finfo(float).eps * scale else float(-s.real / abs(s))
 
 
 def _kind(s, scale):
@@ -122,7 +131,8 @@ def _joint_shape(system, t, q, shape):
 
 
 def format_modes(result, digits=6):
-    """The modes as a text table: one row per mode, the coordinates that move most."""
+    """The modes as a text table: one row per mode, the joints (or, in a model without
+    joint values, the coordinates) that move most, relative to the largest."""
     lin = result.linearization
     independent = ", ".join(lin.state_names[:lin.k]) or "none"
     lines = [f"modes of {result.system_name} at t = {result.t:g}: {lin.k} degree(s) of freedom "
@@ -131,14 +141,26 @@ def format_modes(result, digits=6):
              "  largest motion"]
     for i, mode in enumerate(result.modes, 1):
         s = mode.eigenvalue
-        top = np.argsort(-np.abs(mode.shape))[:SHOWN]
-        moving = ", ".join(f"{result.coordinates[j]} {_short(mode.shape[j])}" for j in top
-                           if abs(mode.shape[j]) > 1e-6)
         lines.append(f"{i:>3}  {mode.frequency:>15.{digits}g}  {mode.damping_ratio:>13.4g}  {mode.kind:<10}  "
-                     f"{f'{s.real:.{digits}g}{s.imag:+.{digits}g}j':<26}  {moving}")
+                     f"{f'{s.real:.{digits}g}{s.imag:+.{digits}g}j':<26}  {_largest(result, mode)}")
     if not result.stable:
         lines.append("unstable: an eigenvalue has a positive real part (the equilibrium is not a rest one keeps)")
     return "\n".join(lines)
+
+
+def _largest(result, mode):
+    """The SHOWN joint values (where the model has joints with values) or coordinates that
+    move most in ``mode``, relative to the largest."""
+    names, values = list(result.coordinates), mode.shape
+    if mode.joint_shape:
+        names = [f"{j}[{c}]" if len(v) > 1 else j for j, v in mode.joint_shape.items() for c in range(len(v))]
+        values = np.concatenate(list(mode.joint_shape.values()))
+    top = np.abs(values).max(initial=0.0)
+    if top == 0:
+        return ""
+    values = values / values[np.argmax(np.abs(values))]
+    order = np.argsort(-np.abs(values))[:SHOWN]
+    return ", ".join(f"{names[j]} {_short(values[j])}" for j in order if abs(values[j]) > 1e-6)
 
 
 def _short(z):

@@ -242,9 +242,10 @@ def test_table_and_json():
 
 
 def test_eigenvalue_error_matches_spectra():
-    assert eigenvalue_error([1j, -1j, 2.0], [2.0, -1j, 1j]) == 0.0
+    assert eigenvalue_error([3j, -3j, 2.0], [2.0, -3j, 3j]) == 0.0
     assert eigenvalue_error([1j, -1j], [1j, -1j, 0]) == float("inf")
-    assert eigenvalue_error([1j, -1j], [1.1j, -1j]) == pytest.approx(0.1 / 1.1)
+    assert eigenvalue_error([3j, -3j], [3.3j, -3j]) == pytest.approx((3.3**2 - 9) / 3.3**2)
+    assert eigenvalue_error([1e-7, -1e-7], [0, 0]) == pytest.approx(1e-14)  # a split double zero
 
 
 # -- robots against Pinocchio ----------------------------------------------------------------
