@@ -6,7 +6,7 @@ gravity-compensating torques, against Pinocchio's `computeABADerivatives`; write
 Per robot (smallest first) and random configuration: τ = rnea(q, 0, 0) as its tau_*
 parameters, `mbsynth.linearize` at rest in maximal coordinates (every link a rigid body in
 7 coordinates), and the eigenvalues of its A against those of [[0, I], [∂v̇/∂q, ∂v̇/∂v]],
-matched one to one, relative to the largest |eigenvalue|; B, mapped to the model's
+matched one to one and compared in s² (validate_modes.eigenvalue_error); B, mapped to the model's
 coordinates, against S M⁻¹ (mbsynth/validate_modes.py). "first s" includes deriving and
 compiling the block functions; "linearize s" is a later call at another configuration.
 Writes benchmarks/modes_results.md after every robot, so an interrupted run keeps what it
@@ -63,12 +63,13 @@ def write(args, rows, elapsed):
              f"`benchmarks/modes_all_robots.py --samples {args.samples}` on {platform.node()} "
              f"({platform.processor() or platform.machine()}, {os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}, "
              f"{elapsed / 60:.1f} min in all; {len(rows)} of {args.total} robots (fixed base, smallest first).", "",
-             f"Each robot held at rest by τ = rnea(q, 0, 0) at {args.samples} random configurations: eigenvalues of "
-             "mbsynth's A (linearize, tangent space of the maximal coordinates) against those of "
-             "[[0, I], [∂v̇/∂q, ∂v̇/∂v]] from `pinocchio.computeABADerivatives`, and B (per unit joint torque, mapped "
-             f"to the model's coordinates) against S M⁻¹: {len(passed)} of {len(results)} robots within "
-             f"{TOLERANCE:.0e} relative. Zero-stiffness directions (a joint whose axis is vertical) give a double "
-             "zero eigenvalue that rounding splits into ±√ε·|s|max on both sides, so their error is about 1e-8.", "",
+             f"Each robot held at rest by τ = rnea(q, 0, 0) at {args.samples} random configurations: eigenvalues s "
+             "of mbsynth's A (linearize, tangent space of the maximal coordinates) against those of "
+             "[[0, I], [∂v̇/∂q, ∂v̇/∂v]] from `pinocchio.computeABADerivatives`, and B (per unit joint torque, "
+             f"mapped to the model's coordinates) against S M⁻¹: {len(passed)} of {len(results)} robots within "
+             f"{TOLERANCE:.0e} relative. Eigenvalues are compared in s², relative to max |s|² "
+             "(at least 1 s⁻²): a zero-stiffness direction (a vertical joint axis) has a double zero eigenvalue "
+             "that a rounding error δ splits into ±√δ, while s² moves by δ (mbsynth/validate_modes.py).", "",
              "| robot | links | nv | eigenvalues rel error | B rel error | build s | first linearize s | "
              "linearize s | result |",
              "|---|---|---|---|---|---|---|---|---|"]

@@ -19,21 +19,29 @@ dependent loop coordinates and massless coordinates fixed by a holonomic balance
   A = [[0, I], [(∂f/∂q, ∂f/∂q̇) T restricted to the rows u]] — exact at any state on the
   manifold, at rest or moving.
 
-Derivatives: exact, from the model's sympy expressions (``System.symbolic``: M, Q, A, b,
-C), not finite differences. Where Result 3 holds, q̈ of (2.14) is the unique q̈ of
-(2.5)–(2.6) with ideal forces Aᵀλ: M q̈ − Q − C − Aᵀλ = 0, A q̈ − b = 0 (λ: the
-multipliers, reactions.py). Differentiating these (the implicit function theorem on the
-KKT form of (2.14)):
+Massless parts. The independent state is that of the masses: a massless coordinate is
+fixed, at every instant, by its balance wᵀ(Q + C) = 0 (closure.py). Written as a
+holonomic row (``closure: auto`` appends it so when it involves no velocities), the
+balance is one of the rows of Φ_q and removes the massless coordinate from the tangent
+space: in example 3 with m1 = 0 the node x1 follows from (5.40) and (5.32), and the state
+is (q2, q̇2), one mode. A balance with velocities (a damper at a massless node) is a
+first-order equation of its own and is refused with the non-holonomic rows.
+
+Derivatives: exact, not finite differences: the complex step (Im f(x + ih)/h, h = 1e-30,
+exact to rounding) on each block's compiled M, Q, a, b, C, ψ (``BlockFunction``; compiled
+sympy Jacobians for a block with a non-analytic function such as Abs). Where Result 3
+holds, q̈ of (2.14) is the unique q̈ of (2.5)–(2.6) with ideal forces Aᵀλ:
+M q̈ − Q − C − Aᵀλ = 0, A q̈ − b = 0 (λ: the multipliers, reactions.py). Differentiating
+these (the implicit function theorem on the KKT form of (2.14)):
 
     [M  −Aᵀ] [dq̈]      [∂(Mq̈ − Q − C − Aᵀλ)/∂(q, q̇)]
     [A   0 ] [dλ ] = − [∂(Aq̈ − b)/∂(q, q̇)          ] [dq; dq̇]
 
-with q̈, λ held at their values in the derivatives on the right (sympy Jacobians, compiled
-once per model structure). The matrix has the null space {0} × null(Aᵀ) when [M; A] has
-full column rank (Result 3), so dq̈ is unique even with redundant rows or singular M;
-least squares picks one dλ. Rows that are redundant all along the manifold change the
-right side only by terms in range(Aᵀ) along tangent directions, so the choice of λ does
-not matter there.
+with q̈, λ held at their values in the derivatives on the right. The matrix has the null
+space {0} × null(Aᵀ) when [M; A] has full column rank (Result 3), so dq̈ is unique even
+with redundant rows or singular M; least squares picks one dλ. Rows that are redundant
+all along the manifold change the right side only by terms in range(Aᵀ) along tangent
+directions, so the choice of λ does not matter there.
 
 Refused, with a SolveError naming the rows or coordinates: states off the manifold,
 non-unique motion, non-holonomic and acceleration-level rows (they restrict velocities or
@@ -167,14 +175,16 @@ def _refuse_unsupported(system, t, q, qd):
 
 def tangent_basis(system, Phi_q, position_rows=None):
     """(N, pivots): a basis N (n × k) of null(Φ_q) that is the identity on the k independent
-    coordinates at the indices ``pivots`` (coordinate partitioning by QR with column pivoting). Raises
-    SolveError near a singular position: a singular value of the row-equilibrated Φ_q
+    coordinates at the indices ``pivots`` (coordinate partitioning, QR with column pivoting).
+    Raises SolveError near a singular position: a singular value of the row-equilibrated Φ_q
     between RANK_RTOL and NEAR_SINGULAR times the largest (equations.py's rank rule)."""
     n = system.n
     if Phi_q.shape[0] == 0:
         return np.eye(n), np.arange(n)
     norms = np.linalg.norm(Phi_q, axis=1)
     rows = norms > 0
+    if not rows.any():
+        return np.eye(n), np.arange(n)
     _, s, Vt = np.linalg.svd(Phi_q[rows] / norms[rows, None])
     rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size else 0
     near = [x for x in s[:rank] if x < NEAR_SINGULAR * s[0]]

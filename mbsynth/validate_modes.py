@@ -5,9 +5,9 @@ robot is held at rest by the gravity-compensating torques τ = rnea(q, 0, 0), se
 ``tau_*`` parameters. Pinocchio's ``computeABADerivatives`` gives ∂v̇/∂q, ∂v̇/∂v and
 ∂v̇/∂τ = M⁻¹ in joint space; the eigenvalues of [[0, I], [∂v̇/∂q, ∂v̇/∂v]] must equal
 those of mbsynth's A (linearization.py, in maximal coordinates reduced to the tangent
-space; compared in s², eigenvalue_error), and the accelerations B gives per unit torque, mapped to the model's coordinates
-(δq̈ = N δü), must equal Pinocchio's mapped by the velocity map S (q̇ = S v, at rest
-q̈ = S v̇). Errors are relative to the largest |eigenvalue| and the largest entry of S M⁻¹.
+space; compared in s²: ``eigenvalue_error``), and the accelerations B gives per unit
+torque, mapped to the model's coordinates (δq̈ = N δü), must equal Pinocchio's mapped by
+the velocity map S (q̇ = S v, at rest q̈ = S v̇), relative to the largest entry of S M⁻¹.
 """
 
 import time

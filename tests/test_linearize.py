@@ -96,6 +96,32 @@ def test_double_pendulum_on_distance_joints():
     assert result.stable
 
 
+DAMPED = """
+name: damped_bob
+parameters: {m: 1.2, k: 80.0, l0: 0.5, c: 1.5, g: 9.81}
+gravity: [0, 0, -g]
+world: {frames: {anchor: {position: [0, 0, 0]}}}
+subsystems:
+  bob: {type: particle, mass: m, initial: {position: [0.05, 0.02, -0.6]}}
+forces:
+  - {name: spring, type: spring, between: [world.anchor, bob], stiffness: k, rest_length: l0, damping: c}
+"""
+
+
+def test_damped_spring_pendulum():
+    """A bob on a spring-damper: bouncing at ω² = k/m with ζ = c/(2√(km)); swinging, as a
+    pendulum of the stretched length l0 + mg/k, undamped (the damper acts along the spring,
+    whose length a small swing does not change)."""
+    system = mb.loads(DAMPED)
+    p = system.parameters
+    result = mb.modes(system, equilibrium=True)
+    swing = np.sqrt(p["g"] / (p["l0"] + p["m"] * p["g"] / p["k"]))
+    assert [m.kind for m in result.modes] == ["vibration"] * 3
+    assert 2 * np.pi * result.frequencies == pytest.approx([swing, swing, np.sqrt(p["k"] / p["m"])], rel=REL)
+    assert result.damping_ratios == pytest.approx([0, 0, p["c"] / (2 * np.sqrt(p["k"] * p["m"]))], rel=REL, abs=1e-12)
+    assert result.stable
+
+
 # -- a four-bar: a parallelogram, its coupler translating -----------------------------------
 
 def parallelogram(crank_angle):
