@@ -16,7 +16,9 @@ import scipy.linalg
 
 from .errors import SolveError
 from .linearization import linearize
+from .projection import project_positions
 from .statics import ACCELERATION_TOL, equilibrium as find_equilibrium
+from .trajectory import Trajectory
 
 # an eigenvalue below this times the largest |s| is zero (a free direction): a zero stiffness
 # computed with rounding error ε splits a double zero eigenvalue into ±√ε, so the cut is near √ε
@@ -128,6 +130,21 @@ def _joint_shape(system, t, q, shape):
     real = system.joint_values(t, q, shape.real)
     imag = system.joint_values(t, q, shape.imag)
     return {name: real[name].rate + 1j * imag[name].rate for name in real}
+
+
+def mode_motion(system, result, index, amplitude=0.05, periods=2, frames=60):
+    """A Trajectory that shows mode ``index`` of ``result`` (for the viewer: one per mode):
+    q(t) = q₀ + amplitude · Re(shape · e^{iωt}) over ``periods`` periods (1 s each for a
+    mode of frequency 0), put back on the constraints at each frame (a finite amplitude
+    leaves the tangent plane). ``amplitude`` is the largest coordinate's excursion, in its
+    units. Energies and residuals are not computed (NaN)."""
+    mode = result.modes[index]
+    omega = 2 * np.pi * (mode.frequency or 1.0)
+    t = np.linspace(0.0, periods * 2 * np.pi / omega, frames)
+    q = np.array([project_positions(system, result.t, result.q + amplitude * (mode.shape * np.exp(1j * omega * x)).real)
+                  for x in t])
+    nan = np.full(frames, np.nan)
+    return Trajectory(result.coordinates, t, q, np.gradient(q, t, axis=0), nan, nan, nan, nan)
 
 
 def format_modes(result, digits=6):

@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 
 import mbsynth as mb
-from mbsynth.modal import format_modes, to_dict
+from mbsynth.modal import format_modes, mode_motion, to_dict
 from mbsynth.validate_modes import eigenvalue_error, validate_modes
 
 REL = 1e-9
@@ -175,6 +175,19 @@ def test_four_bar_single_mode():
     assert joints["ground_O"][0] == pytest.approx(joints["ground_D"][0], rel=REL)
     assert abs(joints["ground_O"][0]) > 0
     assert joints["crank_coupler"][0] == pytest.approx(-joints["ground_O"][0], rel=REL)
+
+
+def test_mode_motion_stays_on_the_constraints():
+    """The animation of the four-bar's mode: every frame on the loop's constraints, the
+    crank swinging by about the amplitude, back where it started after whole periods."""
+    system = mb.loads(parallelogram(0.3))
+    result = mb.modes(system, equilibrium=True)
+    motion = mode_motion(system, result, 0, amplitude=0.01, periods=1, frames=21)
+    for q in motion.q:
+        assert np.abs(system.constraint_residuals(0.0, q, 0 * q)[0]).max() < 1e-10
+    swing = np.ptp(motion.column(result.linearization.state_names[0]))
+    assert swing == pytest.approx(0.02, rel=1e-2)
+    assert motion.q[-1] == pytest.approx(motion.q[0], abs=1e-10)
 
 
 @pytest.mark.parametrize("offset", [0.0, 1e-7])
