@@ -31,6 +31,7 @@ class ForceElement:
 
     def __init__(self, name, V, efforts, q, qd, params, joint=None):
         self.name, self.joint = name, joint
+        self.conservative = all(sp.sympify(effort) == 0 for effort, _ in efforts)  # all of Q from V
         self.V = sp.sympify(V)
         self.Q = Q = generalized_force(self.V, efforts, q, qd)
         used = Q.free_symbols | self.V.free_symbols

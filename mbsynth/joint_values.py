@@ -28,10 +28,11 @@ from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
-from scipy.spatial.transform import Rotation
 
+from .connectors.joints import SHARED_PARTS
 from .kinematics import matrix_quaternion
-from .symbolic import T_SYMBOL, compile_function, jacobian, time_derivative
+from .subsystems.base import Frame
+from .symbolic import T_SYMBOL, JointValue, compile_function, jacobian, time_derivative
 
 # kind -> (position names, rate names, acceleration names, which positions are angles)
 NAMES = {
@@ -68,29 +69,26 @@ class FramePose(NamedTuple):
 class JointKinematics:
     """The compiled joint values of one joint of ``kind`` between ``frame_a`` on ``parent``
     (None: the world) and ``frame_b`` on ``child``, and the pose of ``report_frame`` (a
-    frame on the child with B's origin: B itself, or a robot's link frame)."""
+    frame on the child with B's origin: B itself, or a robot's link frame). Joints alike
+    (kind, types of parts, frames fixed on them) share one derivation and one compiled
+    function (``_template``), their frames' values passed in, as connectors.joints does."""
 
     def __init__(self, name, kind, parent, frame_a, child, frame_b, report_frame, system):
         self.name, self.kind = name, kind
         self.position_names, self.rate_names, self.acceleration_names, self.angles = NAMES.get(kind, ((), (), (), ()))
-        q, qd = list(system.q_symbols), list(system.qd_symbols)
-        where = {s: i for i, s in enumerate(q)}
-        local = sorted({where[s] for part in (parent, child) if part is not None for s in part.q})
-        self.indices = np.array(local, dtype=int)
+        where = {s: i for i, s in enumerate(system.q_symbols)}
+        q = (list(parent.q) if parent is not None else []) + list(child.q)
+        qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+        self.indices = np.array([where[s] for s in q], dtype=int)
         self.child_indices = np.array([where[s] for s in child.q], dtype=int)
-        ql, qdl = [q[i] for i in local], [qd[i] for i in local]
-        pA, RA = _pose(parent, frame_a)
-        pB, RB = child.pose(frame_b)
-        positions, rates = _relative(kind, parent, child, pA, RA, pB, RB, ql, qdl)
-        rates = sp.Matrix(rates) if rates else sp.zeros(0, 1)
-        rate_a = jacobian(rates, qdl)
-        rate_b = -(jacobian(rates, ql) * sp.Matrix(qdl)) - sp.diff(rates, T_SYMBOL) if rates else sp.zeros(0, 1)
-        pR, RR = child.pose(report_frame)
-        frame_rate = sp.Matrix.vstack(sp.Matrix([time_derivative(x, ql, qdl) for x in pR]), child.angular_velocity())
-        J = jacobian(frame_rate, list(child.qd))
-        exprs = [sp.Matrix(positions) if positions else sp.zeros(0, 1), rates, rate_a, rate_b, sp.Matrix(pR),
-                 sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
-        self._evaluate = compile_function((T_SYMBOL, ql, qdl, list(system.parameter_symbols)), exprs)
+        args = (T_SYMBOL, list(q), list(qd), list(system.parameter_symbols))
+        frames = (frame_a, frame_b, report_frame)
+        if _shareable(parent, child, frames):
+            slots, exprs = _template(kind, parent, child)
+            constants = [pair for end, frame in enumerate(frames) for pair in zip(_PLACEHOLDERS[end], _entries(frame))]
+            self._evaluate = compile_function((T_SYMBOL, *slots, args[3]), exprs, constants=constants)
+        else:
+            self._evaluate = compile_function(args, _expressions(kind, parent, child, frames, q, qd))
 
     @property
     def names(self):
@@ -115,6 +113,56 @@ class JointKinematics:
         return FramePose(pR.ravel(), RR, J)
 
 
+def _expressions(kind, parent, child, frames, q, qd):
+    """What a JointKinematics compiles, in the parts' symbols q, q̇ (parent's then child's):
+    scalar positions, rates, ∂rate/∂q̇, the rest of d(rate)/dt (``differentiate``'s b),
+    the report frame's origin and rotation, R_A, R_B, and the report frame's Jacobian."""
+    pA, RA = _pose(parent, frames[0])
+    pB, RB = child.pose(frames[1])
+    positions, rates = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
+    rates = sp.Matrix(rates) if rates else sp.zeros(0, 1)
+    rate_a = jacobian(rates, qd)
+    rate_b = -(jacobian(rates, q) * sp.Matrix(qd)) - sp.diff(rates, T_SYMBOL) if rates else sp.zeros(0, 1)
+    pR, RR = child.pose(frames[2])
+    frame_rate = sp.Matrix.vstack(sp.Matrix([time_derivative(x, q, qd) for x in pR]), child.angular_velocity())
+    J = jacobian(frame_rate, list(child.qd))
+    return [sp.Matrix(positions) if positions else sp.zeros(0, 1), rates, rate_a, rate_b, sp.Matrix(pR),
+            sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
+
+
+# offsets (3) and rotations (3 × 3) of frames A, B and the report frame, as placeholder symbols
+_PLACEHOLDERS = [tuple(sp.symbols(f"_{e}s0:3", cls=sp.Dummy)) + tuple(sp.symbols(f"_{e}R0:9", cls=sp.Dummy))
+                 for e in "ABR"]
+_templates = {}
+
+
+def _template(kind, parent, child):
+    """((q slots, q̇ slots), expressions) of ``_expressions`` for joints of ``kind``
+    between parts of the types of ``parent`` and ``child``, frames as placeholders."""
+    key = (kind, type(parent), len(parent.q) if parent is not None else 0, type(child), len(child.q))
+    if key not in _templates:
+        q = (list(parent.q) if parent is not None else []) + list(child.q)
+        qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+        slots = (tuple(sp.Dummy(f"q{i}") for i in range(len(q))), tuple(sp.Dummy(f"qd{i}") for i in range(len(q))))
+        frames = [Frame("", "", sp.Matrix(x[:3]), sp.Matrix(3, 3, x[3:])) for x in _PLACEHOLDERS]
+        to_slots = dict(zip(q + qd, slots[0] + slots[1]))
+        exprs = [e.xreplace(to_slots) for e in _expressions(kind, parent, child, frames, q, qd)]
+        _templates[key] = ([list(x) for x in slots], exprs)
+    return _templates[key]
+
+
+def _shareable(parent, child, frames):
+    """Whether the joint's expressions can come from a template: parts whose poses depend on
+    their coordinates alone and frames fixed on them."""
+    coordinates = set((parent.q if parent is not None else [])) | set(child.q)
+    return (all(type(p) in SHARED_PARTS for p in (parent, child) if p is not None)
+            and not any(sp.sympify(x).free_symbols & coordinates for f in frames for x in _entries(f)))
+
+
+def _entries(frame):
+    return list(frame.position) + list(frame.rotation)
+
+
 def value_expressions(joint):
     """{name: sympy expression} of a joint's values that are expressions of the state (the
     names model files use as ``<joint>.<name>``): its positions except a spherical joint's
@@ -134,6 +182,20 @@ def value_expressions(joint):
     pB, RB = child.pose(joint.frames[1])
     scalars, rate_exprs = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
     return dict(zip(positions[:len(scalars)] + rates, list(scalars) + list(rate_exprs)))
+
+
+def constraint_symbols(joint):
+    """``value_expressions`` for constraints: each angle a ``symbolic.JointValue`` whose
+    derivative is its rate, so that a constraint on it (a servo row ``angle − θ(t)``) is
+    differentiated through the rate, not through the atan2 (exact on the manifold)."""
+    exprs = value_expressions(joint)
+    if not exprs:
+        return exprs
+    positions, rates, _, angles = NAMES[joint.joint_kind]
+    for position, rate, is_angle in zip(positions, rates, angles):
+        if is_angle:
+            exprs[position] = JointValue(f"{joint.name}.{position}", exprs[position], exprs[rate])
+    return exprs
 
 
 def _pose(part, frame):
@@ -168,6 +230,7 @@ def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):
 def _positions(kind, scalars, RA, RB, origin):
     """The position entries: compiled scalars, or from the frames' rotations."""
     if kind == "spherical":
+        from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
         return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
     if kind == "free":
         return np.concatenate([origin, matrix_quaternion(RB)])

@@ -60,6 +60,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         raise ValueError(f"stabilization must be one of {STABILIZATIONS}, got {stabilization!r}")
     if not t_end > t0:
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0})")
+    system = system.for_run()  # one motion path (tree or KKT) for the whole run
     run = _Run(system, method, rtol, atol, stabilization, baumgarte)
     if q0 is None and qd0 is None:
         q, qd, changes = consistent_initial_state(system, t0)

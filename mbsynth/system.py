@@ -124,7 +124,8 @@ class System:
         Parameters defined by expressions of others, and initial values written as
         expressions of parameters, follow the new values. Closure balances appended at
         load time are kept as derived; they stay valid while the masses that were zero
-        stay zero."""
+        stay zero. The new System shares this one's compiled fast path (``mbsynth.fast``:
+        parameters are arguments of its code), so a sweep compiles once."""
         unknown = sorted(set(values) - set(self.parameters))
         if unknown:
             raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
@@ -149,7 +150,17 @@ class System:
         if problems:
             given = values if len(values) <= 3 else f"{len(values)} new parameter values"
             raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
+        fast.share(self, changed)
         return changed
+
+    def for_run(self):
+        """This System, for one run (``simulate``), with the path of ``motion`` fixed for the
+        whole run: the compiled tree path when it is ready or its kernels are compiled (it
+        is waited for), else the KKT path throughout — never a switch midway, so a run's
+        result does not depend on when a background compilation finishes."""
+        run = replace(self)
+        fast.fix_path(self, run)
+        return run
 
     def part_problems(self):
         """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
@@ -243,7 +254,8 @@ class System:
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
         Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
         (2.14)). "fast" is the linear-time tree path (``mbsynth.fast``) once its compiled
-        kernels are ready (they build in the background on first use) and where its checks
+        kernels are ready (they build in the background on first use; ``for_run`` fixes
+        the choice for a run) and where its checks
         pass, else the KKT path; both fall back to the exact treatment when the problem is
         not well posed.
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
@@ -420,3 +432,21 @@ class System:
             if isinstance(con, Joint) and con.name not in parts:
                 names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
         return names
+
+    def working_forces(self):
+        """The names of what can change the total energy T + V: force elements with efforts
+        (actuation, dampers), parts with generalized forces or an explicit t, constraints
+        with a non-ideal C (friction) or an explicit t (a prescribed motion). Empty: the
+        energy is conserved, and its change along a run is drift."""
+        found = [e.name for e in self.forces if not e.conservative]
+        for part in self.subsystems:
+            own = part.__dict__.get("_symbolic")  # parts shared from a template hold neither
+            if any(f != 0 for f in getattr(part, "forces", ())) or (own and any(T_SYMBOL in x.free_symbols
+                                                                                  for x in own[2:])):
+                found.append(part.name)
+        for con in self.constraints:
+            own = con.__dict__.get("_symbolic")  # placed (joint) rows hold neither
+            if getattr(con, "coulomb", None) or (own and (any(x != 0 for x in own[2]) or any(
+                    T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ()))))):
+                found.append(con.name)
+        return found

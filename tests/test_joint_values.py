@@ -1,17 +1,25 @@
 """Joint values and reactions (issue 19) against Pinocchio, analytic solutions and
 finite differences."""
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
+import sympy as sp
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 import mbsynth as mb
 from mbsynth.constraint import Connector
+from mbsynth.projection import project_velocities
+from mbsynth.joint_values import constraint_symbols
+from mbsynth.robots import fix_base
 from mbsynth.symbolic import T_SYMBOL
 from mbsynth.twin import Twin
 from mbsynth.validate import sample_pinocchio_state
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def _pinocchio_positions(coordinate, q):
@@ -33,9 +41,14 @@ def _same_position(coordinate, ours, theirs):
     return np.abs((ours - theirs + np.pi) % (2 * np.pi) - np.pi).max()
 
 
+@pytest.fixture(scope="module")
+def floating_ur5():
+    return mb.from_robot("ur5", floating=True)
+
+
 @pytest.fixture(scope="module", params=[False, True], ids=["fixed", "floating"])
-def ur5(request):
-    system = mb.from_robot("ur5", floating=request.param)
+def ur5(request, floating_ur5):
+    system = floating_ur5 if request.param else fix_base(floating_ur5)
     return system, Twin(system)
 
 
@@ -78,32 +91,35 @@ def test_joint_values_and_reactions_equal_pinocchio(ur5):
             assert np.abs(reactions[c.name].torque - f.angular).max() < 1e-9 * scale
 
 
-def test_servo_constraints_give_the_inverse_dynamics():
+def test_servo_constraints_give_the_inverse_dynamics(floating_ur5):
     """Every joint angle of the UR5 prescribed by a holonomic constraint (Udwadia's servo
-    constraints), no torques applied: each servo row's multiplier is the joint torque
-    that makes the motion, Pinocchio's rnea."""
-    system = mb.from_robot("ur5")
+    constraints) θ_i(t) = θ0_i + 0.3 (sin(2t + i) − sin i), no torques applied: along the simulated
+    motion each servo row's multiplier is the joint torque that makes it, Pinocchio's rnea,
+    and the joints follow their θ_i."""
+    system = fix_base(floating_ur5)
     twin = Twin(system)
-    rng = np.random.default_rng(3)
-    q, v = sample_pinocchio_state(twin, rng)
-    a = rng.normal(size=twin.model.nv)
-    qm, qdm = twin.to_maximal(q, v)
-    angles = system.joint_values(0.0, qm, qdm)
+    start = np.random.default_rng(3).uniform(-2, 2, twin.model.nq)
+    qm, _ = twin.to_maximal(start, np.zeros(twin.model.nv))
     joints = {c.name: c for c in system.constraints}
     t = T_SYMBOL
-    servos = [Connector.holonomic(f"{c.name}_servo", [joints[c.name].angle - (angles[c.name].position[0]
-                                                                              + v[c.idx_v] * t + a[c.idx_v] * t**2 / 2)],
+    targets = {c.name: start[c.idx_q] + 0.3 * (sp.sin(2 * t + i) - np.sin(i)) for i, c in enumerate(twin.coordinates)}
+    servos = [Connector.holonomic(f"{name}_servo", [constraint_symbols(joints[name])["angle"] - target],
                                   system.q_symbols, system.qd_symbols, system.parameter_symbols)
-              for c in twin.coordinates]
+              for name, target in targets.items()]
     servoed = system.with_constraints(servos)
-    motion = servoed.motion(0.0, qm, qdm)
-    assert motion.unique
-    torque = pin.rnea(twin.model, twin.data, q, v, a)
-    reactions = servoed.reactions(0.0, qm, qdm, motion)
-    found = np.array([reactions[f"{c.name}_servo"].multipliers[0] for c in twin.coordinates])
-    expected = np.array([torque[c.idx_v] for c in twin.coordinates])
-    assert np.abs(found - expected).max() < 1e-9 * np.abs(expected).max()
-    assert np.allclose(motion.lam[-len(servos):], found, rtol=0, atol=1e-12 * np.abs(expected).max())
+    qd0 = project_velocities(servoed, 0.0, qm, np.zeros(system.n))
+    trajectory = mb.simulate(servoed, 0.5, q0=qm, qd0=qd0, dt=0.125)
+    assert trajectory.status == "completed"
+    for time, q, qd in zip(trajectory.t, trajectory.q, trajectory.qd):
+        motion = servoed.motion(time, q, qd)
+        assert motion.unique
+        qp, v, a = twin.to_pinocchio(q, qd, motion.qdd)
+        assert np.allclose(qp, [float(x.subs(T_SYMBOL, time)) for x in targets.values()], rtol=0, atol=1e-9)
+        torque = pin.rnea(twin.model, twin.data, qp, v, a)
+        reactions = servoed.reactions(time, q, qd, motion)
+        found = np.array([reactions[f"{name}_servo"].multipliers[0] for name in targets])
+        assert np.abs(found - torque).max() < 1e-9 * np.abs(torque).max()
+        assert np.array_equal(motion.lam[-len(servos):], found)
 
 
 def test_pendulum_hinge_reaction_is_newtons():
@@ -198,25 +214,8 @@ def test_joint_rates_are_derivatives_of_positions():
         assert np.allclose(derivative, value.rate, rtol=0, atol=1e-7 * (1 + np.abs(value.rate).max()))
 
 
-PD_PENDULUM = """
-name: pd_pendulum
-parameters: {m: 1.0, L: 1.0, g: 9.81, kp: 50.0, kd: 10.0, target: 0.5}
-gravity: [0, 0, -g]
-world: {frames: {pivot: {axis: [0, 1, 0]}}}
-subsystems:
-  rod:
-    type: rigid_body
-    mass: m
-    inertia: [m*L**2/12, m*L**2/12, 0.001]
-    frames: {top: {position: [0, 0, L/2], axis: [0, 1, 0]}}
-    initial: {position: [0, 0, -L/2]}
-joints:
-  - name: hinge
-    type: revolute
-    parent: world.pivot
-    child: rod.top
-    actuation: -kp*(hinge.angle - target) - kd*hinge.rate
-"""
+PD_PENDULUM = (ROOT / "models" / "joints" / "pd_pendulum.yaml").read_text()
+
 
 
 def test_pd_law_on_joint_values_settles_at_the_static_balance():
@@ -251,29 +250,8 @@ def test_joint_named_like_a_part_is_refused():
         mb.loads(text)
 
 
-CART_POLE = """
-name: cart_pole
-parameters: {M: 1.5, m: 0.4, l: 0.3, I: 0.004, g: 9.81}
-gravity: [0, 0, -g]
-world: {frames: {rail: {axis: [1, 0, 0]}}}
-subsystems:
-  cart:
-    type: rigid_body
-    mass: M
-    inertia: [0.01, 0.01, 0.01]
-    frames: {rail: {axis: [1, 0, 0]}, pivot: {axis: [0, 1, 0]}}
-  pole:
-    type: rigid_body
-    mass: m
-    inertia: [I, I, 0.001]
-    frames: {pivot: {position: [0, 0, l], axis: [0, 1, 0]}}
-    initial: {position: [0, 0, -l]}
-joints:
-  - {name: slider, type: prismatic, parent: world.rail, child: cart.rail}
-  - {name: hinge, type: revolute, parent: cart.pivot, child: pole.pivot}
-constraints:
-  - {name: servo, holonomic: slider.displacement - 0.2*sin(3*t)}
-"""
+CART_POLE = (ROOT / "models" / "joints" / "cart_pole_servo.yaml").read_text()
+
 
 
 def test_under_actuated_cart_pole_servo_force():

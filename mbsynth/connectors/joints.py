@@ -28,7 +28,6 @@ from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
-from scipy.spatial.transform import Rotation
 
 from ..constraint import Connector
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
@@ -184,6 +183,8 @@ def _turned(joint, relative):
     (also when ``relative`` is no turn at all: a zero quaternion, left to other checks)."""
     if not (np.all(np.isfinite(relative)) and np.linalg.det(relative) > 0):
         return None
+    from scipy.spatial.transform import Rotation  # scipy.spatial: a tenth of a second, only here
+
     turn = Rotation.from_matrix(relative).as_rotvec()
     angle = np.degrees(np.linalg.norm(turn))
     if angle < 90:

@@ -14,10 +14,10 @@ import sympy as sp
 from ..closure import close
 from ..connectors import Joint
 from ..constraint import Connector
-from ..joint_values import value_expressions
+from ..joint_values import constraint_symbols, value_expressions
 from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
-from ..symbolic import T_SYMBOL
+from ..symbolic import T_SYMBOL, joint_values_in
 from ..system import System
 from .forces import read_forces
 from .joints import read_joints, read_world
@@ -158,6 +158,7 @@ class _Builder:
             for c, qs, qds in zip(part.coordinates, part.q, part.qd):
                 self.global_symbols[f"{part.name}.{c}"] = qs
                 self.global_symbols[f"{part.name}.{c}_dot"] = qds
+        self.constraint_symbols = dict(self.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
         robot_joints, robot_forces = connect_robots(self)
@@ -272,9 +273,9 @@ class _Builder:
                 a, b = self.read_acceleration_row(spec[kind], kpath)
                 constraints.append(Connector.acceleration(name, a, b, *args, C=C))
                 continue
-            expr = self.expression(spec[kind], kpath, self.global_symbols)
+            expr = self.expression(spec[kind], kpath, self.constraint_symbols)
             self.differentiable(expr, kpath, None if kind == "holonomic" else ())
-            has_q = expr.free_symbols & set(self.q)
+            has_q = expr.free_symbols & set(self.q) or joint_values_in(expr)
             has_qd = expr.free_symbols & set(self.qd)
             if kind == "holonomic" and has_qd:
                 self.fail(kpath, f"constraint '{name}' uses velocities {sorted(map(str, has_qd))}; "
@@ -326,6 +327,8 @@ class _Builder:
                           f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
             for key, expr in value_expressions(joint).items():
                 self.global_symbols[f"{joint.name}.{key}"] = expr
+            for key, symbol in constraint_symbols(joint).items():
+                self.constraint_symbols[f"{joint.name}.{key}"] = symbol
 
     def coordinate_names(self):
         return (str(s) for s in self.q)
