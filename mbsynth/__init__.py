@@ -23,6 +23,8 @@ __version__ = "0.1.0"
 _LAZY = {
     "load": "io", "loads": "io", "System": "system", "from_robot": "robots", "simulate": "simulate",
     "sweep": "sweep", "Trajectory": "trajectory", "load_trajectory": "trajectory",
+    "equilibrium": "statics", "linearize": "linearization", "Linearization": "linearization",
+    "modes": "modal", "Modes": "modal",
 }
 # Public submodules imported on first use: mb.viewer.show, mb.viewer.to_html.
 _SUBMODULES = ("viewer",)

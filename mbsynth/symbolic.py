@@ -218,9 +218,11 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     return a, b, psi
 
 
-def compile_function(args, exprs, constants=()):
+def compile_function(args, exprs, constants=(), dtype=float):
     """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
     ``exprs`` (scalars, vectors or matrices), with common subexpressions shared.
+    ``dtype=complex`` keeps complex arguments complex (complex-step derivatives,
+    linearization.py); the constants must then be numbers.
 
     ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
     values (numbers or expressions of ``args``) are put in at each evaluation, so that
@@ -241,7 +243,7 @@ def compile_function(args, exprs, constants=()):
     def evaluate(*given):
         given = [np.float64(v) if isinstance(v, (int, float)) else v for v in given]
         with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
-            out = np.asarray(raw(*given, values(*given), fixed), dtype=float)
+            out = np.asarray(raw(*given, values(*given), fixed), dtype=dtype)
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
 
     return evaluate
