@@ -160,3 +160,19 @@ def test_simulate_plots_joints_and_names_the_work(capsys, tmp_path):
     assert "relative energy change" in text and "work of hinge.actuation" in text
     assert main(["simulate", str(JOINT_MODELS / "mechanisms" / "simple_pendulum.yaml"), "--t-end", "0.5"]) == 0
     assert "relative energy drift" in capsys.readouterr().out
+
+
+def test_modes_of_the_pd_pendulum(capsys, tmp_path):
+    """Linearized about its rest angle θ*, the PD pendulum obeys I s² + kd s + kp + m g (L/2) cos θ* = 0
+    (I = m L²/3): two overdamped modes; --html writes a page with one frame per mode."""
+    from scipy.optimize import brentq
+    page = tmp_path / "modes.html"
+    assert main(["modes", str(JOINT_MODELS / "joints" / "pd_pendulum.yaml"), "--equilibrium", "--json",
+                 "--html", str(page)]) == 0
+    report = json.loads(capsys.readouterr().out)
+    rest = brentq(lambda x: 50.0 * (x - 0.5) + 9.81 * 0.5 * np.sin(x), 0.0, 1.0)
+    expected = np.sort(np.roots([1 / 3, 10.0, 50.0 + 9.81 * 0.5 * np.cos(rest)]).real)
+    found = np.sort([m["eigenvalue"][0] for m in report["modes"]])
+    assert found == pytest.approx(expected, rel=1e-8)
+    assert [m["kind"] for m in report["modes"]] == ["overdamped", "overdamped"]
+    assert page.read_text().count("<iframe") == 2

@@ -15,7 +15,7 @@ def parser():
     top = ArgumentParser(prog="mbsynth", description="The ``mbsynth`` command.")
     top.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     commands = top.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_check, _simulate, _sweep, _view, _validate, _robots):
+    for add in (_check, _simulate, _sweep, _view, _validate, _modes, _robots):
         command = add(commands)
         command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     return top
@@ -120,6 +120,24 @@ def _validate(commands):
     val.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error that passes (default 1e-9)")
     val.add_argument("--json", action="store_true", help="print one JSON object")
     return val
+
+
+def _modes(commands):
+    modes = commands.add_parser(
+        "modes", help="natural frequencies, damping ratios and mode shapes about a rest state",
+        description="Linearize the model about its initial state (or, with --equilibrium, the static "
+                    "equilibrium nearest it) in independent coordinates of its constraints' tangent "
+                    "space, massless parts closed by their balances, and print one row per mode: "
+                    "frequency, damping ratio, kind (vibration, overdamped, unstable, free) and the "
+                    "joints (or coordinates) that move most. Exit 0, 1 when the state is no rest state "
+                    "or the linearization is refused (the reason is printed), 2 on a model error.")
+    modes.add_argument("model", help="model file (YAML)")
+    modes.add_argument("--equilibrium", action="store_true",
+                       help="first find the static equilibrium near the initial state (Newton)")
+    modes.add_argument("--json", action="store_true", help="print one JSON object")
+    modes.add_argument("--html", metavar="FILE.html",
+                       help="write an HTML page animating each mode in meshcat (a selector per mode)")
+    return modes
 
 
 def _robots(commands):
