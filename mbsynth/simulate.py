@@ -89,6 +89,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         if control is not None:
             run.system = control.apply(t0, q, qd)
         run.record(t0, q, qd, writer)
+        run.t_now = t0
         for t_next in sorted(outputs | samples)[1:]:
             q, qd = run.advance(t_next, q, qd)
             if t_next in samples:
@@ -138,6 +139,7 @@ class _Run:
         self.steps = self.evaluations = 0
         self.first_step = None
         self.t_failed = float("nan")
+        self.t_now = None  # the time the state has reached (outputs and control samples alike)
         self.non_unique = False
         self.calls, self.t_mark, self.span = 0, 0.0, 0.0
         self.drift_span = None  # the span between projections, when shorter than the output interval
@@ -174,7 +176,8 @@ class _Run:
         span halves after a larger drift and doubles after one below a hundredth of it; a
         span that drifted more than DRIFT_REDO × DRIFT_TARGET is integrated again in
         quarters (the least-squares motion of the stages is only as good as their drift)."""
-        t, interval = self.t[-1], t_next - self.t[-1]
+        t = self.t_now
+        interval = t_next - t
         while t < t_next:
             t_to = t_next if self.drift_span is None or t + 1.5 * self.drift_span >= t_next else t + self.drift_span
             q_to, qd_to = self._integrate(t, t_to, q, qd)
@@ -190,6 +193,7 @@ class _Run:
         self._note_singular()
         if self.stabilization == "projection":
             self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
+        self.t_now = t_next
         return q, qd
 
     def _adapt_span(self, drift, span, interval):
