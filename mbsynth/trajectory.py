@@ -117,6 +117,9 @@ def load_trajectory(path):
     if path.suffix == ".csv" or path.name.endswith(".csv.partial"):
         with path.open(newline="") as f:
             header = next(csv.reader(f))
+        if "energy" not in header[1:]:
+            raise ModelError(f"{path}: not a trajectory file (its header has no 'energy' column: "
+                             "t, coordinates, velocities, energy, outputs)")
         data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
         energy = header.index("energy", 1)  # t, coordinates, velocities, energy, outputs
         n = (energy - 1) // 2
