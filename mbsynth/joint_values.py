@@ -98,13 +98,10 @@ class JointKinematics:
     def values(self, t, q, qd, qdd, p):
         """``JointValues`` at the model's state (q, q̇) and, when given, q̈."""
         i = self.indices
-        scalars, rates, rate_a, rate_b, _, _, RA, RB, _ = self._evaluate(t, q[i], qd[i], p)
-        position = _positions(self.kind, scalars.ravel(), RA, RB, self._origin(t, q, qd, p))
+        scalars, rates, rate_a, rate_b, origin, _, RA, RB, _ = self._evaluate(t, q[i], qd[i], p)
+        position = _positions(self.kind, scalars.ravel(), RA, RB, origin.ravel())  # free: report frame is B
         acceleration = None if qdd is None else rate_a @ qdd[i] - rate_b.ravel()
         return JointValues(position, rates.ravel(), acceleration)
-
-    def _origin(self, t, q, qd, p):
-        return self._evaluate(t, q[self.indices], qd[self.indices], p)[4].ravel() if self.kind == "free" else None
 
     def frame(self, t, q, qd, p):
         """The ``FramePose`` of the reaction frame."""
