@@ -13,13 +13,8 @@ rest length and damping are expressions of parameters, ≥ 0. ``name`` defaults 
 from ..forces import AXES, applied_force, applied_torque, point_spring
 from .joints import frame_reference
 from .parts import read_nonnegative
+from .schema import FORCE_SECTIONS
 
-KEYS = {"spring": {"between", "stiffness", "rest_length", "damping"},
-        "damper": {"between", "damping"},
-        "force": {"at", "value"},
-        "torque": {"part", "value", "axes"}}
-REQUIRED = {"spring": ("between", "stiffness", "rest_length"), "damper": ("between", "damping"),
-            "force": ("at", "value"), "torque": ("part", "value")}
 TURNING = ("rigid_body", "planar_body")  # parts with an orientation a torque can act on
 
 
@@ -34,13 +29,13 @@ def read_forces(builder):
     for i, spec in enumerate(node):
         path = ("forces", i)
         if not isinstance(spec, dict) or "type" not in spec:
-            builder.fail(path, f"expected a mapping with 'type' (one of {', '.join(KEYS)}) and its data")
+            builder.fail(path, f"expected a mapping with 'type' (one of {', '.join(FORCE_SECTIONS)}) and its data")
         if True in spec:
             builder.fail(path, "YAML reads the key 'on' as true: name the body with 'part:'")
         kind = spec["type"]
-        if kind not in KEYS:
-            builder.fail(path + ("type",), f"unknown force type {kind!r}; known: {', '.join(KEYS)}")
-        builder.mapping(spec, path, {"name", "type", "description", *KEYS[kind]}, required=REQUIRED[kind])
+        if kind not in FORCE_SECTIONS:
+            builder.fail(path + ("type",), f"unknown force type {kind!r}; known: {', '.join(FORCE_SECTIONS)}")
+        builder.section(spec, path, FORCE_SECTIONS[kind])
         name = builder.identifier(spec.get("name", f"{kind}_{i + 1}"), path + ("name",), "force name")
         if name in names:
             builder.fail(path + ("name",), f"duplicate force name '{name}'")

@@ -17,8 +17,7 @@ from ..friction import KINDS as FRICTION_KINDS
 from ..friction import Friction
 from ..joint_forces import MOTIONS, actuation, joint_motion, joint_spring
 from .parts import read_nonnegative
-
-KEYS = {"actuation", "spring", "friction"}
+from .schema import SECTIONS
 
 
 def read_friction(builder, spec, path, kind):
@@ -28,7 +27,7 @@ def read_friction(builder, spec, path, kind):
     path = path + ("friction",)
     if kind not in FRICTION_KINDS:
         builder.fail(path, f"friction acts at {' and '.join(FRICTION_KINDS)} joints, not at a {kind} joint")
-    node = builder.mapping(spec["friction"], path, {"viscous", "coulomb", "radius"})
+    node = builder.section(spec["friction"], path, "joint_friction")
     if not {"viscous", "coulomb"} & set(node):
         builder.fail(path, "give 'viscous:' and/or 'coulomb:'")
     viscous, coulomb = (read_nonnegative(builder, node, key, path, default=0) for key in ("viscous", "coulomb"))
@@ -60,7 +59,7 @@ def read_joint_forces(builder, spec, path, joint):
 
 def read_actuation(builder, node, path, joint):
     """{"torque" and/or "force": expression} from a scalar or a mapping."""
-    allowed = {key for key, (position, _) in MOTIONS.items() if getattr(joint, position) is not None}
+    allowed = {key for key in SECTIONS["joint_actuation"].allowed if getattr(joint, MOTIONS[key][0]) is not None}
     if not allowed:
         builder.fail(path, "actuation drives a revolute, prismatic or cylindrical joint along its axis, "
                            f"not a {joint.joint_kind} joint")
@@ -80,7 +79,7 @@ def read_spring(builder, node, path, joint, args):
     if joint_motion(joint) is None:
         builder.fail(path, "a joint spring acts at a revolute (torsional) or prismatic (linear) joint, "
                            f"not at a {joint.joint_kind} joint")
-    node = builder.mapping(node, path, {"stiffness", "damping", "rest"}, required=("stiffness",))
+    node = builder.section(node, path, "joint_spring")
     stiffness, damping = (read_nonnegative(builder, node, key, path, default=0) for key in ("stiffness", "damping"))
     rest = builder.constant(node.get("rest", 0), path + ("rest",))
     if joint.joint_kind == "revolute" and abs(builder.value(rest)) > float(sp.pi):

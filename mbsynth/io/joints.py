@@ -7,19 +7,16 @@ import sympy as sp
 from ..connectors import JOINT_KINDS, Joint
 from ..connectors.rolling import KnifeEdge, RollingDisk
 from ..subsystems import Frame
-from .joint_forces import KEYS as FORCE_KEYS
 from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
 
-JOINT_KEYS = {"name", "type", "parent", "child", "length", "description", *FORCE_KEYS}
-# ground contacts: extra keys, required keys, the part kinds they may sit on
-CONTACT_TYPES = {"rolling_disk": ({"radius", "ground"}, ("radius",), ("rigid_body",)),
-                 "knife_edge": (set(), (), ("rigid_body", "planar_body"))}
+# ground contacts (their keys: schema.py): the part kinds they may sit on
+CONTACT_TYPES = {"rolling_disk": ("rigid_body",), "knife_edge": ("rigid_body", "planar_body")}
 
 
 def read_world(builder):
     """Frames fixed in the world (``world: {frames: {...}}``)."""
-    node = builder.mapping(builder.root.get("world"), ("world",), {"frames"})
+    node = builder.section(builder.root.get("world"), ("world",), "world")
     return read_frames(builder, "world", node.get("frames"), ("world", "frames"), offsets=True)
 
 
@@ -60,7 +57,7 @@ def read_joints(builder):
         if isinstance(spec, dict) and spec.get("type") in CONTACT_TYPES:
             joints.append(read_contact(builder, spec, path, names))
             continue
-        spec = builder.mapping(spec, path, JOINT_KEYS, required=("name", "type", "parent", "child"))
+        spec = builder.section(spec, path, "joint")
         name = _joint_name(builder, spec, path, names)
         kind = spec["type"]
         if kind not in JOINT_KINDS:
@@ -94,9 +91,8 @@ def read_contact(builder, spec, path, names):
     axis; ``radius``; ``ground`` the height of the plane, 0 by default) or ``knife_edge``
     (``child`` a frame whose x axis is the blade)."""
     kind = spec["type"]
-    extra, required, hosts = CONTACT_TYPES[kind]
-    spec = builder.mapping(spec, path, {"name", "type", "child", "description", *extra},
-                           required=("name", "type", "child", *required))
+    hosts = CONTACT_TYPES[kind]
+    spec = builder.section(spec, path, kind)
     name = _joint_name(builder, spec, path, names)
     part, frame = frame_reference(builder, spec["child"], path + ("child",))
     if part is None or part.kind not in hosts:

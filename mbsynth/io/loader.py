@@ -24,10 +24,9 @@ from .joints import read_joints, read_world
 from .outputs import read_outputs
 from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import connect_robots, read_robot, read_robots
+from .schema import SECTIONS
 from .source import Document, LineDict, LineList, read_document
 
-TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
-            "closure", "initial", "initial_fixed", "forces", "outputs"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
@@ -71,6 +70,12 @@ class _Builder:
             if key not in node:
                 self.fail(path, f"missing required key '{key}'")
         return node
+
+    def section(self, node, path, name):
+        """``node`` checked against the schema's section ``name`` (schema.py): its allowed
+        and required keys."""
+        section = SECTIONS[name]
+        return self.mapping(node, path, section.allowed, required=section.required)
 
     def identifier(self, name, path, what):
         if not isinstance(name, str) or not name.isidentifier() or keyword.iskeyword(name):
@@ -139,7 +144,7 @@ class _Builder:
 
     # -- sections -------------------------------------------------------------------
     def system(self):
-        root = self.mapping(self.root, (), TOP_KEYS, required=("subsystems",))
+        root = self.section(self.root, (), "model")
         name = root.get("name", _stem(self.doc.name))
         if not isinstance(name, str):
             self.fail(("name",), f"expected a string, got {_kind(name)}")
@@ -219,8 +224,7 @@ class _Builder:
         return parts
 
     def read_lagrangian(self, name, spec, path):
-        self.mapping(spec, path, {"type", "coordinates", "T", "V", "forces", "frames", "geometry", "description"},
-                     required=("coordinates", "T"))
+        self.section(spec, path, "lagrangian")
         coords = spec["coordinates"]
         if not isinstance(coords, LineList) or not coords:
             self.fail(path + ("coordinates",), "expected a non-empty list of coordinate names")
@@ -255,7 +259,7 @@ class _Builder:
         constraints, names = [], set()
         for i, spec in enumerate(node):
             path = ("constraints", i)
-            spec = self.mapping(spec, path, {"name", "description", "C", *kinds})
+            spec = self.section(spec, path, "constraint")
             name = spec.get("name", f"constraint_{i + 1}")
             if not isinstance(name, str) or not name.strip():
                 self.fail(path + ("name",), f"constraint name must be a string, got {_kind(name)}")
@@ -290,7 +294,7 @@ class _Builder:
         return constraints
 
     def read_acceleration_row(self, node, path):
-        node = self.mapping(node, path, {"A", "b"}, required=("A",))
+        node = self.section(node, path, "acceleration_row")
         coords = list(self.coordinate_names())
         row = node["A"]
         if isinstance(row, LineList):

@@ -3,8 +3,9 @@
 from ..errors import ModelError
 from ..outputs import energy_output, expression_output, frame_output, reaction_output
 from .joints import frame_reference
+from .schema import SECTIONS
 
-KINDS = ("reaction", "position", "velocity", "energy")
+KINDS = tuple(key.name for key in SECTIONS["output"].keys)
 
 
 def read_outputs(builder, constraints):
@@ -21,7 +22,7 @@ def read_outputs(builder, constraints):
         if not isinstance(spec, dict):
             outputs.append(expression_output(name, builder.expression(spec, path, builder.global_symbols)))
             continue
-        spec = builder.mapping(spec, path, set(KINDS))
+        spec = builder.section(spec, path, "output")
         if len(spec) != 1:
             builder.fail(path, f"give exactly one of {', '.join(KINDS)} (or an expression)")
         (kind, value), = spec.items()

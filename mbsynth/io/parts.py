@@ -21,8 +21,7 @@ COLORS = {"red": (0.85, 0.2, 0.2), "green": (0.2, 0.7, 0.3), "blue": (0.2, 0.4, 
 
 
 def read_rigid_body(builder, name, spec, path):
-    builder.mapping(spec, path, {"type", "mass", "inertia", "frames", "geometry", "initial", "description"},
-                    required=("mass", "inertia"))
+    builder.section(spec, path, "rigid_body")
     mass = read_mass(builder, spec, path)
     inertia = read_inertia(builder, spec["inertia"], path + ("inertia",))
     q, qd = builder.part_symbols(name, RigidBody.COORDINATES)
@@ -33,11 +32,11 @@ def read_rigid_body(builder, name, spec, path):
 
 
 def read_particle(builder, name, spec, path):
-    builder.mapping(spec, path, {"type", "mass", "frames", "geometry", "initial", "description"}, required=("mass",))
+    builder.section(spec, path, "particle")
     q, qd = builder.part_symbols(name, ("x", "y", "z"))
     frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=False)
     initial = {}
-    node = builder.mapping(spec.get("initial"), path + ("initial",), {"position", "velocity"})
+    node = builder.section(spec.get("initial"), path + ("initial",), "initial_particle")
     for key, suffix in (("position", ""), ("velocity", "_dot")):
         if key in node:
             values = builder.numbers(node[key], path + ("initial", key), 3)
@@ -47,8 +46,7 @@ def read_particle(builder, name, spec, path):
 
 
 def read_planar_body(builder, name, spec, path):
-    builder.mapping(spec, path, {"type", "mass", "inertia", "frames", "geometry", "initial", "description"},
-                    required=("mass", "inertia"))
+    builder.section(spec, path, "planar_body")
     inertia = builder.constant(spec["inertia"], path + ("inertia",))
     if builder.value(inertia) < 0:
         builder.fail(path + ("inertia",), "the moment of inertia I_zz must be ≥ 0")
@@ -63,13 +61,11 @@ def read_planar_body(builder, name, spec, path):
 def read_spring(builder, name, spec, path):
     """A spring part: ends ``end1``, ``end2``; ``initial: {end1: [x, y, z], end2: ...,
     end1_velocity: ..., end2_velocity: ...}``."""
-    builder.mapping(spec, path, {"type", "stiffness", "rest_length", "damping", "mass", "initial", "description"},
-                    required=("stiffness", "rest_length"))
+    builder.section(spec, path, "spring")
     stiffness, rest_length, damping, mass = (read_nonnegative(builder, spec, key, path, default=0)
                                              for key in ("stiffness", "rest_length", "damping", "mass"))
     q, qd = builder.part_symbols(name, Spring.COORDINATES)
-    node = builder.mapping(spec.get("initial"), path + ("initial",),
-                           {"end1", "end2", "end1_velocity", "end2_velocity"})
+    node = builder.section(spec.get("initial"), path + ("initial",), "initial_spring")
     initial = {}
     for key, values in node.items():
         end, _, velocity = key.partition("_")
@@ -146,8 +142,7 @@ def read_frames(builder, part, node, path, offsets, symbols=None):
     for name, spec in node.items():
         fpath = path + (name,)
         builder.identifier(name, fpath, "frame name")
-        spec = builder.mapping(spec, fpath,
-                               {"position", "geometry", *ORIENTATION_KEYS})
+        spec = builder.section(spec, fpath, "frame")
         position = (builder.vector(spec.get("position", [0, 0, 0]), fpath + ("position",), 3, symbols) if symbols
                     else builder.constants(spec.get("position", [0, 0, 0]), fpath + ("position",), 3))
         for i, x in enumerate(position):
@@ -163,11 +158,7 @@ def read_frames(builder, part, node, path, offsets, symbols=None):
 def read_body_initial(builder, node, path, planar):
     """Coordinate values from ``position``, an orientation (``theta`` when planar),
     ``velocity`` and ``angular_velocity`` (world axes)."""
-    if planar:
-        keys = {"position", "theta", "velocity", "angular_velocity"}
-    else:
-        keys = {"position", "velocity", "angular_velocity", *ORIENTATION_KEYS}
-    node = builder.mapping(node, path, keys)
+    node = builder.section(node, path, "initial_planar_body" if planar else "initial_rigid_body")
     size = 2 if planar else 3
     names = ("x", "y", "z")[:size]
     values = {}
@@ -205,7 +196,7 @@ def read_geometry(builder, node, path, frames=()):
     shapes = []
     for i, item in enumerate(items):
         ipath = path + (i,) if isinstance(node, list) else path
-        item = builder.mapping(item, ipath, {*SHAPES, "color", "origin", "scale"})
+        item = builder.section(item, ipath, "geometry")
         kinds = [k for k in SHAPES if k in item]
         if len(kinds) != 1:
             builder.fail(ipath, f"a shape needs exactly one of {', '.join(SHAPES)}; got {kinds or 'none'}")
@@ -226,7 +217,7 @@ def read_geometry(builder, node, path, frames=()):
                 builder.fail(ipath + (kind,), f"{kind} dimensions must be positive, got {size}")
             shape["size"] = size
         shape["color"] = read_color(builder, item.get("color", "grey"), ipath + ("color",))
-        origin = builder.mapping(item.get("origin"), ipath + ("origin",), {"position", *ORIENTATION_KEYS})
+        origin = builder.section(item.get("origin"), ipath + ("origin",), "pose")
         shape["position"] = builder.numbers(origin.get("position", [0, 0, 0]), ipath + ("origin", "position"), 3)
         shape["rotation"] = read_rotation(builder, origin, ipath + ("origin",)).tolist()
         shapes.append(shape)

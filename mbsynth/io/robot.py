@@ -22,16 +22,14 @@ import numpy as np
 
 from ..errors import ModelError
 from ..robots import Robot, describe
-from .parts import ORIENTATION_KEYS, read_rotation
-
-KEYS = {"type", "robot", "floating", "base", "description"}
+from .parts import read_rotation
 
 
 class RobotEntry:
     """A ``type: robot`` entry: the URDF read and the names planned (``robot``)."""
 
     def __init__(self, builder, name, spec, path):
-        builder.mapping(spec, path, KEYS, required=("robot",))
+        builder.section(spec, path, "robot")
         floating = spec.get("floating", False)
         if not isinstance(floating, bool):
             builder.fail(path + ("floating",), f"expected true or false, got {floating!r}")
@@ -54,7 +52,7 @@ class RobotEntry:
 
     def parts(self, builder):
         """The robot's bodies, at ``base`` (read now: it may use the model's parameters)."""
-        node = builder.mapping(self.spec.get("base"), self.path + ("base",), {"position", *ORIENTATION_KEYS})
+        node = builder.section(self.spec.get("base"), self.path + ("base",), "pose")
         position = builder.numbers(node.get("position", [0, 0, 0]), self.path + ("base", "position"), 3)
         rotation = read_rotation(builder, node, self.path + ("base",))
         self.robot = replace(self.robot, base=(np.array(position), rotation))

@@ -1,0 +1,306 @@
+"""The keys of a model file: one source of truth for the loader and the reference.
+
+Each ``Section`` is one kind of mapping a model file holds (the top level, a part of a
+given ``type``, a joint, a force element, ...) and lists every key it takes with its
+type, default, meaning and an example. The loader checks a mapping against its section
+(``_Builder.section``: unknown keys and missing required keys, with the file and line);
+the documentation's model-file reference is generated from ``SECTIONS``. Mappings whose
+keys are the model's own names (parameters, coordinates, frames, outputs) are described in
+their section's text and checked by the loader against those names.
+"""
+
+from dataclasses import dataclass
+
+from ..connectors import JOINT_KINDS
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of a section: ``type`` and ``meaning`` in words, ``example`` in YAML,
+    ``default`` (None when the key is required or has no default)."""
+
+    name: str
+    type: str
+    meaning: str
+    example: str
+    default: str | None = None
+    required: bool = False
+
+
+@dataclass(frozen=True)
+class Section:
+    """A kind of mapping: ``name`` (its id), ``where`` it sits in a file, its ``keys``."""
+
+    name: str
+    where: str
+    text: str
+    keys: tuple
+
+    @property
+    def allowed(self):
+        """The names of every key the section takes."""
+        return {key.name for key in self.keys}
+
+    @property
+    def required(self):
+        """The names of the keys that must be given, in the order they are checked."""
+        return tuple(key.name for key in self.keys if key.required)
+
+
+def _required(name, type_, meaning, example):
+    return Key(name, type_, meaning, example, required=True)
+
+
+_EXPR = "expression of parameters"
+_EXPRS = "expressions of parameters"
+_TYPE = {  # the ``type`` key of a part; its value selects the section
+    "lagrangian": "part given by its kinetic and potential energies",
+    "rigid_body": "rigid body in space (position and unit quaternion)",
+    "particle": "point mass in space",
+    "planar_body": "rigid body in the xy plane",
+    "spring": "spring (with optional mass) between two free ends",
+    "robot": "a whole robot from a URDF, one rigid body per link",
+}
+_DESCRIPTION = Key("description", "string", "free text, ignored by the loader", "'the left wheel'")
+_NAME = Key("name", "plain name", "the element's name in reports", "spring_1", default="<type>_<index>")
+_FRAMES = Key("frames", "mapping name → frame", "named frames on the part (section *frame*)",
+              "{tip: {position: [0, 0, -L]}}")
+_GEOMETRY = Key("geometry", "shape or list of shapes", "what the viewer draws (section *geometry*)",
+                "{box: [0.2, 0.1, 0.1], color: blue}")
+_POSITION = Key("position", "list of 3 expressions of parameters", "origin of the frame in the part's "
+                "axes", "[0, 0, -L]", default="[0, 0, 0]")
+_ORIENTATION = (
+    Key("rpy", "list of 3 expressions of parameters", "orientation as roll, pitch, yaw (URDF: "
+        "Rz(yaw) Ry(pitch) Rx(roll)); at most one of rpy, axis, quaternion", "[0, 0, pi/2]",
+        default="identity"),
+    Key("axis", "list of 3 expressions of parameters", "orientation with z along this vector", "[1, 0, 0]",
+        default="identity"),
+    Key("quaternion", "list of 4 expressions of parameters", "orientation as a unit quaternion (w, x, y, z)",
+        "[1, 0, 0, 0]", default="identity"),
+)
+_TYPE_KEY = {kind: _required("type", "string", f"``{kind}``: {meaning}", kind) for kind, meaning in _TYPE.items()}
+_MASS = _required("mass", _EXPR + ", ≥ 0", "mass [kg]; zero is allowed (a massless part)", "m")
+_BETWEEN = _required("between", "list of 2 frames", "the two frames joined (at most one on the world)",
+                     "[body.tip, world.anchor]")
+_FORCE_KEYS = (_NAME, Key("type", "string", "the kind of force element", "spring", required=True), _DESCRIPTION)
+
+SECTIONS = {section.name: section for section in (
+    Section("model", "the top level of a model file",
+            "A model file is one mapping. Only ``subsystems`` is required.",
+            (Key("name", "string", "the model's name", "example1_wheel", default="the file name"),
+             _DESCRIPTION,
+             Key("parameters", "mapping name → expression", "named constants; each may use those before it",
+                 "{m: 2.0, R: 0.3, I: 0.5*m*R**2}", default="{}"),
+             Key("gravity", "list of 3 " + _EXPRS, "gravitational acceleration acting on rigid bodies, "
+                 "particles, planar bodies and spring masses [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
+             Key("world", "mapping (section *world*)", "frames fixed in the world", "{frames: {pin: {}}}"),
+             _required("subsystems", "mapping name → part", "the parts, each with a ``type`` "
+                       "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*)", "{wheel: {type: particle, mass: m}}"),
+             Key("constraints", "list of constraints (section *constraint*)",
+                 "constraints written as equations in the parts' coordinates", "[{holonomic: a.x - b.x}]",
+                 default="[]"),
+             Key("joints", "list of joints (sections *joint*, *rolling_disk*, *knife_edge*)",
+                 "joints between named frames and ground contacts", "[{name: pin, type: revolute, parent: world, child: link.top}]",
+                 default="[]"),
+             Key("closure", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
+                 "part whose motion the model leaves open (closure.py)", "auto", default="none"),
+             Key("initial", "mapping coordinate → " + _EXPR, "initial values by coordinate name "
+                 "(``part.c``, velocities ``part.c_dot``)", "{wheel.theta: 0.0, wheel.theta_dot: 1.0}",
+                 default="0 (orientations: identity)"),
+             Key("initial_fixed", "list of names from ``initial``", "initial values kept exactly when the "
+                 "state is made consistent with the constraints", "[wheel.theta]", default="[]"),
+             Key("forces", "list of force elements (sections *force_spring*, *force_damper*, *force_force*, *force_torque*)", "springs, dampers, forces and "
+                 "torques between frames", "[{type: spring, between: [a.tip, world], stiffness: k, rest_length: 0.3}]", default="[]"),
+             Key("outputs", "mapping name → expression or output (section *output*)",
+                 "quantities recorded along a run", "{height: body.z, pin_force: {reaction: pin.force}}",
+                 default="{}"))),
+    Section("world", "``world:``", "The world's own frames (joints and springs may attach to them).",
+            (Key("frames", "mapping name → frame", "named frames fixed in the world (section *frame*)",
+                 "{anchor: {position: [0, 0, 1]}}", default="{}"),)),
+    Section("frame", "each entry of a ``frames:`` mapping (parts and world)",
+            "A frame fixed on a part, at ``position`` in the part's axes, turned by at most one "
+            "orientation key. On a lagrangian part the position may use its coordinates.",
+            (_POSITION, Key("geometry", "shape or list of shapes", "what the viewer draws at the frame",
+                            "{sphere: 0.05}"), *_ORIENTATION)),
+    Section("lagrangian", "``subsystems: {NAME: {type: lagrangian, ...}}``",
+            "A part in its own coordinates, with M and Q derived from Lagrange's equations. Expressions "
+            "use the parameters, ``t``, the coordinates and their velocities (``c_dot``).",
+            (_TYPE_KEY["lagrangian"],
+             _required("coordinates", "list of names", "the part's coordinates (not ending in ``_dot``)",
+                       "[theta, y]"),
+             _required("T", "expression", "kinetic energy", "0.5*m*(R*theta_dot)**2"),
+             Key("V", "expression of coordinates (no velocities)", "potential energy", "-m*g*y", default="0"),
+             Key("forces", "mapping coordinate → expression", "generalized forces not derived from V",
+                 "{theta: -c*theta_dot}", default="{}"),
+             _FRAMES, _GEOMETRY, _DESCRIPTION)),
+    Section("rigid_body", "``subsystems: {NAME: {type: rigid_body, ...}}``",
+            "A rigid body in space: coordinates x, y, z and the unit quaternion qw, qx, qy, qz.",
+            (_TYPE_KEY["rigid_body"], _MASS,
+             _required("inertia", "list of 3, or 3 × 3 list, of " + _EXPRS,
+                       "principal moments [Ixx, Iyy, Izz] or the inertia matrix about the centre of mass",
+                       "[0.1, 0.1, 0.2]"),
+             _FRAMES, _GEOMETRY,
+             Key("initial", "mapping (section *initial_rigid_body*)", "initial pose and velocities",
+                 "{position: [0, 0, 1]}", default="at rest at the origin"), _DESCRIPTION)),
+    Section("particle", "``subsystems: {NAME: {type: particle, ...}}``",
+            "A point mass in space: coordinates x, y, z. Its frames cannot be offset.",
+            (_TYPE_KEY["particle"], _MASS, _FRAMES, _GEOMETRY,
+             Key("initial", "mapping (section *initial_particle*)", "initial position and velocity",
+                 "{position: [1, 0, 0]}", default="at rest at the origin"), _DESCRIPTION)),
+    Section("planar_body", "``subsystems: {NAME: {type: planar_body, ...}}``",
+            "A rigid body moving in the xy plane: coordinates x, y, theta.",
+            (_TYPE_KEY["planar_body"], _MASS,
+             _required("inertia", _EXPR + ", ≥ 0", "moment of inertia I_zz about the centre of mass", "0.02"),
+             _FRAMES, _GEOMETRY,
+             Key("initial", "mapping (section *initial_planar_body*)", "initial pose and velocities",
+                 "{position: [0, 1], theta: 0.3}", default="at rest at the origin"), _DESCRIPTION)),
+    Section("spring", "``subsystems: {NAME: {type: spring, ...}}``",
+            "A spring part with two free ends, frames ``end1`` and ``end2`` (coordinates x1, y1, z1, x2, y2, z2); "
+            "with mass, the uniform bar's consistent mass matrix and half its weight on each end.",
+            (_TYPE_KEY["spring"],
+             _required("stiffness", _EXPR + ", ≥ 0", "stiffness [N/m]", "k"),
+             _required("rest_length", _EXPR + ", ≥ 0", "unstretched length [m]", "0.5"),
+             Key("damping", _EXPR + ", ≥ 0", "damping [N s/m]", "0.1", default="0"),
+             Key("mass", _EXPR + ", ≥ 0", "mass [kg]", "0.2", default="0"),
+             Key("initial", "mapping (section *initial_spring*)", "initial positions and velocities of the ends",
+                 "{end1: [0, 0, 0], end2: [0.5, 0, 0]}", default="at rest at the origin"), _DESCRIPTION)),
+    Section("robot", "``subsystems: {NAME: {type: robot, ...}}``",
+            "A whole robot: one rigid body per link (``NAME_<link>``), one joint per URDF joint "
+            "(``NAME_<joint>``) and a torque parameter ``tau_NAME_<joint>`` per movable joint.",
+            (_TYPE_KEY["robot"],
+             _required("robot", "string", "an example-robot-data name (``mbsynth robots``) or a URDF file "
+                       "relative to the model file", "ur5"),
+             Key("floating", "boolean", "a free-floating base instead of one welded to the world", "true",
+                 default="false"),
+             Key("base", "mapping (section *pose*)", "pose of the root link (the initial pose when floating)",
+                 "{position: [0, 0, 0.5]}", default="the world's origin"), _DESCRIPTION)),
+    Section("initial_rigid_body", "``initial:`` of a rigid_body",
+            "Velocities are in world axes.",
+            (Key("position", "list of 3 " + _EXPRS, "position of the centre of mass", "[0, 0, 1]",
+                 default="[0, 0, 0]"),
+             Key("velocity", "list of 3 " + _EXPRS, "velocity of the centre of mass", "[1, 0, 0]",
+                 default="[0, 0, 0]"),
+             Key("angular_velocity", "list of 3 " + _EXPRS, "angular velocity (world axes)", "[0, 0, 2]",
+                 default="[0, 0, 0]"), *_ORIENTATION)),
+    Section("initial_particle", "``initial:`` of a particle", "",
+            (Key("position", "list of 3 " + _EXPRS, "position", "[1, 0, 0]", default="[0, 0, 0]"),
+             Key("velocity", "list of 3 " + _EXPRS, "velocity", "[0, 1, 0]", default="[0, 0, 0]"))),
+    Section("initial_planar_body", "``initial:`` of a planar_body", "",
+            (Key("position", "list of 2 " + _EXPRS, "position of the centre of mass", "[0, 1]", default="[0, 0]"),
+             Key("theta", _EXPR, "angle [rad]", "0.3", default="0"),
+             Key("velocity", "list of 2 " + _EXPRS, "velocity of the centre of mass", "[1, 0]", default="[0, 0]"),
+             Key("angular_velocity", _EXPR, "angular velocity [rad/s]", "2.0", default="0"))),
+    Section("initial_spring", "``initial:`` of a spring part", "",
+            tuple(Key(key, "list of 3 " + _EXPRS, f"{key.replace('_', ' ')} of the end", example,
+                      default="[0, 0, 0]")
+                  for key, example in (("end1", "[0, 0, 0]"), ("end2", "[0.5, 0, 0]"),
+                                       ("end1_velocity", "[0, 0, 0]"), ("end2_velocity", "[0, 1, 0]")))),
+    Section("pose", "``base:`` of a robot and ``origin:`` of a shape",
+            "A position and at most one orientation key.",
+            (Key("position", "list of 3 " + _EXPRS, "position", "[0, 0, 0.5]", default="[0, 0, 0]"),
+             *_ORIENTATION)),
+    Section("geometry", "``geometry:`` of a part or frame (one shape or a list)",
+            "Exactly one of box, sphere, cylinder, capsule, mesh, line per shape. A ``line`` "
+            "(on a frame) runs to another frame of the same part and takes only ``color``.",
+            (Key("box", "list of 3 " + _EXPRS, "box sizes along x, y, z", "[0.2, 0.1, 0.1]"),
+             Key("sphere", _EXPR, "sphere radius", "0.05"),
+             Key("cylinder", "list of 2 " + _EXPRS, "[radius, length] along z", "[0.02, 0.5]"),
+             Key("capsule", "list of 2 " + _EXPRS, "[radius, length] along z", "[0.02, 0.5]"),
+             Key("mesh", "file name", "an .stl, .obj or .dae file, relative to the model file", "meshes/arm.stl"),
+             Key("line", "frame name", "another frame of the same part: a line drawn between the two", "tip"),
+             Key("color", "colour name or [r, g, b(, a)] in 0..1", "the shape's colour "
+                 "(red, green, blue, grey, black, white, orange, yellow, purple)", "blue", default="grey"),
+             Key("origin", "mapping (section *pose*)", "the shape's pose in the frame", "{position: [0, 0, 0.1]}",
+                 default="the frame's origin"),
+             Key("scale", "list of 3 " + _EXPRS, "scale of a mesh", "[0.001, 0.001, 0.001]", default="[1, 1, 1]"))),
+    Section("constraint", "each entry of ``constraints:``",
+            "Exactly one of holonomic, nonholonomic, acceleration. Expressions use the parameters, "
+            "``t``, the coordinates ``part.c``, velocities ``part.c_dot`` and joint values "
+            "(``joint.angle``, ...). ``C`` maps coordinates to the constraint's non-ideal force (2.13).",
+            (Key("name", "string", "the constraint's name", "rolling", default="constraint_<index>"),
+             _DESCRIPTION,
+             Key("C", "mapping coordinate → expression", "non-ideal generalized force C of (2.13)",
+                 "{wheel.y: -c*wheel.y_dot}", default="ideal (C = 0)"),
+             Key("holonomic", "expression of coordinates", "φ(q, t) = 0", "wheel.y - R*wheel.theta*sin(alpha)"),
+             Key("nonholonomic", "expression linear in velocities", "ψ(q, q̇, t) = 0",
+                 "cart.x_dot - R*cart.theta_dot"),
+             Key("acceleration", "mapping (section *acceleration_row*)", "a row A q̈ = b given directly",
+                 "{A: {a.x: 1, b.x: -1}, b: 0}"))),
+    Section("acceleration_row", "``acceleration:`` of a constraint",
+            "``A`` is a list with one entry per coordinate, or a mapping coordinate → entry "
+            "(absent entries are zero).",
+            (_required("A", "list or mapping of expressions", "the row of A", "{a.x: 1, b.x: -1}"),
+             Key("b", "expression", "the right-hand side", "0", default="0"))),
+    Section("joint", "each entry of ``joints:`` (other than a ground contact)",
+            f"``type`` is one of {', '.join(JOINT_KINDS)}. Frames are written ``part.frame``, ``part`` "
+            "(its own origin and axes), ``world`` or ``world.frame``.",
+            (_required("name", "plain name", "the joint's name (also the prefix of its values, "
+                       "``pin.angle``)", "pin"),
+             _required("type", "string", f"one of {', '.join(JOINT_KINDS)}", "revolute"),
+             _required("parent", "frame", "frame A, on the parent part or the world", "world.pin"),
+             _required("child", "frame", "frame B, on the child part", "link.top"),
+             Key("length", _EXPR + ", > 0", "the distance kept by a ``distance`` joint (required there)", "0.5"),
+             _DESCRIPTION,
+             Key("actuation", "expression, or mapping (section *joint_actuation*)", "torque (revolute) or "
+                 "force (prismatic) along the joint's axis", "tau*sin(t)"),
+             Key("spring", "mapping (section *joint_spring*)", "torsional or linear spring and damper "
+                 "at a revolute or prismatic joint", "{stiffness: k, rest: 0.1}"),
+             Key("friction", "mapping (section *joint_friction*)", "viscous and Coulomb friction at a "
+                 "revolute or prismatic joint (non-ideal C)", "{viscous: 0.05}"))),
+    Section("rolling_disk", "an entry of ``joints:`` with ``type: rolling_disk``",
+            "A disk rolling without slipping on the plane z = ground.",
+            (_required("name", "plain name", "the contact's name", "roll"),
+             _required("type", "string", "``rolling_disk``", "rolling_disk"),
+             _required("child", "frame", "the disk's centre frame on a rigid body, z along its axis", "disk"),
+             _required("radius", _EXPR + ", > 0", "the disk's radius", "R"),
+             Key("ground", _EXPR, "height of the plane", "0", default="0"), _DESCRIPTION)),
+    Section("knife_edge", "an entry of ``joints:`` with ``type: knife_edge``",
+            "A blade that slides along itself but not across (a nonholonomic constraint).",
+            (_required("name", "plain name", "the contact's name", "blade"),
+             _required("type", "string", "``knife_edge``", "knife_edge"),
+             _required("child", "frame", "a frame on a rigid or planar body whose x axis is the blade", "sled"),
+             _DESCRIPTION)),
+    Section("joint_actuation", "``actuation:`` of a joint, written as a mapping",
+            "A single expression drives the joint's one motion; a cylindrical joint takes both keys.",
+            (Key("torque", "expression", "torque about the joint's z axis (revolute, cylindrical)", "tau"),
+             Key("force", "expression", "force along the joint's z axis (prismatic, cylindrical)", "f"))),
+    Section("joint_spring", "``spring:`` of a joint", "",
+            (_required("stiffness", _EXPR + ", ≥ 0", "stiffness [N m/rad or N/m]", "k"),
+             Key("damping", _EXPR + ", ≥ 0", "damping", "0.1", default="0"),
+             Key("rest", _EXPR, "rest angle (in [−π, π]) or displacement", "0.2", default="0"))),
+    Section("joint_friction", "``friction:`` of a revolute or prismatic joint",
+            "Give viscous and/or coulomb; Coulomb friction at a revolute joint needs the pin radius.",
+            (Key("viscous", _EXPR + ", ≥ 0", "viscous coefficient", "0.05", default="0"),
+             Key("coulomb", _EXPR + ", ≥ 0", "Coulomb coefficient μ", "0.3", default="0"),
+             Key("radius", _EXPR + ", > 0", "pin radius r of a revolute joint, required there with ``coulomb`` (friction torque μ r N)", "0.01"))),
+    Section("force_spring", "an entry of ``forces:`` with ``type: spring``",
+            "A linear spring (and damper) between two frames.",
+            (_BETWEEN, _required("stiffness", _EXPR + ", ≥ 0", "stiffness [N/m]", "k"),
+             _required("rest_length", _EXPR + ", ≥ 0", "unstretched length [m]", "0.3"),
+             Key("damping", _EXPR + ", ≥ 0", "damping [N s/m]", "0.1", default="0"), *_FORCE_KEYS)),
+    Section("force_damper", "an entry of ``forces:`` with ``type: damper``",
+            "A linear damper between two frames.",
+            (_BETWEEN, _required("damping", _EXPR + ", ≥ 0", "damping [N s/m]", "0.1"), *_FORCE_KEYS)),
+    Section("force_force", "an entry of ``forces:`` with ``type: force``",
+            "A force at a frame of a part, in world axes.",
+            (_required("at", "frame", "where the force acts (on a part)", "body.tip"),
+             _required("value", "list of 3 expressions", "the force (world axes); may use t, coordinates, "
+                       "velocities", "[0, 0, -F*sin(t)]"), *_FORCE_KEYS)),
+    Section("force_torque", "an entry of ``forces:`` with ``type: torque``",
+            "A torque on a rigid or planar body.",
+            (_required("part", "part name", "the body the torque acts on", "body"),
+             _required("value", "list of 3 expressions", "the torque", "[0, 0, tau]"),
+             Key("axes", "``world`` or ``body``", "the axes the value is given in", "body", default="world"),
+             *_FORCE_KEYS)),
+    Section("output", "each entry of ``outputs:`` written as a mapping",
+            "An output is an expression (of parameters, t, coordinates, joint values) or a mapping "
+            "with exactly one of these keys.",
+            (Key("reaction", "string", "``<joint>.force``, ``.torque`` or ``.multipliers``", "pin.force"),
+             Key("position", "frame", "world position of a frame", "link.tip"),
+             Key("velocity", "frame", "world velocity of a frame", "link.tip"),
+             Key("energy", "string", "``kinetic``, ``potential`` or ``total``", "total"))),
+)}
+
+PART_SECTIONS = tuple(_TYPE)  # the part sections, by the value of their ``type`` key
+FORCE_SECTIONS = {"spring": "force_spring", "damper": "force_damper", "force": "force_force",
+                  "torque": "force_torque"}
