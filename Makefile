@@ -1,11 +1,12 @@
-# Quick start on a fresh machine (Python 3.11): `make run`, then `make test`.
+# Quick start on a fresh machine (Python 3.11): `make run`, then `make test`; `make docs` builds the site.
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
+DOCS_STAMP := $(VENV)/.installed-docs
 
-.PHONY: run test install clean
+.PHONY: run test docs install clean
 
 run: $(STAMP)
 	$(PY) examples/paper_example3.py
@@ -13,6 +14,10 @@ run: $(STAMP)
 test: $(TEST_STAMP)
 	bash scripts/install-chromium.sh
 	$(PY) -m pytest -q
+
+# The documentation site (Sphinx), warnings as errors; the gallery's scripts run as it builds.
+docs: $(DOCS_STAMP)
+	MPLBACKEND=Agg $(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
 
 install: $(STAMP)
 
@@ -29,5 +34,9 @@ $(TEST_STAMP): pyproject.toml $(STAMP)
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $@
 
+$(DOCS_STAMP): pyproject.toml $(STAMP)
+	$(PY) -m pip install --quiet -e '.[docs]'
+	touch $@
+
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build *.egg-info docs/_build docs/auto_gallery
