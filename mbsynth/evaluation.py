@@ -5,8 +5,8 @@
 - ``constraints(t, q, qd)``: one evaluation of every connector's rows: A (sparse CSR), b,
   C, and the residuals φ, φ̇ (NaN on rows without that level) — drift control and
   projection (projection.py) need them together;
-- ``parts(t, q, qd)``: the block-diagonal M and the stacked Q of (2.1);
-- ``energies(t, q, qd)``: the parts' kinetic and potential energies, summed.
+- ``parts(t, q, qd)``: the block-diagonal M and the stacked Q of (2.1), force elements included;
+- ``energies(t, q, qd)``: kinetic and potential energies of the parts and force elements.
 
 The results equal those of calling each connector and part (``Connector.evaluate``,
 ``residuals``, ``Part.evaluate``, ``energy``), which remain the reference.
@@ -22,6 +22,7 @@ from .grouped import Batch
 from .subsystems.base import Part
 from .symbolic import Compiled
 
+DENSE_ENTRIES = 40000  # rows × coordinates up to which dense arrays beat scipy.sparse's overhead
 _evaluators = {}
 
 
@@ -36,10 +37,10 @@ def evaluator(system):
 
 
 class ConstraintArrays(NamedTuple):
-    """The constraints at one state: rows A (m × n, CSR) q̈ = b (2.4), the non-ideal
+    """The constraints at one state: rows A (m × n, CSR or dense) q̈ = b (2.4), the non-ideal
     force C (2.6), position and velocity residuals φ, φ̇ per row."""
 
-    A: scipy.sparse.csr_matrix
+    A: object  # scipy.sparse.csr_matrix or np.ndarray
     b: np.ndarray
     C: np.ndarray
     phi: np.ndarray
@@ -75,18 +76,36 @@ class Evaluator:
         self.blocks = Batch([s._evaluate if g else s.evaluate for s, g in zip(system.subsystems, grouped)], ranges, 2)
         self.energy = Batch([s._energy if type(s).energy is Part.energy and isinstance(s._energy, Compiled)
                              else s.energy for s in system.subsystems], ranges, 2)
+        forces = system.forces
+        self.forces = Batch([f._evaluate for f in forces], [f.indices for f in forces], 2)
+        self.f_cols = np.concatenate([np.zeros(0, int)] + [f.indices for f in forces])
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
 
-    def constraints(self, t, q, qd, p):
-        """ConstraintArrays at (t, q, q̇) with parameter values p."""
+    def constraints(self, t, q, qd, p, sparse=True):
+        """ConstraintArrays at (t, q, q̇) with parameter values p; A sparse (CSR) or dense
+        (an ndarray), or (sparse=None) dense when it has at most DENSE_ENTRIES entries."""
         a, b, c, phi, psi = self.rows(t, q, qd, p)
-        A = scipy.sparse.csr_matrix((a[self.a_order], self.a_indices, self.a_indptr), shape=(self.m, self.n))
+        if sparse is None:
+            sparse = self.m * self.n > DENSE_ENTRIES
+        if sparse:
+            A = scipy.sparse.csr_matrix((a[self.a_order], self.a_indices, self.a_indptr), shape=(self.m, self.n))
+        else:
+            A = np.zeros((self.m, self.n))
+            A[self.a_dense] = a
+        return ConstraintArrays(A, b, np.bincount(self.c_cols, weights=c, minlength=self.n),
+                                *self._levels(phi, psi))
+
+    def residuals(self, t, q, qd, p):
+        """(φ, φ̇) per row at (t, q, q̇): NaN on rows without that level."""
+        return self._levels(*self.rows(t, q, qd, p)[3:])
+
+    def _levels(self, phi, psi):
         phi, psi = phi.copy(), psi.copy()
         phi[self.no_phi] = np.nan
         psi[self.no_psi] = np.nan
-        return ConstraintArrays(A, b, np.bincount(self.c_cols, weights=c, minlength=self.n), phi, psi)
+        return phi, psi
 
     def dense_rows(self, t, q, qd, p):
         """(A dense, b, C) at (t, q, q̇)."""
@@ -96,13 +115,15 @@ class Evaluator:
         return A, b, np.bincount(self.c_cols, weights=c, minlength=self.n)
 
     def parts(self, t, q, qd, p):
-        """(M, Q) of the parts at (t, q, q̇): M block diagonal (dense), Q stacked."""
+        """(M, Q) at (t, q, q̇): the parts' M block diagonal (dense), their Q stacked plus the
+        force elements'."""
         blocks, Q = self.blocks(t, q, qd, p)
         M = np.zeros((self.n, self.n))
         M[self.m_rows, self.m_cols] = blocks
-        return M, Q
+        return M, Q + np.bincount(self.f_cols, weights=self.forces(t, q, qd, p)[0], minlength=self.n)
 
     def energies(self, t, q, qd, p):
-        """(kinetic, potential): the parts' T and V summed."""
+        """(kinetic, potential): the parts' T and V, and the force elements' potentials, summed."""
         T, V = self.energy(t, q, qd, p)
-        return float(T.sum()), float(V.sum())
+        return float(T.sum()), float(V.sum() + self.forces(t, q, qd, p)[1].sum())
+

@@ -12,8 +12,10 @@ import operator
 
 import numpy as np
 
+from .fast import structures
 from .symbolic import Compiled
 
+STACK_MIN = 8  # fewer instances than this are called one by one (numpy's per-call cost on small arrays)
 CHECK_RTOL = 1e-12  # a stacked call must agree with the single calls to this, relative to the
 # group's largest value (checked once, at the first state)
 
@@ -58,7 +60,7 @@ class Batch:
         groups, singles = [], []
         for members in _shared(self.functions, self.indices):
             group = None
-            if len(members) > 1:
+            if isinstance(self.functions[members[0]], Compiled):
                 group = _Group([self.functions[i] for i in members], np.array([self.indices[i] for i in members]),
                                np.array([dests[i] for i in members]).T)
                 if not group.reproduces(t, q, qd, p, expected):
@@ -85,22 +87,59 @@ def _values_key(values):
 
 
 class _Group:
-    """Functions sharing one raw function: its stacked call. ``dest`` (outputs × members):
-    where each output of each member goes in the flat result."""
+    """Functions sharing one raw function: evaluated by its numba kernel
+    (fast/structures.py) once that is ready, else by one stacked numpy call when there are
+    at least STACK_MIN of them, else one by one. ``dest`` (outputs × members): where each
+    output of each member goes in the flat result."""
 
     def __init__(self, functions, indices, dest):
         first = functions[0]
         self.raw, self.dest = first.raw, dest
-        self.columns = indices.T  # coordinates × members: lambdify unpacks the rows
-        self.fixed = np.array([f.fixed for f in functions]).T
-        constant = hasattr(first.values, "fixed")
-        self.values = np.array([f.values.fixed for f in functions]).T if constant else first.values
-        self.constant = constant
-        self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' rows)
+        self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
+        self.fixed = np.ascontiguousarray(np.array([f.fixed for f in functions], dtype=float).T)
+        self.constant = hasattr(first.values, "fixed")
+        self.values = (np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
+                       if self.constant else first.values)
+        self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
+        self.kernel = None  # the numba kernel once it is ready and checked
+        self.refused = False  # the kernel disagreed with numpy: numpy for good
 
     def __call__(self, t, q, qd, p):
+        values = self.values if self.constant else _stacked(self.values(t, q[self.columns], qd[self.columns], p),
+                                                            self.dest.shape[1])
+        if self.kernel is None and not self.refused:
+            self._take_kernel(t, q, qd, p, values)
+        if self.kernel is not None:
+            result = np.empty(self.dest.shape)
+            self.kernel(t, q, qd, p, self.columns, values, self.fixed, result)
+            return result
+        return self._numpy(t, q, qd, p, values)
+
+    def _take_kernel(self, t, q, qd, p, values):
+        """Use the kernel from now on if it is ready and agrees with numpy at this state."""
+        found = structures.kernel(self.raw)
+        if found is None:
+            return
+        result = np.empty(self.dest.shape)
+        try:
+            found(t, q, qd, p, self.columns, values, self.fixed, result)
+        except Exception:  # noqa: BLE001 - arguments the kernel was not compiled for: numpy serves
+            self.refused = True
+            return
+        if _agree(result, self._numpy(t, q, qd, p, values)):
+            self.kernel = found
+        else:
+            self.refused = True
+
+    def _numpy(self, t, q, qd, p, values):
+        members = self.dest.shape[1]
+        if members < STACK_MIN:
+            result = np.empty(self.dest.shape)
+            for m in range(members):
+                cols = self.columns[:, m]
+                result[:, m] = self.raw(t, q[cols], qd[cols], p, values[:, m], self.fixed[:, m])
+            return result
         qs, qds = q[self.columns], qd[self.columns]
-        values = self.values if self.constant else _stacked(self.values(t, qs, qds, p), self.dest.shape[1])
         out = self.raw(t, qs, qds, p, values, self.fixed)
         if self.pick is None:
             arrays = [k for k, x in enumerate(out) if np.ndim(x) > 0]
@@ -120,10 +159,14 @@ class _Group:
                 got = self(t, q, qd, p)
         except Exception:  # noqa: BLE001 - a raw function that does not broadcast is called singly
             return False
-        want = expected[self.dest]
-        scale = np.abs(want[np.isfinite(want)]).max(initial=0.0)
-        return got.shape == want.shape and np.allclose(got, want, rtol=CHECK_RTOL, atol=CHECK_RTOL * scale,
-                                                       equal_nan=True)
+        return _agree(got, expected[self.dest])
+
+
+def _agree(got, want):
+    """Equal to CHECK_RTOL of the largest finite value, NaN where NaN."""
+    scale = np.abs(want[np.isfinite(want)]).max(initial=0.0)
+    return got.shape == want.shape and np.allclose(got, want, rtol=CHECK_RTOL, atol=CHECK_RTOL * scale,
+                                                   equal_nan=True)
 
 
 def _getter(positions):

@@ -247,8 +247,10 @@ def _lambdify(args, forms):
     """The numpy function of (args, numbers) -> [forms], made once per structure
     (``canonical``): joints alike, and models loaded again (a sweep's workers, a file
     checked then simulated) reuse it."""
-    return sp.lambdify(args, [_beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True,
-                       dummify=True)
+    forms = [_beyond_double_as_inf(x) for x in forms]
+    raw = sp.lambdify(args, forms, modules=[_FLOAT64, "numpy"], cse=True, dummify=True)
+    raw.structure = (args, tuple(forms))  # for fast/structures.py, which compiles it with numba
+    return raw
 
 
 def _frozen(args):

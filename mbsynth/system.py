@@ -8,7 +8,6 @@ assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.sparse
 import sympy as sp
 
 from . import equations, fast, friction, solvers
@@ -200,10 +199,7 @@ class System:
         q, qd = self._state(q, qd)
         p = self.parameter_values
         batches = evaluator(self)
-        M, Q = batches.parts(t, q, qd, p)
-        for element in self.forces:
-            Q[element.indices] += element.evaluate(t, q, qd, p)
-        return Assembly(M, Q, *batches.dense_rows(t, q, qd, p))
+        return Assembly(*batches.parts(t, q, qd, p), *batches.dense_rows(t, q, qd, p))
 
     def constraint_rows(self, t, q, qd):
         """A (m × n, scipy.sparse CSR) and b at (t, q, q̇) — the rows alone, without M:
@@ -211,11 +207,12 @@ class System:
         arrays = self.constraint_arrays(t, q, qd)
         return arrays.A, arrays.b
 
-    def constraint_arrays(self, t, q, qd):
-        """A (CSR), b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
-        (``evaluation.ConstraintArrays``)."""
+    def constraint_arrays(self, t, q, qd, sparse=True):
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
+        dense where that is faster (sparse=None: few rows and coordinates)."""
         q, qd = self._state(q, qd)
-        return evaluator(self).constraints(t, q, qd, self.parameter_values)
+        return evaluator(self).constraints(t, q, qd, self.parameter_values, sparse)
 
     def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
@@ -278,15 +275,12 @@ class System:
     def energy(self, t, q, qd):
         """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
         q, qd = self._state(q, qd)
-        p = self.parameter_values
-        kinetic, potential = evaluator(self).energies(t, q, qd, p)
-        potential += sum(element.potential(t, q, qd, p) for element in self.forces)
-        return kinetic, potential
+        return evaluator(self).energies(t, q, qd, self.parameter_values)
 
     def constraint_residuals(self, t, q, qd):
         """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
-        arrays = self.constraint_arrays(t, q, qd)
-        return arrays.phi, arrays.psi
+        q, qd = self._state(q, qd)
+        return evaluator(self).residuals(t, q, qd, self.parameter_values)
 
     def symbolic(self):
         """(M, Q, A, b, C) as sympy matrices in the model's symbols."""
