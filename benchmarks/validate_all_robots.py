@@ -62,6 +62,10 @@ def comparable(r):
     return r.base != "-" and not (both_undefined and not r.passed)
 
 
+def _figure(x):
+    return "-" if x != x else f"{x:.1e}"  # NaN: not compared
+
+
 def brief(note, limit=300):
     return note if len(note) <= limit else note[:limit] + " …"
 
@@ -82,15 +86,21 @@ def write(args, rows, elapsed):
              "whose data no rigid body has (mbsynth refuses them by link; Pinocchio does not check), and robots "
              "with massless links on which `pinocchio.aba` returns NaN while mbsynth names the indeterminate "
              "directions (a torque on them has no motion at all).", "",
-             "| robot or model | bodies | base | nv | max rel error | max abs error | build s | motion ms | result |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "In joint space, at the same states: `joint_values` against Pinocchio's (q, v, v̇) joint by joint "
+             "(\"joints\", relative to 1 + max |v|, |v̇|), and each joint's `reactions` wrench against `data.f` of "
+             "`rnea` (\"reactions\", relative to its largest entry; \"-\" for models with loops or force elements "
+             "other than the joint torques). Both count towards the result.", "",
+             "| robot or model | bodies | base | nv | max rel error | max abs error | joints | reactions | build s "
+             "| motion ms | result |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows:
         if not comparable(r):
             result = f"{'refused' if r.base == '-' else 'not comparable'}: {brief(r.note)}"
         else:
             result = "passed" if r.passed else f"**failed**: {brief(r.note)}" if r.note else "**failed**"
         lines.append(f"| {name} | {r.links} | {r.base} | {r.nv} | {r.max_rel_error:.1e} | {r.max_abs_error:.1e} "
-                     f"| {r.build_s:.1f} | {r.motion_ms:.2f} | {result} |")
+                     f"| {_figure(r.joint_error)} | {_figure(r.reaction_error)} | {r.build_s:.1f} | {r.motion_ms:.2f} "
+                     f"| {result} |")
     Path(args.out).write_text("\n".join(lines) + "\n")
     name, r = rows[-1]
     print(f"{name} {r.base}: rel {r.max_rel_error:.1e}, build {r.build_s:.1f} s, {'passed' if r.passed else 'FAILED ' + r.note}",

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 import mbsynth as mb
-from mbsynth.cli import format_check
+from mbsynth.cli.check import format_check
 from mbsynth.diagnose import diagnose
 
 MODELS = Path(__file__).resolve().parent.parent / "models" / "paper"

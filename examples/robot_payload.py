@@ -26,7 +26,8 @@ import numpy as np
 import pinocchio as pin
 
 import mbsynth as mb
-from mbsynth.cli import format_check, format_validation
+from mbsynth.cli.check import format_check
+from mbsynth.cli.validate import format_validation
 from mbsynth.diagnose import diagnose
 from mbsynth.robots import robot_files
 from mbsynth.twin import Twin

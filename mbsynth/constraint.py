@@ -3,7 +3,7 @@
 import numpy as np
 import sympy as sp
 
-from .symbolic import T_SYMBOL, compile_function, differentiated, placed_values, positions
+from .symbolic import T_SYMBOL, compile_function, differentiated, expand_joint_values, placed_values, positions
 
 
 class Connector:
@@ -93,12 +93,14 @@ class Connector:
     @classmethod
     def holonomic(cls, name, phis, q, qd, params, C=None, row_labels=None):
         a, b, psi = differentiated(phis, q, qd)
-        return cls(name, "holonomic", a, b, _vector(C, len(q)), list(phis), psi, q, qd, params, row_labels)
+        phis = [expand_joint_values(phi) for phi in phis]
+        return cls(name, "holonomic", a, b, _vector(C, len(q)), phis, psi, q, qd, params, row_labels)
 
     @classmethod
     def nonholonomic(cls, name, psis, q, qd, params, C=None, row_labels=None):
         a, b, _ = differentiated(psis, q, qd)
-        return cls(name, "nonholonomic", a, b, _vector(C, len(q)), None, list(psis), q, qd, params, row_labels)
+        psis = [expand_joint_values(psi) for psi in psis]
+        return cls(name, "nonholonomic", a, b, _vector(C, len(q)), None, psis, q, qd, params, row_labels)
 
     @classmethod
     def acceleration(cls, name, a, b, q, qd, params, C=None):
@@ -126,7 +128,7 @@ def mixed(holonomic, nonholonomic, q, qd):
     ψ(q, q̇, t) = 0 in one connector (2.4): φ is NaN on the velocity-level rows, which
     have no position form."""
     a, b, psi = differentiated(list(holonomic) + list(nonholonomic), q, qd)
-    return a, b, list(holonomic) + [sp.nan] * len(nonholonomic), psi
+    return a, b, [expand_joint_values(phi) for phi in holonomic] + [sp.nan] * len(nonholonomic), psi
 
 
 def _vector(C, n):

@@ -41,6 +41,8 @@ class Diagnosis:
     rank_tolerance: float = None  # singular values below rank_tolerance · σ₁ count as zero
     verdict_margin: float = None  # see RankReport.verdict_margin; None when infinite
     warnings: list = field(default_factory=list)
+    joints: dict = field(default_factory=dict)  # joint -> {coordinates, position, rate, acceleration, ...}
+    free_joints: list = field(default_factory=list)  # per indeterminate direction: {joint: rate per unit}
 
     @property
     def consistent(self):
@@ -65,7 +67,7 @@ def diagnose(system, t=0.0, q=None, qd=None):
         motion = system.motion(t, q, qd, method="reference")
         qdd, error = dict(zip(system.coordinates, map(float, motion.qdd))), None
     except SolveError as err:
-        qdd, error = {}, str(err)
+        motion, qdd, error = None, {}, str(err)
     return Diagnosis(
         model=system.name, n=report.n, m=report.m, rank_M=report.rank_M, rank_A=report.rank_A,
         rank_Mhat=report.rank_Mhat, unique=report.unique,
@@ -76,7 +78,36 @@ def diagnose(system, t=0.0, q=None, qd=None):
         closures=[{"constraint": c.constraint, "equation": c.equation, "direction": c.direction,
                    "state_dependent": c.state_dependent} for c in system.closures],
         constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
-        rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report))
+        rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report),
+        joints=_joints(system, t, q, qd, motion), free_joints=_moved_joints(system, t, q, report.nullspace))
+
+
+def _joints(system, t, q, qd, motion):
+    """{joint: {coordinates, position, rate, acceleration names and values}} at the state
+    (accelerations None without a motion): System.joint_values."""
+    kinematics = system.joint_kinematics()
+    values = system.joint_values(t, q, qd, None if motion is None else motion.qdd)
+    return {name: {"coordinates": list(kinematics[name].position_names),
+                   "accelerations": list(kinematics[name].acceleration_names),
+                   "position": v.position.tolist(), "rate": v.rate.tolist(),
+                   "acceleration": None if v.acceleration is None else v.acceleration.tolist()}
+            for name, v in values.items()}
+
+
+def _moved_joints(system, t, q, nullspace):
+    """Per indeterminate direction w (scaled as in ``indeterminate``), {joint: its rates
+    when the state moves along w}: the joints the free direction turns or slides."""
+    if not nullspace.shape[1] or not system.joint_kinematics():
+        return [{} for _ in nullspace.T]
+    rest = system.joint_values(t, q, np.zeros(system.n))
+    found = []
+    for w in nullspace.T:
+        moving = system.joint_values(t, q, w / w[np.argmax(np.abs(w))])
+        rates = {name: (v.rate - rest[name].rate) for name, v in moving.items()}
+        scale = max((np.abs(r).max(initial=0.0) for r in rates.values()), default=0.0)
+        found.append({name: r.tolist() for name, r in rates.items() if np.abs(r).max(initial=0.0) > COMPONENT_TOL
+                      * max(scale, 1.0)})
+    return found
 
 
 def _balance(system, balance, force, q):

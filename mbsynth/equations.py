@@ -136,7 +136,10 @@ class Motion:
     the constraint force M q̈ − Q of (2.5); ``residual``: relative residual of the
     row-equilibrated (2.12) at q̈; ``method``: the formula that produced q̈;
     ``singular``: under the drift rule, the constraint rows of the nearly dependent
-    directions at this state (a singular position near; empty elsewhere).
+    directions at this state (a singular position near; empty elsewhere); ``C``: the
+    non-ideal force used where it depends on q̈ (Coulomb friction), else None;
+    ``lam``: the multipliers, one per row of A, with Qc − C = Aᵀλ (reactions.py),
+    computed on first use where the Motion knows its rows (System.motion).
     """
 
     qdd: np.ndarray
@@ -146,6 +149,22 @@ class Motion:
     residual: float
     method: str
     singular: tuple = ()
+    C: np.ndarray = None
+
+    @property
+    def lam(self):
+        """λ, one multiplier per row of A (Qc − C = Aᵀλ, minimum norm where rows are
+        dependent); None where the Motion was made without its rows."""
+        if "_lam" not in self.__dict__:
+            source = self.__dict__.get("_lam_source")
+            self.__dict__["_lam"] = None if source is None else source()
+        return self.__dict__["_lam"]
+
+    def with_multipliers(self, source):
+        """This Motion, with ``source()`` giving ``lam`` on first use."""
+        self.__dict__["_lam_source"] = source
+        self.__dict__.pop("_lam", None)
+        return self
 
     @classmethod
     def made(cls, qdd, unique, nullspace, Qc, residual, method, singular=()):
@@ -153,7 +172,7 @@ class Motion:
         per field, 1 µs): for the fast path, which makes one per call."""
         motion = object.__new__(cls)
         motion.__dict__.update(qdd=qdd, unique=unique, nullspace=nullspace, Qc=Qc, residual=residual, method=method,
-                               singular=singular)
+                               singular=singular, C=None)
         return motion
 
 

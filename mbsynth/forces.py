@@ -26,10 +26,12 @@ AXES = ("world", "body")
 
 class ForceElement:
     """A named force element: ``Q`` (sympy, over all the model's coordinates) and its
-    potential energy ``V`` (0 for non-conservative elements)."""
+    potential energy ``V`` (0 for non-conservative elements). ``joint``: the name of the
+    joint it acts across (joint_forces.py), whose reaction includes it; None otherwise."""
 
-    def __init__(self, name, V, efforts, q, qd, params):
-        self.name = name
+    def __init__(self, name, V, efforts, q, qd, params, joint=None):
+        self.name, self.joint = name, joint
+        self.conservative = all(sp.sympify(effort) == 0 for effort, _ in efforts)  # all of Q from V
         self.V = sp.sympify(V)
         self.Q = Q = generalized_force(self.V, efforts, q, qd)
         used = Q.free_symbols | self.V.free_symbols

@@ -28,7 +28,7 @@ equations may have no solution, or several), the iteration does not converge and
 ``SolveError`` names the joints.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import sympy as sp
@@ -122,7 +122,7 @@ def coulomb_motion(constraints, arrays, solve, t, q, qd, p):
         scale = np.linalg.norm(arrays.Q) + np.linalg.norm(C) + np.linalg.norm(inertial)
         change = np.abs(new - N)
         if np.all(change <= RTOL * new + noise * scale):
-            return motion
+            return replace(motion, C=C)
         N = new
     names = [name for (name, _, _), dN, load in zip(sliding, change, new) if dN > RTOL * load]
     raise SolveError(f"Coulomb friction at joint(s) {', '.join(names)}: the joint load N did not settle "

@@ -26,11 +26,12 @@ def actuation(name, joint, efforts, q, qd, params):
     """A torque about / force along the joint's axis: ``efforts`` maps "torque" and/or
     "force" to expressions (of t, parameters, coordinates)."""
     pairs = [(effort, getattr(joint, MOTIONS[key][1])) for key, effort in efforts.items()]
-    return ForceElement(name, 0, pairs, q, qd, params)
+    return ForceElement(name, 0, pairs, q, qd, params, joint=joint.name)
 
 
 def joint_spring(name, joint, stiffness, damping, rest, q, qd, params):
     """A torsional (revolute) or linear (prismatic) spring k with rest position ``rest``
     and a damper c along the joint's one motion."""
     position, rate = (getattr(joint, attr) for attr in MOTIONS[joint_motion(joint)])
-    return ForceElement(name, stiffness * (position - rest) ** 2 / 2, [(-damping * rate, rate)], q, qd, params)
+    return ForceElement(name, stiffness * (position - rest) ** 2 / 2, [(-damping * rate, rate)], q, qd, params,
+                        joint=joint.name)

@@ -171,8 +171,9 @@ class Robot:
         elements = []
         for joint in self.description.joints:
             on_parent, on_child = self.joint_frames(joint)
+            child = parts[on_child.part]
             connector = Joint(self.joints[joint.name], JOINT_KINDS[joint.kind], parts[on_parent.part], on_parent,
-                              parts[on_child.part], on_child, q, qd, params)
+                              child, on_child, q, qd, params, report_frame=child.frames[LINK_FRAME])
             joints.append(connector)
             if joint.name in self.torques:
                 effort = {"revolute": "torque", "prismatic": "force"}[connector.joint_kind]

@@ -26,7 +26,9 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .control import SampledControl
 from .errors import SimulationError, SolveError
+from .outputs import OutputEvaluator
 from .projection import consistent_initial_state, project, relative_drift
 from .trajectory import COMPLETED, Trajectory, TrajectoryWriter
 
@@ -46,20 +48,26 @@ MIN_SPAN = 1e-6  # of the output interval: the shortest span that is redone
 
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
-             stabilization="projection", baumgarte=(10.0, 10.0), out=None, progress=None):
-    """Integrate ``system`` from t0 to t_end; returns a Trajectory with one row per output time.
+             stabilization="projection", baumgarte=(10.0, 10.0), out=None, progress=None, controller=None,
+             control_dt=None):
+    """Integrate ``system`` from t0 to t_end; returns a Trajectory with one row per output time
+    (and the model's declared outputs: mbsynth.outputs).
 
     q0, qd0: the initial state (default: the model's, made consistent by projection
     keeping every value the model sets; the changes are logged and kept in
     ``stats["initial_changes"]``). dt: output interval (default (t_end − t0)/500).
     method, rtol, atol: scipy ``solve_ivp`` settings. out: a .npz or .csv path written as
     the run goes. progress: a callable(t) called at every output time.
+    controller: ``f(t, joint_values) -> {parameter: value}``, called at t0 and every
+    ``control_dt`` (default: the output interval), its values held in between (sampled
+    control, mbsynth.control).
     Raises SimulationError (with the partial trajectory) when the run cannot go on.
     """
     if stabilization not in STABILIZATIONS:
         raise ValueError(f"stabilization must be one of {STABILIZATIONS}, got {stabilization!r}")
     if not t_end > t0:
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0})")
+    system = system.for_run()  # one motion path (tree or KKT) for the whole run
     run = _Run(system, method, rtol, atol, stabilization, baumgarte)
     if q0 is None and qd0 is None:
         q, qd, changes = consistent_initial_state(system, t0)
@@ -71,16 +79,25 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
         changes = {}
     times = _output_times(t0, t_end, dt)
-    writer = TrajectoryWriter(out, system.coordinates) if out is not None else None
+    control = None if controller is None else SampledControl(system, controller, control_dt or times[1] - times[0])
+    samples = set() if control is None else set(control.times(t0, t_end))
+    outputs = set(times)
+    writer = TrajectoryWriter(out, system.coordinates, run.outputs.names) if out is not None else None
     started = time.perf_counter()
     status = "stopped"
     try:
+        if control is not None:
+            run.system = control.apply(t0, q, qd)
         run.record(t0, q, qd, writer)
-        for t_next in times[1:]:
+        run.t_now = t0
+        for t_next in sorted(outputs | samples)[1:]:
             q, qd = run.advance(t_next, q, qd)
-            run.record(t_next, q, qd, writer)
-            if progress is not None:
-                progress(t_next)
+            if t_next in samples:
+                run.restart(control.apply(t_next, q, qd))
+            if t_next in outputs:
+                run.record(t_next, q, qd, writer)
+                if progress is not None:
+                    progress(t_next)
         status = COMPLETED
     except SolveError as err:
         status = f"failed at t = {run.t_failed:.9g}: {err}"
@@ -113,13 +130,16 @@ class _Run:
 
     def __init__(self, system, method, rtol, atol, stabilization, baumgarte):
         self.system, self.method, self.rtol, self.atol = system, method, rtol, atol
+        self.outputs = OutputEvaluator(system)
         self.stabilization = stabilization
         self.baumgarte = baumgarte if stabilization == "baumgarte" else None
         self.n = system.n
-        self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity")}
+        self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity",
+                                     "outputs")}
         self.steps = self.evaluations = 0
         self.first_step = None
         self.t_failed = float("nan")
+        self.t_now = None  # the time the state has reached (outputs and control samples alike)
         self.non_unique = False
         self.calls, self.t_mark, self.span = 0, 0.0, 0.0
         self.drift_span = None  # the span between projections, when shorter than the output interval
@@ -129,6 +149,11 @@ class _Run:
     @property
     def t(self):
         return self.rows["t"]
+
+    def restart(self, system):
+        """Go on with ``system`` (new parameter values at a control sample): the forces jump,
+        so the integrator starts afresh."""
+        self.system, self.outputs.system, self.first_step = system, system, None
 
     def rhs(self, t, y):
         self.t_failed = t
@@ -151,7 +176,8 @@ class _Run:
         span halves after a larger drift and doubles after one below a hundredth of it; a
         span that drifted more than DRIFT_REDO × DRIFT_TARGET is integrated again in
         quarters (the least-squares motion of the stages is only as good as their drift)."""
-        t, interval = self.t[-1], t_next - self.t[-1]
+        t = self.t_now
+        interval = t_next - t
         while t < t_next:
             t_to = t_next if self.drift_span is None or t + 1.5 * self.drift_span >= t_next else t + self.drift_span
             q_to, qd_to = self._integrate(t, t_to, q, qd)
@@ -167,6 +193,7 @@ class _Run:
         self._note_singular()
         if self.stabilization == "projection":
             self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
+        self.t_now = t_next
         return q, qd
 
     def _adapt_span(self, drift, span, interval):
@@ -224,17 +251,20 @@ class _Run:
         kinetic, potential = self.system.energy(t, q, qd)
         phi, psi = self.system.constraint_residuals(t, q, qd)
         row = dict(t=t, q=np.array(q), qd=np.array(qd), energy=kinetic + potential, kinetic=kinetic,
-                   residual_position=_max_abs(phi), residual_velocity=_max_abs(psi))
+                   residual_position=_max_abs(phi), residual_velocity=_max_abs(psi),
+                   outputs=self.outputs.evaluate(t, q, qd) if self.outputs else np.zeros(0))
         for k, v in row.items():
             self.rows[k].append(v)
         if writer is not None:
-            writer.append(_chunk(self.system.coordinates, row))
+            writer.append(_chunk(self.system.coordinates, row, self.outputs.names))
 
     def trajectory(self, status):
         r = self.rows
         traj = Trajectory(tuple(self.system.coordinates), np.array(r["t"]), np.array(r["q"]).reshape(-1, self.n),
                           np.array(r["qd"]).reshape(-1, self.n), np.array(r["energy"]), np.array(r["kinetic"]),
-                          np.array(r["residual_position"]), np.array(r["residual_velocity"]), status)
+                          np.array(r["residual_position"]), np.array(r["residual_velocity"]), status,
+                          outputs=np.array(r["outputs"], dtype=float).reshape(len(r["t"]), len(self.outputs.names)),
+                          output_names=tuple(self.outputs.names))
         traj.stats.update(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique,
                           singular_positions=self.singular_positions)
         if self.non_unique:
@@ -248,7 +278,8 @@ def _max_abs(values):
     return float(np.abs(finite).max()) if finite.size else 0.0
 
 
-def _chunk(coordinates, row):
+def _chunk(coordinates, row, output_names):
     return Trajectory(tuple(coordinates), np.array([row["t"]]), row["q"][None, :], row["qd"][None, :],
                       np.array([row["energy"]]), np.array([row["kinetic"]]), np.array([row["residual_position"]]),
-                      np.array([row["residual_velocity"]]))
+                      np.array([row["residual_velocity"]]), outputs=row["outputs"][None, :],
+                      output_names=tuple(output_names))

@@ -47,7 +47,8 @@ LOCALHOST = "127.0.0.1"  # where the local cluster listens: its scheduler, worke
 class Metric:
     """A summary of one run: ``energy_drift``, ``max_residual``, or ``AGG:expression``
     with AGG one of final, max, min, mean over the output times and the expression of
-    coordinates (``part.coord``), velocities (``part.coord_dot``), parameters and t."""
+    coordinates (``part.coord``), velocities (``part.coord_dot``), joint values
+    (``joint.angle``, ``joint.rate``, …), parameters and t."""
 
     spec: str
 
@@ -80,9 +81,7 @@ class Metric:
 
 
 def _symbols(system):
-    table = {str(s): s for s in (*system.q_symbols, *system.qd_symbols, *system.parameter_symbols)}
-    table["t"] = T_SYMBOL
-    return table
+    return system.expression_names()
 
 
 def grid(ranges):

@@ -62,9 +62,36 @@ def jacobian(exprs, symbols):
     return out
 
 
+class JointValue(sp.Dummy):
+    """A joint's angle (``hinge.angle``) in a constraint: a symbol standing for ``value``,
+    an expression of the coordinates (an atan2 of the parts' axes), whose time derivative
+    is ``rate`` (the joint's rate, linear in q̇). Constraints on it are differentiated by
+    the chain rule through the rate — cheap — instead of through the atan2 twice, which
+    is exact on the constraint manifold, where d(value)/dt = rate (joint_values.py); the
+    value is put in afterwards (``expand_joint_values``)."""
+
+    def __new__(cls, name, value, rate):
+        symbol = super().__new__(cls, name)
+        symbol.value, symbol.rate = sp.sympify(value), sp.sympify(rate)
+        return symbol
+
+
+def joint_values_in(expr):
+    """The JointValue symbols of ``expr``."""
+    return [s for s in sp.sympify(expr).free_symbols if isinstance(s, JointValue)]
+
+
+def expand_joint_values(expr):
+    """``expr`` with its JointValue symbols replaced by their values."""
+    found = joint_values_in(expr)
+    return sp.sympify(expr).xreplace({s: s.value for s in found}) if found else expr
+
+
 def time_derivative(expr, q, qd, t=T_SYMBOL):
-    """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t."""
-    return (jacobian([expr], q) * sp.Matrix(qd))[0] + sp.diff(expr, t)
+    """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t, and the
+    chain rule Σ (∂e/∂s) ṡ through the JointValue symbols s it holds."""
+    chain = sum((sp.diff(expr, s) * s.rate for s in joint_values_in(expr)), sp.S.Zero)
+    return (jacobian([expr], q) * sp.Matrix(qd))[0] + sp.diff(expr, t) + chain
 
 
 def generalized_force(V, efforts, q, qd):
@@ -119,6 +146,11 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
     """(A rows (sparse, len(exprs) × len(q)), b, velocity-level forms) of the
     constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure."""
     exprs = [sp.sympify(e) for e in exprs]
+    if any(joint_values_in(e) for e in exprs):  # the chain rule through joint rates (JointValue)
+        rows = [differentiate(e, q, qd, t) for e in exprs]
+        entries = {(r, j): expand_joint_values(x) for r, row in enumerate(rows) for j, x in enumerate(row[0]) if x != 0}
+        return (sp.SparseMatrix(len(exprs), len(q), entries), [expand_joint_values(row[1]) for row in rows],
+                [expand_joint_values(row[2]) for row in rows])
     where = positions(q, qd)
     involved = sorted({where[s] for e in exprs for s in e.free_symbols if s in where})
     forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved])
@@ -175,18 +207,22 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     A position-level phi(q, t) is differentiated twice (phidot = d phi/dt); a
     velocity-level phi(q, q̇, t) once (phidot is phi itself). With ψ the
     velocity-level form, ψ̇ = (∂ψ/∂q̇) q̈ + (∂ψ/∂q) q̇ + ∂ψ/∂t = 0, so
-    a = ∂ψ/∂q̇ and b = −(∂ψ/∂q) q̇ − ∂ψ/∂t.
+    a = ∂ψ/∂q̇ and b = −(∂ψ/∂q) q̇ − ∂ψ/∂t (plus the chain rule through JointValue
+    symbols, whose rates are exact on the manifold).
     """
     velocity_level = bool(set(qd) & phi.free_symbols)
     psi = phi if velocity_level else time_derivative(phi, q, qd, t)
     a = jacobian([psi], qd)
-    b = -(jacobian([psi], q) * sp.Matrix(qd))[0] - sp.diff(psi, t)
+    chain = sum((sp.diff(psi, s) * s.rate for s in joint_values_in(psi)), sp.S.Zero)  # JointValue symbols
+    b = -(jacobian([psi], q) * sp.Matrix(qd))[0] - sp.diff(psi, t) - chain
     return a, b, psi
 
 
-def compile_function(args, exprs, constants=()):
+def compile_function(args, exprs, constants=(), dtype=float):
     """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
     ``exprs`` (scalars, vectors or matrices), with common subexpressions shared.
+    ``dtype=complex`` keeps complex arguments complex (complex-step derivatives,
+    linearization.py); the constants must then be numbers.
 
     ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
     values (numbers or expressions of ``args``) are put in at each evaluation, so that
@@ -200,7 +236,7 @@ def compile_function(args, exprs, constants=()):
     frozen = _frozen(args)
     raw, numbers = _compiled(frozen, tuple(flat), tuple(c[0] for c in constants))
     fixed = np.array([_as_double(x) for x in numbers], dtype=float)
-    return Compiled(raw, _values(frozen, tuple(sp.sympify(c[1]) for c in constants)), fixed, shapes)
+    return Compiled(raw, _values(frozen, tuple(sp.sympify(c[1]) for c in constants)), fixed, shapes, dtype)
 
 
 class Compiled:
@@ -209,14 +245,14 @@ class Compiled:
     (``values``: a function of the arguments) and this instance's numbers ``fixed``.
     grouped.py calls ``raw`` once for many instances, on stacked arguments."""
 
-    def __init__(self, raw, values, fixed, shapes):
-        self.raw, self.values, self.fixed, self.shapes = raw, values, fixed, shapes
+    def __init__(self, raw, values, fixed, shapes, dtype=float):
+        self.raw, self.values, self.fixed, self.shapes, self.dtype = raw, values, fixed, shapes, dtype
         self.splits = np.cumsum([int(np.prod(s)) for s in shapes])[:-1]
 
     def __call__(self, *given):
         given = [np.float64(v) if isinstance(v, (int, float)) else v for v in given]
         with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
-            out = np.asarray(self.raw(*given, self.values(*given), self.fixed), dtype=float)
+            out = np.asarray(self.raw(*given, self.values(*given), self.fixed), dtype=self.dtype)
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, self.splits), self.shapes))
 
 

@@ -10,9 +10,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
-from . import equations, fast, friction, solvers
+from . import equations, fast, friction, reactions, solvers
+from .connectors import Joint
 from .errors import ModelError, SolveError
 from .evaluation import evaluator
+from .joint_values import JointKinematics, value_expressions
+from .subsystems import Frame
 from .symbolic import T_SYMBOL
 
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
@@ -61,6 +64,7 @@ class System:
     source: str = ""  # the model file's text, for workers that rebuild the System
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
+    outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
 
     @classmethod
     def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
@@ -120,7 +124,8 @@ class System:
         Parameters defined by expressions of others, and initial values written as
         expressions of parameters, follow the new values. Closure balances appended at
         load time are kept as derived; they stay valid while the masses that were zero
-        stay zero."""
+        stay zero. The new System shares this one's compiled fast path (``mbsynth.fast``:
+        parameters are arguments of its code), so a sweep compiles once."""
         unknown = sorted(set(values) - set(self.parameters))
         if unknown:
             raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
@@ -145,7 +150,17 @@ class System:
         if problems:
             given = values if len(values) <= 3 else f"{len(values)} new parameter values"
             raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
+        fast.share(self, changed)
         return changed
+
+    def for_run(self):
+        """This System, for one run (``simulate``), with the path of ``motion`` fixed for the
+        whole run: the compiled tree path when it is ready or its kernels are compiled (it
+        is waited for), else the KKT path throughout — never a switch midway, so a run's
+        result does not depend on when a background compilation finishes."""
+        run = replace(self)
+        fast.fix_path(self, run)
+        return run
 
     def part_problems(self):
         """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
@@ -218,7 +233,8 @@ class System:
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
         Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
         (2.14)). "fast" is the linear-time tree path (``mbsynth.fast``) once its compiled
-        kernels are ready (they build in the background on first use) and where its checks
+        kernels are ready (they build in the background on first use; ``for_run`` fixes
+        the choice for a run) and where its checks
         pass, else the KKT path; both fall back to the exact treatment when the problem is
         not well posed.
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
@@ -228,10 +244,16 @@ class System:
         ``drift=True``: the state may lie off the constraint manifold (an integrator's
         stage): b is judged by the drift rule of ``equations`` (least squares where the
         drift explains an inconsistency, near-singular directions the drift dominates set
-        aside) instead of raising SolveError for contradictory constraints."""
+        aside) instead of raising SolveError for contradictory constraints.
+        The Motion's ``lam`` (the multipliers, reactions.py) is computed when first read."""
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
+        motion = self._solved(t, q, qd, method, baumgarte, drift)
+        return motion.with_multipliers(lambda: self._multipliers(t, q, qd, motion)[0])
+
+    def _solved(self, t, q, qd, method, baumgarte, drift):
+        """The Motion of ``motion``, without its multipliers."""
         if method == "fast":
             motion = self._tree_motion(t, q, qd, baumgarte, drift)
             if motion is not None:
@@ -292,3 +314,107 @@ class System:
         b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.constraints])
         C = sum((con.C for con in self.constraints), sp.zeros(n, 1))
         return M, Q, A, b, C
+
+    def _multipliers(self, t, q, qd, motion, arrays=None):
+        """(λ, dependent rows) of ``motion`` at (t, q, q̇): Qc − C = Aᵀλ (reactions.py)."""
+        arrays = self.evaluate(t, q, qd) if arrays is None else arrays
+        C = arrays.C if motion.C is None else motion.C
+        return reactions.multipliers(arrays.A, arrays.M @ motion.qdd - arrays.Q - C)
+
+    def joint_kinematics(self):
+        """{name: joint_values.JointKinematics} of every joint (reaction frames; fixed and
+        distance joints have no values) and of each floating robot's root link
+        (``<prefix>root_joint``, a free joint, as Pinocchio names it), compiled on first use."""
+        found = self.__dict__.get("_joint_kinematics")
+        if found is None:
+            from .robots import LINK_FRAME  # robots.py builds on this module
+            found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
+                                             c.report_frame, self)
+                     for c in self.constraints if isinstance(c, Joint)}
+            parts = {p.name: p for p in self.subsystems}
+            for robot in self.robots:
+                if robot.floating:
+                    root = parts[robot.parts[robot.description.root]]
+                    frame = root.frames[LINK_FRAME]
+                    world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
+                    name = f"{robot.prefix}root_joint"
+                    found[name] = JointKinematics(name, "free", None, world, root, frame, frame, self)
+            object.__setattr__(self, "_joint_kinematics", found)
+        return found
+
+    def joint_values(self, t, q, qd, qdd=None):
+        """{joint name: JointValues(position, rate, acceleration)} of every joint that has
+        values (joint_values.py: revolute ``angle``, prismatic ``displacement``, …, a
+        floating robot's ``root_joint``), in model order; acceleration None without q̈."""
+        q, qd = self._state(q, qd)
+        qdd = None if qdd is None else np.asarray(qdd, dtype=float).ravel()
+        p = self.parameter_values
+        return {name: k.values(t, q, qd, qdd, p) for name, k in self.joint_kinematics().items() if k.position_names}
+
+    def reactions(self, t, q, qd, motion=None):
+        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default
+        ``self.motion(t, q, qd)``): the multipliers of each connector's rows, and for each
+        joint the wrench (``force``, ``torque``) the parent exerts on the child through it —
+        its rows, its friction, its actuation and spring — at the child's reaction frame
+        (the frame B of the joint; a robot's child link frame), in that frame's axes."""
+        q, qd = self._state(q, qd)
+        motion = self.motion(t, q, qd) if motion is None else motion
+        arrays = self.evaluate(t, q, qd)
+        lam, dependent = self._multipliers(t, q, qd, motion, arrays)
+        kinematics, p = self.joint_kinematics(), self.parameter_values
+        out, row = {}, 0
+        for con in self.constraints:
+            rows = slice(row, row + con.size)
+            force = torque = None
+            if con.name in kinematics:
+                k = kinematics[con.name]
+                g = self._joint_force(con, lam[rows], t, q, qd, p)
+                force, torque = reactions.wrench(k.frame(t, q, qd, p), con.parts[1].idle_directions(q[k.child_indices]),
+                                                 g[k.child_indices])
+            out[con.name] = reactions.Reaction(lam[rows].copy(), bool(dependent[rows].any()), force, torque)
+            row += con.size
+        return out
+
+    def _joint_force(self, joint, lam, t, q, qd, p):
+        """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the
+        load λ gives, Coulomb friction: friction.py) and its force elements."""
+        g = np.zeros(self.n)
+        a, _, c = joint.evaluate(t, q, qd, p)
+        g[joint.indices] += a.T @ lam + c
+        if joint.coulomb is not None:
+            w, direction = joint.coulomb.evaluate(t, q, qd, p)
+            g[joint.coulomb.indices] -= np.sign(w) * np.linalg.norm(lam[joint.coulomb.load_rows]) * direction
+        for element in self.forces:
+            if element.joint == joint.name:
+                g[element.indices] += element.evaluate(t, q, qd, p)
+        return g
+
+    def expression_names(self):
+        """{name: sympy expression} of what expressions about this model may use: t, the
+        parameters, coordinates ``part.c``, velocities ``part.c_dot`` and joint values
+        ``joint.angle``, ``joint.rate``, … (joint_values.value_expressions; a robot joint
+        named like a part has none)."""
+        names = {"t": T_SYMBOL, **{str(s): s for s in (*self.parameter_symbols, *self.q_symbols, *self.qd_symbols)}}
+        parts = {p.name for p in self.subsystems}
+        for con in self.constraints:
+            if isinstance(con, Joint) and con.name not in parts:
+                names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
+        return names
+
+    def working_forces(self):
+        """The names of what can change the total energy T + V: force elements with efforts
+        (actuation, dampers), parts with generalized forces or an explicit t, constraints
+        with a non-ideal C (friction) or an explicit t (a prescribed motion). Empty: the
+        energy is conserved, and its change along a run is drift."""
+        found = [e.name for e in self.forces if not e.conservative]
+        for part in self.subsystems:
+            own = part.__dict__.get("_symbolic")  # parts shared from a template hold neither
+            if any(f != 0 for f in getattr(part, "forces", ())) or (own and any(T_SYMBOL in x.free_symbols
+                                                                                  for x in own[2:])):
+                found.append(part.name)
+        for con in self.constraints:
+            own = con.__dict__.get("_symbolic")  # placed (joint) rows hold neither
+            if getattr(con, "coulomb", None) or (own and (any(x != 0 for x in own[2]) or any(
+                    T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ()))))):
+                found.append(con.name)
+        return found

@@ -1,11 +1,13 @@
 """Trajectories and their files.
 
 A ``Trajectory`` holds one row per output time: ``t``, ``q``, ``qd``, the largest
-position and velocity constraint residuals, and the total energy. Files:
+position and velocity constraint residuals, the total energy, and the model's declared
+``outputs`` (one column per name in ``output_names``: mbsynth.outputs). Files:
 
 - ``.npz``: arrays ``t``, ``q``, ``qd``, ``coordinates`` (plus ``energy``,
-  ``residual_position``, ``residual_velocity``, ``status``);
-- ``.csv``: a header ``t, <coordinate>..., <coordinate>_dot..., energy`` and one row per time.
+  ``residual_position``, ``residual_velocity``, ``status``, ``outputs``, ``output_names``);
+- ``.csv``: a header ``t, <coordinate>..., <coordinate>_dot..., energy, <output>...`` and
+  one row per time.
 
 ``TrajectoryWriter`` writes while a run goes on, so an interrupted or failed run keeps
 everything computed so far, and never leaves half a file under the final name: CSV
@@ -42,6 +44,12 @@ class Trajectory:
     residual_velocity: np.ndarray
     status: str = COMPLETED
     stats: dict = field(default_factory=dict)
+    outputs: np.ndarray = None  # T × len(output_names): the model's declared outputs
+    output_names: tuple = ()
+
+    def __post_init__(self):
+        if self.outputs is None:
+            self.outputs = np.zeros((len(self.t), len(self.output_names)))
 
     @property
     def energy_drift(self):
@@ -60,17 +68,21 @@ class Trajectory:
         return float(values.max()) if values.size else 0.0
 
     def column(self, name):
-        """The history of one coordinate (``part.coord``) or velocity (``part.coord_dot``)."""
+        """The history of one coordinate (``part.coord``), velocity (``part.coord_dot``) or
+        output (its column name: ``tip[x]``)."""
+        if name in self.output_names:
+            return self.outputs[:, self.output_names.index(name)]
         if name in self.coordinates:
             return self.q[:, self.coordinates.index(name)]
         if name.endswith("_dot") and name[:-4] in self.coordinates:
             return self.qd[:, self.coordinates.index(name[:-4])]
-        raise KeyError(f"no coordinate '{name}'; coordinates: {', '.join(self.coordinates)}")
+        raise KeyError(f"no coordinate or output '{name}'; coordinates: {', '.join(self.coordinates)}"
+                       + (f"; outputs: {', '.join(self.output_names)}" if self.output_names else ""))
 
     def save(self, path):
         """Write the whole trajectory to ``path`` (.npz or .csv), atomically; the CSV of a
         run that did not complete goes to ``path``.partial (see the module docstring)."""
-        with TrajectoryWriter(path, self.coordinates) as writer:
+        with TrajectoryWriter(path, self.coordinates, self.output_names) as writer:
             writer.append(self)
             writer.status = self.status
 
@@ -98,30 +110,36 @@ def load_trajectory(path):
             get = {k: data[k] for k in data.files}
         n_rows = get["t"].size
         nan = np.full(n_rows, np.nan)
+        names = tuple(str(x) for x in get.get("output_names", ()))
         return Trajectory(coordinates, get["t"], get["q"], get["qd"], get.get("energy", nan),
                           get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
-                          str(get.get("status", COMPLETED)))
+                          str(get.get("status", COMPLETED)), outputs=get.get("outputs"), output_names=names)
     if path.suffix == ".csv" or path.name.endswith(".csv.partial"):
         with path.open(newline="") as f:
             header = next(csv.reader(f))
+        if "energy" not in header[1:]:
+            raise ModelError(f"{path}: not a trajectory file (its header has no 'energy' column: "
+                             "t, coordinates, velocities, energy, outputs)")
         data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-        n = (len(header) - 2) // 2
+        energy = header.index("energy", 1)  # t, coordinates, velocities, energy, outputs
+        n = (energy - 1) // 2
         nan = np.full(data.shape[0], np.nan)
         return Trajectory(tuple(header[1:1 + n]), data[:, 0], data[:, 1:1 + n], data[:, 1 + n:1 + 2 * n],
-                          data[:, -1], nan, nan, nan)
+                          data[:, energy], nan, nan, nan, outputs=data[:, energy + 1:],
+                          output_names=tuple(header[energy + 1:]))
     raise ModelError(f"{path}: unknown trajectory format (use {' or '.join(FORMATS)})")
 
 
 class TrajectoryWriter:
     """Writes trajectory rows as they come (see the module docstring)."""
 
-    def __init__(self, path, coordinates, checkpoint_seconds=2.0):
+    def __init__(self, path, coordinates, output_names=(), checkpoint_seconds=2.0):
         self.path = Path(path)
         if self.path.suffix not in FORMATS:
             raise ModelError(f"{self.path}: output must end in {' or '.join(FORMATS)}")
         if not self.path.parent.is_dir():
             raise ModelError(f"{self.path}: the folder {self.path.parent} does not exist")
-        self.coordinates = tuple(coordinates)
+        self.coordinates, self.output_names = tuple(coordinates), tuple(output_names)
         self.checkpoint_seconds = checkpoint_seconds
         self.status = "running"
         self._chunks = []
@@ -134,7 +152,8 @@ class TrajectoryWriter:
             except OSError as err:
                 raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
             self._csv = csv.writer(self._csv_file)
-            self._csv.writerow(["t", *self.coordinates, *(c + "_dot" for c in self.coordinates), "energy"])
+            self._csv.writerow(["t", *self.coordinates, *(c + "_dot" for c in self.coordinates), "energy",
+                                *self.output_names])
             self._csv_file.flush()
             self._complete = self._csv_file.tell()  # bytes of complete rows
         else:
@@ -149,9 +168,9 @@ class TrajectoryWriter:
     def append(self, traj):
         """Add the rows of a Trajectory (or a chunk of one)."""
         if self.path.suffix == ".csv":
-            for row in zip(traj.t, traj.q, traj.qd, traj.energy):
+            for row in zip(traj.t, traj.q, traj.qd, traj.energy, traj.outputs):
                 self._csv.writerow([repr(float(row[0])), *map(repr, map(float, row[1])),
-                                    *map(repr, map(float, row[2])), repr(float(row[3]))])
+                                    *map(repr, map(float, row[2])), repr(float(row[3])), *map(repr, map(float, row[4]))])
             self._csv_file.flush()
             self._complete = self._csv_file.tell()
         else:
@@ -178,14 +197,16 @@ class TrajectoryWriter:
         def stack(name, width=None):
             parts = [getattr(c, name) for c in chunks]
             if not parts:
-                return np.zeros((0, n) if width else 0)
+                return np.zeros(0) if width is None else np.zeros((0, width))
             return np.concatenate(parts)
 
         tmp = self.path.with_name(self.path.name + ".tmp.npz")
         try:
             np.savez(tmp, t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
                      energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
-                     residual_velocity=stack("residual_velocity"), status=np.array(self.status))
+                     residual_velocity=stack("residual_velocity"), status=np.array(self.status),
+                     outputs=stack("outputs", len(self.output_names)),
+                     output_names=np.array(self.output_names, dtype=str))
             os.replace(tmp, self.path)
         except BaseException as err:
             tmp.unlink(missing_ok=True)

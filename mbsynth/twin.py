@@ -65,10 +65,12 @@ class Coordinate:
     """One Pinocchio joint read off mbsynth's state: ``positions`` (its nq entries of q)
     and ``rates`` (its nv entries of v) as expressions of the model's symbols, compiled
     with the rates' time derivatives. ``kind``: revolute, continuous, prismatic or free;
-    ``limits``: (lower, upper) of its q entries; ``torque``: the parameter driving it."""
+    ``limits``: (lower, upper) of its q entries; ``torque``: the parameter driving it;
+    ``sign``: −1 where Pinocchio's joint runs from the mbsynth joint's child to its parent."""
 
-    def __init__(self, name, joint_id, model, kind, positions, rates, system, limits=None, torque=None):
+    def __init__(self, name, joint_id, model, kind, positions, rates, system, limits=None, torque=None, sign=1):
         self.name, self.joint_id, self.kind, self.torque = name, joint_id, kind, torque
+        self.sign = sign  # −1: the mbsynth joint walked from child to parent (its values and reaction reversed)
         joint = model.joints[joint_id]
         self.idx_q, self.nq, self.idx_v, self.nv = joint.idx_q, joint.nq, joint.idx_v, joint.nv
         self.limits = limits
@@ -278,7 +280,7 @@ def _joint_coordinate(name, joint_id, model, joint, sign, system, kind, limits=N
     position, rate = ((joint.angle, joint.angle_rate) if joint.joint_kind == "revolute"
                       else (joint.displacement, joint.displacement_rate))
     positions = [sp.cos(position), sp.sin(position)] if kind == "continuous" else [sign * position]
-    return Coordinate(name, joint_id, model, kind, positions, [sign * rate], system, limits, torque)
+    return Coordinate(name, joint_id, model, kind, positions, [sign * rate], system, limits, torque, sign)
 
 
 def _kind(joint_model):

@@ -10,6 +10,13 @@ on the constraint manifold (projection.py) and read back. mbsynth's q̈ (2.14) b
 (twin.py) and is compared with Pinocchio's: absolute error ‖Δv̇‖∞, relative error
 ‖Δv̇‖∞ / ‖v̇‖∞, the largest over the samples. Force elements other than the joint
 torques (springs, applied forces) enter Pinocchio as τ = Sᵀ Q_e, S = ∂q̇/∂v (virtual power).
+
+Joint space, at the same samples: ``System.joint_values`` against Pinocchio's (q, v, v̇)
+joint by joint (angles modulo 2π, a free-flyer's quaternion up to sign; relative to
+1 + the largest |v|, |v̇|), and, on a tree without other force elements, each joint's
+``System.reactions`` wrench against ``data.f`` of ``rnea(q, v, v̇)`` (relative to the
+largest entry of data.f). Loop joints are not compared: where their rows are redundant
+(as Pinocchio's closures of a revolute joint are) the split of the reaction is not unique.
 """
 
 import contextlib
@@ -37,7 +44,8 @@ class Validation:
     floating, or "model" for a model file), its ``links`` (bodies) and ``nv`` (Pinocchio's
     velocity count, before loops close); the largest errors over ``samples`` states; ``passed`` (below ``tolerance``);
     ``build_s`` (seconds to build the System), ``motion_ms`` (mean mbsynth evaluation);
-    ``note`` says why a comparison was impossible (no unique motion, NaN from Pinocchio)."""
+    ``note`` says why a comparison was impossible (no unique motion, NaN from Pinocchio);
+    ``joint_error``, ``reaction_error``: the joint-space comparisons (module docstring)."""
 
     robot: str
     base: str
@@ -51,6 +59,8 @@ class Validation:
     build_s: float
     motion_ms: float
     note: str = ""
+    joint_error: float = float("nan")  # joint_values against Pinocchio's (q, v, v̇), relative
+    reaction_error: float = float("nan")  # reactions against rnea's data.f, relative (NaN: not compared)
 
     def to_dict(self):
         return asdict(self)
@@ -77,7 +87,8 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
     efforts = {robot.torques[j.name]: j.effort for robot in system.robots for j in robot.description.joints
                if j.name in robot.torques}
     others = [e for e in system.forces if e.name not in twin.torque_elements]
-    worst_abs = worst_rel = 0.0
+    worst_abs = worst_rel = worst_joint = 0.0
+    worst_reaction = 0.0 if not (others or twin.constraints) else float("nan")
     notes, seconds = [], []
     for _ in range(samples):
         q, v, qm, qdm = _consistent_sample(system, twin, rng)
@@ -107,11 +118,59 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
         scale = np.abs(reference).max() if reference.size else 0.0
         worst_abs = max(worst_abs, error)
         worst_rel = max(worst_rel, error / scale if scale > 0 else error)
+        worst_joint = max(worst_joint, joint_space_error(driven, twin, (q, v, reference), (qm, qdm), motion))
+        if not np.isnan(worst_reaction):
+            worst_reaction = max(worst_reaction, reaction_error(driven, twin, (q, v, reference), (qm, qdm), motion))
     links = len(system.subsystems)
     note = notes[0] if notes else ""
+    joint_ok = worst_joint <= tolerance and not worst_reaction > tolerance
     return Validation(label or system.name, base, links, twin.model.nv, samples, float(worst_abs), float(worst_rel),
-                      bool(not notes and worst_rel <= tolerance), tolerance, round(build_s, 3),
-                      round(1e3 * float(np.mean(seconds)), 3) if seconds else 0.0, note)
+                      bool(not notes and worst_rel <= tolerance and joint_ok), tolerance, round(build_s, 3),
+                      round(1e3 * float(np.mean(seconds)), 3) if seconds else 0.0, note, float(worst_joint),
+                      float(worst_reaction))
+
+
+def joint_space_error(system, twin, pinocchio_state, state, motion):
+    """The largest error of ``system.joint_values`` against Pinocchio's (q, v, v̇) of
+    the twin's joints (module docstring)."""
+    q, v, a = pinocchio_state
+    values = system.joint_values(0.0, *state, motion.qdd)
+    scale = 1 + max(np.abs(v).max(initial=0), np.abs(a).max(initial=0))
+    worst = 0.0
+    for c in twin.coordinates:
+        if c.name not in values:  # a body no joint reaches: Pinocchio's free-flyer only
+            continue
+        ours, window = values[c.name], slice(c.idx_v, c.idx_v + c.nv)
+        worst = max(worst, _position_error(c, c.sign * ours.position, q[c.idx_q:c.idx_q + c.nq]),
+                    np.abs(c.sign * ours.rate - v[window]).max() / scale,
+                    np.abs(c.sign * ours.acceleration - a[window]).max() / scale)
+    return worst
+
+
+def _position_error(coordinate, ours, theirs):
+    """|Δ position|: angles modulo 2π (a continuous joint's q is (cos, sin)), a free-flyer's
+    quaternion (Pinocchio's x, y, z, w) up to its sign."""
+    if coordinate.kind == "continuous":
+        theirs = np.array([np.arctan2(theirs[1], theirs[0])])
+    if coordinate.kind == "free":
+        theirs = np.r_[theirs[:3], theirs[6], theirs[3:6]]
+        ours = np.r_[ours[:3], np.sign(ours[3:] @ theirs[3:]) * ours[3:]]
+        return np.abs(ours - theirs).max()
+    return np.abs((ours - theirs + np.pi) % (2 * np.pi) - np.pi).max()
+
+
+def reaction_error(system, twin, pinocchio_state, state, motion):
+    """The largest error of the joints' ``system.reactions`` against ``data.f`` of
+    Pinocchio's ``rnea`` at the same (q, v, v̇), relative to its largest entry."""
+    q, v, a = pinocchio_state
+    pin.rnea(twin.model, twin.data, q, v, a)
+    reactions = system.reactions(0.0, *state, motion)
+    joints = [c for c in twin.coordinates if c.kind != "free" and c.sign == 1 and c.name in reactions]
+    if not joints:
+        return 0.0
+    scale = max(np.abs(twin.data.f[c.joint_id].vector).max() for c in joints) or 1.0
+    return max(max(np.abs(reactions[c.name].force - twin.data.f[c.joint_id].linear).max(),
+                   np.abs(reactions[c.name].torque - twin.data.f[c.joint_id].angular).max()) for c in joints) / scale
 
 
 def sample_pinocchio_state(twin, rng):

@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import sympy as sp
 
@@ -104,3 +105,74 @@ def test_simulate_names_the_singular_position_it_passed(capsys):
     assert "ground0[x]" in first["rows"]
     assert main(["simulate", str(root / "models" / "mechanisms" / "n_four_bar.yaml"), "--t-end", "1"]) == 0
     assert "passed near singular positions at t ≈ 0.7143" in capsys.readouterr().out
+
+
+JOINT_MODELS = Path(__file__).resolve().parent.parent / "models"
+LEAF = """
+name: massless_leaf
+gravity: [0, 0, -9.81]
+world: {frames: {pivot: {axis: [0, 1, 0]}}}
+subsystems:
+  rod: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.01], initial: {position: [0, 0, -0.5]},
+        frames: {top: {position: [0, 0, 0.5], axis: [0, 1, 0]}, bottom: {position: [0, 0, -0.5], axis: [0, 1, 0]}}}
+  leaf: {type: rigid_body, mass: 0, inertia: [0, 0, 0], initial: {position: [0, 0, -1.2]},
+         frames: {top: {position: [0, 0, 0.2], axis: [0, 1, 0]}}}
+joints:
+  - {name: shoulder, type: revolute, parent: world.pivot, child: rod.top}
+  - {name: wrist, type: revolute, parent: rod.bottom, child: leaf.top}
+"""
+
+
+def test_check_reports_joint_accelerations(capsys):
+    """driven_pendulum.yaml at rest at θ0 = 0.6: θ̈ = (−m g (L/2) sin θ0 + τ0)/(m L²/3)."""
+    path = JOINT_MODELS / "joints" / "driven_pendulum.yaml"
+    assert main(["check", str(path)]) == 0
+    text = capsys.readouterr().out
+    m, L, g, tau0, theta0 = 1.2, 0.8, 9.81, 0.4, 0.6
+    expected = (-m * g * L / 2 * np.sin(theta0) + tau0) / (m * L**2 / 3)
+    line = next(x for x in text.splitlines() if "joint accelerations" in x)
+    assert float(line.split("hinge.acceleration = ")[1]) == pytest.approx(expected, rel=1e-5)
+    assert main(["check", str(path), "--coordinates", "maximal"]) == 0
+    assert "rod.qw = " in capsys.readouterr().out
+    assert main(["check", str(path), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["joints"]["hinge"]["acceleration"][0] == pytest.approx(expected, rel=1e-9)
+    assert len(report["qdd"]) == 7
+
+
+def test_check_names_the_joint_a_free_direction_turns(capsys, tmp_path):
+    path = tmp_path / "leaf.yaml"
+    path.write_text(LEAF)
+    main(["check", str(path)])
+    text = capsys.readouterr().out
+    assert "1 indeterminate direction" in text and "moves joint(s) wrist" in text
+    main(["check", str(path), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert list(report["free_joints"][0]) == ["wrist"]
+
+
+def test_simulate_plots_joints_and_names_the_work(capsys, tmp_path):
+    picture = tmp_path / "pd.png"
+    assert main(["simulate", str(JOINT_MODELS / "joints" / "pd_pendulum.yaml"), "--t-end", "0.5",
+                 "--plot", str(picture)]) == 0
+    text = capsys.readouterr().out
+    assert picture.stat().st_size > 10_000
+    assert "relative energy change" in text and "work of hinge.actuation" in text
+    assert main(["simulate", str(JOINT_MODELS / "mechanisms" / "simple_pendulum.yaml"), "--t-end", "0.5"]) == 0
+    assert "relative energy drift" in capsys.readouterr().out
+
+
+def test_modes_of_the_pd_pendulum(capsys, tmp_path):
+    """Linearized about its rest angle θ*, the PD pendulum obeys I s² + kd s + kp + m g (L/2) cos θ* = 0
+    (I = m L²/3): two overdamped modes; --html writes a page with one frame per mode."""
+    from scipy.optimize import brentq
+    page = tmp_path / "modes.html"
+    assert main(["modes", str(JOINT_MODELS / "joints" / "pd_pendulum.yaml"), "--equilibrium", "--json",
+                 "--html", str(page)]) == 0
+    report = json.loads(capsys.readouterr().out)
+    rest = brentq(lambda x: 50.0 * (x - 0.5) + 9.81 * 0.5 * np.sin(x), 0.0, 1.0)
+    expected = np.sort(np.roots([1 / 3, 10.0, 50.0 + 9.81 * 0.5 * np.cos(rest)]).real)
+    found = np.sort([m["eigenvalue"][0] for m in report["modes"]])
+    assert found == pytest.approx(expected, rel=1e-8)
+    assert [m["kind"] for m in report["modes"]] == ["overdamped", "overdamped"]
+    assert page.read_text().count("<iframe") == 2

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mbsynth import cli
+from mbsynth.cli import simulate as simulate_command
 from mbsynth.cli import main
 from mbsynth.trajectory import load_trajectory
 
@@ -121,7 +121,7 @@ def test_usage_errors_with_json_are_one_json_object(capsys, line):
 def test_ctrl_c_keeps_the_output_and_exits_130(capsys, tmp_path, monkeypatch):
     """Ctrl-C in the middle of a run: one line, exit 130 (128 + SIGINT), the rows computed
     so far in --out, JSON with --json."""
-    real = cli.simulate
+    real = simulate_command.simulate
 
     def interrupted(*args, **kwargs):
         def progress(t):
@@ -129,7 +129,7 @@ def test_ctrl_c_keeps_the_output_and_exits_130(capsys, tmp_path, monkeypatch):
                 raise KeyboardInterrupt
         return real(*args, **dict(kwargs, progress=progress))
 
-    monkeypatch.setattr(cli, "simulate", interrupted)
+    monkeypatch.setattr(simulate_command, "simulate", interrupted)
     out = tmp_path / "run.npz"
     code, stdout, err = run(capsys, f"simulate {MODEL} --t-end 1 --out {out}")
     assert code == 130 and err.strip().count("\n") == 0 and "interrupted" in err and str(out) in err

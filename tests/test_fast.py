@@ -574,7 +574,8 @@ def test_motion_made_is_the_frozen_dataclass():
     fields = dict(qdd=np.arange(3.0), unique=True, nullspace=np.zeros((3, 0)), Qc=np.ones(3), residual=1e-16,
                   method="tree (Baraff)", singular=())
     made, built = Motion.made(**fields), Motion(**fields)
-    assert [f.name for f in dataclasses.fields(made)] == list(fields)
+    assert [f.name for f in dataclasses.fields(made)] == [*fields, "C"]  # C: only from friction.coulomb_motion
+    assert made.C is None and built.C is None
     for name, value in fields.items():
         assert np.array_equal(getattr(made, name), getattr(built, name))
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -1,9 +1,14 @@
 """Every module of mbsynth can be the first one imported: no import cycle hidden by the
-order in which ``mbsynth/__init__.py`` happens to import its submodules."""
+order in which ``mbsynth/__init__.py`` happens to import its submodules; and what is
+imported is only what is used (issue 20, a light import)."""
 
+import argparse
+import importlib
 import subprocess
 import sys
 from pathlib import Path
+
+from mbsynth.cli import parser
 
 PACKAGE = Path(__file__).resolve().parent.parent / "mbsynth"
 
@@ -43,3 +48,53 @@ def test_every_submodule_imports_first_in_a_fresh_interpreter():
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == ""
 
+
+
+# Libraries that load when their feature is used (issue 20, a light import), never before.
+HEAVY = ("pandas", "dask", "matplotlib", "meshcat", "pinocchio", "numba")
+MODEL = PACKAGE.parent / "models" / "paper" / "example3_m1_zero.yaml"
+
+
+def run_fresh(code):
+    """Run ``code`` in a fresh interpreter; its stdout, then the heavy libraries it left loaded."""
+    probe = f"import sys\n{code}\nprint('loaded:', *[m for m in {HEAVY!r} if m in sys.modules])"
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=600,
+                            check=False, cwd=PACKAGE.parent)
+    assert result.returncode == 0, result.stderr
+    out, loaded = result.stdout.rsplit("loaded:", 1)
+    return out, loaded.split()
+
+
+def test_import_mbsynth_loads_no_heavy_library():
+    out, loaded = run_fresh("import mbsynth")
+    assert loaded == []
+
+
+def test_check_loads_only_what_check_needs():
+    """``mbsynth check`` (the paper's example 3 with m1 = 0, unique by Result 3) runs to
+    its verdict without dask, pandas, matplotlib, meshcat or pinocchio."""
+    out, loaded = run_fresh(f"from mbsynth.cli import main\nassert main(['check', {str(MODEL)!r}]) == 0")
+    assert "motion: unique (Result 3)" in out
+    assert set(loaded) <= {"numba"}, loaded
+
+
+def test_public_names_resolve_after_any_import_order():
+    """``mb.simulate`` and ``mb.sweep`` stay the functions even when their modules were
+    imported first (importing a submodule binds its name on the package)."""
+    out, _ = run_fresh("import types, mbsynth.sweep, mbsynth.simulate, mbsynth as mb\n"
+                       "for name in mb.__all__:\n"
+                       "    value = getattr(mb, name)\n"
+                       "    assert isinstance(value, types.ModuleType) == (name == 'viewer'), name\n"
+                       "assert mb.simulate is sys.modules['mbsynth.simulate'].simulate\n"
+                       "assert mb.sweep is sys.modules['mbsynth.sweep'].sweep\n"
+                       "print(sorted(set(mb.__all__) - set(dir(mb))))")
+    assert out.strip() == "[]"
+
+
+def test_every_command_of_the_parser_has_its_module():
+    """``mbsynth.cli.parser()`` is the whole command line (the CLI reference is generated
+    from it); main runs a command from the module of the same name."""
+    commands = next(a for a in parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert {"check", "simulate", "sweep", "view", "validate", "robots"} <= set(commands)
+    for name in commands:
+        assert callable(importlib.import_module(f"mbsynth.cli.{name}").run), name

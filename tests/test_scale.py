@@ -73,3 +73,41 @@ def test_rigid_double_pendulum_at_any_scale(length, mass):
         angle = 2 * np.arctan2(traj.column(f"{link}.qy"), traj.column(f"{link}.qw"))
         expected = 2 * np.arctan2(reference.column(f"{link}.qy"), reference.column(f"{link}.qw"))
         assert np.abs(np.angle(np.exp(1j * (angle - expected)))).max() < 1e-7
+
+
+def _scaled_urdf(source, length, mass, target):
+    """The URDF ``source`` with every length ×``length`` and mass ×``mass`` (inertias ×
+    mass·length²), written to ``target``."""
+    import xml.etree.ElementTree as ET
+    tree = ET.parse(source)
+    for origin in tree.iter("origin"):
+        if "xyz" in origin.attrib:
+            origin.set("xyz", " ".join(str(float(x) * length) for x in origin.get("xyz").split()))
+    for element in tree.iter("mass"):
+        element.set("value", str(float(element.get("value")) * mass))
+    for inertia in tree.iter("inertia"):
+        for key, value in inertia.attrib.items():
+            inertia.set(key, str(float(value) * mass * length**2))
+    tree.write(target)
+    return target
+
+
+@pytest.mark.parametrize("length, mass", [(1e-3, 1e3), (1e3, 1e-3)])
+def test_urdf_robot_at_any_scale(length, mass, tmp_path):
+    """example-robot-data's double pendulum, its URDF scaled in length and mass: released
+    at the same joint angles, its joints move as the original's after rescaling time
+    (System.joint_values), to 1e-7 rad."""
+    from mbsynth.robots import robot_files
+    from mbsynth.twin import Twin
+    angles = np.array([0.8, -0.5])
+    runs = []
+    for s, k in ((1.0, 1.0), (length, mass)):
+        system = mb.from_robot(_scaled_urdf(robot_files()["double_pendulum"], s, k, tmp_path / f"robot_{s}.urdf"))
+        q0, qd0 = Twin(system).to_maximal(angles, np.zeros(2))
+        unit = math.sqrt(s)
+        traj = mb.simulate(system, 0.7 * unit, q0=q0, qd0=qd0, dt=0.1 * unit)  # before its chaos amplifies rtol
+        assert traj.status == "completed" and traj.max_residual < 1e-9
+        runs.append(np.array([[v.position[0] for v in system.joint_values(t, q, qd).values()]
+                              for t, q, qd in zip(traj.t, traj.q, traj.qd)]))
+    assert np.abs(runs[0] - angles).max() > 0.1  # it moves
+    assert np.abs(runs[1] - runs[0]).max() < 1e-7

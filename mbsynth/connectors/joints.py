@@ -28,7 +28,6 @@ from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
-from scipy.spatial.transform import Rotation
 
 from ..constraint import Connector
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
@@ -98,10 +97,14 @@ class Joint(Connector):
     cylindrical), and ``displacement`` z_A·(p_B − p_A) along z_A with its rate
     (prismatic, cylindrical) — what actuation, joint springs and friction act on."""
 
-    def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None, friction=None):
+    def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None, friction=None,
+                 report_frame=None):
         """``friction`` (a ``friction.Friction``) puts viscous friction into the joint's C
-        (2.6) and keeps Coulomb friction, which needs the joint's load, in ``coulomb``."""
+        (2.6) and keeps Coulomb friction, which needs the joint's load, in ``coulomb``.
+        ``report_frame``: the frame on the child, with B's origin, in whose axes the
+        joint's reaction is given (``System.reactions``); B itself by default."""
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
+        self.report_frame = frame_b if report_frame is None else report_frame
         self.length = length  # a distance joint's L (sympy), None for the other kinds
         where = positions(q, qd)
         values = _frame_values(frame_a, 0, where), _frame_values(frame_b, 1, where)
@@ -180,6 +183,8 @@ def _turned(joint, relative):
     (also when ``relative`` is no turn at all: a zero quaternion, left to other checks)."""
     if not (np.all(np.isfinite(relative)) and np.linalg.det(relative) > 0):
         return None
+    from scipy.spatial.transform import Rotation  # scipy.spatial: a tenth of a second, only here
+
     turn = Rotation.from_matrix(relative).as_rotvec()
     angle = np.degrees(np.linalg.norm(turn))
     if angle < 90:

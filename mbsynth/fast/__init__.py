@@ -9,15 +9,15 @@
     tree.py        the tree's elimination in articulated form (null spaces, rigid transports)
     eigen.py       small symmetric eigendecomposition (the loops' Schur system)
     kernel.py      the whole evaluation and its checks
-    engine.py      an Engine per System: motion, motion_batch
-    background.py  building Engines off the caller's thread; MBSYNTH_FAST
+    engine.py      a Template per model structure, an Engine per System: motion, motion_batch
+    background.py  building Engines off the caller's thread, shared and freed; MBSYNTH_FAST
     batch.py       System.motion_batch
     cache.py       where compiled code is kept
 
 Importing this package does not import numba (``mbsynth check`` never needs it).
 """
 
-from .background import engine_for
+from .background import engine_for, fix_path, share
 from .batch import motion_batch
 
-__all__ = ["engine_for", "motion_batch"]
+__all__ = ["engine_for", "fix_path", "motion_batch", "share"]

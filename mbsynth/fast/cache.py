@@ -88,6 +88,18 @@ def _mark_and_prune(version):
         pass
 
 
+def compiled_mark():
+    """The file whose presence says that numba's cache holds the kernels of these sources
+    (background.py writes it when an Engine has been warmed): ``<numba cache>/.compiled-<sources_hash()>``."""
+    global _sources
+    if _sources is None:
+        _sources = sources_hash()
+    return Path(os.environ.get("NUMBA_CACHE_DIR") or cache_dir() / "numba" / _sources) / f".compiled-{_sources}"
+
+
+_sources = None  # sources_hash() of this package, once computed
+
+
 def generated_dir():
     path = cache_dir() / "generated"
     path.mkdir(parents=True, exist_ok=True)

@@ -1,9 +1,16 @@
-"""The compiled fast path of one System: layout, generated function, work buffers.
+"""The compiled fast path: a Template per model structure, an Engine per System.
 
-``Engine.build(system)`` returns None when the kernels cover no part of the System
-(layout.build). ``motion`` returns a ``Motion`` equal to (2.14)'s, or None when the
-kernel's checks send the problem to the exact treatment (kernel.py's status);
-``motion_batch`` evaluates many states in parallel.
+``Template.build(system)`` lays the System out (layout.build) and compiles its generated
+function (codegen.py), or returns None when the kernels cover no part of it. Systems that
+differ only in parameter values (``System.with_parameters``) share one Template: the
+parameters are arguments of the generated function, and the Layout's numbers (masses,
+inertias, frame offsets) are re-evaluated per System (layout.with_parameters), which costs
+no compilation. ``Template.engine(system)`` makes a System's Engine: its numbers and work
+buffers. An Engine holds no reference to its System.
+
+``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
+send the problem to the exact treatment (kernel.py's status); ``motion_batch`` evaluates
+many states in parallel.
 """
 
 import os
@@ -22,18 +29,37 @@ THREADS = os.cpu_count() or 1
 CHUNK = 16  # fewest rows a thread takes at a time
 
 
-class Engine:
-    """The fast path for ``system`` at its parameter values."""
+class Template:
+    """What the Systems with one structure share: the Layout (with the numbers of the System
+    it was built from, at parameter values ``p``) and the compiled generated function."""
 
     def __init__(self, system, L, exprs):
-        self.system, self.L = system, L
-        self.n = system.n
-        self.p = system.parameter_values
+        self.L, self.n, self.p = L, system.n, system.parameter_values
         self.outputs = len(exprs)
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
-        self.gen = np.zeros(self.outputs)
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
+
+    @classmethod
+    def build(cls, system):
+        found = layout.build(system)
+        return None if found is None else cls(system, *found)
+
+    def engine(self, system):
+        """The Engine of ``system``: this Template's structure and code, its own numbers."""
+        p = system.parameter_values
+        same = p.shape == self.p.shape and np.array_equal(p, self.p)
+        return Engine(self, self.L if same else layout.with_parameters(self.L, system), p)
+
+
+class Engine:
+    """The fast path for one System at its parameter values ``p`` (Layout ``L``)."""
+
+    def __init__(self, template, L, p):
+        self.template, self.L, self.p = template, L, p
+        self.n, self.outputs, self.module = template.n, template.outputs, template.module
+        self.closes_loops = template.closes_loops
+        self.gen = np.zeros(self.outputs)
         self.packed = pack(L)
         self.work, self.W = self.new_work()
         self.buffers = (*self.packed, *self.work)  # kernel.motion's last six arguments
@@ -49,14 +75,8 @@ class Engine:
         packed = pack(work)
         return packed, views(Work, work, *packed)
 
-    @classmethod
-    def build(cls, system):
-        found = layout.build(system)
-        return None if found is None else cls(system, *found)
-
-    def warm(self):
-        """Compile (or load from the cache) everything ``motion`` calls, at the initial state."""
-        q, qd = self.system.initial_state()
+    def warm(self, q, qd):
+        """Compile (or load from the cache) everything ``motion`` calls, at the state (q, q̇)."""
         self.motion(0.0, q, qd)
 
     def motion(self, t, q, qd, bshift=None):

@@ -13,8 +13,11 @@ coordinates are the *extra coordinates*), and the rows a, b of the other constra
 order of its outputs: Q additions, C, M entries of the extra coordinates, entries of
 extra rows, b of extra rows.
 
-Masses, inertias and frame offsets are evaluated at the System's parameter values, so a
-System from ``with_parameters`` needs its own Layout (the generated code is shared).
+Masses, inertias, gravity forces, frame offsets and rotations and rod lengths are the
+*numbers* of a Layout, evaluated at the System's parameter values; every other array
+depends only on the parts, the constraints and the parameters' names. ``with_parameters``
+re-evaluates the numbers for a System that differs only in parameter values
+(``System.with_parameters``) and shares the rest, so the compiled code is reused.
 """
 
 from collections import deque
@@ -165,6 +168,44 @@ def _tree(count, joints, node_of):
     return parent, pjoint, order
 
 
+def with_parameters(L, system):
+    """``L``, built from a System with the parts and constraints of ``system`` (other
+    parameter values: ``System.with_parameters``), with the numbers of ``system``."""
+    starts = np.cumsum([0] + [len(p.coordinates) for p in system.subsystems])
+    rows = np.cumsum([0] + [c.size for c in system.constraints])
+    part_at = {int(s): part for part, s in zip(system.subsystems, starts)}
+    con_at = {int(r): con for con, r in zip(system.constraints, rows)}
+    return L._replace(**_numbers([part_at[int(c)] for c in L.node_q], [con_at[int(r)] for r in L.joint_row],
+                                 _Numbers(system)))
+
+
+def _numbers(parts, joints, number):
+    """The Layout's fields that depend on parameter values, for its nodes' ``parts`` and its
+    kernel ``joints``: node_mass, node_mg, node_J, joint_s, joint_R, joint_length."""
+    masses, mg, inertia = [], [], []
+    for part in parts:
+        if isinstance(part, RigidBody):
+            masses.append(number(part.mass)[0, 0])
+            inertia.append(number(part.inertia))
+            mg.append(number(part.mass * part.gravity).ravel())
+        else:
+            masses.append(number(part.M[0, 0])[0, 0])
+            inertia.append(np.zeros((3, 3)))
+            mg.append(number(part.Q[:3, 0]).ravel())  # m g: the first three entries of Q, constant
+    offsets, rotations, lengths = [], [], []
+    for con in joints:
+        for part, frame in zip(con.parts, con.frames):
+            offsets.append(np.zeros(3) if isinstance(part, Particle) else number(frame.position).ravel())
+            rotations.append(number(frame.rotation))
+        lengths.append(number(con.length)[0, 0] if con.joint_kind == "distance" else 1.0)
+    N = len(parts)
+    return dict(node_mass=np.array(masses, dtype=float), node_mg=np.array(mg, dtype=float).reshape(N, 3),
+                node_J=np.array(inertia, dtype=float).reshape(N, 3, 3),
+                joint_s=np.array(offsets, dtype=float).reshape(-1, 2, 3),
+                joint_R=np.array(rotations, dtype=float).reshape(-1, 2, 3, 3),
+                joint_length=np.array(lengths, dtype=float))
+
+
 class _Builder:
     def __init__(self, system, number, starts, nodes, node_of, quat, joints, others, parent, pjoint, order):
         self.system, self.number, self.starts = system, number, starts
@@ -188,7 +229,6 @@ class _Builder:
         yoff = np.cumsum([0] + d)
         rows = np.cumsum([0] + k)
         end = [self._end_of(i, j) for i, j in enumerate(self.pjoint)]
-        masses, mg, inertia = self._bodies(rigid)
         loops = [j for j in range(len(joints)) if j not in set(self.pjoint)]
         xrow_row, segs, joint_xrow, joint_xseg = [], [], [-1] * len(joints), [[-1, -1] for _ in joints]
         for j in loops:
@@ -205,11 +245,11 @@ class _Builder:
         exprs, gen = self._generated(xrow_row, segs)
         seg_ptr = np.cumsum([0] + [len(s) for s in segs])
         kernel = [self._joint(con) for con, _ in joints]
+        numbers = _numbers([part for part, _ in nodes], [con for con, _ in joints], self.number)
         sizes = [self.system.n, sum(c.size for c in self.system.constraints), int(yoff[-1]),
                  int(rows[-1])]
         layout = Layout(
             node_kind=_ints([RIGID if r else PARTICLE for r in rigid]), node_q=_ints([s for _, s in nodes]),
-            node_mass=np.array(masses), node_mg=np.array(mg).reshape(N, 3), node_J=np.array(inertia).reshape(N, 3, 3),
             node_v=_ints(v), node_k=_ints(k), node_yoff=_ints(yoff[:-1]),
             node_rows=_ints(rows[:-1]), node_parent=_ints(self.parent), node_joint=_ints(self.pjoint),
             node_end=_ints(end), node_transport=_ints([self._transport(i, j, rigid) for i, j in enumerate(self.pjoint)]),
@@ -217,17 +257,14 @@ class _Builder:
             joint_kinds=_ints([x[0] for x in kernel], (-1, 2)), joint_start=_ints([x[1] for x in kernel], (-1, 2)),
             joint_node=_ints([[len(self.nodes) if p is None else self.node_of[p.name] for p in con.parts] for con, _ in joints],
                              (-1, 2)),
-            joint_s=np.array([x[2] for x in kernel], dtype=float).reshape(-1, 2, 3),
-            joint_R=np.array([x[3] for x in kernel], dtype=float).reshape(-1, 2, 3, 3),
-            joint_length=np.array([x[4] for x in kernel], dtype=float),
-            joint_program=_ints([x[5] for x in kernel], (-1, MAX_ROWS, 3)),
+            joint_program=_ints([x[2] for x in kernel], (-1, MAX_ROWS, 3)),
             joint_k=_ints([con.size for con, _ in joints]), joint_row=_ints([row for _, row in joints]),
             joint_xrow=_ints(joint_xrow), joint_xseg=_ints(joint_xseg, (-1, 2)),
             x_coord=_ints(self.x_coord), xrow_row=_ints(xrow_row), xseg_ptr=_ints(seg_ptr),
             xseg_node=_ints([i for s in segs for i in s]),
             quat_row=_ints([self.quat[f"{part.name}.unit_quaternion"] if r else -1
                             for (part, _), r in zip(nodes, rigid)]),
-            sizes=_ints(sizes), **gen)
+            sizes=_ints(sizes), **numbers, **gen)
         return layout, exprs
 
     def _end_of(self, i, j):
@@ -249,22 +286,9 @@ class _Builder:
             return RIGID_COMPONENTS
         return GENERAL if p < 0 else RIGID_INVARIANT
 
-    def _bodies(self, rigid):
-        masses, mg, inertia = [], [], []
-        for (part, _), r in zip(self.nodes, rigid):
-            if r:
-                masses.append(self.number(part.mass)[0, 0])
-                inertia.append(self.number(part.inertia))
-                mg.append(self.number(part.mass * part.gravity).ravel())
-            else:
-                masses.append(self.number(part.M[0, 0])[0, 0])
-                inertia.append(np.zeros((3, 3)))
-                mg.append(self.number(part.Q[:3, 0]).ravel())  # m g: the first three entries of Q, constant
-        return masses, mg, inertia
-
     def _joint(self, con):
-        kinds, starts, offsets, rotations = [], [], [], []
-        for part, frame in zip(con.parts, con.frames):
+        kinds, starts = [], []
+        for part in con.parts:
             if part is None:
                 kinds.append(WORLD)
                 starts.append(0)
@@ -272,12 +296,9 @@ class _Builder:
                 i = self.node_of[part.name]
                 kinds.append(RIGID if isinstance(part, RigidBody) else PARTICLE)
                 starts.append(self.nodes[i][1])
-            offsets.append(np.zeros(3) if isinstance(part, Particle) else self.number(frame.position).ravel())
-            rotations.append(self.number(frame.rotation))
         program = np.zeros((MAX_ROWS, 3), dtype=np.int64)
         program[:con.size] = PROGRAMS[con.joint_kind]
-        length = self.number(con.length)[0, 0] if con.joint_kind == "distance" else 1.0
-        return kinds, starts, offsets, rotations, length, program
+        return kinds, starts, program
 
     def _generated(self, xrow_row, segs):
         """Expressions of the generated function, and where each output goes."""

@@ -54,7 +54,7 @@ def read_joints(builder):
         return [], []
     if not isinstance(node, list):
         builder.fail(("joints",), "expected a list of joints")
-    joints, elements, names = [], [], set()
+    joints, forces, names = [], [], set()
     for i, spec in enumerate(node):
         path = ("joints", i)
         if isinstance(spec, dict) and spec.get("type") in CONTACT_TYPES:
@@ -83,7 +83,9 @@ def read_joints(builder):
         joint = Joint(name, kind, parent, frame_a, child, frame_b, builder.q, builder.qd,
                       builder.param_symbols.values(), length, friction)
         joints.append(joint)
-        elements += read_joint_forces(builder, spec, path, joint)
+        forces.append((spec, path, joint))
+    builder.register_joints(joints)  # joint values in the expressions of actuation and springs
+    elements = [e for spec, path, joint in forces for e in read_joint_forces(builder, spec, path, joint)]
     return joints, elements
 
 

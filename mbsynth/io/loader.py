@@ -12,19 +12,22 @@ import numpy as np
 import sympy as sp
 
 from ..closure import close
+from ..connectors import Joint
 from ..constraint import Connector
+from ..joint_values import constraint_symbols, value_expressions
 from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
-from ..symbolic import T_SYMBOL
+from ..symbolic import T_SYMBOL, joint_values_in
 from ..system import System
 from .forces import read_forces
 from .joints import read_joints, read_world
+from .outputs import read_outputs
 from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import connect_robots, read_robot, read_robots
 from .source import Document, LineDict, LineList, read_document
 
 TOP_KEYS = {"name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
-            "closure", "initial", "initial_fixed", "forces"}
+            "closure", "initial", "initial_fixed", "forces", "outputs"}
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
@@ -155,10 +158,12 @@ class _Builder:
             for c, qs, qds in zip(part.coordinates, part.q, part.qd):
                 self.global_symbols[f"{part.name}.{c}"] = qs
                 self.global_symbols[f"{part.name}.{c}_dot"] = qds
+        self.constraint_symbols = dict(self.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
-        joints, joint_forces = read_joints(self)
         robot_joints, robot_forces = connect_robots(self)
+        self.register_joints(robot_joints, robot=True)
+        joints, joint_forces = read_joints(self)
         constraints += robot_joints + self.read_constraints() + joints
         self.check_names(constraints)
         initial = self.read_initial(parts)
@@ -167,7 +172,8 @@ class _Builder:
                               forces=[*robot_forces, *read_forces(self), *joint_forces])
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
                          source=self.doc.text, source_folder=str(self.doc.folder),
-                         robots=tuple(entry.robot for entry in self.robots.values()))
+                         robots=tuple(entry.robot for entry in self.robots.values()),
+                         outputs=read_outputs(self, constraints))
         self.check_parts(system)
         self.check_branches(system)
         closure = root.get("closure", "none")
@@ -267,9 +273,9 @@ class _Builder:
                 a, b = self.read_acceleration_row(spec[kind], kpath)
                 constraints.append(Connector.acceleration(name, a, b, *args, C=C))
                 continue
-            expr = self.expression(spec[kind], kpath, self.global_symbols)
+            expr = self.expression(spec[kind], kpath, self.constraint_symbols)
             self.differentiable(expr, kpath, None if kind == "holonomic" else ())
-            has_q = expr.free_symbols & set(self.q)
+            has_q = expr.free_symbols & set(self.q) or joint_values_in(expr)
             has_qd = expr.free_symbols & set(self.qd)
             if kind == "holonomic" and has_qd:
                 self.fail(kpath, f"constraint '{name}' uses velocities {sorted(map(str, has_qd))}; "
@@ -306,6 +312,23 @@ class _Builder:
         node = self.mapping(spec["C"], path + ("C",), set(coords))
         return [self.expression(node[c], path + ("C", c), self.global_symbols) if c in node
                 else sp.S.Zero for c in coords]
+
+    def register_joints(self, joints, robot=False):
+        """Put the joints' values (``<joint>.angle``, ``<joint>.rate``, …: joint_values.py)
+        among the names expressions may use; a joint and a part share one namespace. A
+        URDF may give a joint its child link's name: such a robot joint has no values in
+        expressions (its part's coordinates keep the name)."""
+        for joint in joints:
+            if not isinstance(joint, Joint) or (robot and joint.name in self.parts):
+                continue
+            if joint.name in self.parts:
+                self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
+                          f"joint '{joint.name}' has the name of part '{joint.name}': joints and parts share one "
+                          f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
+            for key, expr in value_expressions(joint).items():
+                self.global_symbols[f"{joint.name}.{key}"] = expr
+            for key, symbol in constraint_symbols(joint).items():
+                self.constraint_symbols[f"{joint.name}.{key}"] = symbol
 
     def coordinate_names(self):
         return (str(s) for s in self.q)

@@ -3,6 +3,7 @@ own coordinates, compiled once; its energies; its named frames."""
 
 from dataclasses import dataclass, field
 
+import numpy as np
 import sympy as sp
 
 from ..symbolic import T_SYMBOL, compile_function, placed_values
@@ -92,6 +93,11 @@ class Part:
     def angular_velocity(self):
         """The part's angular velocity in world axes (zero for point-like parts)."""
         return sp.zeros(3, 1)
+
+    def idle_directions(self, q):
+        """Orthonormal columns (over the part's coordinates, at its coordinates ``q``) of
+        the directions that move nothing: none for most parts."""
+        return np.zeros((len(self.coordinates), 0))
 
 
 def frame_velocity(position, q, qd):

@@ -1,5 +1,7 @@
 """A part given by its kinetic energy T, potential energy V and generalized forces."""
 
+import sympy as sp
+
 from ..symbolic import lagrange
 from .base import Part
 
@@ -16,6 +18,7 @@ class LagrangianSubsystem(Part):
     kind = "lagrangian"
 
     def __init__(self, name, coordinates, q, qd, T, V, forces, params, frames=(), geometry=()):
+        self.forces = tuple(sp.sympify(f) for f in forces)  # generalized forces beyond V (they may do work)
         M, Q = lagrange(T, V, list(forces), q, qd)
         super().__init__(name, coordinates, q, qd, M, Q, T, V, params, frames, geometry)
 

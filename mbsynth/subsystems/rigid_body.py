@@ -3,6 +3,7 @@ quaternion u (scalar-first) for its orientation."""
 
 import functools
 
+import numpy as np
 import sympy as sp
 
 from ..constraint import Connector
@@ -44,6 +45,12 @@ class RigidBody(Part):
 
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:]) * sp.Matrix(self.qd[3:])
+
+    def idle_directions(self, q):
+        """The quaternion's own direction: scaling u turns nothing (E(u) u = G(u) u = 0)."""
+        direction = np.zeros((7, 1))
+        direction[3:, 0] = q[3:7] / np.linalg.norm(q[3:7])
+        return direction
 
 
 

@@ -1,0 +1,80 @@
+"""``mbsynth check MODEL``: is the motion unique? (Result 3 at the initial state)"""
+
+import json
+
+from ..diagnose import diagnose
+from ..io import load
+
+
+def run(args):
+    system = load(args.model)
+    report = diagnose(system)
+    if args.json:
+        print(json.dumps(report.to_dict(), indent=2))
+    else:
+        print(format_check(report, args.model, args.coordinates))
+    return 0 if report.consistent and not report.suggested_constraints else 1
+
+
+def format_check(report, path, coordinates="joints"):
+    """The human-readable ``mbsynth check`` report; ``coordinates``: "joints" reports the
+    accelerations and free directions per joint where the model has joints, "maximal" per
+    coordinate of the parts."""
+    in_joints = coordinates == "joints" and bool(report.joints)
+    lines = [f"model {report.model} ({path})",
+             f"  coordinates n = {report.n}, constraints m = {report.m}",
+             f"  rank M = {report.rank_M}, rank A = {report.rank_A}, "
+             f"rank [M; A] = {report.rank_Mhat} of {report.n}"]
+    for closure in report.closures:
+        lines.append(f"  closure: auto appended {closure['constraint']}: {closure['equation']}")
+    if report.unique:
+        lines.append("  motion: unique (Result 3)")
+    else:
+        lines.append(f"  motion: NOT unique, {report.n - report.rank_Mhat} indeterminate direction(s)")
+        for balance, moved in zip(report.balances, report.free_joints or [{}] * len(report.balances)):
+            lines.append(f"    direction {_format_direction(balance['direction'])}")
+            if in_joints and moved:
+                lines.append(f"      moves joint(s) {', '.join(moved)}")
+            if balance["free"]:
+                lines.append("      free: no force acts along it, its acceleration is arbitrary")
+            else:
+                lines += _format_balance(balance)
+        if report.state_dependent:
+            lines.append("    note: these directions depend on the state; the balances hold only "
+                         "where the null space keeps this form")
+    condition = "infinite" if report.condition is None else f"{report.condition:.3g}"
+    margin = "" if report.verdict_margin is None else f", verdict margin {report.verdict_margin:.3g}"
+    lines.append(f"  condition number of the equilibrated [M; A] = {condition} "
+                 f"(rank tolerance {report.rank_tolerance:g} × σ_max{margin})")
+    lines += [f"  warning: {warning}" for warning in report.warnings]
+    if report.error:
+        lines.append(f"  no motion at the initial state: {report.error}")
+    elif in_joints:
+        accelerations = ", ".join(f"{joint}.{name} = {x:.6g}" for joint, j in report.joints.items()
+                                  for name, x in zip(j["accelerations"], j["acceleration"]))
+        lines.append(f"  joint accelerations at the initial state{'' if report.unique else ' (η = 0)'}: "
+                     f"{accelerations or 'none (no joint moves)'}")
+    else:
+        accelerations = ", ".join(f"{c} = {x:.6g}" for c, x in report.qdd.items())
+        lines.append(f"  accelerations at the initial state{'' if report.unique else ' (η = 0)'}: {accelerations}")
+    violated = [name for name, r in report.constraint_residuals.items()
+                if any(v is not None and abs(v) > 1e-9 for v in r.values())]
+    if violated:
+        lines.append(f"  warning: the initial state violates {', '.join(violated)}")
+    return "\n".join(lines)
+
+
+def _format_balance(balance):
+    """The lines of a balance that is needed: what it is physically where that is known,
+    and the equation, its numbers rounded (closure.readable)."""
+    effort = balance["effort"]
+    advice = "(add it as a constraint, or set 'closure: auto')"
+    if effort is None:
+        return [f"      balance needed: {balance['readable']}  {advice}"]
+    value = "0 at this state, not at every state" if effort["value"] == 0 else f"{effort['value']:.6g} ≠ 0"
+    return [f"      balance needed: {effort['name']}: {value}; it must vanish:",
+            f"        {balance['readable']}  {advice}"]
+
+
+def _format_direction(direction):
+    return "(" + ", ".join(f"{c}: {x:+.4g}" for c, x in direction.items()) + ")"

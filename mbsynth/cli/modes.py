@@ -1,0 +1,46 @@
+"""``mbsynth modes MODEL``: natural frequencies, damping ratios and mode shapes (mbsynth.modal)."""
+
+import html
+import json
+import tempfile
+from pathlib import Path
+
+from ..io import load
+from ..modal import format_modes, mode_motion, modes, to_dict
+from .parsers import check_flags
+
+
+def run(args):
+    check_flags(args, outputs=(("--html", (".html",)),))
+    system = load(args.model)
+    result = modes(system, equilibrium=args.equilibrium)
+    if args.html:
+        write_html(system, result, args.html)
+    if args.json:
+        print(json.dumps(to_dict(result), indent=2))
+    else:
+        print(format_modes(result))
+        if args.html:
+            print(f"wrote {args.html}")
+    return 0
+
+
+def write_html(system, result, path):
+    """One HTML page: each mode's animation (viewer.to_html, self-contained) in a frame,
+    chosen with a selector."""
+    from ..viewer import to_html  # meshcat: only for --html
+    pages = []
+    with tempfile.TemporaryDirectory() as folder:
+        for i, mode in enumerate(result.modes):
+            page = to_html(system, mode_motion(system, result, i), Path(folder) / f"mode_{i}.html")
+            label = f"mode {i + 1}: {mode.frequency:.4g} Hz, {mode.kind}"
+            pages.append((label, page.read_text(encoding="utf-8")))
+    options = "".join(f'<option value="{i}">{html.escape(label)}</option>' for i, (label, _) in enumerate(pages))
+    frames = "".join(f'<iframe id="m{i}" srcdoc="{html.escape(text)}" style="display:{"block" if i == 0 else "none"}">'
+                     "</iframe>" for i, (_, text) in enumerate(pages))
+    Path(path).write_text(
+        "<!DOCTYPE html><html><head><meta charset='utf-8'><title>modes of "
+        f"{html.escape(result.system_name)}</title><style>iframe{{width:100%;height:90vh;border:0}}</style></head>"
+        f"<body><label>mode <select id='mode' onchange=\"for (const f of document.querySelectorAll('iframe')) "
+        "f.style.display = f.id === 'm' + this.value ? 'block' : 'none'\">"
+        f"{options}</select></label>{frames}</body></html>", encoding="utf-8")

@@ -1,0 +1,198 @@
+"""The command line of every ``mbsynth`` command, in argparse only (no model code is
+imported here: ``parser()`` is cheap, and the CLI reference is generated from it)."""
+
+import argparse
+import importlib
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..errors import ModelError
+
+
+def parser():
+    """The full ``mbsynth`` ArgumentParser; ``args.command`` names the command module."""
+    top = ArgumentParser(prog="mbsynth", description="The ``mbsynth`` command.")
+    top.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    commands = top.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for add in (_check, _simulate, _sweep, _view, _validate, _modes, _robots):
+        command = add(commands)
+        command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    return top
+
+
+def _check(commands):
+    check = commands.add_parser(
+        "check", help="is the motion of a model unique? (Result 3 at the initial state)",
+        description="Report the ranks of M, A and [M; A] at the model's initial state, whether the "
+                    "motion is unique, each indeterminate direction and the force balance that "
+                    "would close it. Exit 0 when the motion is determined or only free directions "
+                    "remain, 1 when a balance is missing or no motion exists, 2 on a model error. "
+                    "A model with joints gets its accelerations as joint accelerations (a revolute "
+                    "joint's angle, a prismatic joint's displacement, ...: the time derivatives of "
+                    "the joints' rates) and the joints each indeterminate direction moves.")
+    check.add_argument("model", help="model file (YAML)")
+    check.add_argument("--json", action="store_true",
+                       help="print one JSON object (both 'qdd', per coordinate, and 'joints')")
+    check.add_argument("--coordinates", choices=("joints", "maximal"), default="joints",
+                       help="report accelerations per joint (default, where the model has joints) or per "
+                            "coordinate of the parts ('maximal')")
+    return check
+
+
+def _simulate(commands):
+    sim = commands.add_parser(
+        "simulate", help="integrate a model over time",
+        description="Integrate the model from its initial state (made consistent with the constraints) "
+                    "to --t-end, keeping the constraints by projection; print a summary.")
+    sim.add_argument("model", help="model file (YAML)")
+    sim.add_argument("--t-end", type=float, required=True, help="end time [s]")
+    sim.add_argument("--dt", type=float, help="output interval [s] (default t_end/500)")
+    sim.add_argument("--out", help="trajectory file (.npz or .csv), written as the run goes")
+    sim.add_argument("--plot", help="figure (.png, .pdf, .svg) of the joint coordinates (or the model's outputs, "
+                                    "or --plot-vars), kinetic and potential energy, and the constraint residuals")
+    sim.add_argument("--plot-vars", nargs="+", metavar="NAME",
+                     help="what the figure's top panel draws: coordinates (part.c), velocities (part.c_dot), "
+                          "outputs")
+    sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
+    sim.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
+    sim.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance (default 1e-10)")
+    sim.add_argument("--stabilization", choices=_Deferred("mbsynth.simulate", "STABILIZATIONS"), metavar="KIND",
+                     default="projection", help="drift control: %(choices)s (default projection)")
+    sim.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    return sim
+
+
+def _sweep(commands):
+    sw = commands.add_parser(
+        "sweep", help="a parameter study: many simulations on Dask",
+        description="Simulate the model for every combination of the --param ranges (or every row of "
+                    "--samples) on a Dask cluster (a local one by default, or --scheduler), one result "
+                    "row per run. Restarting with the same --out skips the runs already done.")
+    sw.add_argument("model", help="model file (YAML)")
+    grid = sw.add_mutually_exclusive_group(required=True)
+    grid.add_argument("--param", action="append", metavar="NAME=START:STOP:COUNT", help="a swept parameter")
+    grid.add_argument("--samples", metavar="FILE.csv", help="one run per row; columns are parameter names")
+    sw.add_argument("--t-end", type=float, required=True, help="end time of every run [s]")
+    sw.add_argument("--out", required=True, help="results table (.parquet or .csv)")
+    sw.add_argument("--metric", action="append", metavar="M",
+                    help="energy_drift, max_residual, or AGG:expression with AGG final|max|min|mean "
+                         "(repeatable; default energy_drift and max_residual)")
+    sw.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (default: a local cluster)")
+    sw.add_argument("--workers", type=int, help="local workers (default: one per core; not with --scheduler)")
+    sw.add_argument("--trajectories", metavar="DIR",
+                    help="also save each run's trajectory as DIR/<run_id>.npz (on this machine)")
+    sw.add_argument("--dt", type=float, help="output interval of each run [s]")
+    sw.add_argument("--json", action="store_true", help="print a summary as one JSON object")
+    return sw
+
+
+def _view(commands):
+    view = commands.add_parser(
+        "view", help="see the motion: a live meshcat viewer or a self-contained HTML animation",
+        description="Simulate the model (or read --trajectory) and draw its motion in meshcat: served live "
+                    "on this machine (the URL is printed; Ctrl-C stops it), or with --html written as one "
+                    "HTML file that plays offline in any browser.")
+    view.add_argument("model", help="model file (YAML)")
+    view.add_argument("--t-end", type=float, default=5.0, help="end time of the simulation [s] (default 5)")
+    view.add_argument("--trajectory", metavar="FILE.npz", help="draw this saved trajectory instead of simulating")
+    view.add_argument("--html", metavar="FILE.html", help="write the animation to this file instead of serving it")
+    view.add_argument("--axes", action="store_true", help="draw a triad at every body and frame")
+    view.add_argument("--joints", action="store_true", help="mark the frames of every joint")
+    return view
+
+
+def _validate(commands):
+    val = commands.add_parser(
+        "validate", help="compare with Pinocchio: a robot (fixed and floating base) or a model file",
+        description="Draw random states and joint torques (within the joint limits), compute mbsynth's "
+                    "joint accelerations and Pinocchio's (aba, or constraintDynamics where loops are closed) "
+                    "and print the largest differences; in joint space too: the joint values against "
+                    "Pinocchio's (q, v, v̇) and each joint's reaction (the wrench its parent exerts on its child, "
+                    "at the child link frame, in its axes) against data.f of rnea. "
+                    "ROBOT_OR_MODEL is a robot name (see 'mbsynth robots'), "
+                    "a URDF file, or a model file (.yaml) of rigid bodies and robots, compared with its "
+                    "equivalent Pinocchio model. Exit 0 when every relative error is within the tolerance, "
+                    "1 when one is not (or no comparison is possible), 2 on a model error.")
+    val.add_argument("target", metavar="ROBOT_OR_MODEL", help="robot name, URDF file or model file")
+    val.add_argument("--samples", type=int, default=20, help="random states per base (default 20)")
+    val.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    val.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error that passes (default 1e-9)")
+    val.add_argument("--json", action="store_true", help="print one JSON object")
+    return val
+
+
+def _modes(commands):
+    modes = commands.add_parser(
+        "modes", help="natural frequencies, damping ratios and mode shapes about a rest state",
+        description="Linearize the model about its initial state (or, with --equilibrium, the static "
+                    "equilibrium nearest it) in independent coordinates of its constraints' tangent "
+                    "space, massless parts closed by their balances, and print one row per mode: "
+                    "frequency, damping ratio, kind (vibration, overdamped, unstable, free) and the "
+                    "joints (or coordinates) that move most. Exit 0, 1 when the state is no rest state "
+                    "or the linearization is refused (the reason is printed), 2 on a model error.")
+    modes.add_argument("model", help="model file (YAML)")
+    modes.add_argument("--equilibrium", action="store_true",
+                       help="first find the static equilibrium near the initial state (Newton)")
+    modes.add_argument("--json", action="store_true", help="print one JSON object")
+    modes.add_argument("--html", metavar="FILE.html",
+                       help="write an HTML page animating each mode in meshcat (a selector per mode)")
+    return modes
+
+
+def _robots(commands):
+    robots = commands.add_parser(
+        "robots", help="the robots example-robot-data ships",
+        description="List the robots of the example-robot-data package by the names 'mbsynth validate' and "
+                    "type: robot accept, with their links, movable joints and whether Pinocchio loads them.")
+    robots.add_argument("--json", action="store_true", help="print one JSON object")
+    return robots
+
+
+def check_flags(args, positive=(), outputs=()):
+    """ModelError for a flag given a value the command cannot use: each of ``positive``
+    must be a positive finite number; each of ``outputs`` (flag, suffixes) must be a
+    path in an existing folder, ending in one of the suffixes."""
+    for flag in positive:
+        value = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ModelError(f"{flag} must be a positive number, got {value}")
+    for flag, suffixes in outputs:
+        value = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if value is None:
+            continue
+        if Path(value).suffix.lower() not in suffixes:
+            raise ModelError(f"{flag} {value}: the file must end in {', '.join(suffixes)}")
+        if not Path(value).parent.is_dir():
+            raise ModelError(f"{flag} {value}: the folder {Path(value).parent} does not exist")
+
+
+class UsageError(Exception):
+    """A command line argparse cannot read (``parser``: the command's, for its usage)."""
+
+    def __init__(self, parser, message):
+        super().__init__(message)
+        self.parser, self.message = parser, message
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse that raises UsageError instead of exiting, so that main can answer
+    with --json's {"error": ...} object."""
+
+    def error(self, message):
+        raise UsageError(self, message)
+
+
+class _Deferred(Sequence):
+    """A tuple of choices defined in a module that is imported only when argparse reads
+    them: to check a value given on the command line, or to print help (the argument
+    needs a metavar, which argparse would otherwise build from the choices at once)."""
+
+    def __init__(self, module, name):
+        self.module, self.name = module, name
+
+    def __getitem__(self, index):
+        return getattr(importlib.import_module(self.module), self.name)[index]
+
+    def __len__(self):
+        return len(getattr(importlib.import_module(self.module), self.name))

@@ -1,0 +1,84 @@
+"""``mbsynth simulate MODEL --t-end T``: integrate a model, print a summary."""
+
+import json
+import sys
+import time
+
+from ..errors import ModelError, SimulationError
+from ..io import load
+from ..simulate import simulate
+from ..trajectory import output_file
+from .parsers import check_flags
+from .report import ProgressBar, on_terminal
+
+INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # scipy solve_ivp's methods
+PLOT_FORMATS = (".png", ".pdf", ".svg")
+
+
+def run(args):
+    check_flags(args, positive=("--t-end", "--dt", "--rtol", "--atol"),
+                outputs=(("--out", (".npz", ".csv")), ("--plot", PLOT_FORMATS)))
+    if args.method not in INTEGRATORS:
+        raise ModelError(f"--method {args.method}: not one of {', '.join(INTEGRATORS)}")
+    system = load(args.model)
+    bar = ProgressBar(args.t_end) if on_terminal(args) else None
+    started = time.perf_counter()
+    try:
+        traj = simulate(system, args.t_end, dt=args.dt, method=args.method, rtol=args.rtol, atol=args.atol,
+                        stabilization=args.stabilization, out=args.out, progress=bar)
+        error = None
+    except SimulationError as err:
+        traj, error = err.trajectory, str(err)
+    finally:
+        if bar:
+            bar.close()
+    summary = {"model": system.name, "t_end": float(traj.t[-1]) if traj.t.size else 0.0, "outputs": int(traj.t.size),
+               "steps": traj.stats.get("steps"), "evaluations": traj.stats.get("evaluations"),
+               "wall_time_s": round(time.perf_counter() - started, 3), "max_residual": traj.max_residual,
+               "energy_drift": traj.energy_drift, "working_forces": system.working_forces(),
+               "initial_changes": traj.stats.get("initial_changes", {}),
+               "singular_positions": [{"t_from": float(e["t_from"]), "t_to": float(e["t_to"]), "rows": e["rows"]}
+                                      for e in traj.stats.get("singular_positions", [])],
+               "out": args.out and str(output_file(args.out, completed=error is None)), "plot": args.plot,
+               "status": "completed" if error is None else "failed"}
+    if error:
+        summary["error"] = error
+    if args.plot and traj.t.size:
+        from ..plot import plot_trajectory  # matplotlib: only for --plot
+
+        plot_trajectory(traj, args.plot, title=f"{system.name}", system=system, names=args.plot_vars)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(format_summary(summary))
+    if error and not args.json:
+        print(f"error: {error}", file=sys.stderr)
+    return 0 if error is None else 1
+
+
+def format_summary(s):
+    """The human-readable summary of a run."""
+    lines = [f"model {s['model']}: simulated to t = {s['t_end']:.6g} s ({s['status']})",
+             f"  {s['steps']} steps, {s['evaluations']} evaluations of (2.14), {s['wall_time_s']:.3g} s wall time",
+             f"  max constraint residual {s['max_residual']:.3g}, " + _energy_line(s)]
+    for name, (given, new) in s["initial_changes"].items():
+        lines.append(f"  initial {name}: {given:.9g} -> {new:.9g} (made consistent)")
+    if s["singular_positions"]:
+        times = ", ".join(f"{e['t_from']:.6g}" for e in s["singular_positions"][:8])
+        more = len(s["singular_positions"]) - 8
+        rows = sorted({r for e in s["singular_positions"] for r in e["rows"]})
+        lines.append(f"  passed near singular positions at t ≈ {times}{f' and {more} more' if more > 0 else ''} "
+                     f"(nearly dependent rows: {', '.join(rows[:6])}{', ...' if len(rows) > 6 else ''})")
+    for key in ("out", "plot"):
+        if s[key]:
+            lines.append(f"  wrote {s[key]}")
+    return "\n".join(lines)
+
+
+def _energy_line(s):
+    """The relative change of T + V: "drift" only where nothing in the model does work."""
+    working = s["working_forces"]
+    if not working:
+        return f"relative energy drift {s['energy_drift']:.3g}"
+    return (f"relative energy change {s['energy_drift']:.3g} (work of {', '.join(working[:4])}"
+            f"{', ...' if len(working) > 4 else ''})")

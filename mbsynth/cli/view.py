@@ -1,0 +1,31 @@
+"""``mbsynth view MODEL``: the motion in a live meshcat viewer or a self-contained HTML file."""
+
+import sys
+
+from .. import viewer
+from ..errors import SimulationError
+from ..io import load
+from ..simulate import simulate
+from ..trajectory import load_trajectory
+from .parsers import check_flags
+
+
+def run(args):
+    check_flags(args, positive=("--t-end",), outputs=(("--html", (".html",)),))
+    system = load(args.model)
+    status = 0
+    if args.trajectory:
+        traj = load_trajectory(args.trajectory)
+    else:
+        try:
+            traj = simulate(system, args.t_end, dt=1 / viewer.FPS)
+        except SimulationError as err:
+            traj, status = err.trajectory, 1
+            print(f"error: {err}; drawing the motion up to there", file=sys.stderr)
+    options = {"axes": args.axes, "joints": args.joints}
+    if args.html:
+        path = viewer.to_html(system, traj, args.html, **options)
+        print(f"wrote {path}: {system.name}, t = {traj.t[0]:.6g} to {traj.t[-1]:.6g} s")
+    else:
+        viewer.show(system, traj, **options)
+    return status

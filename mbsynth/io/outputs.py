@@ -1,0 +1,43 @@
+"""Reading a model's ``outputs:`` mapping (the kinds are described in mbsynth.outputs)."""
+
+from ..errors import ModelError
+from ..outputs import energy_output, expression_output, frame_output, reaction_output
+from .joints import frame_reference
+
+KINDS = ("reaction", "position", "velocity", "energy")
+
+
+def read_outputs(builder, constraints):
+    """The Outputs the file declares; ``constraints``: the model's connectors."""
+    node = builder.root.get("outputs")
+    if node is None:
+        return ()
+    node = builder.mapping(node, ("outputs",), set(node) if isinstance(node, dict) else set())
+    by_name = {c.name: c for c in constraints}
+    outputs = []
+    for name, spec in node.items():
+        path = ("outputs", name)
+        builder.identifier(name, path, "output name")
+        if not isinstance(spec, dict):
+            outputs.append(expression_output(name, builder.expression(spec, path, builder.global_symbols)))
+            continue
+        spec = builder.mapping(spec, path, set(KINDS))
+        if len(spec) != 1:
+            builder.fail(path, f"give exactly one of {', '.join(KINDS)} (or an expression)")
+        (kind, value), = spec.items()
+        kpath = path + (kind,)
+        try:
+            if kind == "reaction":
+                connector, _, which = str(value).rpartition(".")
+                if connector not in by_name:
+                    builder.fail(kpath, f"unknown joint or constraint '{connector}' in '{value}' (write "
+                                        f"'<joint>.force', '.torque' or '.multipliers'); known: {', '.join(by_name)}")
+                outputs.append(reaction_output(name, by_name[connector], which))
+            elif kind == "energy":
+                outputs.append(energy_output(name, value))
+            else:
+                part, frame = frame_reference(builder, value, kpath)
+                outputs.append(frame_output(name, kind, part, frame, builder.q, builder.qd))
+        except ModelError as err:
+            builder.fail(kpath, str(err))
+    return tuple(outputs)

@@ -1,0 +1,173 @@
+"""Engines are reused, freed and chosen once per run (mbsynth.fast.background, engine.py).
+
+A System from ``with_parameters`` shares its parent's compiled Template and gets its own
+numbers, which must equal those of a Layout built afresh for it, and motions equal to the
+literal (2.14) — also when a parameter makes a body massless. Engines die with their
+Systems. A run's path is fixed at its start, so runs are bit-identical.
+"""
+
+import gc
+import os
+import subprocess
+import sys
+import textwrap
+import weakref
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import mbsynth as mb
+from mbsynth.fast import background, engine_for
+from mbsynth.fast.layout import build as build_layout
+
+# Parameters in a mass, an inertia, frame offsets, a rod's length, gravity and a force.
+MODEL = """
+name: reuse
+parameters: {m: 1.3, L: 0.4, mb: 0.7, Ib: 0.03, R: 0.5, g: 9.81, k: 2.0}
+gravity: [0.3, -0.2, -g]
+world:
+  frames:
+    pivot: {position: [0.1, -0.2, 1.5], rpy: [0.3, -0.2, 0.5]}
+subsystems:
+  b0: {type: rigid_body, mass: m, inertia: [0.05, 0.04, 0.03], initial: {position: [0.1, -0.2, 1.1]},
+       frames: {top: {position: [0, 0, L]}, low: {position: [0.1, 0, -L], rpy: [0.2, 0, 0]}}}
+  b1: {type: rigid_body, mass: mb, inertia: [Ib, Ib, 2*Ib], initial: {position: [0.15, -0.25828, 0.48412], rpy: [0.2, 0, 0]},
+       frames: {a: {position: [0.05, 0.1, L/2]}}}
+  bob: {type: particle, mass: 0.5, initial: {position: [0.4, -0.2, 0.7]}}
+joints:
+  - {name: pivot, type: spherical, parent: world.pivot, child: b0.top}
+  - {name: weld, type: fixed, parent: b0.low, child: b1.a}
+  - {name: rod, type: distance, parent: b0, child: bob, length: R}
+forces:
+  - {name: push, type: force, at: bob, value: ["k*sin(t)", 0, 0]}
+"""
+
+
+def rel(x, y):
+    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
+
+
+@pytest.fixture
+def background_mode(monkeypatch):
+    monkeypatch.setenv("MBSYNTH_FAST", "background")
+
+
+@pytest.fixture(scope="module")
+def model():
+    return mb.loads(MODEL, "reuse")
+
+
+def a_state(system, seed=3):
+    """Random coordinates (unit quaternions) and velocities: (2.14) holds at any state."""
+    rng = np.random.default_rng(seed)
+    q, qd = rng.standard_normal(system.n), rng.standard_normal(system.n)
+    for body in ("b0", "b1"):
+        at = system.coordinates.index(f"{body}.qw")
+        q[at:at + 4] /= np.linalg.norm(q[at:at + 4])
+    return q, qd
+
+
+def assert_layout_as_built(system, engine):
+    """Every array of the Engine's Layout equals that of a Layout built afresh for ``system``."""
+    fresh, _ = build_layout(system)
+    for field, a, b in zip(fresh._fields, engine.L, fresh):
+        assert a.shape == b.shape and np.array_equal(a, b), field
+
+
+def test_with_parameters_shares_the_compiled_code(model, background_mode):
+    engine = engine_for(model, wait=True)
+    heavier = model.with_parameters(m=2.1, L=0.55, R=0.7, g=3.0, k=-1.0, Ib=0.05)
+    derived = engine_for(heavier)  # no wait: nothing to compile
+    assert derived is not None and derived is not engine
+    assert derived.template is engine.template and derived.module is engine.module
+    assert_layout_as_built(heavier, derived)
+    for system, fast in ((model, engine), (heavier, derived)):
+        q, qd = a_state(system)
+        answer = fast.motion(0.5, q, qd)
+        assert answer is not None and answer.method == "tree (Baraff)"
+        assert rel(answer.qdd, system.motion(0.5, q, qd, method="reference").qdd) < 1e-10
+    q, qd = a_state(heavier)
+    assert rel(engine.motion(0.5, q, qd).qdd, derived.motion(0.5, q, qd).qdd) > 1e-3  # the numbers differ
+
+
+def test_a_massless_body_from_a_parameter(model, background_mode):
+    """b1 welded to b0 loses its mass and inertia: M gets a zero block (a structural change
+    of (2.14)'s problem), which the reused Engine meets with the numbers a fresh build has."""
+    engine_for(model, wait=True)
+    massless = model.with_parameters(mb=0.0, Ib=0.0)
+    derived = engine_for(massless)
+    assert derived is not None
+    assert_layout_as_built(massless, derived)
+    q, qd = a_state(massless)
+    arrays = massless.evaluate(0.3, q, qd)
+    assert np.linalg.matrix_rank(arrays.M) < massless.n - 2  # b1's six unknowns carry no mass
+    ref = massless.motion(0.3, q, qd, method="reference")
+    assert ref.unique
+    fast = derived.motion(0.3, q, qd)
+    assert fast is not None and rel(fast.qdd, ref.qdd) < 1e-10
+    assert rel(massless.motion(0.3, q, qd).qdd, ref.qdd) < 1e-10
+
+
+def test_engines_die_with_their_systems(background_mode):
+    system = mb.loads(MODEL, "reuse")
+    child = system.with_parameters(m=3.0)
+    engines = [engine_for(system, wait=True), engine_for(child)]
+    assert None not in engines
+    refs = [weakref.ref(x) for x in (system, child, *engines, engines[0].template)]
+    del system, child, engines
+    gc.collect()
+    assert [r() for r in refs] == [None] * len(refs)
+
+
+def test_equal_systems_are_not_confused(model, background_mode):
+    """A copy with other numbers but no ``with_parameters`` lineage, and a second load of
+    the same text, get Engines of their own."""
+    engine = engine_for(model, wait=True)
+    again = mb.loads(MODEL, "reuse")
+    assert engine_for(again, wait=True) is not engine
+    other = replace(model, parameters={**model.parameters, "m": 5.0})
+    theirs = engine_for(other, wait=True)
+    assert theirs is not engine and theirs.template is not engine.template
+    assert theirs.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
+
+
+def test_a_run_keeps_the_path_it_started_with(monkeypatch, background_mode):
+    """Kernels not compiled and the Engine not ready: the run takes the KKT path, and keeps it
+    after the Engine becomes ready; with them compiled, the run waits for the Engine."""
+    system = mb.loads(MODEL, "reuse")
+    monkeypatch.setattr(background, "compiled", lambda: False)
+    monkeypatch.setattr(background, "_submit", lambda system, shared: shared.future)  # nothing builds
+    run = system.for_run()
+    assert engine_for(run) is None
+    monkeypatch.undo()
+    monkeypatch.setenv("MBSYNTH_FAST", "background")
+    engine = engine_for(system, wait=True)
+    assert engine is not None
+    assert engine_for(run) is None and engine_for(run, wait=True) is None
+    assert background.compiled()  # an Engine was warmed in this process
+    later = system.for_run()
+    assert engine_for(later) is engine
+
+
+RUN = textwrap.dedent("""
+    import sys
+    import numpy as np
+    import mbsynth as mb
+    system = mb.loads(sys.argv[1], "reuse").with_parameters(m=1.7)
+    traj = mb.simulate(system, 4.0, dt=0.05)
+    np.save(sys.argv[2], np.hstack([traj.q, traj.qd]))
+""")
+
+
+def test_runs_are_bit_identical(tmp_path):
+    """Two runs of one model in fresh processes, each compiling in the background: 4 s are
+    long enough that a run switching paths when its compilation finished (as they did) would
+    switch at a different step each time, and differ by about 1e-12."""
+    env = {**os.environ, "MBSYNTH_FAST": "background"}
+    results = []
+    for k in range(2):
+        out = tmp_path / f"run{k}.npy"
+        subprocess.run([sys.executable, "-c", RUN, MODEL, str(out)], env=env, check=True, timeout=900)
+        results.append(np.load(out))
+    assert results[0].shape == (81, 2 * 17) and np.array_equal(results[0], results[1])
