@@ -83,6 +83,11 @@ class Evaluator:
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
 
+    def fix_kernels(self, wait):
+        """Fix every group's path at its first evaluation (grouped.Batch.fix_kernels)."""
+        for batch in (self.rows, self.blocks, self.energy, self.forces):
+            batch.fix_kernels(wait)
+
     def constraints(self, t, q, qd, p, sparse=True):
         """ConstraintArrays at (t, q, q̇) with parameter values p; A sparse (CSR) or dense
         (an ndarray), or (sparse=None) dense when it has at most DENSE_ENTRIES entries."""

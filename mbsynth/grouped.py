@@ -30,6 +30,13 @@ class Batch:
         self.functions, self.slots = list(functions), slots
         self.indices = [np.asarray(i, dtype=int) for i in indices]
         self.layout = None
+        self.kernels = "when ready"  # or "wait" / "never": decided at the first call, for good (fix_kernels)
+
+    def fix_kernels(self, wait):
+        """From now on each group's path is decided at its first call and kept: its numba
+        kernel, built then if need be (``wait``), or numpy throughout (not ``wait``) — so
+        that results do not depend on when a background compilation finishes."""
+        self.kernels = "wait" if wait else "never"
 
     def __call__(self, t, q, qd, p):
         t = np.float64(t)
@@ -62,7 +69,7 @@ class Batch:
             group = None
             if isinstance(self.functions[members[0]], Compiled):
                 group = _Group([self.functions[i] for i in members], np.array([self.indices[i] for i in members]),
-                               np.array([dests[i] for i in members]).T)
+                               np.array([dests[i] for i in members]).T, self.kernels)
                 if not group.reproduces(t, q, qd, p, expected):
                     group = None
             if group is None:
@@ -92,7 +99,7 @@ class _Group:
     at least STACK_MIN of them, else one by one. ``dest`` (outputs × members): where each
     output of each member goes in the flat result."""
 
-    def __init__(self, functions, indices, dest):
+    def __init__(self, functions, indices, dest, kernels="when ready"):
         first = functions[0]
         self.raw, self.dest = first.raw, dest
         self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
@@ -102,7 +109,8 @@ class _Group:
                        if self.constant else first.values)
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
         self.kernel = None  # the numba kernel once it is ready and checked
-        self.refused = False  # the kernel disagreed with numpy: numpy for good
+        self.refused = kernels == "never"  # numpy for good (also when the kernel disagreed with numpy)
+        self.wait = kernels == "wait"
 
     def __call__(self, t, q, qd, p):
         values = self.values if self.constant else _stacked(self.values(t, q[self.columns], qd[self.columns], p),
@@ -117,8 +125,9 @@ class _Group:
 
     def _take_kernel(self, t, q, qd, p, values):
         """Use the kernel from now on if it is ready and agrees with numpy at this state."""
-        found = structures.kernel(self.raw)
+        found = structures.kernel(self.raw, wait=self.wait)
         if found is None:
+            self.refused = self.wait  # waited for, and none: numpy for good
             return
         result = np.empty(self.dest.shape)
         try:

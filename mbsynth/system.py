@@ -157,9 +157,11 @@ class System:
         """This System, for one run (``simulate``), with the path of ``motion`` fixed for the
         whole run: the compiled tree path when it is ready or its kernels are compiled (it
         is waited for), else the KKT path throughout — never a switch midway, so a run's
-        result does not depend on when a background compilation finishes."""
+        result does not depend on when a background compilation finishes. The grouped
+        evaluation of connectors and parts (evaluation.py) is fixed the same way."""
         run = replace(self)
         fast.fix_path(self, run)
+        evaluator(run).fix_kernels(wait=fast.compiled())  # the connectors' kernels likewise
         return run
 
     def part_problems(self):

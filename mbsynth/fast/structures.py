@@ -47,22 +47,23 @@ _tasks = queue.Queue()
 _worker = None
 
 
-def kernel(raw):
+def kernel(raw, wait=False):
     """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
-    symbolic._lambdify), or None: not ready yet, MBSYNTH_FAST=off, or not compilable."""
+    symbolic._lambdify), or None: not ready yet, MBSYNTH_FAST=off, or not compilable.
+    ``wait``: build it now if it is not ready (as MBSYNTH_FAST=wait does)."""
     found = _kernels.get(id(raw))
-    if found is not None and found[0] is raw:
+    if found is not None and found[0] is raw and (found[1] is not None or not wait):
         return found[1]
     setting = mode()
     if setting == "off" or not hasattr(raw, "structure"):
         return None
     with _lock:
-        if id(raw) in _kernels and _kernels[id(raw)][0] is raw:
-            return _kernels[id(raw)][1]
-        _kernels[id(raw)] = (raw, None)
-    if setting == "wait":
-        _build(raw)
-    else:
+        building = id(raw) in _kernels and _kernels[id(raw)][0] is raw
+        if not building:
+            _kernels[id(raw)] = (raw, None)
+    if setting == "wait" or wait:
+        _build(raw)  # a background build of the same structure may run too: either result serves
+    elif not building:
         _start(raw)
     return _kernels[id(raw)][1]
 
