@@ -6,10 +6,11 @@ import textwrap
 
 import numpy as np
 import pinocchio as pin
+import pytest
 
 import mbsynth as mb
 from mbsynth.cli.validate import format_validation
-from mbsynth.kinematics import matrix_quaternion, rpy_matrix
+from mbsynth.kinematics import matrix_quaternion, quaternion_matrix, rpy_matrix
 from mbsynth.twin import Twin
 from mbsynth.validate import (Validation, _consistent_sample, determined_projector, loop_reaction_error,
                               self_stresses, validate_system)
@@ -51,14 +52,16 @@ def _state(rng):
     return np.r_[p, u], np.r_[np.cross(omega, p - PIVOT), G_u.T @ omega / 2], R, omega
 
 
-def newton_euler(R, omega):
-    """The force the pivot exerts on the body, in the world (Euler's equations about the
-    fixed point P): I_P α + ω × I_P ω = r × m g, r = c − P, and m a_c = F + m g with
-    a_c = α × r + ω × (ω × r)."""
+def newton_euler(R, omega, axis=None):
+    """(force, torque) the pivot exerts on the body, at the pivot, in the world, by Euler's
+    equations about the fixed point P: I_P α + ω × I_P ω = τ + r × m g, r = c − P, and
+    m a_c = F + m g, a_c = α × r + ω × (ω × r). A ball joint has τ = 0; a hinge about
+    ``axis`` e (ω ∥ e) has eᵀτ = 0, so α = e eᵀ(r × m g − ω × I_P ω) / eᵀ I_P e."""
     r = -R @ TIP
     I_P = R @ np.diag(INERTIA) @ R.T + M * (r @ r * np.eye(3) - np.outer(r, r))
-    alpha = np.linalg.solve(I_P, np.cross(r, M * G) - np.cross(omega, I_P @ omega))
-    return M * (np.cross(alpha, r) + np.cross(omega, np.cross(omega, r))) - M * G
+    moment = np.cross(r, M * G) - np.cross(omega, I_P @ omega)
+    alpha = np.linalg.solve(I_P, moment) if axis is None else axis * (axis @ moment) / (axis @ I_P @ axis)
+    return M * (np.cross(alpha, r) + np.cross(omega, np.cross(omega, r))) - M * G, I_P @ alpha - moment
 
 
 def test_heavy_top_loop_reaction_is_newton_euler_and_lambda_c(tmp_path):
@@ -73,7 +76,9 @@ def test_heavy_top_loop_reaction_is_newton_euler_and_lambda_c(tmp_path):
     R_tip = rpy_matrix(*TIP_RPY)
     for _ in range(3):
         q, qd, R, omega = _state(rng)
-        expected = np.r_[(R @ R_tip).T @ newton_euler(R, omega), np.zeros(3)]
+        force, torque = newton_euler(R, omega)
+        assert np.abs(torque).max() < 1e-12 * np.abs(force).max()
+        expected = np.r_[(R @ R_tip).T @ force, np.zeros(3)]
         scale = np.abs(expected).max()
         motion = system.motion(0.0, q, qd)
         reaction = system.reactions(0.0, q, qd, motion)["pin"]
@@ -86,6 +91,74 @@ def test_heavy_top_loop_reaction_is_newton_euler_and_lambda_c(tmp_path):
         assert np.abs(theirs - expected).max() < 1e-8 * scale
         error, free = loop_reaction_error(system, twin, (q, qd), motion)
         assert error < 1e-8 and free == 0
+
+
+GANTRY = f"""\
+name: gantry_hinge
+gravity: {G.tolist()}
+world:
+  frames:
+    px: {{axis: [1, 0, 0]}}
+    pivot: {{position: {PIVOT.tolist()}, rpy: {list(PIVOT_RPY)}}}
+subsystems:
+  s1: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{px: {{axis: [1, 0, 0]}}, py: {{axis: [0, 1, 0]}}}}}}
+  s2: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{py: {{axis: [0, 1, 0]}}, pz: {{axis: [0, 0, 1]}}}}}}
+  s3: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{pz: {{axis: [0, 0, 1]}}, rx: {{axis: [1, 0, 0]}}}}}}
+  g1: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{rx: {{axis: [1, 0, 0]}}, ry: {{axis: [0, 1, 0]}}}}}}
+  g2: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{ry: {{axis: [0, 1, 0]}}, rz: {{axis: [0, 0, 1]}}}}}}
+  body:
+    type: rigid_body
+    mass: {M}
+    inertia: {INERTIA.tolist()}
+    frames: {{rz: {{axis: [0, 0, 1]}}, tip: {{position: {TIP.tolist()}, rpy: {list(TIP_RPY)}}}}}
+joints:
+  - {{name: slide_x, type: prismatic, parent: world.px, child: s1.px}}
+  - {{name: slide_y, type: prismatic, parent: s1.py, child: s2.py}}
+  - {{name: slide_z, type: prismatic, parent: s2.pz, child: s3.pz}}
+  - {{name: turn_x, type: revolute, parent: s3.rx, child: g1.rx}}
+  - {{name: turn_y, type: revolute, parent: g1.ry, child: g2.ry}}
+  - {{name: turn_z, type: revolute, parent: g2.rz, child: body.rz}}
+  - {{name: hinge, type: revolute, parent: world.pivot, child: body.tip}}
+"""
+
+
+def test_hinge_closing_a_loop_is_newton_euler_and_lambda_c(tmp_path):
+    """A revolute loop that is not redundant: the body is carried by a massless gantry
+    (three slides) and gimbal (three hinges), six joints that free all six motions and so
+    carry no load, and hinged to the world's pivot by a revolute joint that closes the
+    loop (two CONTACT_3D, one row of six redundant in Pinocchio, none in the wrench). At
+    states on the constraints: mbsynth's hinge reaction, and the wrench of lambda_c (its
+    two points added up), both equal Euler's equations about the hinge's axis — force,
+    and the moment across the axis that holds it — and the gantry's joints carry nothing."""
+    path = tmp_path / "gantry.yaml"
+    path.write_text(GANTRY)
+    system = mb.load(path)
+    twin = Twin(system)
+    assert [loop.name for loop in twin.loops] == ["hinge"] and twin.model.nv == 6
+    rng = np.random.default_rng(3)
+    axis, R_tip = rpy_matrix(*PIVOT_RPY)[:, 2], rpy_matrix(*TIP_RPY)
+    body = system.coordinates.index("body.x")
+    for _ in range(2):
+        q, v, qm, qdm = _consistent_sample(system, twin, rng)
+        u, u_dot = qm[body + 3:body + 7], qdm[body + 3:body + 7]
+        R = quaternion_matrix(u)
+        omega = 2 * np.column_stack([-u[1:], u[0] * np.eye(3) + pin.skew(u[1:])]) @ u_dot
+        assert np.linalg.norm(np.cross(omega, axis)) < 1e-9 * np.linalg.norm(omega)
+        force, torque = newton_euler(R, omega, axis)
+        R_child = R @ R_tip
+        expected = np.r_[R_child.T @ force, R_child.T @ torque]
+        scale = np.abs(expected).max()
+        assert abs(expected[5]) < 1e-12 * scale and np.abs(expected[3:5]).max() > 1e-3 * scale
+        motion = system.motion(0.0, qm, qdm)
+        reactions = system.reactions(0.0, qm, qdm, motion)
+        assert not reactions["hinge"].redundant
+        assert np.abs(np.r_[reactions["hinge"].force, reactions["hinge"].torque] - expected).max() < 1e-9 * scale
+        for joint in ("slide_x", "slide_y", "slide_z", "turn_x", "turn_y", "turn_z"):
+            assert np.abs(np.r_[reactions[joint].force, reactions[joint].torque]).max() < 1e-9 * scale
+        twin.accelerations(q, v, np.zeros(twin.model.nv))
+        theirs = twin.loop_wrench_maps()["hinge"] @ twin.data.lambda_c[twin.loops[0].rows]
+        assert np.abs(theirs - expected).max() < 1e-8 * scale
+        assert loop_reaction_error(system, twin, (qm, qdm), motion) == (pytest.approx(0, abs=1e-8), 0)
 
 
 def test_heavy_top_validates_with_its_loop_reaction(tmp_path):
