@@ -65,12 +65,13 @@ class Placed:
 class Loop:
     """A loop-closing mbsynth joint ``name``: Pinocchio's constraints ``first`` … ``first +
     len(offsets) − 1``, one per point at ``offsets`` along the joint frame's z (``LOOPS``),
-    and their rows ``rows`` of ``data.lambda_c``."""
+    their rows ``rows`` of ``data.lambda_c``, and whether its child is the world."""
 
     name: str
     first: int
     offsets: tuple
     rows: slice
+    to_world: bool
 
 
 class Coordinate:
@@ -243,7 +244,8 @@ class Twin:
             frames = [end.placement * self._se3(frame) for end, frame in zip(ends, joint.frames)]
             start = self.loops[-1].rows.stop if self.loops else 0
             size = len(offsets) * (6 if kind == pin.ContactType.CONTACT_6D else 3)
-            self.loops.append(Loop(joint.name, len(self.constraints), offsets, slice(start, start + size)))
+            self.loops.append(Loop(joint.name, len(self.constraints), offsets, slice(start, start + size),
+                                   joint.parts[1] is None))
             for offset in offsets:
                 at = [frame * pin.SE3(np.eye(3), np.array([0.0, 0.0, offset])) for frame in frames]
                 self.constraints.append(pin.RigidConstraintModel(kind, self.model, ends[0].joint, at[0],
@@ -302,12 +304,10 @@ class Twin:
         add up to one wrench at the origin; the split of their forces along z is Pinocchio's
         (any split gives the same wrench)."""
         maps = {}
-        for loop in self.loops:
+        for loop in (loop for loop in self.loops if not loop.to_world):
             blocks = []
             for k, offset in enumerate(loop.offsets):
                 model = self.constraints[loop.first + k]
-                if model.joint2_id == 0:
-                    break
                 oMc1 = self.data.oMi[model.joint1_id] * model.joint1_placement
                 oMc2 = self.data.oMi[model.joint2_id] * model.joint2_placement
                 c2Mc1 = oMc2.actInv(oMc1)
@@ -317,8 +317,7 @@ class Twin:
                     on_c2 = np.vstack([-c2Mc1.rotation, np.zeros((3, 3))])  # the force −λ at the point c2
                 at_origin = pin.SE3(np.eye(3), np.array([0.0, 0.0, offset])).toDualActionMatrix()
                 blocks.append(at_origin @ on_c2)
-            else:
-                maps[loop.name] = np.hstack(blocks)
+            maps[loop.name] = np.hstack(blocks)
         return maps
 
 
