@@ -1,7 +1,7 @@
 """`mbsynth validate` for every robot of example-robot-data that Pinocchio loads, fixed and
 floating base, and for the model files of robots and loops; writes a results table.
 
-    .venv/bin/python benchmarks/validate_all_robots.py [--samples 20] [--only ur5 panda ...]
+    .venv/bin/python benchmarks/validate_all_robots.py [--samples 20] [--only ur5 panda four_bar_3d ...] [--out FILE]
 
 Each robot is built once (floating; the fixed base adds a weld), so "build s" is the time
 to derive and compile every part, joint and torque symbolically (sympy), shared by both
@@ -20,18 +20,21 @@ import platform  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+from mbsynth.cli.validate import figure, loop_figure  # noqa: E402
 from mbsynth.errors import ModelError, SolveError  # noqa: E402
 from mbsynth.io import load  # noqa: E402
 from mbsynth.validate import TOLERANCE, Validation, robot_table, validate_robot, validate_system  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
-MODELS = [HERE.parent / "models" / "mechanisms" / "four_bar_3d.yaml", *sorted((HERE.parent / "models" / "robots").glob("*.yaml"))]
+MODELS = [*(HERE.parent / "models" / "mechanisms" / f"{name}.yaml" for name in ("four_bar_3d", "bennett")),
+          *sorted((HERE.parent / "models" / "robots").glob("*.yaml"))]
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=20)
-    parser.add_argument("--only", nargs="*", help="robot names (default: all that Pinocchio loads)")
+    parser.add_argument("--only", nargs="*", help="robot names or model file stems (default: every robot that "
+                                                  "Pinocchio loads and every model file)")
     parser.add_argument("--out", default=str(HERE / "validate_results.md"))
     args = parser.parse_args()
     robots = sorted((links, name) for name, _, links, _, loads in robot_table() if loads)  # small first
@@ -46,8 +49,8 @@ def main():
             rows.append((name, Validation(name, "-", 0, 0, args.samples, float("nan"), float("nan"), False,
                                           TOLERANCE, 0.0, 0.0, str(err))))
         write(args, rows, time.perf_counter() - started)
-    if not args.only:
-        for path in MODELS:
+    for path in MODELS:
+        if not args.only or path.stem in args.only:
             began = time.perf_counter()
             system = load(path)
             rows.append((str(path.relative_to(HERE.parent)),
@@ -60,10 +63,6 @@ def comparable(r):
     Pinocchio returns NaN and mbsynth finds no unique motion."""
     both_undefined = r.note.startswith("Pinocchio returns NaN") and "mbsynth:" in r.note
     return r.base != "-" and not (both_undefined and not r.passed)
-
-
-def _figure(x):
-    return "-" if x != x else f"{x:.1e}"  # NaN: not compared
 
 
 def brief(note, limit=300):
@@ -89,17 +88,23 @@ def write(args, rows, elapsed):
              "In joint space, at the same states: `joint_values` against Pinocchio's (q, v, v̇) joint by joint "
              "(\"joints\", relative to 1 + max |v|, |v̇|), and each joint's `reactions` wrench against `data.f` of "
              "`rnea` (\"reactions\", relative to its largest entry; \"-\" for models with loops or force elements "
-             "other than the joint torques). Both count towards the result.", "",
-             "| robot or model | bodies | base | nv | max rel error | max abs error | joints | reactions | build s "
-             "| motion ms | result |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "other than the joint torques), and each loop-closing joint's wrench against the one of "
+             "`constraintDynamics`' `lambda_c` (\"loops\", relative to its largest entry; \"-\" for models without "
+             "loops). A redundant loop (a planar four-bar in space) carries a wrench that is not unique: any "
+             "self-stress of the loop may be added, and the two solvers pick different ones, so only the components "
+             "no self-stress changes are compared; \"(k free)\" says how many of a joint's six are left out. "
+             "All count towards the result.", "",
+             "| robot or model | bodies | base | nv | max rel error | max abs error | joints | reactions | loops "
+             "| build s | motion ms | result |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows:
         if not comparable(r):
             result = f"{'refused' if r.base == '-' else 'not comparable'}: {brief(r.note)}"
         else:
             result = "passed" if r.passed else f"**failed**: {brief(r.note)}" if r.note else "**failed**"
         lines.append(f"| {name} | {r.links} | {r.base} | {r.nv} | {r.max_rel_error:.1e} | {r.max_abs_error:.1e} "
-                     f"| {_figure(r.joint_error)} | {_figure(r.reaction_error)} | {r.build_s:.1f} | {r.motion_ms:.2f} "
+                     f"| {figure(r.joint_error)} | {figure(r.reaction_error)} | {loop_figure(r)} | {r.build_s:.1f} "
+                     f"| {r.motion_ms:.2f} "
                      f"| {result} |")
     Path(args.out).write_text("\n".join(lines) + "\n")
     name, r = rows[-1]

@@ -20,6 +20,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from .equations import term_scales
+from .evaluation import DENSE_ENTRIES
 from .errors import SolveError
 
 TOLERANCE = 1e-12  # largest residual accepted after projection, relative to the row's terms
@@ -44,13 +45,17 @@ def _correction(J, r):
     quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
     moved, not turned, as one 1 m long is. With G = J D (D = diag(1/c)) and independent
     rows, Δ = D Gᵀ (G Gᵀ)⁻¹ r, G Gᵀ factored sparse (a tree of joints gives a
-    tree-structured G Gᵀ: linear time). Rows that are dependent, or dependent to within
+    tree-structured G Gᵀ: linear time), or dense when J is small (DENSE_ENTRIES). Rows that are dependent, or dependent to within
     ``PROJECTION_RCOND`` (a loop whose dependency moves with the configuration, off its
     manifold: the step along the near-dependent direction would be r's drift over σ), go to
     dense least squares that drops those directions; so does a sparse step that does not
     meet J Δ = r to SPARSE_ACCEPT."""
     if J.shape[0] == 0:
         return np.zeros(J.shape[1])
+    if not scipy.sparse.issparse(J):
+        return _dense_correction(J, r)
+    if J.shape[0] * J.shape[1] <= DENSE_ENTRIES:
+        return _dense_correction(J.toarray(), r)
     columns = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
     D = scipy.sparse.diags(1.0 / np.where(columns > 0, columns, 1.0))
     G = (J @ D).tocsr()
@@ -58,13 +63,34 @@ def _correction(J, r):
     try:
         with np.errstate(all="ignore"):
             z = G.T @ scipy.sparse.linalg.splu((G @ G.T).tocsc()).solve(r)
-        well_posed = np.linalg.norm(z) * PROJECTION_RCOND * scipy.sparse.linalg.norm(G) <= size
-        if np.all(np.isfinite(z)) and well_posed and np.linalg.norm(G @ z - r) <= SPARSE_ACCEPT * size:
+        if _accepted(z, G, scipy.sparse.linalg.norm(G), r, size):
             return D @ z
     except RuntimeError:  # splu: the matrix is exactly singular
         pass
-    G = G.toarray()
-    return D @ np.linalg.lstsq(G, r, rcond=PROJECTION_RCOND)[0]
+    return D @ np.linalg.lstsq(G.toarray(), r, rcond=PROJECTION_RCOND)[0]
+
+
+def _dense_correction(J, r):
+    """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
+    columns = np.linalg.norm(J, axis=0)
+    d = 1.0 / np.where(columns > 0, columns, 1.0)
+    G = J * d
+    size = np.linalg.norm(r) + 1e-300
+    try:
+        with np.errstate(all="ignore"):
+            z = G.T @ np.linalg.solve(G @ G.T, r)
+        if _accepted(z, G, np.linalg.norm(G), r, size):
+            return d * z
+    except np.linalg.LinAlgError:  # exactly singular
+        pass
+    return d * np.linalg.lstsq(G, r, rcond=PROJECTION_RCOND)[0]
+
+
+def _accepted(z, G, norm_G, r, size):
+    """The step z from the normal equations: finite, not amplified beyond PROJECTION_RCOND
+    (nearly dependent rows), and meeting G z = r to SPARSE_ACCEPT."""
+    well_posed = np.linalg.norm(z) * PROJECTION_RCOND * norm_G <= size
+    return bool(np.all(np.isfinite(z)) and well_posed and np.linalg.norm(G @ z - r) <= SPARSE_ACCEPT * size)
 
 
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
@@ -73,17 +99,18 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
     qd = np.zeros_like(q)
     free = _free_columns(q.size, fixed)
     for _ in range(MAX_ITERATIONS):
-        phi, _ = system.constraint_residuals(t, q, qd)
+        arrays = system.constraint_arrays(t, q, qd, sparse=None)
+        phi = arrays.phi
         rows = np.isfinite(phi)
-        A = system.constraint_rows(t, q, qd)[0][rows]
+        A = arrays.A[rows]
         unmet = np.abs(phi[rows]) > tolerance * term_scales(A, q)
         if not unmet.any():
             return q
         q[free] -= _correction(A[:, free], phi[rows])
         if not np.all(np.isfinite(q)):
             break
-    phi, _ = system.constraint_residuals(t, q, qd)
-    A = system.constraint_rows(t, q, qd)[0]
+    arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    phi, A = arrays.phi, arrays.A
     raise SolveError(_unmet(system, phi, "positions", free),
                      constraints=[n for n, r, s in zip(system.constraint_names, phi, term_scales(A, q))
                                   if abs(r) > tolerance * s])
@@ -93,9 +120,10 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
     """q̇ on the velocity-level rows (φ̇ = 0, ψ = 0), changing only free velocities."""
     qd = np.array(qd, dtype=float)
     free = _free_columns(qd.size, fixed)
-    _, psi = system.constraint_residuals(t, q, qd)
+    arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    psi = arrays.psi
     rows = np.isfinite(psi)
-    A = system.constraint_rows(t, q, qd)[0][rows]
+    A = arrays.A[rows]
     if not (np.abs(psi[rows]) > tolerance * term_scales(A, qd)).any():
         return qd
     qd[free] -= _correction(A[:, free], psi[rows])  # ψ is affine in q̇ with slope A
@@ -110,8 +138,8 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
 def relative_drift(system, t, q, qd):
     """The largest residual of φ or ψ relative to its row's terms (module docstring): how far
     the state lies off the manifold, alike at every scale."""
-    phi, psi = system.constraint_residuals(t, q, qd)
-    A = system.constraint_rows(t, q, qd)[0]
+    arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    phi, psi, A = arrays.phi, arrays.psi, arrays.A
     worst = 0.0
     for residual, x in ((phi, q), (psi, qd)):
         rows = np.isfinite(residual)

@@ -236,17 +236,24 @@ def compile_function(args, exprs, constants=(), dtype=float):
     frozen = _frozen(args)
     raw, numbers = _compiled(frozen, tuple(flat), tuple(c[0] for c in constants))
     fixed = np.array([_as_double(x) for x in numbers], dtype=float)
-    values = _values(frozen, tuple(sp.sympify(c[1]) for c in constants))
-    sizes = [int(np.prod(s)) for s in shapes]
-    splits = np.cumsum(sizes)[:-1]
+    return Compiled(raw, _values(frozen, tuple(sp.sympify(c[1]) for c in constants)), fixed, shapes, dtype)
 
-    def evaluate(*given):
+
+class Compiled:
+    """The function ``compile_function`` returns: ``raw`` (shared by every function of the
+    same structure, ``canonical``) applied to the arguments, the values of the constants
+    (``values``: a function of the arguments) and this instance's numbers ``fixed``.
+    grouped.py calls ``raw`` once for many instances, on stacked arguments."""
+
+    def __init__(self, raw, values, fixed, shapes, dtype=float):
+        self.raw, self.values, self.fixed, self.shapes, self.dtype = raw, values, fixed, shapes, dtype
+        self.splits = np.cumsum([int(np.prod(s)) for s in shapes])[:-1]
+
+    def __call__(self, *given):
         given = [np.float64(v) if isinstance(v, (int, float)) else v for v in given]
         with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
-            out = np.asarray(raw(*given, values(*given), fixed), dtype=dtype)
-        return tuple(part.reshape(shape) for part, shape in zip(np.split(out, splits), shapes))
-
-    return evaluate
+            out = np.asarray(self.raw(*given, self.values(*given), self.fixed), dtype=self.dtype)
+        return tuple(part.reshape(shape) for part, shape in zip(np.split(out, self.splits), self.shapes))
 
 
 @functools.lru_cache(maxsize=4096)
@@ -264,7 +271,9 @@ def _values(args, values):
     """A function of ``args`` giving the array of ``values``: constant when they are numbers."""
     if all(v.is_Number for v in values):
         fixed = np.array([_as_double(v) for v in values], dtype=float)
-        return lambda *_: fixed
+        constant = lambda *_: fixed  # noqa: E731
+        constant.fixed = fixed  # grouped.py stacks these instead of calling
+        return constant
     raw = sp.lambdify(args, [_beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"], dummify=True)
     return lambda *given: np.asarray(raw(*given), dtype=float)
 
@@ -274,8 +283,10 @@ def _lambdify(args, forms):
     """The numpy function of (args, numbers) -> [forms], made once per structure
     (``canonical``): joints alike, and models loaded again (a sweep's workers, a file
     checked then simulated) reuse it."""
-    return sp.lambdify(args, [_beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True,
-                       dummify=True)
+    forms = [_beyond_double_as_inf(x) for x in forms]
+    raw = sp.lambdify(args, forms, modules=[_FLOAT64, "numpy"], cse=True, dummify=True)
+    raw.structure = (args, tuple(forms))  # for fast/structures.py, which compiles it with numba
+    return raw
 
 
 def _frozen(args):

@@ -8,12 +8,12 @@ assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.sparse
 import sympy as sp
 
 from . import equations, fast, friction, reactions, solvers
 from .connectors import Joint
 from .errors import ModelError, SolveError
+from .evaluation import evaluator
 from .joint_values import JointKinematics, value_expressions
 from .subsystems import Frame
 from .symbolic import T_SYMBOL
@@ -157,9 +157,11 @@ class System:
         """This System, for one run (``simulate``), with the path of ``motion`` fixed for the
         whole run: the compiled tree path when it is ready or its kernels are compiled (it
         is waited for), else the KKT path throughout — never a switch midway, so a run's
-        result does not depend on when a background compilation finishes."""
+        result does not depend on when a background compilation finishes. The grouped
+        evaluation of connectors and parts (evaluation.py) is fixed the same way."""
         run = replace(self)
         fast.fix_path(self, run)
+        evaluator(run).fix_kernels(wait=fast.compiled())  # the connectors' kernels likewise
         return run
 
     def part_problems(self):
@@ -213,42 +215,21 @@ class System:
         """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
         q, qd = self._state(q, qd)
         p = self.parameter_values
-        n, m = self.n, sum(c.size for c in self.constraints)
-        M, Q = np.zeros((n, n)), np.zeros(n)
-        start = 0
-        for part in self.subsystems:
-            stop = start + len(part.coordinates)
-            M[start:stop, start:stop], Q[start:stop] = part.evaluate(t, q[start:stop], qd[start:stop], p)
-            start = stop
-        for element in self.forces:
-            Q[element.indices] += element.evaluate(t, q, qd, p)
-        A, b, C = np.zeros((m, n)), np.zeros(m), np.zeros(n)
-        row = 0
-        for con in self.constraints:
-            a, b[row:row + con.size], c = con.evaluate(t, q, qd, p)
-            A[row:row + con.size, con.indices] = a
-            C[con.indices] += c
-            row += con.size
-        return Assembly(M, Q, A, b, C)
+        batches = evaluator(self)
+        return Assembly(*batches.parts(t, q, qd, p), *batches.dense_rows(t, q, qd, p))
 
     def constraint_rows(self, t, q, qd):
         """A (m × n, scipy.sparse CSR) and b at (t, q, q̇) — the rows alone, without M:
         what projection.py needs, in memory proportional to the rows' entries."""
+        arrays = self.constraint_arrays(t, q, qd)
+        return arrays.A, arrays.b
+
+    def constraint_arrays(self, t, q, qd, sparse=True):
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
+        dense where that is faster (sparse=None: few rows and coordinates)."""
         q, qd = self._state(q, qd)
-        p = self.parameter_values
-        rows, cols, values, b = [], [], [], []
-        row = 0
-        for con in self.constraints:
-            a, b_con, _ = con.evaluate(t, q, qd, p)
-            r, c = np.meshgrid(np.arange(row, row + con.size), con.indices, indexing="ij")
-            rows.append(r.ravel())
-            cols.append(c.ravel())
-            values.append(np.asarray(a, dtype=float).ravel())
-            b.append(b_con)
-            row += con.size
-        join = lambda parts, kind: np.concatenate([np.zeros(0, kind)] + parts)  # noqa: E731
-        A = scipy.sparse.csr_matrix((join(values, float), (join(rows, int), join(cols, int))), shape=(row, self.n))
-        return A, join(b, float)
+        return evaluator(self).constraints(t, q, qd, self.parameter_values, sparse)
 
     def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
@@ -318,23 +299,12 @@ class System:
     def energy(self, t, q, qd):
         """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
         q, qd = self._state(q, qd)
-        p = self.parameter_values
-        kinetic = potential = 0.0
-        start = 0
-        for part in self.subsystems:
-            stop = start + len(part.coordinates)
-            T, V = part.energy(t, q[start:stop], qd[start:stop], p)
-            kinetic, potential, start = kinetic + T, potential + V, stop
-        potential += sum(element.potential(t, q, qd, p) for element in self.forces)
-        return kinetic, potential
+        return evaluator(self).energies(t, q, qd, self.parameter_values)
 
     def constraint_residuals(self, t, q, qd):
         """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
         q, qd = self._state(q, qd)
-        p = self.parameter_values
-        pairs = [con.residuals(t, q, qd, p) for con in self.constraints]
-        return (np.concatenate([np.zeros(0)] + [r[0] for r in pairs]),
-                np.concatenate([np.zeros(0)] + [r[1] for r in pairs]))
+        return evaluator(self).residuals(t, q, qd, self.parameter_values)
 
     def symbolic(self):
         """(M, Q, A, b, C) as sympy matrices in the model's symbols."""

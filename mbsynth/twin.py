@@ -9,7 +9,7 @@ joined by constraints. The twin of a System is built as follows:
   parser, not ours), with a free-flyer root when floating, grafted at its base;
 - every other rigid body hangs from a body already placed by the joint between them:
   fixed (welded to that body), revolute (``JointModelRZ``) or prismatic (``JointModelPZ``)
-  in the joint's frame; a body no joint reaches is a free-flyer;
+  in the joint's frame; a body no such joint reaches is a free-flyer;
 - the remaining joints close loops: fixed → ``CONTACT_6D``, spherical → ``CONTACT_3D``,
   revolute → two ``CONTACT_3D`` at two points of its axis (the frame origin and one
   metre along z), which hold the same five freedoms (one of the six rows is redundant,
@@ -61,6 +61,19 @@ class Placed:
     placement: pin.SE3
 
 
+@dataclass(frozen=True)
+class Loop:
+    """A loop-closing mbsynth joint ``name``: Pinocchio's constraints ``first`` … ``first +
+    len(offsets) − 1``, one per point at ``offsets`` along the joint frame's z (``LOOPS``),
+    their rows ``rows`` of ``data.lambda_c``, and whether its child is the world."""
+
+    name: str
+    first: int
+    offsets: tuple
+    rows: slice
+    to_world: bool
+
+
 class Coordinate:
     """One Pinocchio joint read off mbsynth's state: ``positions`` (its nq entries of q)
     and ``rates`` (its nv entries of v) as expressions of the model's symbols, compiled
@@ -97,7 +110,7 @@ class Twin:
     def __init__(self, system):
         self.system = system
         self.model = pin.Model()
-        self.bodies, self.coordinates, self.constraints = {}, [], []
+        self.bodies, self.coordinates, self.constraints, self.loops = {}, [], [], []
         parts = {p.name: p for p in system.subsystems}
         odd = [p.name for p in system.subsystems if not isinstance(p, RigidBody)]
         if odd:
@@ -183,13 +196,14 @@ class Twin:
                                            self.system))
 
     def _add_tree(self, joints, parts, used):
-        """Hang every body not yet placed from a placed one, breadth first; a body no
-        joint reaches becomes a free-flyer."""
+        """Hang every body not yet placed from a placed one by a revolute, prismatic or
+        fixed joint, breadth first; a body no such joint reaches becomes a free-flyer (its
+        spherical joints then close loops)."""
         self.bodies.setdefault(None, Placed(0, pin.SE3.Identity()))  # the world
         while len(self.bodies) <= len(parts):
-            edges = [(j, side) for j in joints if j.name not in used for side in (0, 1)
+            edges = [(j, side) for j in joints if j.name not in used and j.joint_kind in (*TREE_JOINTS, "fixed")
+                     for side in (0, 1)
                      if _name(j.parts[side]) in self.bodies and _name(j.parts[1 - side]) not in self.bodies]
-            edges.sort(key=lambda edge: edge[0].joint_kind not in (*TREE_JOINTS, "fixed"))  # tree joints first
             edge = edges[0] if edges else None
             if edge is None:
                 part = next(p for name, p in parts.items() if name not in self.bodies)
@@ -213,9 +227,6 @@ class Twin:
             self.bodies[part.name] = Placed(placed.joint, at * body)
             self.model.appendBodyToJoint(placed.joint, self._inertia(part, at * body), pin.SE3.Identity())
             return
-        if joint.joint_kind not in TREE_JOINTS:
-            raise no_twin(self.system, f"joint '{joint.name}' ({joint.joint_kind}) is not revolute, prismatic or fixed "
-                                       "and does not close a loop")
         jid = self.model.addJoint(placed.joint, TREE_JOINTS[joint.joint_kind](), at, joint.name)
         self.model.appendBodyToJoint(jid, self._inertia(part, body), pin.SE3.Identity())
         self.bodies[part.name] = Placed(jid, body)
@@ -225,11 +236,16 @@ class Twin:
     def _add_loops(self, joints):
         for joint in joints:
             if joint.joint_kind not in LOOPS:
-                raise no_twin(self.system, f"joint '{joint.name}' ({joint.joint_kind}) closes a loop; Pinocchio's "
-                                           f"rigid constraints stand for {', '.join(LOOPS)} joints only")
+                raise no_twin(self.system, f"joint '{joint.name}' ({joint.joint_kind}) is neither a tree joint "
+                                           f"({', '.join(TREE_JOINTS)}, fixed) nor one that Pinocchio's rigid "
+                                           f"constraints close ({', '.join(LOOPS)})")
             kind, offsets = LOOPS[joint.joint_kind]
             ends = [self.bodies[_name(part)] for part in joint.parts]
             frames = [end.placement * self._se3(frame) for end, frame in zip(ends, joint.frames)]
+            start = self.loops[-1].rows.stop if self.loops else 0
+            size = len(offsets) * (6 if kind == pin.ContactType.CONTACT_6D else 3)
+            self.loops.append(Loop(joint.name, len(self.constraints), offsets, slice(start, start + size),
+                                   joint.parts[1] is None))
             for offset in offsets:
                 at = [frame * pin.SE3(np.eye(3), np.array([0.0, 0.0, offset])) for frame in frames]
                 self.constraints.append(pin.RigidConstraintModel(kind, self.model, ends[0].joint, at[0],
@@ -273,6 +289,36 @@ class Twin:
         settings = pin.ProximalSettings(*PROXIMAL)
         return pin.constraintDynamics(self.model, self.data, q, v, tau, self.constraints, self.constraint_data,
                                       settings)
+
+    def loop_wrench_maps(self):
+        """{loop joint name: W}, W (6 × the loop's rows of ``data.lambda_c``): the wrench
+        [force; torque] the joint's parent exerts on its child, at the child frame's
+        origin, in its axes, is W λ — at the configuration of the last
+        ``accelerations`` (``constraintDynamics``). A loop whose child is the world has none.
+
+        Pinocchio's convention (constrained-dynamics.hxx; M v̇ = τ − b + Jᵀλ): a
+        constraint's λ, in the LOCAL axes of its frame c1 on joint1 (the mbsynth joint's
+        parent), acts on joint1 at c1 and, reversed, on joint2 (the child) at c2: a
+        CONTACT_3D's force −λ at the point c2, a CONTACT_6D's wrench −λ carried from c1
+        to c2. A revolute joint's two points, the frame origin and one metre along its z,
+        add up to one wrench at the origin; the split of their forces along z is Pinocchio's
+        (any split gives the same wrench)."""
+        maps = {}
+        for loop in (loop for loop in self.loops if not loop.to_world):
+            blocks = []
+            for k, offset in enumerate(loop.offsets):
+                model = self.constraints[loop.first + k]
+                oMc1 = self.data.oMi[model.joint1_id] * model.joint1_placement
+                oMc2 = self.data.oMi[model.joint2_id] * model.joint2_placement
+                c2Mc1 = oMc2.actInv(oMc1)
+                if model.type == pin.ContactType.CONTACT_6D:
+                    on_c2 = -c2Mc1.toDualActionMatrix()  # the wrench −λ moved from c1 to c2
+                else:
+                    on_c2 = np.vstack([-c2Mc1.rotation, np.zeros((3, 3))])  # the force −λ at the point c2
+                at_origin = pin.SE3(np.eye(3), np.array([0.0, 0.0, offset])).toDualActionMatrix()
+                blocks.append(at_origin @ on_c2)
+            maps[loop.name] = np.hstack(blocks)
+        return maps
 
 
 def _joint_coordinate(name, joint_id, model, joint, sign, system, kind, limits=None, torque=None):

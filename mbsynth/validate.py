@@ -15,8 +15,18 @@ Joint space, at the same samples: ``System.joint_values`` against Pinocchio's (q
 joint by joint (angles modulo 2π, a free-flyer's quaternion up to sign; relative to
 1 + the largest |v|, |v̇|), and, on a tree without other force elements, each joint's
 ``System.reactions`` wrench against ``data.f`` of ``rnea(q, v, v̇)`` (relative to the
-largest entry of data.f). Loop joints are not compared: where their rows are redundant
-(as Pinocchio's closures of a revolute joint are) the split of the reaction is not unique.
+largest entry of data.f).
+
+Loop-closing joints, at the same samples, against ``data.lambda_c`` of
+``constraintDynamics`` (each loop's wrench at its child frame: ``Twin.loop_wrench_maps``).
+Where a loop is over-constrained (a planar four-bar in space) the wrenches its joints
+carry are not unique: any self-stress — λ with Jᵀλ = 0, J Pinocchio's constraint Jacobian
+— may be added, and mbsynth (the least-norm λ in its rows) and Pinocchio (the proximal
+solution in its contact forces) legitimately choose differently. Only what is determined
+is compared: each joint's wrench projected onto the orthogonal complement of the wrenches
+the self-stresses give it (``determined_projector``), relative to the largest projected
+entry of Pinocchio's wrenches. ``loop_free`` counts the undetermined components (0: the
+whole wrench is compared).
 """
 
 import contextlib
@@ -35,6 +45,7 @@ from .robots import describe, fix_base, from_robot, robot_files
 from .twin import Twin
 
 TOLERANCE = 1e-9  # largest relative error that passes
+NULL_RTOL = 1e-9  # self-stresses: singular values of J below NULL_RTOL · σ_max; wrench directions likewise
 MAX_TRIES = 20  # samples drawn to find one a loop can close at
 
 
@@ -45,7 +56,8 @@ class Validation:
     velocity count, before loops close); the largest errors over ``samples`` states; ``passed`` (below ``tolerance``);
     ``build_s`` (seconds to build the System), ``motion_ms`` (mean mbsynth evaluation);
     ``note`` says why a comparison was impossible (no unique motion, NaN from Pinocchio);
-    ``joint_error``, ``reaction_error``: the joint-space comparisons (module docstring)."""
+    ``joint_error``, ``reaction_error``, ``loop_reaction_error`` (with ``loop_free``): the
+    joint-space comparisons (module docstring)."""
 
     robot: str
     base: str
@@ -61,6 +73,8 @@ class Validation:
     note: str = ""
     joint_error: float = float("nan")  # joint_values against Pinocchio's (q, v, v̇), relative
     reaction_error: float = float("nan")  # reactions against rnea's data.f, relative (NaN: not compared)
+    loop_reaction_error: float = float("nan")  # loop joints against lambda_c, relative (NaN: no loops)
+    loop_free: int = 0  # the most undetermined wrench components of a loop joint (module docstring)
 
     def to_dict(self):
         return asdict(self)
@@ -89,6 +103,7 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
     others = [e for e in system.forces if e.name not in twin.torque_elements]
     worst_abs = worst_rel = worst_joint = 0.0
     worst_reaction = 0.0 if not (others or twin.constraints) else float("nan")
+    worst_loop, loop_free = float("nan"), 0
     notes, seconds = [], []
     for _ in range(samples):
         q, v, qm, qdm = _consistent_sample(system, twin, rng)
@@ -114,6 +129,9 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
         if isinstance(motion, SolveError) or not motion.unique or not np.all(np.isfinite(reference)):
             notes.append(_why(motion, reference, system))
             continue
+        if twin.loops:  # first: the twin's data still holds this sample's lambda_c
+            error, free = loop_reaction_error(driven, twin, (qm, qdm), motion)
+            worst_loop, loop_free = float(np.fmax(worst_loop, error)), max(loop_free, free)
         error = np.abs(twin.to_pinocchio(qm, qdm, motion.qdd)[2] - reference).max() if reference.size else 0.0
         scale = np.abs(reference).max() if reference.size else 0.0
         worst_abs = max(worst_abs, error)
@@ -123,11 +141,11 @@ def validate_system(system, samples=20, seed=0, tolerance=TOLERANCE, base="model
             worst_reaction = max(worst_reaction, reaction_error(driven, twin, (q, v, reference), (qm, qdm), motion))
     links = len(system.subsystems)
     note = notes[0] if notes else ""
-    joint_ok = worst_joint <= tolerance and not worst_reaction > tolerance
+    joint_ok = worst_joint <= tolerance and not worst_reaction > tolerance and not worst_loop > tolerance
     return Validation(label or system.name, base, links, twin.model.nv, samples, float(worst_abs), float(worst_rel),
                       bool(not notes and worst_rel <= tolerance and joint_ok), tolerance, round(build_s, 3),
                       round(1e3 * float(np.mean(seconds)), 3) if seconds else 0.0, note, float(worst_joint),
-                      float(worst_reaction))
+                      float(worst_reaction), float(worst_loop), int(loop_free))
 
 
 def joint_space_error(system, twin, pinocchio_state, state, motion):
@@ -171,6 +189,51 @@ def reaction_error(system, twin, pinocchio_state, state, motion):
     scale = max(np.abs(twin.data.f[c.joint_id].vector).max() for c in joints) or 1.0
     return max(max(np.abs(reactions[c.name].force - twin.data.f[c.joint_id].linear).max(),
                    np.abs(reactions[c.name].torque - twin.data.f[c.joint_id].angular).max()) for c in joints) / scale
+
+
+def loop_reaction_error(system, twin, state, motion):
+    """(error, free) of the loop joints' ``system.reactions`` against the wrenches of
+    Pinocchio's ``data.lambda_c`` from the twin's last ``constraintDynamics``, on their
+    determined components (module docstring): the largest error relative to the largest
+    determined entry of Pinocchio's wrenches, and the most undetermined components of
+    one joint. Left out: a loop whose child is the world, and one that carries its own
+    actuation or spring (mbsynth's reaction includes them, lambda_c does not); NaN when
+    no loop is left."""
+    maps = twin.loop_wrench_maps()
+    jacobian = pin.getConstraintsJacobian(twin.model, twin.data, twin.constraints, twin.constraint_data)
+    stresses = self_stresses(jacobian)
+    reactions = system.reactions(0.0, *state, motion)
+    errors, scale, free = [], 0.0, 0
+    own = {e.joint for e in system.forces}
+    for loop in twin.loops:
+        if loop.name not in maps or loop.name in own:
+            continue
+        W = maps[loop.name]
+        P = determined_projector(W, stresses[loop.rows])
+        ours = np.r_[reactions[loop.name].force, reactions[loop.name].torque]
+        theirs = W @ twin.data.lambda_c[loop.rows]
+        errors.append(np.abs(P @ (ours - theirs)).max())
+        scale = max(scale, np.abs(P @ theirs).max())
+        free = max(free, 6 - int(round(np.trace(P))))
+    return (max(errors) / (scale or 1.0) if errors else float("nan")), free
+
+
+def self_stresses(jacobian):
+    """Orthonormal columns spanning the λ with Jᵀλ = 0: the constraint forces that balance
+    among themselves (the left null space of Pinocchio's constraint Jacobian J)."""
+    U, s, _ = np.linalg.svd(jacobian, full_matrices=True)
+    rank = int(np.sum(s > NULL_RTOL * s[0])) if s.size and s[0] > 0 else 0
+    return U[:, rank:]
+
+
+def determined_projector(W, stresses):
+    """The orthogonal projector onto the wrench components that no self-stress changes:
+    I − B Bᵀ, B an orthonormal basis of the wrenches W N (N: ``stresses`` restricted to
+    the loop's rows), directions below NULL_RTOL · ‖W‖ dropped (a revolute loop's two
+    points trading force along its axis change no wrench)."""
+    U, s, _ = np.linalg.svd(W @ stresses, full_matrices=True)
+    basis = U[:, :int(np.sum(s > NULL_RTOL * np.linalg.norm(W, 2)))]
+    return np.eye(6) - basis @ basis.T
 
 
 def sample_pinocchio_state(twin, rng):

@@ -54,3 +54,13 @@ def test_dependent_rows_still_give_the_least_norm_step():
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-9 * np.linalg.norm(expected)
     assert np.linalg.norm(J @ step - r) < 1e-9 * np.linalg.norm(r)
+
+
+def test_a_small_system_takes_the_dense_route_to_the_same_step():
+    """Below DENSE_ENTRIES the step is solved densely: still the weighted least-norm step."""
+    from mbsynth.projection import DENSE_ENTRIES
+    J = tree_rows(4)
+    assert J.shape[0] * J.shape[1] <= DENSE_ENTRIES
+    r = RNG.normal(size=J.shape[0])
+    expected = weighted_least_norm(J, r)
+    assert np.linalg.norm(_correction(J, r) - expected) < 1e-10 * np.linalg.norm(expected)

@@ -145,12 +145,16 @@ def test_continuous_joints_read_as_cos_and_sin():
 
 def test_four_bar_loop_equals_constraint_dynamics():
     """The spatial four-bar (three rigid bodies, four revolute joints, one closing the
-    loop) against pinocchio.constraintDynamics with two CONTACT_3D on the closing axis."""
+    loop) against pinocchio.constraintDynamics with two CONTACT_3D on the closing axis;
+    the closing joint's reaction against lambda_c on the three wrench components a planar
+    loop in space determines (in-plane force, moment about the axes; the other three are
+    a self-stress: test_loop_reactions.py)."""
     system = mb.load(MODELS / "mechanisms" / "four_bar_3d.yaml")
     twin = Twin(system)
     assert len(twin.constraints) == 2 and twin.model.nv == 3
     result = validate_system(system, samples=SAMPLES)
     assert result.passed and result.max_rel_error <= TOLERANCE, result
+    assert result.loop_reaction_error <= 1e-8 and result.loop_free == 3, result
 
 
 def arm_with_loop(tmp_path):
@@ -192,7 +196,8 @@ def test_robot_holding_a_pinned_bar_with_a_hanging_payload(tmp_path):
     """A robot, a loop and parts of the user's own in one model file: the bar is welded
     to the arm (appended to its wrist in Pinocchio), its pin to the world closes a loop
     (CONTACT_3D), the payload is a free-flyer driven by the spring through Sᵀ Q_spring.
-    Unique motion at the initial state; equal to pinocchio.constraintDynamics."""
+    Unique motion at the initial state; equal to pinocchio.constraintDynamics, and the
+    pin's reaction (the whole force: the loop is not redundant) equal to its lambda_c."""
     system = mb.load(arm_with_loop(tmp_path))
     assert system.parameters["tau_arm_elbow_flex"] == 0.4  # the model's value wins over the default 0
     assert "arm_gripper" in [p.name for p in system.subsystems] and system.robots[0].prefix == "arm_"
@@ -204,6 +209,7 @@ def test_robot_holding_a_pinned_bar_with_a_hanging_payload(tmp_path):
     assert len(twin.constraints) == 1 and twin.model.nv == 6 + 6
     result = validate_system(system, samples=SAMPLES)
     assert result.passed and result.max_rel_error <= TOLERANCE, result
+    assert result.loop_reaction_error <= 1e-8 and result.loop_free == 0, result
 
 
 def massless_leaf_urdf(tmp_path):

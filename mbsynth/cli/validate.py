@@ -37,17 +37,25 @@ def format_validation(results, target):
     lines = [f"{first.robot} ({target}): {first.links} bodies, against Pinocchio "
              f"(relative tolerance {first.tolerance:.0e})",
              f"  {'base':<9} {'nv':>4} {'samples':>7} {'max abs error':>14} {'max rel error':>14} "
-             f"{'joints':>9} {'reactions':>9} {'build s':>8} {'motion ms':>9}  result"]
+             f"{'joints':>9} {'reactions':>9} {'loops':>15} {'build s':>8} {'motion ms':>9}  result"]
     for r in results:
         lines.append(f"  {r.base:<9} {r.nv:>4} {r.samples:>7} {r.max_abs_error:>14.3e} {r.max_rel_error:>14.3e} "
-                     f"{_figure(r.joint_error):>9} {_figure(r.reaction_error):>9} {r.build_s:>8.2f} "
-                     f"{r.motion_ms:>9.2f}  {'passed' if r.passed else 'FAILED'}")
+                     f"{figure(r.joint_error):>9} {figure(r.reaction_error):>9} {loop_figure(r):>15} "
+                     f"{r.build_s:>8.2f} {r.motion_ms:>9.2f}  {'passed' if r.passed else 'FAILED'}")
         if r.note:
             lines.append(f"    {r.note}")
     lines.append("  joints: joint values against Pinocchio's (q, v, v̇); reactions: joint wrenches against rnea's "
-                 "data.f (relative; '-': a model with loops or other force elements)")
+                 "data.f (relative; '-': a model with loops or other force elements); loops: loop joints' "
+                 "wrenches against constraintDynamics' lambda_c (relative; '-': no loops), on the components "
+                 "that are unique ('k free': k components of a redundant loop's wrench are not, and are left out)")
     return "\n".join(lines)
 
 
-def _figure(x):
-    return "-" if x != x else f"{x:.1e}"  # NaN: not compared
+def figure(x):
+    """A relative error in a table; '-' for NaN (not compared)."""
+    return "-" if x != x else f"{x:.1e}"
+
+
+def loop_figure(r):
+    """The loop reactions' error, and how many wrench components a redundant loop leaves free."""
+    return figure(r.loop_reaction_error) + (f" ({r.loop_free} free)" if r.loop_free else "")

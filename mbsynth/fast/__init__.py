@@ -17,7 +17,7 @@
 Importing this package does not import numba (``mbsynth check`` never needs it).
 """
 
-from .background import engine_for, fix_path, share
+from .background import compiled, engine_for, fix_path, share
 from .batch import motion_batch
 
-__all__ = ["engine_for", "fix_path", "motion_batch", "share"]
+__all__ = ["compiled", "engine_for", "fix_path", "motion_batch", "share"]

@@ -64,12 +64,17 @@ def source(exprs, q, qd, p):
 def compile_expressions(exprs, q, qd, p):
     """The generated module for ``exprs`` (imported, not yet compiled: numba compiles at
     the first call, or loads the cache)."""
-    text = source(exprs, q, qd, p)
+    return load(source(exprs, q, qd, p))
+
+
+def load(text, prefix="mbsynth_generated"):
+    """The module of source ``text``, written once into the cache under the hash of its
+    text (the name numba's cache finds it by), imported once per process."""
     digest = hashlib.sha256(text.encode()).hexdigest()[:24]
     with _lock:
         if digest in _modules:
             return _modules[digest]
-        path = cache.generated_dir() / f"mbsynth_generated_{digest}.py"
+        path = cache.generated_dir() / f"{prefix}_{digest}.py"
         if not path.exists():
             partial = path.with_suffix(f".{os.getpid()}.tmp")
             partial.write_text(text)
