@@ -3,7 +3,7 @@ A four-bar loop with a massless coupler
 =======================================
 
 The crank-rocker of ``models/mechanisms/four_bar.yaml`` (three planar bodies, four
-revolute joints closing one loop: 20 rows of A of rank 8, one degree of freedom), with
+revolute joints closing one loop: 9 coordinates, 8 rows of A, one degree of freedom), with
 the coupler's mass and inertia set to zero by ``System.with_parameters(m2=0, I2=0)``.
 The coupler's block of M vanishes, yet [M; A] keeps full column rank — both its ends
 are pinned — so the motion is unique (Result 3) and (2.14) gives it directly.

@@ -11,8 +11,8 @@ acts along it, so no balance is needed and η = 0 gives it no acceleration.
 
 The bob must move as a spherical pendulum of length L. We give it a sideways velocity
 and compare with an independent integration of that pendulum in Cartesian coordinates,
-r̈ = g − λ r with λ = (|ṙ|² + r·g)/L² (the rod's tension per unit mass, from
-d²/dt² |r|² = 0), done with scipy alone.
+``r̈ = g − λ r`` with ``λ = (ṙ·ṙ + r·g)/L²`` (the rod's tension per unit mass, from
+d²/dt² (r·r) = 0), done with scipy alone.
 """
 
 # %%

@@ -82,14 +82,15 @@ fig.tight_layout()
 # -----------------------
 # ``mb.viewer.to_html`` writes the animation as one self-contained page that plays
 # offline: :download:`example3_m1_zero.html </gallery/example3_m1_zero.html>`. Below, a
-# still of it taken with headless Chromium (without Chromium, the masses' positions are
-# drawn instead).
-from viewer_still import still
+# still of it taken with headless Chromium (``mbsynth.screenshot``, as
+# ``scripts/readme_pictures.py`` takes the README's pictures; ``scripts/install-chromium.sh``
+# installs Chromium). Without Chromium the masses' positions are drawn instead.
+from mbsynth.screenshot import chromium, screenshot
 
-page, png = still(system, traj, "example3_m1_zero", budget_ms=1500)
+page = mb.viewer.to_html(system, traj, Path("example3_m1_zero.html"))
 fig, ax = plt.subplots(figsize=(7, 5))
-if png is not None:
-    ax.imshow(plt.imread(png))
+if chromium() is not None:
+    ax.imshow(plt.imread(screenshot(page, Path("example3_m1_zero.png"), budget_ms=1500)))
     ax.set_axis_off()
 else:
     ax.plot(traj.t, traj.column("body1.x1") + p["d"] / 2, label="mass 1 (massless)")

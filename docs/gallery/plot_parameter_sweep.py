@@ -40,7 +40,7 @@ print(table[columns].to_string(index=False, float_format=lambda x: f"{x:.6g}"))
 
 # %%
 # Against the balance kp (θ − target) = −m g (L/2) sin θ
-# -----------------------------------------------------
+# ------------------------------------------------------------
 p = mb.load(MODELS / "joints" / "pd_pendulum.yaml").parameters
 
 

@@ -81,13 +81,16 @@ for i, name in enumerate(joints, start=1):
 # The robot in the viewer
 # -----------------------
 # The offline animation: :download:`ur5_falling.html </gallery/ur5_falling.html>`; a still
-# of it from headless Chromium (without Chromium, the tool's height is drawn instead).
-from viewer_still import still
+# of it from headless Chromium (``mbsynth.screenshot``; without Chromium, the joint
+# angles are drawn instead).
+from pathlib import Path
 
-page, png = still(robot, traj, "ur5_falling", budget_ms=400)
+from mbsynth.screenshot import chromium, screenshot
+
+page = mb.viewer.to_html(robot, traj, Path("ur5_falling.html"))
 fig, ax = plt.subplots(figsize=(7, 5))
-if png is not None:
-    ax.imshow(plt.imread(png))
+if chromium() is not None:
+    ax.imshow(plt.imread(screenshot(page, Path("ur5_falling.png"), budget_ms=400)))
     ax.set_axis_off()
 else:
     ax.plot(traj.t, angles)
