@@ -92,6 +92,7 @@ fig, ax = plt.subplots(figsize=(7, 5))
 if chromium() is not None:
     ax.imshow(plt.imread(screenshot(page, Path("example3_m1_zero.png"), budget_ms=1500)))
     ax.set_axis_off()
+    fig.subplots_adjust(0, 0, 1, 1)  # the picture alone, no margins
 else:
     ax.plot(traj.t, traj.column("body1.x1") + p["d"] / 2, label="mass 1 (massless)")
     ax.plot(traj.t, traj.column("body2.q1") + traj.column("body2.q2") + p["d"] / 2, label="mass 2")

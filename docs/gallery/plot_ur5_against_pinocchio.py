@@ -92,6 +92,7 @@ fig, ax = plt.subplots(figsize=(7, 5))
 if chromium() is not None:
     ax.imshow(plt.imread(screenshot(page, Path("ur5_falling.png"), budget_ms=400)))
     ax.set_axis_off()
+    fig.subplots_adjust(0, 0, 1, 1)  # the picture alone, no margins
 else:
     ax.plot(traj.t, angles)
     ax.set_xlabel("t [s]")
