@@ -37,9 +37,10 @@ def _free_columns(n, fixed):
 SPARSE_ACCEPT = 1e-10  # relative residual under which the sparse least-norm step is taken
 PROJECTION_RCOND = 1e-8  # directions of J (columns equilibrated) below this × σ₁ count as dependent
 VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity step
+COLUMN_FLOOR = 1e-4  # a retried projection's smallest column scale, relative to the largest entry of its rows
 
 
-def _correction(J, r):
+def _correction(J, r, floor=0.0):
     """The smallest Δ with J Δ = r in the metric that weighs each coordinate by how strongly
     it moves the constraints, ‖diag(c) Δ‖ with c_j = ‖J_:j‖ (column equilibration): a
     quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
@@ -53,11 +54,16 @@ def _correction(J, r):
     if J.shape[0] == 0:
         return np.zeros(J.shape[1])
     if not scipy.sparse.issparse(J):
-        return _dense_correction(J, r)
+        return _dense_correction(J, r, floor)
     if J.shape[0] * J.shape[1] <= DENSE_ENTRIES:
-        return _dense_correction(J.toarray(), r)
+        return _dense_correction(J.toarray(), r, floor)
     columns = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
-    D = scipy.sparse.diags(1.0 / np.where(columns > 0, columns, 1.0))
+    magnitude = abs(J).tocsr()
+    widest = np.asarray(magnitude.max(axis=1).todense()).ravel()  # each row's largest entry
+    touched = magnitude.copy()
+    touched.data = np.repeat(widest, np.diff(touched.indptr))
+    columns = _floored(columns, floor * np.asarray(touched.max(axis=0).todense()).ravel())
+    D = scipy.sparse.diags(1.0 / columns)
     G = (J @ D).tocsr()
     size = np.linalg.norm(r) + 1e-300
     try:
@@ -70,10 +76,11 @@ def _correction(J, r):
     return D @ np.linalg.lstsq(G.toarray(), r, rcond=PROJECTION_RCOND)[0]
 
 
-def _dense_correction(J, r):
+def _dense_correction(J, r, floor=0.0):
     """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
-    columns = np.linalg.norm(J, axis=0)
-    d = 1.0 / np.where(columns > 0, columns, 1.0)
+    magnitude = np.abs(J)
+    touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True), 0.0)
+    d = 1.0 / _floored(np.linalg.norm(J, axis=0), floor * touched.max(axis=0, initial=0.0))
     G = J * d
     size = np.linalg.norm(r) + 1e-300
     try:
@@ -86,6 +93,12 @@ def _dense_correction(J, r):
     return d * np.linalg.lstsq(G, r, rcond=PROJECTION_RCOND)[0]
 
 
+def _floored(columns, least):
+    """Column scales c_j, at least ``least`` (1 for a column that is zero)."""
+    floored = np.maximum(columns, least)
+    return np.where(floored > 0, floored, 1.0)
+
+
 def _accepted(z, G, norm_G, r, size):
     """The step z from the normal equations: finite, not amplified beyond PROJECTION_RCOND
     (nearly dependent rows), and meeting G z = r to SPARSE_ACCEPT."""
@@ -94,10 +107,25 @@ def _accepted(z, G, norm_G, r, size):
 
 
 def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
-    """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices)."""
-    q = np.array(q, dtype=float)
-    qd = np.zeros_like(q)
-    free = _free_columns(q.size, fixed)
+    """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices).
+
+    Gauss–Newton in the equilibrated metric of ``_correction``; where its residual grows,
+    again from q with every column scale at least COLUMN_FLOOR × the largest entry of the
+    rows it meets. A column nearly zero only at this point (a quaternion component near 0:
+    ∂(|u|² − 1)/∂u_z = 2u_z) counts in that metric as nearly free to move: the step moves
+    it by about r/c_j, whose second-order effect (r/c_j)² exceeds r, and Newton diverges
+    even from a state on the manifold to rounding."""
+    start = np.array(q, dtype=float)
+    free = _free_columns(start.size, fixed)
+    q = _newton(system, t, start, free, tolerance, floor=0.0)
+    return q if q is not None else _newton(system, t, start, free, tolerance, floor=COLUMN_FLOOR, last=True)
+
+
+def _newton(system, t, q, free, tolerance, floor, last=False):
+    """Gauss–Newton steps from q (a copy is changed) until every position row is met; None
+    when the residual grows (unless ``last``: then a SolveError names the unmet rows)."""
+    q, qd = q.copy(), np.zeros_like(q)
+    previous = np.inf
     for _ in range(MAX_ITERATIONS):
         arrays = system.constraint_arrays(t, q, qd, sparse=None)
         phi = arrays.phi
@@ -106,9 +134,15 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
         unmet = np.abs(phi[rows]) > tolerance * term_scales(A, q)
         if not unmet.any():
             return q
-        q[free] -= _correction(A[:, free], phi[rows])
+        size = np.abs(phi[rows]).max()
+        if not last and size > 2 * previous:
+            return None
+        previous = size
+        q[free] -= _correction(A[:, free], phi[rows], floor)
         if not np.all(np.isfinite(q)):
             break
+    if not last:
+        return None
     arrays = system.constraint_arrays(t, q, qd, sparse=None)
     phi, A = arrays.phi, arrays.A
     raise SolveError(_unmet(system, phi, "positions", free),

@@ -64,3 +64,21 @@ def test_a_small_system_takes_the_dense_route_to_the_same_step():
     r = RNG.normal(size=J.shape[0])
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(_correction(J, r) - expected) < 1e-10 * np.linalg.norm(expected)
+
+
+def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
+    """A free body whose quaternion is u = (1 + 5e-12, 0, 0, 1e-14): the unit-norm row's
+    column for u_z is 2u_z = 2e-14, so in the equilibrated metric u_z looks free to move
+    and the least-norm step moves it by about r/(4 u_z) — Newton then diverges. The
+    projection must land on |u| = 1 by the obvious small move (u_w by about −5e-12)."""
+    import mbsynth as mb
+    from mbsynth.projection import project_positions
+
+    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+                      "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
+    q = system.initial_state()[0]
+    u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
+    q[u] = [1 + 5e-12, 0.0, 0.0, 1e-14]
+    projected = project_positions(system, 0.0, q)
+    assert abs(np.linalg.norm(projected[u]) - 1) < 2e-16
+    assert np.abs(projected - q).max() < 1e-11
