@@ -51,7 +51,7 @@ def _correction(J, r, floor=0.0):
     manifold: the step along the near-dependent direction would be r's drift over σ), go to
     dense least squares that drops those directions; so does a sparse step that does not
     meet J Δ = r to SPARSE_ACCEPT."""
-    if J.shape[0] == 0:
+    if J.shape[0] == 0 or J.shape[1] == 0:  # no rows, or every coordinate fixed
         return np.zeros(J.shape[1])
     if not scipy.sparse.issparse(J):
         return _dense_correction(J, r, floor)
@@ -79,7 +79,7 @@ def _correction(J, r, floor=0.0):
 def _dense_correction(J, r, floor=0.0):
     """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
     magnitude = np.abs(J)
-    touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True), 0.0)
+    touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True, initial=0.0), 0.0)
     d = 1.0 / _floored(np.linalg.norm(J, axis=0), floor * touched.max(axis=0, initial=0.0))
     G = J * d
     size = np.linalg.norm(r) + 1e-300
