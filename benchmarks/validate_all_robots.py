@@ -14,6 +14,7 @@ robot, so an interrupted run keeps what it measured.
 import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MBSYNTH_FAST", "wait")  # the production (compiled) path, not the KKT path while it builds
 
 import argparse  # noqa: E402
 import platform  # noqa: E402
