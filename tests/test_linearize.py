@@ -5,6 +5,8 @@ analytical derivatives of robots (validate_modes.py)."""
 
 import json
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -69,18 +71,7 @@ def test_massless_link_with_free_spin_is_refused():
 
 # -- a double pendulum of particles on massless rods ------------------------------------------
 
-DOUBLE = """
-name: double_pendulum
-parameters: {m: 1.3, l: 0.7, g: 9.81}
-gravity: [0, 0, -g]
-world: {frames: {pivot: {position: [0, 0, 0]}}}
-subsystems:
-  p1: {type: particle, mass: m, initial: {position: [0.1, 0, -0.6]}}
-  p2: {type: particle, mass: m, initial: {position: [0.2, 0.1, -1.3]}}
-joints:
-  - {name: rod1, type: distance, parent: world.pivot, child: p1, length: l}
-  - {name: rod2, type: distance, parent: p1, child: p2, length: l}
-"""
+DOUBLE = (Path(__file__).resolve().parent.parent / "models" / "mechanisms" / "double_pendulum_rods.yaml").read_text()
 
 
 def test_double_pendulum_on_distance_joints():

@@ -17,7 +17,6 @@ the mass m2 on the two springs in series: ω² = k1 k2 / ((k1 + k2) m2).
 
 # %%
 from pathlib import Path
-from textwrap import dedent
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -25,18 +24,7 @@ import numpy as np
 import mbsynth as mb
 from mbsynth.modal import format_modes
 
-double = mb.loads(dedent("""
-    name: double_pendulum
-    parameters: {m: 1.3, l: 0.7, g: 9.81}
-    gravity: [0, 0, -g]
-    world: {frames: {pivot: {position: [0, 0, 0]}}}
-    subsystems:
-      p1: {type: particle, mass: m, initial: {position: [0.1, 0, -0.6]}}
-      p2: {type: particle, mass: m, initial: {position: [0.2, 0.1, -1.3]}}
-    joints:
-      - {name: rod1, type: distance, parent: world.pivot, child: p1, length: l}
-      - {name: rod2, type: distance, parent: p1, child: p2, length: l}
-    """))
+double = mb.load(Path("../../models/mechanisms/double_pendulum_rods.yaml"))
 result = mb.modes(double, equilibrium=True)  # the rest position found from the initial one
 print(format_modes(result))
 
