@@ -187,4 +187,8 @@ def _getter(positions):
 
 
 def _stacked(values, members):
-    return np.array([np.broadcast_to(v, (members,)) for v in values], dtype=float).reshape(-1, members)
+    """The values as rows of a (len(values), members) array, scalars repeated along their row."""
+    stacked = np.empty((len(values), members))
+    for row, value in zip(stacked, values):
+        row[...] = value
+    return stacked
