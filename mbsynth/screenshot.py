@@ -38,3 +38,16 @@ def screenshot(page, png, size=(800, 600), budget_ms=5000, timeout=120):
     if not png.is_file():
         raise RuntimeError(f"chromium wrote no screenshot (exit {done.returncode}): {done.stderr[-2000:]}")
     return png
+
+
+def show_still(ax, page, png, budget_ms=1500):
+    """Draw a still of ``page`` on the matplotlib axes ``ax``, filling its figure; False
+    (and nothing drawn) when Chromium is not installed, so the caller can plot instead."""
+    if chromium() is None:
+        return False
+    import matplotlib.pyplot as plt  # only a caller drawing figures needs matplotlib
+
+    ax.imshow(plt.imread(screenshot(page, png, budget_ms=budget_ms)))
+    ax.set_axis_off()
+    ax.figure.subplots_adjust(0, 0, 1, 1)  # the picture alone, no margins
+    return True

@@ -19,6 +19,7 @@ import pytest
 import mbsynth as mb
 from mbsynth import viewer
 from mbsynth.cli import main
+from mbsynth import screenshot as screenshot_module
 from mbsynth.screenshot import chromium, screenshot
 from mbsynth.trajectory import Trajectory
 from mbsynth.viewer_scene import build_scene, drawn_rows
@@ -249,6 +250,31 @@ def test_live_page_draws_the_model_and_the_server_stops(tmp_path):
         empty.frame(build_scene(system, traj))
         reference = screenshot(empty.url, tmp_path / "empty.png")
     assert changed_pixels(shot, reference) > 3000
+
+
+@needs_chromium
+def test_show_still_puts_the_page_on_the_axes_alone(tmp_path):
+    import matplotlib.pyplot as plt
+
+    page = tmp_path / "page.html"
+    page.write_text("<html><body style='background: rgb(255, 0, 0)'></body></html>")
+    fig, ax = plt.subplots()
+    assert screenshot_module.show_still(ax, page, tmp_path / "page.png", budget_ms=100)
+    (image,) = ax.get_images()
+    pixels = image.get_array()
+    assert pixels.shape[:2] == (600, 800) and np.allclose(pixels[300, 400, :3], [1, 0, 0], atol=0.02)
+    assert not ax.axison and fig.subplotpars.left == 0 and fig.subplotpars.top == 1
+    plt.close(fig)
+
+
+def test_show_still_without_chromium_draws_nothing(tmp_path, monkeypatch):
+    import matplotlib.pyplot as plt
+
+    monkeypatch.setattr(screenshot_module, "chromium", lambda: None)
+    fig, ax = plt.subplots()
+    assert not screenshot_module.show_still(ax, tmp_path / "page.html", tmp_path / "page.png")
+    assert ax.get_images() == [] and ax.axison and not (tmp_path / "page.png").exists()
+    plt.close(fig)
 
 
 def test_cli_writes_the_html_animation(tmp_path, capsys):

@@ -85,15 +85,11 @@ fig.tight_layout()
 # still of it taken with headless Chromium (``mbsynth.screenshot``, as
 # ``scripts/readme_pictures.py`` takes the README's pictures; ``scripts/install-chromium.sh``
 # installs Chromium). Without Chromium the masses' positions are drawn instead.
-from mbsynth.screenshot import chromium, screenshot
+from mbsynth.screenshot import show_still
 
 page = mb.viewer.to_html(system, traj, Path("example3_m1_zero.html"))
 fig, ax = plt.subplots(figsize=(7, 5))
-if chromium() is not None:
-    ax.imshow(plt.imread(screenshot(page, Path("example3_m1_zero.png"), budget_ms=1500)))
-    ax.set_axis_off()
-    fig.subplots_adjust(0, 0, 1, 1)  # the picture alone, no margins
-else:
+if not show_still(ax, page, Path("example3_m1_zero.png"), budget_ms=1500):
     ax.plot(traj.t, traj.column("body1.x1") + p["d"] / 2, label="mass 1 (massless)")
     ax.plot(traj.t, traj.column("body2.q1") + traj.column("body2.q2") + p["d"] / 2, label="mass 2")
     ax.set_xlabel("t [s]")

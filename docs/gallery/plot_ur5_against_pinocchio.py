@@ -85,15 +85,11 @@ for i, name in enumerate(joints, start=1):
 # angles are drawn instead).
 from pathlib import Path
 
-from mbsynth.screenshot import chromium, screenshot
+from mbsynth.screenshot import show_still
 
 page = mb.viewer.to_html(robot, traj, Path("ur5_falling.html"))
 fig, ax = plt.subplots(figsize=(7, 5))
-if chromium() is not None:
-    ax.imshow(plt.imread(screenshot(page, Path("ur5_falling.png"), budget_ms=400)))
-    ax.set_axis_off()
-    fig.subplots_adjust(0, 0, 1, 1)  # the picture alone, no margins
-else:
+if not show_still(ax, page, Path("ur5_falling.png"), budget_ms=400):
     ax.plot(traj.t, angles)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("joint angle [rad]")
