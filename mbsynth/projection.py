@@ -40,11 +40,15 @@ VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity st
 COLUMN_FLOOR = 1e-4  # a retried projection's smallest column scale, relative to the largest entry of its rows
 
 
-def _correction(J, r, floor=0.0):
+def _correction(J, r, groups, floor=0.0):
     """The smallest Δ with J Δ = r in the metric that weighs each coordinate by how strongly
     it moves the constraints, ‖diag(c) Δ‖ with c_j = ‖J_:j‖ (column equilibration): a
     quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
-    moved, not turned, as one 1 m long is. With G = J D (D = diag(1/c)) and independent
+    moved, not turned, as one 1 m long is. Coordinates that move together (``groups``, one
+    label per column: System.coordinate_groups) share one scale, the root mean square of
+    their columns' norms: a single component's column vanishes where that component passes
+    through zero (∂(|u|² − 1)/∂u_z = 2u_z; a particle's x on a rod), and a scale of its own
+    would let the step move it by r/c_j. With G = J D (D = diag(1/c)) and independent
     rows, Δ = D Gᵀ (G Gᵀ)⁻¹ r, G Gᵀ factored sparse (a tree of joints gives a
     tree-structured G Gᵀ: linear time), or dense when J is small (DENSE_ENTRIES). Rows that are dependent, or dependent to within
     ``PROJECTION_RCOND`` (a loop whose dependency moves with the configuration, off its
@@ -54,10 +58,10 @@ def _correction(J, r, floor=0.0):
     if J.shape[0] == 0 or J.shape[1] == 0:  # no rows, or every coordinate fixed
         return np.zeros(J.shape[1])
     if not scipy.sparse.issparse(J):
-        return _dense_correction(J, r, floor)
+        return _dense_correction(J, r, groups, floor)
     if J.shape[0] * J.shape[1] <= DENSE_ENTRIES:
-        return _dense_correction(J.toarray(), r, floor)
-    columns = np.sqrt(np.asarray(J.multiply(J).sum(axis=0)).ravel())
+        return _dense_correction(J.toarray(), r, groups, floor)
+    columns = _grouped(np.asarray(J.multiply(J).sum(axis=0)).ravel(), groups)
     magnitude = abs(J).tocsr()
     widest = np.asarray(magnitude.max(axis=1).todense()).ravel()  # each row's largest entry
     touched = magnitude.copy()
@@ -76,11 +80,12 @@ def _correction(J, r, floor=0.0):
     return D @ np.linalg.lstsq(G.toarray(), r, rcond=PROJECTION_RCOND)[0]
 
 
-def _dense_correction(J, r, floor=0.0):
+def _dense_correction(J, r, groups, floor=0.0):
     """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
     magnitude = np.abs(J)
     touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True, initial=0.0), 0.0)
-    d = 1.0 / _floored(np.linalg.norm(J, axis=0), floor * touched.max(axis=0, initial=0.0))
+    columns = _grouped(np.einsum("ij,ij->j", J, J), groups)
+    d = 1.0 / _floored(columns, floor * touched.max(axis=0, initial=0.0))
     G = J * d
     size = np.linalg.norm(r) + 1e-300
     try:
@@ -91,6 +96,12 @@ def _dense_correction(J, r, floor=0.0):
     except np.linalg.LinAlgError:  # exactly singular
         pass
     return d * np.linalg.lstsq(G, r, rcond=PROJECTION_RCOND)[0]
+
+
+def _grouped(squares, groups):
+    """Column scales from the squared column norms: per group, the root mean square."""
+    labels, inverse, counts = np.unique(groups, return_inverse=True, return_counts=True)
+    return np.sqrt(np.bincount(inverse, weights=squares, minlength=labels.size)[inverse] / counts[inverse])
 
 
 def _floored(columns, least):
@@ -138,7 +149,7 @@ def _newton(system, t, q, free, tolerance, floor, last=False):
         if not last and size > 2 * previous:
             return None
         previous = size
-        q[free] -= _correction(A[:, free], phi[rows], floor)
+        q[free] -= _correction(A[:, free], phi[rows], system.coordinate_groups[free], floor)
         if not np.all(np.isfinite(q)):
             break
     if not last:
@@ -160,7 +171,7 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
     A = arrays.A[rows]
     if not (np.abs(psi[rows]) > tolerance * term_scales(A, qd)).any():
         return qd
-    qd[free] -= _correction(A[:, free], psi[rows])  # ψ is affine in q̇ with slope A
+    qd[free] -= _correction(A[:, free], psi[rows], system.coordinate_groups[free])  # ψ is affine in q̇, slope A
     _, psi = system.constraint_residuals(t, q, qd)
     unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
     if unmet.any():

@@ -102,6 +102,21 @@ class System:
         return len(self.coordinates)
 
     @property
+    def coordinate_groups(self):
+        """One label per coordinate, equal for the coordinates that move together (a part's
+        ``groups``: a point's x, y, z, a quaternion's four numbers), for projection.py's metric."""
+        found = self.__dict__.get("_coordinate_groups")
+        if found is None:
+            labels, start = [], 0
+            for part in self.subsystems:
+                group = {c: start + k for k, members in enumerate(part.groups) for c in members}
+                labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
+                start += len(part.groups) + len(part.coordinates)
+            found = np.array(labels)
+            object.__setattr__(self, "_coordinate_groups", found)
+        return found
+
+    @property
     def constraint_names(self):
         """One name per row of A (a joint with k rows names them ``joint[label]``)."""
         return [row for c in self.constraints for row in c.row_names]

@@ -31,7 +31,7 @@ def test_independent_rows_give_the_least_norm_step():
     J = tree_rows(40)
     J = (J @ scipy.sparse.diags(RNG.uniform(1e-3, 1e3, size=J.shape[1]))).tocsr()  # coordinates in mixed units
     r = RNG.normal(size=J.shape[0])
-    step = _correction(J, r)
+    step = _correction(J, r, np.arange(J.shape[1]))
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-10 * np.linalg.norm(expected)
 
@@ -42,15 +42,16 @@ def test_the_step_does_not_depend_on_the_coordinates_units():
     J = tree_rows(10)
     r = RNG.normal(size=J.shape[0])
     units = RNG.uniform(1e-3, 1e3, size=J.shape[1])
-    scaled = _correction((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r)  # coordinate j counted in 1/units_j
-    np.testing.assert_allclose(scaled / units, _correction(J, r), rtol=1e-9, atol=1e-12)
+    scaled = _correction((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r,
+                         np.arange(J.shape[1]))  # coordinate j counted in 1/units_j
+    np.testing.assert_allclose(scaled / units, _correction(J, r, np.arange(J.shape[1])), rtol=1e-9, atol=1e-12)
 
 
 def test_dependent_rows_still_give_the_least_norm_step():
     J = tree_rows(10)
     J = scipy.sparse.vstack([J, J[3] + 2 * J[17]]).tocsr()  # a redundant row, as a planar loop in 3D has
     r = J @ RNG.normal(size=J.shape[1])  # consistent right side
-    step = _correction(J, r)
+    step = _correction(J, r, np.arange(J.shape[1]))
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-9 * np.linalg.norm(expected)
     assert np.linalg.norm(J @ step - r) < 1e-9 * np.linalg.norm(r)
@@ -63,7 +64,7 @@ def test_a_small_system_takes_the_dense_route_to_the_same_step():
     assert J.shape[0] * J.shape[1] <= DENSE_ENTRIES
     r = RNG.normal(size=J.shape[0])
     expected = weighted_least_norm(J, r)
-    assert np.linalg.norm(_correction(J, r) - expected) < 1e-10 * np.linalg.norm(expected)
+    assert np.linalg.norm(_correction(J, r, np.arange(J.shape[1])) - expected) < 1e-10 * np.linalg.norm(expected)
 
 
 def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
@@ -82,3 +83,23 @@ def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
     projected = project_positions(system, 0.0, q)
     assert abs(np.linalg.norm(projected[u]) - 1) < 2e-16
     assert np.abs(projected - q).max() < 1e-11
+
+
+def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near_zero():
+    """The velocity row u·u̇ = 0 of a body with u = (0.6, 0.8, 0, 1e-8) and ψ = 1e-9: a scale
+    of u_z's column alone (2u_z) would take the correction almost entirely on u̇_z, about
+    ψ/(3 u_z) = 0.03 rad/s, a kick to the spin. The quaternion's four columns share one
+    scale (System.coordinate_groups), so u̇ moves along u by ψ/|u|² and no more."""
+    import mbsynth as mb
+    from mbsynth.projection import project_velocities
+
+    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+                      "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
+    q, qd = system.initial_state()
+    u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
+    q[u] = [0.6, 0.8, 0.0, 1e-8]
+    rate = np.array([-0.8, 0.6, 0.3, 0.2])  # ω of about 2 rad/s
+    qd[u] = rate - (q[u] @ rate) * q[u] + 1e-9 * q[u]  # u·u̇ = 1e-9
+    projected = project_velocities(system, 0.0, q, qd)
+    assert abs(q[u] @ projected[u]) < 1e-15
+    assert np.abs(projected - qd).max() < 1.5e-9

@@ -36,6 +36,9 @@ class Part:
 
     kind = "part"
     defaults = {}  # initial coordinate values that are not zero unless the model says otherwise
+    # coordinates that move together (a point's x, y, z; a quaternion's four numbers): one
+    # scale for all of them in the projection's metric (projection.py); others stand alone
+    groups = ()
 
     def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None,
                  shared=None):

@@ -9,6 +9,7 @@ class Particle(Part):
     """M = m I₃ (m ≥ 0; a massless particle is legal), Q = m g. Its frames are the point."""
 
     kind = "particle"
+    groups = (("x", "y", "z"),)
 
     def __init__(self, name, q, qd, mass, gravity, params, frames=(), geometry=(), initial=None):
         r, rd = sp.Matrix(q), sp.Matrix(qd)

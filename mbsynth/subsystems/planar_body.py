@@ -10,6 +10,7 @@ class PlanarBody(Part):
     """M = diag(m, m, I_zz), Q = (m g_x, m g_y, 0); frames rotate with θ about z."""
 
     kind = "planar_body"
+    groups = (("x", "y"),)
 
     def __init__(self, name, q, qd, mass, inertia_zz, gravity, params, frames=(), geometry=(), initial=None):
         g = sp.Matrix(gravity)

@@ -24,6 +24,7 @@ class RigidBody(Part):
 
     kind = "rigid_body"
     COORDINATES = COORDINATES
+    groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}  # the identity orientation
 
     def __init__(self, name, q, qd, mass, inertia, gravity, params, frames=(), geometry=(), initial=None):

@@ -43,6 +43,7 @@ class Spring(Part):
 
     kind = "spring"
     COORDINATES = COORDINATES
+    groups = (("x1", "y1", "z1"), ("x2", "y2", "z2"))
 
     def __init__(self, name, q, qd, stiffness, rest_length, damping, mass, gravity, params, initial=None):
         p1, p2 = sp.Matrix(q[:3]), sp.Matrix(q[3:])
