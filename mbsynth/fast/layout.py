@@ -221,7 +221,6 @@ class _Builder:
 
     def layout(self):
         nodes, joints = self.nodes, self.joints
-        N = len(nodes)
         rigid = [isinstance(part, RigidBody) for part, _ in nodes]
         v = [6 if r else 3 for r in rigid]
         k = [joints[j][0].size if j >= 0 else 0 for j in self.pjoint]
