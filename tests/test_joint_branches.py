@@ -101,3 +101,26 @@ def test_a_pose_where_the_rows_do_not_hold_yet_is_checked_once_consistent():
     assert info.value.constraints == ("hinge",)
     with pytest.raises(mb.SolveError, match="hinge"):
         mb.simulate(system, 0.1)
+
+
+@pytest.mark.parametrize("model", ["rigid/double_pendulum_spatial.yaml", "mechanisms/four_bar.yaml",
+                                   "mechanisms/bricard.yaml", "mechanisms/slider_crank.yaml", "robots/ur5_payload.yaml"])
+def test_frame_rotations_of_the_branch_check_equal_the_poses_sympy_gives(model):
+    """The branch check's numeric rotations (R(u) R_frame, R_z(θ) R_frame, R_frame) against
+    substitution into each part's sympy pose, at a random state off the manifold."""
+    from pathlib import Path
+
+    from mbsynth.connectors.joints import _numeric, _pose, _rotation_at
+    from mbsynth.symbolic import T_SYMBOL
+
+    system = mb.load(Path(__file__).resolve().parent.parent / "models" / model)
+    q = system.initial_state()[0] + 0.3 * np.random.default_rng(5).normal(size=system.n)
+    values = {**dict(zip(system.q_symbols, q)), **dict(zip(system.parameter_symbols, system.parameter_values)),
+              T_SYMBOL: 0.0}
+    compared = 0
+    for joint in system.constraints:
+        for part, frame in zip(getattr(joint, "parts", ()), getattr(joint, "frames", ())):
+            expected = _numeric(_pose(part, frame)[1], values)
+            np.testing.assert_allclose(_rotation_at(part, frame, values), expected, atol=1e-14)
+            compared += 1
+    assert compared >= 2
