@@ -62,10 +62,17 @@ def axis_matrix(axis):
     return np.column_stack([x, np.cross(z, x), z])
 
 
+def quaternion_rotation(u):
+    """R(u) as a numpy array, in the homogeneous form of ``rotation`` (|u|² R for u not unit)."""
+    w, v = float(u[0]), np.asarray(u[1:], dtype=float)
+    skew = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * w * skew
+
+
 def quaternion_matrix(u):
     """R of a unit scalar-first quaternion, as a numpy array."""
     u = np.asarray(u, dtype=float)
-    return np.array(rotation(sp.Matrix(u / np.linalg.norm(u))).evalf(), dtype=float)
+    return quaternion_rotation(u / np.linalg.norm(u))
 
 
 def matrix_quaternion(R):

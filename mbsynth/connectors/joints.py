@@ -30,6 +30,7 @@ import numpy as np
 import sympy as sp
 
 from ..constraint import Connector
+from ..kinematics import quaternion_rotation
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
 from ..symbolic import differentiate, differentiated, placed_values, positions, time_derivative
 
@@ -181,7 +182,7 @@ def _numeric(matrix, values):
 def _rotation_at(part, frame, values):
     """The world rotation of ``frame`` (on ``part``, None: the world) at ``values`` as floats,
     or None where that is no real number. The shared part kinds are computed from their
-    coordinates' values — R(u) R_frame in R(u)'s homogeneous form (kinematics.rotation),
+    coordinates' values — R(u) R_frame in R(u)'s homogeneous form (kinematics.quaternion_rotation),
     R_z(θ) R_frame, R_frame — since substituting into the pose's sympy matrices took 1.6 s
     per check on talos; other parts by substitution."""
     if part is not None and not isinstance(part, SHARED_PARTS):
@@ -195,10 +196,7 @@ def _rotation_at(part, frame, values):
         theta = float(values[part.q[2]])
         c, s = np.cos(theta), np.sin(theta)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ own
-    w, *v = (float(values[x]) for x in part.q[3:])
-    v = np.array(v)
-    skew = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-    return ((w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * w * skew) @ own
+    return quaternion_rotation([float(values[x]) for x in part.q[3:]]) @ own
 
 
 def _turned(joint, relative):
