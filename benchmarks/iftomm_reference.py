@@ -121,6 +121,23 @@ def n_four_bar_constants(N, L=1.0, m=1.0, g=9.81):
     return J, K
 
 
+def n_four_bar_state(coordinates, N, psi, psi_dot, L=1.0):
+    """(q, q') of the n_four_bar_yaml model with every vertical bar at psi turning at psi'
+    (the exact one-degree-of-freedom motion's state): bar v{i}'s centre at
+    (i L + (L/2) sin psi, (L/2) cos psi), its angle -psi; h{i} translating with the tops."""
+    index = {name: k for k, name in enumerate(coordinates)}
+    q, qd = np.zeros(len(coordinates)), np.zeros(len(coordinates))
+    s, c = math.sin(psi), math.cos(psi)
+    for i in range(N + 1):
+        for name, value, rate in (("x", i * L + L / 2 * s, L / 2 * c * psi_dot),
+                                  ("y", L / 2 * c, -L / 2 * s * psi_dot), ("theta", -psi, -psi_dot)):
+            q[index[f"v{i}.{name}"]], qd[index[f"v{i}.{name}"]] = value, rate
+    for i in range(N):
+        for name, value, rate in (("x", i * L + L / 2 + L * s, L * c * psi_dot), ("y", L * c, -L * s * psi_dot)):
+            q[index[f"h{i}.{name}"]], qd[index[f"h{i}.{name}"]] = value, rate
+    return q, qd
+
+
 def n_four_bar_reference(times, N, L=1.0, m=1.0, g=9.81, v0=1.0, rtol=1e-13, atol=1e-13):
     """Position of B0 (the first vertical bar's top) at ``times``: (x, y) arrays.
 

@@ -233,21 +233,21 @@ def constrained_acceleration(M, Q, A, b, C=None, *, rtol=RANK_RTOL,
     singular position: (a) gives way to the drift rule of the module docstring.
     """
     d = _prepare(M, Q, A, b, C, coordinates, constraints)
-    singular = ()
+    singular, row_space = (), None
     if drift is not None and d.m:
-        d, singular = _trusted(d, rtol, drift)
-    report, s_hat, Ua, sa, Vk, qdd = _solve(d, rtol)
+        d, row_space, singular = _trusted(d, rtol, drift)
+    report, s_hat, Ua, sa, Vk, qdd = _solve(d, row_space, rtol=rtol)
     if drift is None:
         _check_constraints(d, Ua, sa, Vk.shape[1], qdd)
     _check_forces(d, report.nullspace, s_hat, report.rank_Mhat, qdd)
     return _motion(d, qdd, Vk, "pseudoinverse (2.14)", report.nullspace, singular)
 
 
-def _solve(d: "_Data", rtol):
+def _solve(d: "_Data", row_space=None, *, rtol):
     """(2.14) with η = 0 on equilibrated data: (rank report, σ of M̂, SVD of A_e as
-    (U, s, V_k), q̈)."""
-    report, s_hat = _rank_report(d, rtol)
-    Ua, sa, Vk = _row_space(d.Ae, rtol)
+    (U, s, V_k), q̈). ``row_space``: that SVD when already known."""
+    Ua, sa, Vk = _row_space(d.Ae, rtol) if row_space is None else row_space
+    report, s_hat = _rank_report(d, rtol, sa)
     r = report.rank_Mhat
     Mbar = np.vstack([(d.M - Vk @ (Vk.T @ d.M)) / d.mu, d.Ae])  # (2.13), rows equilibrated
     U, s, Vt = np.linalg.svd(Mbar, full_matrices=False)
@@ -257,8 +257,8 @@ def _solve(d: "_Data", rtol):
 
 def _trusted(d: "_Data", rtol, drift):
     """The drift rule (module docstring): d with A_e, b_e replaced by their trusted part
-    (same rows, consistent by construction) and the names of the rows of the nearly
-    dependent directions of a singular position near."""
+    (same rows, consistent by construction), that part's SVD as (U, s, V_k) and the names
+    of the rows of the nearly dependent directions of a singular position near."""
     U, s, Vt = np.linalg.svd(d.Ae, full_matrices=False)
     c = U.T @ d.be
     keep = s > rtol * s[0] if s[0] > 0 else np.zeros(s.size, dtype=bool)
@@ -268,13 +268,14 @@ def _trusted(d: "_Data", rtol, drift):
         dependent = near & (s <= DRIFT_RANK * _relative_drift(d, drift) * s[0])  # (1): the drift's own
         keep &= ~dependent
         near &= ~dependent
-        rest = _solve(_restricted(d, U, s, Vt, c, keep & ~near), rtol)[-1]
+        rest = _solve(*_restricted(d, U, s, Vt, c, keep & ~near), rtol=rtol)[-1]
         asks = np.abs(c[near]) / s[near]
         drifted = np.flatnonzero(near)[asks > DRIFT_GAIN * np.linalg.norm(rest)]
         keep[drifted] = False
         if near.any():
             singular = tuple(d.constraints[i] for i in _named(np.abs(U[:, near]).max(axis=1)))
-    return _restricted(d, U, s, Vt, c, keep), singular
+    kept, row_space = _restricted(d, U, s, Vt, c, keep)
+    return kept, row_space, singular
 
 
 def _relative_drift(d: "_Data", drift):
@@ -297,8 +298,10 @@ def term_scales(A, x):
 
 
 def _restricted(d: "_Data", U, s, Vt, c, keep):
-    """d with A_e = U Σ Vᵀ and b_e = U c kept on the singular directions ``keep`` only."""
-    return replace(d, Ae=(U[:, keep] * s[keep]) @ Vt[keep], be=U[:, keep] @ c[keep])
+    """(d with A_e = U Σ Vᵀ and b_e = U c kept on the singular directions ``keep`` only,
+    the SVD of that A_e as (U, s, V_k))."""
+    kept = replace(d, Ae=(U[:, keep] * s[keep]) @ Vt[keep], be=U[:, keep] @ c[keep])
+    return kept, (U[:, keep], s[keep], Vt[keep].T)
 
 
 def udwadia_kalaba(M, Q, A, b, C=None, *, coordinates=None, constraints=None) -> Motion:
@@ -421,12 +424,16 @@ def _rank(s, rtol):
     return int(np.count_nonzero(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
 
-def _rank_report(d: _Data, rtol):
-    """RankReport of M̂ = [M/μ; A_e] and the singular values of that matrix."""
+def _rank_report(d: _Data, rtol, s_A=None):
+    """RankReport of M̂ = [M/μ; A_e] and the singular values of that matrix. ``s_A``: the
+    singular values of A_e when already known. M is symmetric: its singular values are the
+    absolute values of its eigenvalues."""
     _, s, Vt = np.linalg.svd(np.vstack([d.M / d.mu, d.Ae]), full_matrices=False)
     r = _rank(s, rtol)
-    rank_M = _rank(np.linalg.svd(d.M / d.mu, compute_uv=False), rtol)
-    rank_A = _rank(np.linalg.svd(d.Ae, compute_uv=False), rtol) if d.m else 0
+    rank_M = _rank(np.sort(np.abs(np.linalg.eigvalsh(d.M / d.mu)))[::-1], rtol)
+    if s_A is None and d.m:
+        s_A = np.linalg.svd(d.Ae, compute_uv=False)
+    rank_A = _rank(s_A, rtol) if d.m else 0
     report = RankReport(rank_M=rank_M, rank_A=rank_A, rank_Mhat=r, n=d.n, m=d.m,
                         nullspace=Vt[r:].T.copy(), singular_values=s, rtol=rtol)
     return report, s

@@ -45,6 +45,12 @@ COLLAPSE_SPAN = 1e-8
 DRIFT_TARGET = 1e-9  # largest relative drift off the manifold between two projections
 DRIFT_REDO = 1e3  # a span that drifted more than this × DRIFT_TARGET is integrated again, shorter
 MIN_SPAN = 1e-6  # of the output interval: the shortest span that is redone
+# near a singular position the stages' accelerations carry noise of about |q̇| ψ / σ² (ψ the
+# velocity drift, σ the smallest singular value of A), which a tight tolerance chases with
+# ever smaller steps: a span whose stages came near one (Motion.singular) and then took
+# more than CRAWL_CALLS evaluations is integrated again at RELAXED_RTOL (atol alike)
+CRAWL_CALLS = 240
+RELAXED_RTOL = 1e-8
 
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
@@ -145,6 +151,8 @@ class _Run:
         self.drift_span = None  # the span between projections, when shorter than the output interval
         self.singular = []  # (t, rows) of the stages near a singular position (Motion.singular)
         self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
+        self.singular_call = None  # the span's evaluation count at its first stage near a singular position
+        self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again at RELAXED_RTOL
 
     @property
     def t(self):
@@ -167,6 +175,10 @@ class _Run:
         self.non_unique |= not motion.unique
         if motion.singular:
             self.singular.append((t, motion.singular))
+            self.singular_call = self.calls if self.singular_call is None else self.singular_call
+        if self.singular_call is not None and self.calls - self.singular_call > CRAWL_CALLS \
+                and self.span_rtol < RELAXED_RTOL:
+            raise _Crawl
         return np.concatenate([qd, motion.qdd])
 
     def advance(self, t_next, q, qd):
@@ -203,11 +215,16 @@ class _Run:
             self.drift_span = None if 2 * self.drift_span >= interval else 2 * self.drift_span
 
     def _integrate(self, t, t_next, q, qd):
-        """solve_ivp from (t, q, q̇) to t_next; the state at t_next, checked."""
-        self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
-        first_step = min(self.first_step, t_next - t) if self.first_step else None
-        sol = solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=self.rtol,
-                        atol=self.atol, first_step=first_step)
+        """solve_ivp from (t, q, q̇) to t_next; the state at t_next, checked. A span that
+        crawls near a singular position (CRAWL_CALLS) is integrated again at RELAXED_RTOL."""
+        try:
+            sol = self._solve_ivp(t, t_next, q, qd, self.rtol, self.atol)
+        except _Crawl:
+            relax = RELAXED_RTOL / self.rtol
+            self.relaxed_spans.append(dict(t_from=t, t_to=t_next, rtol=RELAXED_RTOL, atol=self.atol * relax))
+            log.info("near a singular position between t = %.6g and %.6g: integrated at rtol %g, atol %g",
+                     t, t_next, RELAXED_RTOL, self.atol * relax)
+            sol = self._solve_ivp(t, t_next, q, qd, RELAXED_RTOL, self.atol * relax)
         self.evaluations += sol.nfev
         self.steps += len(sol.t) - 1
         if sol.status != 0:
@@ -218,6 +235,17 @@ class _Run:
         y = sol.y[:, -1]
         self._check(t_next, y)
         return y[:self.n], y[self.n:]
+
+    def _solve_ivp(self, t, t_next, q, qd, rtol, atol):
+        self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
+        self.singular_call, self.span_rtol = None, rtol
+        first_step = min(self.first_step, t_next - t) if self.first_step else None
+        try:
+            return solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=rtol,
+                             atol=atol, first_step=first_step)
+        except _Crawl:
+            self.evaluations += self.calls
+            raise
 
     def _note_singular(self):
         """One entry of ``singular_positions`` for the stages of the interval just done."""
@@ -266,11 +294,15 @@ class _Run:
                           outputs=np.array(r["outputs"], dtype=float).reshape(len(r["t"]), len(self.outputs.names)),
                           output_names=tuple(self.outputs.names))
         traj.stats.update(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique,
-                          singular_positions=self.singular_positions)
+                          singular_positions=self.singular_positions, relaxed_spans=self.relaxed_spans)
         if self.non_unique:
             log.warning("the motion was not unique somewhere on this run; the free directions got zero "
                         "acceleration (η = 0 in (2.14))")
         return traj
+
+
+class _Crawl(Exception):
+    """A span's stages near a singular position take too many evaluations (CRAWL_CALLS)."""
 
 
 def _max_abs(values):

@@ -39,6 +39,7 @@ def run(args):
                "initial_changes": traj.stats.get("initial_changes", {}),
                "singular_positions": [{"t_from": float(e["t_from"]), "t_to": float(e["t_to"]), "rows": e["rows"]}
                                       for e in traj.stats.get("singular_positions", [])],
+               "relaxed_spans": [{k: float(v) for k, v in e.items()} for e in traj.stats.get("relaxed_spans", [])],
                "out": args.out and str(output_file(args.out, completed=error is None)), "plot": args.plot,
                "status": "completed" if error is None else "failed"}
     if error:
@@ -69,6 +70,11 @@ def format_summary(s):
         rows = sorted({r for e in s["singular_positions"] for r in e["rows"]})
         lines.append(f"  passed near singular positions at t ≈ {times}{f' and {more} more' if more > 0 else ''} "
                      f"(nearly dependent rows: {', '.join(rows[:6])}{', ...' if len(rows) > 6 else ''})")
+    if s["relaxed_spans"]:
+        spans = s["relaxed_spans"]
+        lines.append(f"  integrated at rtol {spans[0]['rtol']:.3g} near them: {len(spans)} span(s) of "
+                     f"{sum(e['t_to'] - e['t_from'] for e in spans):.3g} s in all, the first from t = "
+                     f"{spans[0]['t_from']:.6g} (the requested tolerance crawled there)")
     for key in ("out", "plot"):
         if s[key]:
             lines.append(f"  wrote {s[key]}")
