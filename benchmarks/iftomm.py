@@ -112,6 +112,11 @@ def _four_bar_eval(N):
         singular = ref.n_four_bar_singular_times(N, float(traj.t[-1]) if traj.t.size else 0.0)
         notes = [f"{len(singular)} singular positions passed (first at t = {singular[0]:.6g} s)" if len(singular)
                  else "no singular position reached"]
+        relaxed = traj.stats.get("relaxed_spans", [])
+        if relaxed:
+            notes.append(f"{len(relaxed)} spans near them integrated again at a looser tolerance (the default "
+                         f"crawled there): rtol up to {max(e['rtol'] for e in relaxed):.0e}, "
+                         f"{sum(e['t_to'] - e['t_from'] for e in relaxed):.3g} s of the run")
         return _fmt((xr[-1], yr[-1])), _fmt((bx[-1], by[-1])), err, notes
     return evaluate
 

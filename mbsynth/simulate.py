@@ -17,7 +17,12 @@ output state the constraints are judged strictly: a real contradiction raises
 SolveError there. ``stats["singular_positions"]`` lists the output intervals in which a
 stage came near a singular position (σ < 1e-5 σ₁ of the equilibrated A: the drift rule's
 zone); a crossing whose stages all stay farther from it needs no special treatment and
-may go unlisted.
+may go unlisted. There the stages' accelerations carry noise of about |q̇| ψ / σ² (ψ the
+velocity drift the projection leaves, about 1e-12): a tolerance tighter than that noise
+allows makes the integrator crawl. A span that takes more than CRAWL_CALLS evaluations
+after its first stage near a singular position is integrated again at RELAXED_RTOL (atol
+relaxed by the same factor; ten times looser again while it crawls still, up to
+RELAXED_MAX) and listed in ``stats["relaxed_spans"]``.
 """
 
 import logging
@@ -48,9 +53,11 @@ MIN_SPAN = 1e-6  # of the output interval: the shortest span that is redone
 # near a singular position the stages' accelerations carry noise of about |q̇| ψ / σ² (ψ the
 # velocity drift, σ the smallest singular value of A), which a tight tolerance chases with
 # ever smaller steps: a span whose stages came near one (Motion.singular) and then took
-# more than CRAWL_CALLS evaluations is integrated again at RELAXED_RTOL (atol alike)
+# more than CRAWL_CALLS evaluations is integrated again at RELAXED_RTOL (atol alike), and
+# again ten times looser each time it crawls still, up to RELAXED_MAX
 CRAWL_CALLS = 240
 RELAXED_RTOL = 1e-8
+RELAXED_MAX = 1e-7
 
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
@@ -177,7 +184,7 @@ class _Run:
             self.singular.append((t, motion.singular))
             self.singular_call = self.calls if self.singular_call is None else self.singular_call
         if self.singular_call is not None and self.calls - self.singular_call > CRAWL_CALLS \
-                and self.span_rtol < RELAXED_RTOL:
+                and self.span_rtol < RELAXED_MAX:
             raise _Crawl
         return np.concatenate([qd, motion.qdd])
 
@@ -216,15 +223,20 @@ class _Run:
 
     def _integrate(self, t, t_next, q, qd):
         """solve_ivp from (t, q, q̇) to t_next; the state at t_next, checked. A span that
-        crawls near a singular position (CRAWL_CALLS) is integrated again at RELAXED_RTOL."""
-        try:
-            sol = self._solve_ivp(t, t_next, q, qd, self.rtol, self.atol)
-        except _Crawl:
-            relax = RELAXED_RTOL / self.rtol
-            self.relaxed_spans.append(dict(t_from=t, t_to=t_next, rtol=RELAXED_RTOL, atol=self.atol * relax))
+        crawls near a singular position (CRAWL_CALLS) is integrated again at a looser
+        tolerance: RELAXED_RTOL, then ten times looser each time, up to RELAXED_MAX."""
+        rtol, atol = self.rtol, self.atol
+        while True:
+            try:
+                sol = self._solve_ivp(t, t_next, q, qd, rtol, atol)
+                break
+            except _Crawl:
+                looser = min(max(RELAXED_RTOL, 10 * rtol), RELAXED_MAX)
+                rtol, atol = looser, atol * looser / rtol
+        if rtol != self.rtol:
+            self.relaxed_spans.append(dict(t_from=t, t_to=t_next, rtol=rtol, atol=atol))
             log.info("near a singular position between t = %.6g and %.6g: integrated at rtol %g, atol %g",
-                     t, t_next, RELAXED_RTOL, self.atol * relax)
-            sol = self._solve_ivp(t, t_next, q, qd, RELAXED_RTOL, self.atol * relax)
+                     t, t_next, rtol, atol)
         self.evaluations += sol.nfev
         self.steps += len(sol.t) - 1
         if sol.status != 0:

@@ -72,9 +72,9 @@ def format_summary(s):
                      f"(nearly dependent rows: {', '.join(rows[:6])}{', ...' if len(rows) > 6 else ''})")
     if s["relaxed_spans"]:
         spans = s["relaxed_spans"]
-        lines.append(f"  integrated at rtol {spans[0]['rtol']:.3g} near them: {len(spans)} span(s) of "
-                     f"{sum(e['t_to'] - e['t_from'] for e in spans):.3g} s in all, the first from t = "
-                     f"{spans[0]['t_from']:.6g} (the requested tolerance crawled there)")
+        lines.append(f"  integrated at rtol up to {max(e['rtol'] for e in spans):.3g} near them: {len(spans)} "
+                     f"span(s) of {sum(e['t_to'] - e['t_from'] for e in spans):.3g} s in all, the first from "
+                     f"t = {spans[0]['t_from']:.6g} (the requested tolerance crawled there)")
     for key in ("out", "plot"):
         if s[key]:
             lines.append(f"  wrote {s[key]}")
