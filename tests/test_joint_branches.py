@@ -4,13 +4,16 @@ joint's orientation lock x_A·y_B = y_A·z_B = z_A·x_B = 0 holds with the frame
 z_B = −z_A. A model starting there is refused, naming the joint; the meant pose loads."""
 
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.projection import consistent_initial_state, project_positions
+from mbsynth.connectors.joints import _numeric, _pose, _rotation_at
 from mbsynth.kinematics import matrix_quaternion, rpy_matrix
+from mbsynth.projection import consistent_initial_state, project_positions
+from mbsynth.symbolic import T_SYMBOL
 
 # a block hung from the world by one joint at its frame ``top`` (z up in the block)
 MODEL = """\
@@ -108,11 +111,6 @@ def test_a_pose_where_the_rows_do_not_hold_yet_is_checked_once_consistent():
 def test_frame_rotations_of_the_branch_check_equal_the_poses_sympy_gives(model):
     """The branch check's numeric rotations (R(u) R_frame, R_z(θ) R_frame, R_frame) against
     substitution into each part's sympy pose, at a random state off the manifold."""
-    from pathlib import Path
-
-    from mbsynth.connectors.joints import _numeric, _pose, _rotation_at
-    from mbsynth.symbolic import T_SYMBOL
-
     system = mb.load(Path(__file__).resolve().parent.parent / "models" / model)
     q = system.initial_state()[0] + 0.3 * np.random.default_rng(5).normal(size=system.n)
     values = {**dict(zip(system.q_symbols, q)), **dict(zip(system.parameter_symbols, system.parameter_values)),
