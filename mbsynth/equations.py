@@ -286,15 +286,16 @@ def _relative_drift(d: "_Data", drift):
     return float(finite.max(initial=0.0))
 
 
-def term_scales(A, x):
+def term_scales(A, x, floor=TERM_FLOOR):
     """The size of the terms of each row's residual at x, estimated from its row of A:
     Σ_j |A_ij x_j| (x² + y² − L² at x, y ≈ L: 2L², where rounding is ε L²; each
-    coordinate counts in its own units, so angles and millimetres mix), plus a thousandth
-    of ‖A_i‖₁ ‖x‖∞ for rows whose coordinates are near zero. A dense or scipy.sparse A."""
+    coordinate counts in its own units, so angles and millimetres mix), plus ``floor``
+    (a thousandth unless given) of ‖A_i‖₁ ‖x‖∞ for rows whose coordinates are near zero.
+    A dense or scipy.sparse A."""
     x = np.abs(np.asarray(x, dtype=float))
     weights = abs(A)
     return (np.asarray(weights @ x).ravel()
-            + TERM_FLOOR * np.asarray(weights.sum(axis=1)).ravel() * x.max(initial=0.0))
+            + floor * np.asarray(weights.sum(axis=1)).ravel() * x.max(initial=0.0))
 
 
 def _restricted(d: "_Data", U, s, Vt, c, keep):

@@ -182,7 +182,7 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
 
 # relative_drift: a row's scale is at least this share of ‖A_i‖₁ ‖x‖∞. At a singular position
 # some rows' terms vanish (the N-four-bar's horizontal velocity rows when the bars lie flat)
-# down to term_scales' own floor of 1e-3 of that, and the same absolute drift read up to a
+# down to term_scales' default floor of 1e-3 of that, and the same absolute drift read up to a
 # thousand times larger there: simulate's spans between projections then shrank to 5e-10 s
 # and stayed there (N = 2 at dt = 0.001, its second crossing)
 DRIFT_FLOOR = 0.1
@@ -197,8 +197,7 @@ def relative_drift(system, t, q, qd):
     worst = 0.0
     for residual, x in ((phi, q), (psi, qd)):
         rows = np.isfinite(residual)
-        norms = np.asarray(abs(A[rows]).sum(axis=1)).ravel()
-        scale = term_scales(A[rows], x) + DRIFT_FLOOR * norms * np.abs(x).max(initial=0.0)
+        scale = term_scales(A[rows], x, floor=DRIFT_FLOOR)
         relative = np.abs(residual[rows]) / np.maximum(scale, np.finfo(float).tiny)
         worst = max(worst, float(relative.max(initial=0.0)))
     return worst

@@ -159,7 +159,8 @@ class _Run:
         self.singular = []  # (t, rows) of the stages near a singular position (Motion.singular)
         self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
         self.singular_call = None  # the span's evaluation count at its first stage near a singular position
-        self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again at RELAXED_RTOL
+        self.span_rtol = rtol  # the rtol the span under way is integrated at
+        self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
 
     @property
     def t(self):
