@@ -1,5 +1,7 @@
 """Constraints as sympy expressions of the model's coordinates: the rows of A q̈ = b (2.4)."""
 
+import functools
+
 import numpy as np
 import sympy as sp
 
@@ -51,9 +53,8 @@ class Connector:
         a, b, phi, psi = rows
         self._name_rows(name, kind, len(b), row_labels)
         q_slots, qd_slots = slots
-        free = set().union(*(x.free_symbols for x in (*b, *phi, *psi, *(e for row in a for e in row))))
-        used = sorted({coordinates[j] for j, s in enumerate(q_slots) if s in free}
-                      | {coordinates[j] for j, s in enumerate(qd_slots) if s in free})
+        free = _slots_in(rows, slots)
+        used = sorted({coordinates[j] for j in free})
         slot_of = {c: j for j, c in enumerate(coordinates)}
         local = [slot_of[i] for i in used]
         self.indices = np.array(used, dtype=int)
@@ -121,6 +122,15 @@ class Connector:
         _, _, _, phi, psi = self._rows(t, q[self.indices], qd[self.indices], p)
         nan = np.full(self.size, np.nan)
         return (phi.ravel() if self._levels[0] else nan, psi.ravel() if self._levels[1] else nan)
+
+
+@functools.lru_cache(maxsize=256)
+def _slots_in(rows, slots):
+    """The positions j whose coordinate slot or velocity slot the rows (a, b, φ, ψ) hold:
+    once per template (connectors alike share their rows)."""
+    a, b, phi, psi = rows
+    free = set().union(*(x.free_symbols for x in (*b, *phi, *psi, *(e for row in a for e in row))))
+    return [j for j, (s, sd) in enumerate(zip(*slots)) if s in free or sd in free]
 
 
 def mixed(holonomic, nonholonomic, q, qd):

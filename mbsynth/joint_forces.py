@@ -11,6 +11,8 @@ joint does both. Along these:
 a turn from θ = 0 (its potential jumps where θ wraps).
 """
 
+import sympy as sp
+
 from .forces import ForceElement
 
 # the joint's (position, rate) attribute for each kind of motion
@@ -25,7 +27,13 @@ def joint_motion(joint):
 def actuation(name, joint, efforts, q, qd, params):
     """A torque about / force along the joint's axis: ``efforts`` maps "torque" and/or
     "force" to expressions (of t, parameters, coordinates)."""
-    pairs = [(effort, getattr(joint, MOTIONS[key][1])) for key, effort in efforts.items()]
+    rates = [MOTIONS[key][1] for key in efforts]
+    gradients = [joint.rate_gradient(rate) for rate in rates]
+    coordinates = set(q) | set(qd)
+    if all(g is not None for g in gradients) and not any(sp.sympify(e).free_symbols & coordinates
+                                                         for e in efforts.values()):
+        return ForceElement.along_rates(name, list(efforts.values()), gradients, joint.placed, params, joint=joint.name)
+    pairs = [(effort, getattr(joint, rate)) for effort, rate in zip(efforts.values(), rates)]
     return ForceElement(name, 0, pairs, q, qd, params, joint=joint.name)
 
 

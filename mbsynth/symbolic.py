@@ -15,9 +15,14 @@ differentiated and compiled a handful of times, not fifty.
 """
 
 import functools
+import importlib
+import inspect
+import linecache
 
 import numpy as np
 import sympy as sp
+
+from .derivation_cache import Unstable, placeholder, remembered
 
 T_SYMBOL = sp.Symbol("t")
 _LARGEST = sp.Float(np.finfo(float).max)
@@ -102,19 +107,20 @@ def generalized_force(V, efforts, q, qd):
     return Q
 
 
-class _Slots:
-    """Positional placeholder symbols (Dummies: they clash with no model's names)."""
+class Slots:
+    """Positional placeholder symbols ``<prefix><i>``, named so that they clash with no
+    model's names and stay the same across processes (derivation_cache.placeholder)."""
 
     def __init__(self, prefix):
         self.prefix, self.items = prefix, []
 
     def __getitem__(self, i):
         while len(self.items) <= i:
-            self.items.append(sp.Dummy(f"{self.prefix}{len(self.items)}"))
+            self.items.append(placeholder(f"{self.prefix}{len(self.items)}"))
         return self.items[i]
 
 
-_ARGUMENT, _RATE, _NUMBER = _Slots("a"), _Slots("r"), _Slots("k")
+_ARGUMENT, _RATE, _NUMBER = Slots("a"), Slots("r"), Slots("k")
 
 
 def _numbers(expr, found):
@@ -195,10 +201,13 @@ def positions(q, qd):
 def _differentiated(forms, count, t):
     """``differentiate`` of each placeholder form in the coordinates a_0 … a_{count−1}
     and velocities a_count …: (rows of a over the involved coordinates, b, ψ)."""
-    q = [_ARGUMENT[i] for i in range(count)]
-    qd = [_ARGUMENT[count + i] for i in range(count)]
-    rows = [differentiate(e, q, qd, t) for e in forms]
-    return tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows), tuple(r[2] for r in rows)
+    def derive():
+        q = [_ARGUMENT[i] for i in range(count)]
+        qd = [_ARGUMENT[count + i] for i in range(count)]
+        rows = [differentiate(e, q, qd, t) for e in forms]
+        return tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows), tuple(r[2] for r in rows)
+
+    return remembered("differentiated", (forms, count, t), derive)
 
 
 def differentiate(phi, q, qd, t=T_SYMBOL):
@@ -274,7 +283,19 @@ def _values(args, values):
         constant = lambda *_: fixed  # noqa: E731
         constant.fixed = fixed  # grouped.py stacks these instead of calling
         return constant
-    raw = sp.lambdify(args, [_beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"], dummify=True)
+    where = {s: (a, None) for a, s in enumerate(args) if isinstance(s, sp.Symbol)}
+    where.update({s: (a, i) for a, group in enumerate(args) if isinstance(group, tuple) for i, s in enumerate(group)})
+    if all(v.is_Number or v in where for v in values):  # numbers and arguments (a joint's effort τ)
+        fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
+        picks = [(k, *where[v]) for k, v in enumerate(values) if not v.is_Number]
+
+        def gathered(*given):
+            out = fixed.astype(np.result_type(fixed, *(np.asarray(given[a]) for _, a, _ in picks)))
+            for k, a, i in picks:
+                out[k] = given[a] if i is None else given[a][i]
+            return out
+        return gathered
+    raw = sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"], dummify=True)
     return lambda *given: np.asarray(raw(*given), dtype=float)
 
 
@@ -283,10 +304,42 @@ def _lambdify(args, forms):
     """The numpy function of (args, numbers) -> [forms], made once per structure
     (``canonical``): joints alike, and models loaded again (a sweep's workers, a file
     checked then simulated) reuse it."""
-    forms = [_beyond_double_as_inf(x) for x in forms]
-    raw = sp.lambdify(args, forms, modules=[_FLOAT64, "numpy"], cse=True, dummify=True)
-    raw.structure = (args, tuple(forms))  # for fast/structures.py, which compiles it with numba
+    raw = remembered("lambdified", (args, forms),
+                     lambda: sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"],
+                                         cse=True, dummify=True),
+                     store=_function_source, load=_function_from_source)
+    raw.structure = (args, forms)  # for fast/structures.py, which compiles it with numba
     return raw
+
+
+@functools.lru_cache(maxsize=1)
+def _lambdify_namespace():
+    """The names every lambdified function sees (numpy's, _FLOAT64)."""
+    return sp.lambdify((), [], modules=[_FLOAT64, "numpy"]).__globals__
+
+
+def _function_source(raw):
+    """(source, [(module, name)] of the names it imports beyond ``_lambdify_namespace``)
+    of a lambdified function, for the derivation cache."""
+    base = _lambdify_namespace()
+    extra = []
+    for name, value in raw.__globals__.items():
+        if name not in base:
+            module = getattr(value, "__module__", None)
+            if module is None or getattr(importlib.import_module(module), name, None) is not value:
+                raise Unstable(name)
+            extra.append((module, name))
+    return inspect.getsource(raw), extra
+
+
+def _function_from_source(stored):
+    source, extra = stored
+    namespace = dict(_lambdify_namespace())
+    namespace.update({name: getattr(importlib.import_module(module), name) for module, name in extra})
+    filename = f"<lambdified-cached-{len(linecache.cache)}>"
+    linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)  # for tracebacks
+    exec(compile(source, filename, "exec"), namespace)  # noqa: S102 - code sympy generated, from our cache
+    return namespace["_lambdifygenerated"]
 
 
 def _frozen(args):
@@ -309,7 +362,7 @@ def _as_double(x):
     return float(x) if abs(x) <= _LARGEST else float(sp.sign(x)) * np.inf
 
 
-def _beyond_double_as_inf(expr):
+def beyond_double_as_inf(expr):
     """``expr`` with exact numbers beyond the double range (a mass of 1e308 times g = 1e308)
     replaced by ±inf, as float arithmetic would give, instead of an OverflowError when
     evaluated; the non-finite result is then reported by the checks of M, Q, A, b."""

@@ -24,6 +24,7 @@ built only when asked. Joints on parts whose frames move with their coordinates,
 friction, are derived directly.
 """
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -32,7 +33,8 @@ import sympy as sp
 from ..constraint import Connector
 from ..kinematics import quaternion_rotation
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
-from ..symbolic import differentiate, differentiated, placed_values, positions, time_derivative
+from ..derivation_cache import remembered, placeholder
+from ..symbolic import Slots, compile_function, differentiate, differentiated, jacobian, placed_values, positions, time_derivative
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}
@@ -130,15 +132,24 @@ class Joint(Connector):
         constants = dict(values)
         if length is not None:
             constants[_LENGTH] = sp.sympify(length)
-        kept = [i for i, phi in enumerate(template.phis) if phi.xreplace(constants) != 0]  # planar parts
+        kept = _kept_rows(template, constants)
         rows = tuple(tuple(x[i] for i in kept) for x in (template.a, template.b, template.phis, template.psi))
         where = positions(q, qd)
         coordinates = [where[s] for s in (parent.q if parent else []) + child.q]
-        self._motions = template.motions
+        self._motions, self._template = template.motions, template
         self._motion_put = (template.slots, coordinates, constants, q, qd)
         self.coulomb = None
         self._place(name, "holonomic", rows, template.slots, coordinates, list(constants.items()), q, qd, params,
                     [template.labels[i] for i in kept])
+
+    def rate_gradient(self, rate):
+        """∂rate/∂q̇ over the velocity slots of the joint's template (``placed``) of ``rate``
+        ("angle_rate" or "displacement_rate"); None for a joint without a template or
+        without that motion."""
+        return None if self._motion_put is None else self._template.gradients[_MOTION_NAMES.index(rate)]
+
+    placed = property(lambda self: self._motion_put,
+                      doc="(slots, coordinates, constants, q, q̇) of the joint's template, or None")
 
     def _motion(self, k):
         expr = self._motions[k]
@@ -168,7 +179,7 @@ class Joint(Connector):
 
 
 SHARED_PARTS = (RigidBody, Particle, PlanarBody)  # poses that depend on their coordinates alone
-_LENGTH = sp.Dummy("L")
+_LENGTH = placeholder("joint_length")
 
 
 def _numeric(matrix, values):
@@ -246,6 +257,27 @@ def _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd):
     return motions
 
 
+def _kept_rows(template, constants):
+    """The rows of ``template`` that do not vanish identically with the frames' values
+    ``constants`` put in (planar parts have no z rows): a row nonzero at a random state is
+    kept; one that is zero there is tested exactly (sympy, slow on big rows)."""
+    if not all(sp.sympify(v).is_Number for v in constants.values()):
+        return [i for i, phi in enumerate(template.phis) if phi.xreplace(constants) != 0]
+    symbols = tuple(constants)
+    values = _phi_function(template.phis, template.slots[0], symbols)(
+        _PROBE[:len(template.slots[0])], np.array([float(constants[s]) for s in symbols]))[0].ravel()
+    return [i for i, (phi, value) in enumerate(zip(template.phis, values))
+            if value != 0 or phi.xreplace(constants) != 0]
+
+
+_PROBE = np.random.default_rng(2006).uniform(0.1, 0.9, 64)  # the random state of _kept_rows
+
+
+@functools.lru_cache(maxsize=64)
+def _phi_function(phis, slots, symbols):
+    return compile_function((list(slots), list(symbols)), [sp.Matrix(phis)])
+
+
 class _Template(NamedTuple):
     """A joint's rows in placeholder symbols: frames (``_PLACEHOLDERS``), the distance
     (``_LENGTH``) and the two parts' coordinates (``slots``: parent's then child's)."""
@@ -256,7 +288,11 @@ class _Template(NamedTuple):
     a: tuple      # per row, its entries over the slots' coordinates
     b: tuple
     psi: tuple
-    motions: tuple
+    motions: tuple    # angle, its rate, displacement, its rate (None where the kind has none)
+    gradients: tuple  # per motion: ∂/∂q̇ over the velocity slots of a rate, else None
+
+
+_MOTION_NAMES = ("angle", "angle_rate", "displacement", "displacement_rate")
 
 
 _templates = {}
@@ -264,29 +300,38 @@ _templates = {}
 
 def _template(kind, parent, child, has_length):
     """The template of joints of ``kind`` between parts of the types of ``parent`` and
-    ``child``, derived (once) from these two."""
+    ``child``, derived (once, and kept on disk: derivation_cache.py) from these two."""
     key = (kind, type(parent), len(parent.q) if parent else 0, type(child), len(child.q), has_length)
     if key not in _templates:
-        q = (list(parent.q) if parent else []) + list(child.q)
-        qd = (list(parent.qd) if parent else []) + list(child.qd)
-        slots = (tuple(sp.Dummy(f"q{i}") for i in range(len(q))), tuple(sp.Dummy(f"qd{i}") for i in range(len(q))))
-        to_slots = dict(zip(q + qd, slots[0] + slots[1]))
-        pA, RA = _pose(parent, _placeholder_frame(0))
-        pB, RB = _pose(child, _placeholder_frame(1))
-        pA, RA, pB, RB = (x.xreplace(to_slots) for x in (pA, RA, pB, RB))
-        phis, labels = joint_equations(kind, pA, RA, pB, RB, _LENGTH if has_length else None)
-        phis = [sp.sympify(phi) for phi in phis]
-        rows = [differentiate(phi, list(slots[0]), list(slots[1])) for phi in phis]
-        motions = _free_motions(kind, parent, child, pA, RA, pB, RB, list(slots[0]), list(slots[1]))
-        motions = tuple(None if m is None else sp.sympify(m).xreplace(to_slots) for m in motions)
-        _templates[key] = _Template(slots, tuple(phis), tuple(labels), tuple(tuple(r[0]) for r in rows),
-                                    tuple(r[1] for r in rows), tuple(r[2] for r in rows), motions)
+        names = (kind, type(parent).__qualname__, key[2], type(child).__qualname__, key[4], has_length)
+        _templates[key] = _Template(*remembered("joint-template", names,
+                                                lambda: _derive_template(kind, parent, child, has_length)))
     return _templates[key]
 
 
-# the offset (3) and rotation (3 × 3) of frames A and B in their parts, as symbols
-_PLACEHOLDERS = [(sp.Matrix(sp.symbols(f"_s{e}:3", cls=sp.Dummy)), sp.Matrix(3, 3, sp.symbols(f"_R{e}:9", cls=sp.Dummy)))
-                 for e in "AB"]
+def _derive_template(kind, parent, child, has_length):
+    q = (list(parent.q) if parent else []) + list(child.q)
+    qd = (list(parent.qd) if parent else []) + list(child.qd)
+    slots = (tuple(_SLOT_Q[i] for i in range(len(q))), tuple(_SLOT_QD[i] for i in range(len(q))))
+    to_slots = dict(zip(q + qd, slots[0] + slots[1]))
+    pA, RA = _pose(parent, _placeholder_frame(0))
+    pB, RB = _pose(child, _placeholder_frame(1))
+    pA, RA, pB, RB = (x.xreplace(to_slots) for x in (pA, RA, pB, RB))
+    phis, labels = joint_equations(kind, pA, RA, pB, RB, _LENGTH if has_length else None)
+    phis = [sp.sympify(phi) for phi in phis]
+    rows = [differentiate(phi, list(slots[0]), list(slots[1])) for phi in phis]
+    motions = _free_motions(kind, parent, child, pA, RA, pB, RB, list(slots[0]), list(slots[1]))
+    motions = tuple(None if m is None else sp.sympify(m).xreplace(to_slots) for m in motions)
+    gradients = tuple(None if m is None or k % 2 == 0 else tuple(jacobian([m], slots[1])) for k, m in enumerate(motions))
+    return (slots, tuple(phis), tuple(labels), tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows),
+            tuple(r[2] for r in rows), motions, gradients)
+
+
+# the slots of the two parts' coordinates and velocities, and the offset (3) and rotation
+# (3 × 3) of frames A and B in their parts: placeholders kept by the derivation cache
+_SLOT_Q, _SLOT_QD = Slots("joint_q"), Slots("joint_qd")
+_PLACEHOLDERS = [(sp.Matrix([placeholder(f"joint_s{e}{i}") for i in range(3)]),
+                  sp.Matrix(3, 3, [placeholder(f"joint_R{e}{i}") for i in range(9)])) for e in "AB"]
 
 
 def _placeholder_frame(end):

@@ -62,7 +62,7 @@ def configure():
     if not os.environ.get("NUMBA_CACHE_DIR"):
         version = cache_dir() / "numba" / sources_hash()
         os.environ["NUMBA_CACHE_DIR"] = str(version)
-        _mark_and_prune(version)
+        mark_and_prune(version)
     import sys
     config = sys.modules.get("numba.core.config")
     # numba imported before us: tell it directly (while another thread is still importing it,
@@ -71,7 +71,7 @@ def configure():
         config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
 
 
-def _mark_and_prune(version):
+def mark_and_prune(version):
     """Touch ``version``'s mark, then remove its siblings whose mark (or, unmarked, whose
     directory) is older than STALE_DAYS. A cache that cannot be written is left alone."""
     try:

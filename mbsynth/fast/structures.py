@@ -23,6 +23,7 @@ import threading
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
+from ..symbolic import beyond_double_as_inf
 from .background import mode
 from .codegen import load
 
@@ -103,7 +104,7 @@ def source(args, forms):
     names.update({s: f"values[{j}, m]" for j, s in enumerate(constants)})
     names.update({s: f"fixed[{j}, m]" for j, s in enumerate(numbers)})
     local = {s: sp.Symbol(f"_a{i}") for i, s in enumerate(names)}
-    renamed = [sp.sympify(e).xreplace(local) for e in forms]
+    renamed = [beyond_double_as_inf(e).xreplace(local) for e in forms]
     used = set().union(*(e.free_symbols for e in renamed)) if renamed else set()
     steps, results = sp.cse(renamed, symbols=sp.numbered_symbols("_x"), order="none")
     used |= set().union(*(e.free_symbols for _, e in steps)) if steps else set()
