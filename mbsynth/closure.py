@@ -65,15 +65,15 @@ def balances(system, t=0.0, q=None, qd=None):
     q0, qd0 = system.initial_state()
     q = q0 if q is None else np.asarray(q, dtype=float)
     qd = qd0 if qd is None else np.asarray(qd, dtype=float)
+    arrays = system.evaluate(t, q, qd)
+    numeric = rank_report(arrays.M, arrays.A).nullspace
+    if numeric.shape[1] == 0:
+        return []  # before the sympy form of the model: seconds on a robot
     values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in system.parameters.items()}
     M, Q, A, _, C = system.symbolic()
     force = Q + C
     state = {s: v for s, v in zip(system.q_symbols + system.qd_symbols, np.concatenate([q, qd]))}
     state[T_SYMBOL] = t
-    arrays = system.evaluate(t, q, qd)
-    numeric = rank_report(arrays.M, arrays.A).nullspace
-    if numeric.shape[1] == 0:
-        return []
     dynamic = set(system.q_symbols) | set(system.qd_symbols) | {T_SYMBOL}
     Mhat = M.col_join(A).subs(values)
     symbolic_w = [] if Mhat.free_symbols & dynamic else Mhat.nullspace(simplify=True)

@@ -56,7 +56,7 @@ def remembered(kind, inputs, derive, *, store=_stable, load=lambda stored: store
     if folder is None:
         return derive()
     try:
-        key = _fingerprint(inputs, {})
+        key = fingerprint(inputs)
     except Unstable:
         return derive()
     path = folder / f"{kind}-{key}.pkl"
@@ -73,12 +73,13 @@ def remembered(kind, inputs, derive, *, store=_stable, load=lambda stored: store
     return result
 
 
-def _fingerprint(value, seen):
+def fingerprint(value, seen=None):
     """A digest of ``value`` (nested tuples of sympy expressions, strings, numbers) that
-    is the same in every process: each expression node hashed once from its class, its
+    is the same in every process (raises Unstable for a Dummy): each expression node hashed once from its class, its
     atoms' exact content and its arguments' digests (``seen``: node -> digest)."""
+    seen = {} if seen is None else seen
     if isinstance(value, (tuple, list)):
-        parts = [_fingerprint(v, seen) for v in value]
+        parts = [fingerprint(v, seen) for v in value]
         return hashlib.sha1(f"{type(value).__name__}({','.join(parts)})".encode()).hexdigest()
     if not isinstance(value, sp.Basic):
         return hashlib.sha1(f"{type(value).__name__}:{value!r}".encode()).hexdigest()
@@ -86,7 +87,7 @@ def _fingerprint(value, seen):
     digest = seen.get(node)
     if digest is None:
         if value.args:
-            content = ",".join(_fingerprint(arg, seen) for arg in value.args)
+            content = ",".join(fingerprint(arg, seen) for arg in value.args)
         elif isinstance(value, sp.Dummy):
             raise Unstable(value)
         elif isinstance(value, sp.Symbol):

@@ -30,9 +30,10 @@ import numpy as np
 import sympy as sp
 
 from .connectors.joints import SHARED_PARTS
+from .derivation_cache import placeholder, remembered
 from .kinematics import matrix_quaternion
 from .subsystems.base import Frame
-from .symbolic import T_SYMBOL, JointValue, compile_function, jacobian, time_derivative
+from .symbolic import T_SYMBOL, JointValue, Slots, compile_function, jacobian, time_derivative
 
 # kind -> (position names, rate names, acceleration names, which positions are angles)
 NAMES = {
@@ -127,25 +128,31 @@ def _expressions(kind, parent, child, frames, q, qd):
             sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
 
 
-# offsets (3) and rotations (3 × 3) of frames A, B and the report frame, as placeholder symbols
-_PLACEHOLDERS = [tuple(sp.symbols(f"_{e}s0:3", cls=sp.Dummy)) + tuple(sp.symbols(f"_{e}R0:9", cls=sp.Dummy))
-                 for e in "ABR"]
+# offsets (3) and rotations (3 × 3) of frames A, B and the report frame, and the slots of the
+# parts' coordinates and velocities: placeholders kept by the derivation cache
+_PLACEHOLDERS = [tuple(placeholder(f"joint_value_{e}{i}") for i in range(12)) for e in "ABR"]
+_SLOT_Q, _SLOT_QD = Slots("joint_value_q"), Slots("joint_value_qd")
 _templates = {}
 
 
 def _template(kind, parent, child):
     """((q slots, q̇ slots), expressions) of ``_expressions`` for joints of ``kind``
-    between parts of the types of ``parent`` and ``child``, frames as placeholders."""
+    between parts of the types of ``parent`` and ``child``, frames as placeholders;
+    derived once, and kept on disk (derivation_cache.py)."""
     key = (kind, type(parent), len(parent.q) if parent is not None else 0, type(child), len(child.q))
     if key not in _templates:
-        q = (list(parent.q) if parent is not None else []) + list(child.q)
-        qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
-        slots = (tuple(sp.Dummy(f"q{i}") for i in range(len(q))), tuple(sp.Dummy(f"qd{i}") for i in range(len(q))))
-        frames = [Frame("", "", sp.Matrix(x[:3]), sp.Matrix(3, 3, x[3:])) for x in _PLACEHOLDERS]
-        to_slots = dict(zip(q + qd, slots[0] + slots[1]))
-        exprs = [e.xreplace(to_slots) for e in _expressions(kind, parent, child, frames, q, qd)]
-        _templates[key] = ([list(x) for x in slots], exprs)
+        names = (kind, type(parent).__qualname__, key[2], type(child).__qualname__, key[4])
+        _templates[key] = remembered("joint-values", names, lambda: _derive_template(kind, parent, child))
     return _templates[key]
+
+
+def _derive_template(kind, parent, child):
+    q = (list(parent.q) if parent is not None else []) + list(child.q)
+    qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+    slots = ([_SLOT_Q[i] for i in range(len(q))], [_SLOT_QD[i] for i in range(len(q))])
+    frames = [Frame("", "", sp.Matrix(x[:3]), sp.Matrix(3, 3, x[3:])) for x in _PLACEHOLDERS]
+    to_slots = dict(zip(q + qd, slots[0] + slots[1]))
+    return slots, [e.xreplace(to_slots) for e in _expressions(kind, parent, child, frames, q, qd)]
 
 
 def _shareable(parent, child, frames):
@@ -179,6 +186,14 @@ def value_expressions(joint):
     pB, RB = child.pose(joint.frames[1])
     scalars, rate_exprs = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
     return dict(zip(positions[:len(scalars)] + rates, list(scalars) + list(rate_exprs)))
+
+
+def value_names(joint):
+    """The names of ``value_expressions`` (found without deriving them)."""
+    if joint.joint_kind not in NAMES:
+        return []
+    positions, rates, _, _ = NAMES[joint.joint_kind]
+    return list(positions if joint.joint_kind not in MATRIX_POSITIONS else ()) + list(rates)
 
 
 def constraint_symbols(joint):

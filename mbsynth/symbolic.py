@@ -22,7 +22,7 @@ import linecache
 import numpy as np
 import sympy as sp
 
-from .derivation_cache import Unstable, placeholder, remembered
+from .derivation_cache import Unstable, fingerprint, placeholder, remembered
 
 T_SYMBOL = sp.Symbol("t")
 _LARGEST = sp.Float(np.finfo(float).max)
@@ -268,11 +268,58 @@ class Compiled:
 @functools.lru_cache(maxsize=4096)
 def _compiled(args, flat, placeholders):
     """(numpy function of (args, placeholder values, numbers), the numbers): the
-    expressions in ``canonical`` form, compiled once per structure."""
+    expressions in ``canonical`` form, compiled once per structure. Both the canonical
+    form's digest and numbers and the compiled source are kept on disk
+    (derivation_cache.py): a model built again in a fresh process skips ``canonical``."""
     symbols = _flat(args) + list(placeholders)
-    forms, numbers = canonical(flat, symbols)
     slots = _placed(args + (placeholders,), iter(_ARGUMENT[i] for i in range(len(symbols))))
-    return _lambdify(slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms), numbers
+    derived = []
+
+    def derive():
+        derived.append(canonical(flat, symbols))
+        forms, numbers = derived[0]
+        try:
+            return fingerprint((slots, len(numbers), forms)), numbers
+        except Unstable:  # a Dummy in the forms: a structure of this process alone
+            return None, numbers
+
+    digest, numbers = remembered("canonical", (args, flat, placeholders), derive, store=_stable_record)
+
+    def structure():
+        """(argument slots, canonical forms): what fast/structures.py compiles with numba."""
+        forms = (derived[0] if derived else canonical(flat, symbols))[0]
+        return slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms
+
+    return _lambdified(digest, structure), numbers
+
+
+_by_structure = {}  # structure digest -> its numpy function, one per structure in this process
+
+
+def _lambdified(digest, structure):
+    """The numpy function of the structure ``digest`` (``structure()``: its argument slots
+    and forms), made once per structure: joints alike, and models loaded again (a sweep's
+    workers, a file checked then simulated) reuse it."""
+    raw = _by_structure.get(digest)
+    if raw is None:
+        def derive():
+            args, forms = structure()
+            return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"],
+                               cse=True, dummify=True)
+
+        if digest is None:
+            raw = derive()
+        else:
+            raw = _by_structure[digest] = remembered("lambdified", digest, derive, store=_function_source,
+                                                     load=_function_from_source)
+        raw.structure = structure  # for fast/structures.py, which compiles it with numba
+    return raw
+
+
+def _stable_record(record):
+    if record[0] is None:
+        raise Unstable(record)
+    return record
 
 
 @functools.lru_cache(maxsize=4096)
@@ -297,19 +344,6 @@ def _values(args, values):
         return gathered
     raw = sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"], dummify=True)
     return lambda *given: np.asarray(raw(*given), dtype=float)
-
-
-@functools.lru_cache(maxsize=4096)
-def _lambdify(args, forms):
-    """The numpy function of (args, numbers) -> [forms], made once per structure
-    (``canonical``): joints alike, and models loaded again (a sweep's workers, a file
-    checked then simulated) reuse it."""
-    raw = remembered("lambdified", (args, forms),
-                     lambda: sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"],
-                                         cse=True, dummify=True),
-                     store=_function_source, load=_function_from_source)
-    raw.structure = (args, forms)  # for fast/structures.py, which compiles it with numba
-    return raw
 
 
 @functools.lru_cache(maxsize=1)

@@ -71,7 +71,7 @@ def kernel(raw, wait=False):
 
 def _build(raw):
     try:
-        evaluate = load(source(*raw.structure), prefix="mbsynth_structure").evaluate
+        evaluate = load(source(*raw.structure()), prefix="mbsynth_structure").evaluate
         evaluate.compile(SIGNATURE)  # here, not at the first call (which may be on the caller's thread)
     except Exception as err:  # noqa: BLE001 - numpy serves
         log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)

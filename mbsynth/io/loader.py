@@ -14,7 +14,7 @@ import sympy as sp
 from ..closure import close
 from ..connectors import Joint
 from ..constraint import Connector
-from ..joint_values import constraint_symbols, value_expressions
+from ..joint_values import constraint_symbols, value_expressions, value_names
 from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..subsystems import LagrangianSubsystem
 from ..symbolic import T_SYMBOL, joint_values_in
@@ -158,12 +158,12 @@ class _Builder:
         self.parts = {part.name: part for part in parts}
         self.q = [sym for part in parts for sym in part.q]
         self.qd = [sym for part in parts for sym in part.qd]
-        self.global_symbols = dict(self.param_symbols, t=T_SYMBOL)
+        self.global_symbols = Names(self.param_symbols, t=T_SYMBOL)
         for part in parts:
             for c, qs, qds in zip(part.coordinates, part.q, part.qd):
                 self.global_symbols[f"{part.name}.{c}"] = qs
                 self.global_symbols[f"{part.name}.{c}_dot"] = qds
-        self.constraint_symbols = dict(self.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
+        self.constraint_symbols = Names(self.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
         args = (self.q, self.qd, self.param_symbols.values())
         constraints = [c for part in parts for c in part.own_constraints(*args)]
         robot_joints, robot_forces = connect_robots(self)
@@ -329,10 +329,11 @@ class _Builder:
                 self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
                           f"joint '{joint.name}' has the name of part '{joint.name}': joints and parts share one "
                           f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
-            for key, expr in value_expressions(joint).items():
-                self.global_symbols[f"{joint.name}.{key}"] = expr
-            for key, symbol in constraint_symbols(joint).items():
-                self.constraint_symbols[f"{joint.name}.{key}"] = symbol
+            values = _Deferred(value_expressions, joint)
+            symbols = _Deferred(constraint_symbols, joint)
+            for key in value_names(joint):  # derived when an expression uses them (sympy: tenths of a second)
+                self.global_symbols[f"{joint.name}.{key}"] = values.entry(key)
+                self.constraint_symbols[f"{joint.name}.{key}"] = symbols.entry(key)
 
     def coordinate_names(self):
         return (str(s) for s in self.q)
@@ -417,3 +418,36 @@ def _kind(value):
 
 def _stem(name):
     return name.rsplit("/", 1)[-1].rsplit(".", 1)[0]
+
+
+class Names(dict):
+    """The names expressions may use (expressions.parse's ``symbols``): a value that is a
+    ``_Deferred`` entry is derived at its first use."""
+
+    def __getitem__(self, name):
+        value = super().__getitem__(name)
+        if isinstance(value, _Entry):
+            value = value.resolve()
+            self[name] = value
+        return value
+
+
+class _Deferred:
+    """``derive(*args)``, a dict, computed once when one of its entries is first used."""
+
+    def __init__(self, derive, *args):
+        self.derive, self.args, self.value = derive, args, None
+
+    def entry(self, key):
+        return _Entry(self, key)
+
+
+class _Entry:
+    def __init__(self, deferred, key):
+        self.deferred, self.key = deferred, key
+
+    def resolve(self):
+        d = self.deferred
+        if d.value is None:
+            d.value = d.derive(*d.args)
+        return d.value[self.key]

@@ -7,6 +7,7 @@ import numpy as np
 import sympy as sp
 
 from ..constraint import Connector
+from ..derivation_cache import placeholder, remembered
 from ..kinematics import body_rate_matrix, rotation, world_rate_matrix
 from .base import Part
 
@@ -59,8 +60,14 @@ class RigidBody(Part):
 def _template():
     """(coordinate slots (q, q̇), placeholders (m, J row by row, g), (M, Q, T, V)): the
     body's equations derived once, for every body (base.Part's ``shared``)."""
-    q, qd = sp.symbols("x y z qw qx qy qz", cls=sp.Dummy), sp.symbols("xd yd zd qwd qxd qyd qzd", cls=sp.Dummy)
-    mass, J, gravity = sp.Dummy("m"), sp.Matrix(3, 3, sp.symbols("J0:9", cls=sp.Dummy)), sp.Matrix(sp.symbols("g0:3", cls=sp.Dummy))
+    return remembered("rigid-body", (), _derive_template)
+
+
+def _derive_template():
+    names = ("x", "y", "z", "qw", "qx", "qy", "qz")
+    q, qd = [placeholder(f"body_{c}") for c in names], [placeholder(f"body_{c}_dot") for c in names]
+    mass, gravity = placeholder("body_m"), sp.Matrix([placeholder(f"body_g{i}") for i in range(3)])
+    J = sp.Matrix(3, 3, [placeholder(f"body_J{i}") for i in range(9)])
     r, u = sp.Matrix(q[:3]), sp.Matrix(q[3:])
     rd, ud = sp.Matrix(qd[:3]), sp.Matrix(qd[3:])
     E, Ed = body_rate_matrix(u), body_rate_matrix(ud)
