@@ -12,14 +12,21 @@ given as q0, q̇0 (the integration alone). Each figure is the best of ``--rounds
 alternating within a round; ratios are to Pinocchio's time in the same run. Also: the
 evaluations of the right-hand side, and for mbsynth the largest position residual of the
 outputs and the spread of the total energy (zero for the exact motion). Model building is
-not timed here (the issue's build targets are measured apart). Writes
-benchmarks/end_to_end_results.md (or ``--out``).
+timed in that table; the second table times it, each figure in a fresh process (best of
+``--rounds``): ``import mbsynth``, ``mb.from_robot`` of the UR5 and of talos (the call,
+sympy and the rest loaded on the way) with the caches warm and with the derivation cache
+off (``MBSYNTH_DERIVATION_CACHE=off``: every derivation done again; numba's cache warm),
+and ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process);
+Pinocchio's ``buildModelFromUrdf`` for scale. Writes benchmarks/end_to_end_results.md (or
+``--out``).
 """
 
 import argparse
 import datetime
 import os
 import platform
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -59,6 +66,46 @@ def mbsynth_run(system, **settings):
     return seconds, traj.stats["evaluations"], float(traj.residual_position.max()), float(np.ptp(traj.energy))
 
 
+TIMED = "import time, sys; t = time.perf_counter(); {code}; print(time.perf_counter() - t)"
+BUILDS = {  # what is timed in a fresh process: (code, settings)
+    "import mbsynth": ("import mbsynth", {}),
+    "from_robot(\"ur5\")": ("import mbsynth as mb; t = time.perf_counter(); mb.from_robot('ur5')", {}),
+    "from_robot(\"talos\")": ("import mbsynth as mb; t = time.perf_counter(); mb.from_robot('talos')", {}),
+    "from_robot(\"ur5\"), derivation cache off": (
+        "import mbsynth as mb; t = time.perf_counter(); mb.from_robot('ur5')", {"MBSYNTH_DERIVATION_CACHE": "off"}),
+    "from_robot(\"talos\"), derivation cache off": (
+        "import mbsynth as mb; t = time.perf_counter(); mb.from_robot('talos')", {"MBSYNTH_DERIVATION_CACHE": "off"}),
+}
+CHECK = ["-m", "mbsynth", "check", "models/robots/ur5_payload.yaml"]
+
+
+def fresh_seconds(code, settings):
+    """Seconds ``code`` reports in a fresh interpreter (TIMED)."""
+    result = subprocess.run([sys.executable, "-c", TIMED.format(code=code)], env={**os.environ, **settings},
+                            capture_output=True, text=True, check=True, cwd=HERE.parent)
+    return float(result.stdout.split()[-1])
+
+
+def check_seconds():
+    """Wall seconds of ``mbsynth check`` on the UR5 with a payload, the whole process."""
+    started = time.perf_counter()
+    subprocess.run([sys.executable, *CHECK], capture_output=True, check=True, cwd=HERE.parent)
+    return time.perf_counter() - started
+
+
+def build_lines(rounds):
+    """The table of model building, in fresh processes (best of ``rounds``; caches warmed first)."""
+    for code, settings in BUILDS.values():
+        fresh_seconds(code, {k: v for k, v in settings.items() if k != "MBSYNTH_DERIVATION_CACHE"})
+    check_seconds()
+    best = {name: min(fresh_seconds(*spec) for _ in range(rounds)) for name, spec in BUILDS.items()}
+    best["mbsynth check ur5_payload.yaml (whole process)"] = min(check_seconds() for _ in range(rounds))
+    started = time.perf_counter()
+    pin.buildModelFromUrdf(robot_files()["talos"])
+    best["Pinocchio buildModelFromUrdf(talos), in process"] = time.perf_counter() - started
+    return ["| step, fresh process | seconds |", "|---|---:|"] + [f"| {k} | {v:.3f} |" for k, v in best.items()]
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=3)
@@ -87,6 +134,7 @@ def main():
         seconds, evaluations = values[:2]
         extra = f"{values[2]:.1e} | {values[3]:.1e}" if len(values) > 2 else "– | –"
         lines.append(f"| {name} | {seconds:.3f} | {seconds / reference:.1f} | {evaluations} | {extra} |")
+    lines += ["", "Building the model (numba's cache warm):", ""] + build_lines(args.rounds)
     text = "\n".join(lines) + "\n"
     Path(args.out).write_text(text)
     print(text)

@@ -39,11 +39,12 @@ class Unstable(Exception):
 
 
 def _stable(value):
-    """``value``, checked to hold no Dummy (nested tuples and lists of expressions)."""
+    """``value``, checked to hold no Dummy (nested tuples and lists of expressions and
+    matrices)."""
     if isinstance(value, (tuple, list)):
         for v in value:
             _stable(v)
-    elif isinstance(value, sp.Basic) and value.has(sp.Dummy):
+    elif isinstance(value, (sp.Basic, sp.MatrixBase)) and value.has(sp.Dummy):
         raise Unstable(value)
     return value
 
@@ -74,10 +75,13 @@ def remembered(kind, inputs, derive, *, store=_stable, load=lambda stored: store
 
 
 def fingerprint(value, seen=None):
-    """A digest of ``value`` (nested tuples of sympy expressions, strings, numbers) that
-    is the same in every process (raises Unstable for a Dummy): each expression node hashed once from its class, its
-    atoms' exact content and its arguments' digests (``seen``: node -> digest)."""
+    """A digest of ``value`` (nested tuples of sympy expressions and matrices, strings,
+    numbers) that is the same in every process (Unstable for a Dummy): each expression node
+    hashed once, from its class, an atom's exact content and its arguments' digests
+    (``seen``: node -> digest)."""
     seen = {} if seen is None else seen
+    if isinstance(value, sp.MatrixBase):
+        return fingerprint(("Matrix", value.shape, tuple(value)), seen)
     if isinstance(value, (tuple, list)):
         parts = [fingerprint(v, seen) for v in value]
         return hashlib.sha1(f"{type(value).__name__}({','.join(parts)})".encode()).hexdigest()

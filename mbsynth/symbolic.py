@@ -38,14 +38,18 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
 
     Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
     M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
-    Each entry is simplified when it is small (``tidy``).
+    Each entry is simplified when it is small (``tidy``). Kept on disk (derivation_cache.py).
     """
-    q, qd = sp.Matrix(q), sp.Matrix(qd)
-    p = sp.Matrix([T]).jacobian(qd).T  # generalized momenta ∂T/∂q̇
-    M = p.jacobian(qd)
-    Q = (sp.Matrix(F) + sp.Matrix([T - V]).jacobian(q).T
-         - p.jacobian(q) * qd - p.diff(t))
-    return M.applyfunc(tidy), Q.applyfunc(tidy)
+    def derive():
+        qs, qds = sp.Matrix(q), sp.Matrix(qd)
+        p = sp.Matrix([T]).jacobian(qds).T  # generalized momenta ∂T/∂q̇
+        M = p.jacobian(qds)
+        Q = (sp.Matrix(F) + sp.Matrix([T - V]).jacobian(qs).T
+             - p.jacobian(qs) * qds - p.diff(t))
+        return M.applyfunc(tidy), Q.applyfunc(tidy)
+
+    inputs = (sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F), tuple(q), tuple(qd), t)
+    return remembered("lagrange", inputs, derive)
 
 
 def tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
@@ -100,11 +104,17 @@ def time_derivative(expr, q, qd, t=T_SYMBOL):
 
 
 def generalized_force(V, efforts, q, qd):
-    """Q = −∂V/∂q + Σ effort ∂rate/∂q̇ (virtual power; each rate linear in q̇), a column over q."""
-    Q = -jacobian([V], q).T
-    for effort, rate in efforts:
-        Q += sp.sympify(effort) * jacobian([rate], qd).T
-    return Q
+    """Q = −∂V/∂q + Σ effort ∂rate/∂q̇ (virtual power; each rate linear in q̇), a column over
+    q; kept on disk (derivation_cache.py)."""
+    efforts = tuple((sp.sympify(effort), sp.sympify(rate)) for effort, rate in efforts)
+
+    def derive():
+        Q = -jacobian([V], q).T
+        for effort, rate in efforts:
+            Q += effort * jacobian([rate], qd).T
+        return Q
+
+    return remembered("generalized-force", (sp.sympify(V), efforts, tuple(q), tuple(qd)), derive)
 
 
 class Slots:
@@ -342,7 +352,10 @@ def _values(args, values):
                 out[k] = given[a] if i is None else given[a][i]
             return out
         return gathered
-    raw = sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"], dummify=True)
+    raw = remembered("values", (args, values),
+                     lambda: sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"],
+                                         dummify=True),
+                     store=_function_source, load=_function_from_source)
     return lambda *given: np.asarray(raw(*given), dtype=float)
 
 
