@@ -16,6 +16,7 @@ timed in that table; the second table times it, each figure in a fresh process (
 ``--rounds``): ``import mbsynth``, ``mb.from_robot`` of the UR5 and of talos (the call,
 sympy and the rest loaded on the way) with the caches warm and with the derivation cache
 off (``MBSYNTH_DERIVATION_CACHE=off``: every derivation done again; numba's cache warm),
+the same with the first ``System.motion`` (the compiled engine built from numba's cache),
 and ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process);
 Pinocchio's ``buildModelFromUrdf`` for scale. Writes benchmarks/end_to_end_results.md (or
 ``--out``).
@@ -71,6 +72,12 @@ BUILDS = {  # what is timed in a fresh process: (code, settings)
     "import mbsynth": ("import mbsynth", {}),
     "from_robot(\"ur5\")": ("import mbsynth as mb; t = time.perf_counter(); mb.from_robot('ur5')", {}),
     "from_robot(\"talos\")": ("import mbsynth as mb; t = time.perf_counter(); mb.from_robot('talos')", {}),
+    "from_robot(\"ur5\") and its first motion": (
+        "import mbsynth as mb; t = time.perf_counter(); s = mb.from_robot('ur5'); s.motion(0.0, *s.initial_state())",
+        {}),
+    "from_robot(\"talos\") and its first motion": (
+        "import mbsynth as mb; t = time.perf_counter(); s = mb.from_robot('talos'); s.motion(0.0, *s.initial_state())",
+        {}),
     "from_robot(\"ur5\"), derivation cache off": (
         "import mbsynth as mb; t = time.perf_counter(); mb.from_robot('ur5')", {"MBSYNTH_DERIVATION_CACHE": "off"}),
     "from_robot(\"talos\"), derivation cache off": (
