@@ -12,12 +12,12 @@ given as q0, q̇0 (the integration alone). Each figure is the best of ``--rounds
 alternating within a round; ratios are to Pinocchio's time in the same run. Also: the
 evaluations of the right-hand side, and for mbsynth the largest position residual of the
 outputs and the spread of the total energy (zero for the exact motion). Model building is
-timed in that table; the second table times it, each figure in a fresh process (best of
-``--rounds``): ``import mbsynth``, ``mb.from_robot`` of the UR5 and of talos (the call,
-sympy and the rest loaded on the way) with the caches warm and with the derivation cache
-off (``MBSYNTH_DERIVATION_CACHE=off``: every derivation done again; numba's cache warm),
-the same with the first ``System.motion`` (the compiled engine built from numba's cache),
-and ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process);
+not timed in that table; the second table times it, each figure in a fresh process (best
+of ``--rounds``): ``import mbsynth``; ``mb.from_robot`` of the UR5 and of talos (the call,
+sympy and the rest loaded on the way) with the caches warm, then with its first
+``System.motion`` (the compiled engine built from numba's cache), then with the derivation
+cache off (``MBSYNTH_DERIVATION_CACHE=off``: every derivation done again; numba's cache
+warm); and ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process);
 Pinocchio's ``buildModelFromUrdf`` for scale. Writes benchmarks/end_to_end_results.md (or
 ``--out``).
 """
