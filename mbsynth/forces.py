@@ -37,7 +37,6 @@ class ForceElement:
         self.conservative = all(sp.sympify(effort) == 0 for effort, _ in efforts)  # all of Q from V
         self.V = sp.sympify(V)
         self._Q = Q = generalized_force(self.V, efforts, q, qd)
-        self._placed = None
         used = Q.free_symbols | self.V.free_symbols
         self.indices = np.array([i for i in range(len(q)) if q[i] in used or qd[i] in used or Q[i] != 0], dtype=int)
         local = [int(i) for i in self.indices]
