@@ -1,6 +1,7 @@
 """`mbsynth check` on the paper's models: ranks, verdicts and balances (Result 3)."""
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -35,6 +36,22 @@ def test_unique_models(capsys, name, n, m, rank_M, rank_A):
         n, m, rank_M, rank_A, n)
     assert report["unique"] and report["indeterminate"] == [] and report["suggested_constraints"] == []
     assert report["consistent"]
+
+
+def test_check_compiles_nothing_and_leaves_the_fast_mode_as_it_was(capsys, monkeypatch):
+    """``check`` runs with MBSYNTH_FAST taken as "off" where the user left it unset, and
+    only while it runs: the models simulated after it in the same process (as in this test
+    session) still get the compiled path; a value the user set is kept."""
+    from mbsynth.fast import background, structures
+    monkeypatch.delenv("MBSYNTH_FAST", raising=False)
+    seen = []  # kernels put to build (the UR5's joints alike are evaluated stacked: grouped.py)
+    monkeypatch.setattr(background, "_submit", lambda *args: seen.append("engine"))
+    monkeypatch.setattr(structures, "_start", lambda *args: seen.append("structure"))
+    assert main(["check", str(MODELS.parent / "robots" / "ur5_payload.yaml")]) == 0
+    assert "MBSYNTH_FAST" not in os.environ and background.mode() == "background" and seen == []
+    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    with background.default_mode("off"):
+        assert background.mode() == "wait"
 
 
 def test_massless_particle_is_a_free_direction(capsys):

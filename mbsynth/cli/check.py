@@ -1,18 +1,18 @@
 """``mbsynth check MODEL``: is the motion unique? (Result 3 at the initial state)"""
 
 import json
-import os
 
 from ..diagnose import diagnose
+from ..fast.background import default_mode
 from ..io import load
 
 
 def run(args):
     # a handful of evaluations at one state: compiling kernels (numba) in the background
-    # would only compete with them; MBSYNTH_FAST set by the user is kept
-    os.environ.setdefault("MBSYNTH_FAST", "off")
-    system = load(args.model)
-    report = diagnose(system)
+    # would only compete with them (MBSYNTH_FAST set by the user is kept)
+    with default_mode("off"):
+        system = load(args.model)
+        report = diagnose(system)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:

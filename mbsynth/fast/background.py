@@ -23,6 +23,7 @@ The worker is a daemon thread: leaving Python never waits for a compilation; one
 short starts again next time.
 """
 
+import contextlib
 import logging
 import os
 import queue
@@ -78,10 +79,23 @@ _lock = threading.Lock()
 _tasks = queue.Queue()
 _worker = None
 _compiled = False  # an Engine has been warmed in this process: the kernels are compiled
+_default_mode = "background"  # MBSYNTH_FAST when it is not set (``default_mode``)
+
+
+@contextlib.contextmanager
+def default_mode(value):
+    """MBSYNTH_FAST taken as ``value`` inside the block where the user has not set it (a
+    command that evaluates a handful of states has no use for compiling kernels)."""
+    global _default_mode
+    before, _default_mode = _default_mode, value
+    try:
+        yield
+    finally:
+        _default_mode = before
 
 
 def mode():
-    value = os.environ.get("MBSYNTH_FAST", "background")
+    value = os.environ.get("MBSYNTH_FAST", _default_mode)
     if value not in MODES:
         raise ValueError(f"MBSYNTH_FAST must be one of {MODES}, got {value!r}")
     return value
