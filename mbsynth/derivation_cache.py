@@ -127,19 +127,12 @@ def _cache_folder():
         _folder = False
         if os.environ.get("MBSYNTH_DERIVATION_CACHE", "").lower() not in ("off", "0", "no"):
             try:
-                from .fast.cache import cache_dir, mark_and_prune
-                folder = cache_dir() / "derivations" / _sources_digest()
+                from .fast.cache import cache_dir, mark_and_prune, sources_hash
+                digest = sources_hash(Path(__file__).resolve().parent, "**/*.py", salt=version("sympy"))
+                folder = cache_dir() / "derivations" / digest
                 folder.mkdir(parents=True, exist_ok=True)
                 mark_and_prune(folder)  # and the entries of older sources removed
                 _folder = folder
             except OSError:
                 pass
     return _folder or None
-
-
-def _sources_digest():
-    digest = hashlib.sha256(version("sympy").encode())
-    root = Path(__file__).resolve().parent
-    for path in sorted(root.rglob("*.py")):
-        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
-    return digest.hexdigest()[:16]

@@ -90,7 +90,9 @@ def _shared(functions, indices):
 
 
 def _values_key(values):
-    return ("fixed", len(values.fixed)) if hasattr(values, "fixed") else id(values)
+    if not hasattr(values, "picks"):
+        return id(values)
+    return ("gathered", len(values.fixed), tuple((k, a, i is None) for k, a, i in values.picks))
 
 
 class _Group:
@@ -104,17 +106,26 @@ class _Group:
         self.raw, self.dest = first.raw, dest
         self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
         self.fixed = np.ascontiguousarray(np.array([f.fixed for f in functions], dtype=float).T)
-        self.constant = hasattr(first.values, "fixed")
-        self.values = (np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
-                       if self.constant else first.values)
+        # constants that are numbers and arguments (symbolic.gather): stacked, and per pick k the
+        # argument a and each member's position in it (None: a scalar), put in per call
+        self.picks = None
+        self.values = first.values
+        if hasattr(first.values, "picks"):
+            self.values = np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
+            self.picks = [(k, a, None if i is None else np.array([f.values.picks[n][2] for f in functions]))
+                          for n, (k, a, i) in enumerate(first.values.picks)]
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
         self.kernel = None  # the numba kernel once it is ready and checked
         self.refused = kernels == "never"  # numpy for good (also when the kernel disagreed with numpy)
         self.wait = kernels == "wait"
 
     def __call__(self, t, q, qd, p):
-        values = self.values if self.constant else _stacked(self.values(t, q[self.columns], qd[self.columns], p),
-                                                            self.dest.shape[1])
+        if self.picks is None:
+            values = _stacked(self.values(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
+        elif self.picks:
+            values = self._gathered(t, q, qd, p)
+        else:
+            values = self.values
         if self.kernel is None and not self.refused:
             self._take_kernel(t, q, qd, p, values)
         if self.kernel is not None:
@@ -122,6 +133,19 @@ class _Group:
             self.kernel(t, q, qd, p, self.columns, values, self.fixed, result)
             return result
         return self._numpy(t, q, qd, p, values)
+
+    def _gathered(self, t, q, qd, p):
+        """The stacked constants with each member's arguments put in."""
+        values, members = self.values.copy(), np.arange(self.dest.shape[1])
+        for k, a, at in self.picks:
+            given = (t, q, qd, p)[a]
+            if at is None:
+                values[k] = given
+            elif a in (1, 2):  # a coordinate or velocity slot: the member's column
+                values[k] = given[self.columns[at, members]]
+            else:
+                values[k] = given[at]
+        return values
 
     def _take_kernel(self, t, q, qd, p, values):
         """Use the kernel from now on if it is ready and agrees with numpy at this state."""

@@ -17,6 +17,7 @@ differentiated and compiled a handful of times, not fifty.
 import functools
 import importlib
 import inspect
+import itertools
 import linecache
 
 import numpy as np
@@ -334,29 +335,32 @@ def _stable_record(record):
 
 @functools.lru_cache(maxsize=4096)
 def _values(args, values):
-    """A function of ``args`` giving the array of ``values``: constant when they are numbers."""
-    if all(v.is_Number for v in values):
-        fixed = np.array([_as_double(v) for v in values], dtype=float)
-        constant = lambda *_: fixed  # noqa: E731
-        constant.fixed = fixed  # grouped.py stacks these instead of calling
-        return constant
+    """A function of ``args`` giving the array of ``values``: gathered from numbers and picks
+    (k, argument a, position i or None) of the arguments where that is all they are, else
+    lambdified."""
     where = {s: (a, None) for a, s in enumerate(args) if isinstance(s, sp.Symbol)}
     where.update({s: (a, i) for a, group in enumerate(args) if isinstance(group, tuple) for i, s in enumerate(group)})
-    if all(v.is_Number or v in where for v in values):  # numbers and arguments (a joint's effort τ)
+    if all(v.is_Number or v in where for v in values):  # numbers, and arguments (a joint's effort τ)
         fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
-        picks = [(k, *where[v]) for k, v in enumerate(values) if not v.is_Number]
+        picks = tuple((k, *where[v]) for k, v in enumerate(values) if not v.is_Number)
 
         def gathered(*given):
+            if not picks:
+                return fixed
             out = fixed.astype(np.result_type(fixed, *(np.asarray(given[a]) for _, a, _ in picks)))
             for k, a, i in picks:
                 out[k] = given[a] if i is None else given[a][i]
             return out
+        gathered.fixed, gathered.picks = fixed, picks  # grouped.py stacks these instead of calling
         return gathered
     raw = remembered("values", (args, values),
                      lambda: sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"],
                                          dummify=True),
                      store=_function_source, load=_function_from_source)
     return lambda *given: np.asarray(raw(*given), dtype=float)
+
+
+_loaded = itertools.count()  # numbers the sources read back, for their traceback file names
 
 
 @functools.lru_cache(maxsize=1)
@@ -383,7 +387,7 @@ def _function_from_source(stored):
     source, extra = stored
     namespace = dict(_lambdify_namespace())
     namespace.update({name: getattr(importlib.import_module(module), name) for module, name in extra})
-    filename = f"<lambdified-cached-{len(linecache.cache)}>"
+    filename = f"<lambdified-cached-{next(_loaded)}>"
     linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)  # for tracebacks
     exec(compile(source, filename, "exec"), namespace)  # noqa: S102 - code sympy generated, from our cache
     return namespace["_lambdifygenerated"]

@@ -77,3 +77,28 @@ def test_a_robots_joints_share_one_call():
     batch = evaluator(system).rows
     groups, singles = batch.layout[1], batch.layout[2]
     assert len(groups) + len(singles) < len(system.constraints) / 2
+
+
+def test_a_robots_joint_torques_share_one_call_and_equal_their_sympy_force():
+    """Talos's 32 actuations, each with its own torque parameter: one stacked call per joint
+    template, and Q equal to the sum of the elements' sympy Q put in numbers by substitution."""
+    import sympy as sp
+    from mbsynth.evaluation import evaluator
+    system = mb.from_robot("talos", floating=True)
+    torques = sorted(k for k in system.parameters if k.startswith("tau_"))
+    system = system.with_parameters(**{k: 0.1 + 0.01 * i for i, k in enumerate(torques)})
+    q, qd = system.initial_state()
+    qd = qd + RNG.normal(size=qd.size)
+    Q = np.zeros(system.n)
+    values = {sp.Symbol(k): v for k, v in system.parameters.items()}
+    values.update(zip(system.q_symbols + system.qd_symbols, np.concatenate([q, qd])))
+    for element in system.forces:
+        for (i, _), x in element.Q.todok().items():
+            Q[i] += float(x.xreplace(values))
+    forces = evaluator(system)
+    for _ in range(2):  # the first call lays the groups out, the second uses them
+        stacked = np.bincount(forces.f_cols, weights=forces.forces(0.0, q, qd, system.parameter_values)[0],
+                              minlength=system.n)
+        assert np.abs(stacked - Q).max() <= 1e-12 * np.abs(Q).max()
+    groups, singles = forces.forces.layout[1], forces.forces.layout[2]
+    assert len(torques) == len(system.forces) == 32 and len(groups) + len(singles) <= 3

@@ -33,8 +33,9 @@ import sympy as sp
 from ..constraint import Connector
 from ..kinematics import quaternion_rotation
 from ..subsystems import Frame, Particle, PlanarBody, RigidBody
-from ..derivation_cache import remembered, placeholder
-from ..symbolic import Slots, compile_function, differentiate, differentiated, jacobian, placed_values, positions, time_derivative
+from ..derivation_cache import placeholder, remembered
+from ..symbolic import (Slots, compile_function, differentiate, differentiated, jacobian, placed_values, positions,
+                        time_derivative)
 
 ROTATING = {"revolute", "cylindrical"}
 SLIDING = {"prismatic", "cylindrical"}

@@ -47,12 +47,13 @@ def cache_dir():
     raise OSError(f"no writable cache directory among {[str(p) for p in candidates]}")
 
 
-def sources_hash(folder=None):
-    """A digest of the fast path's sources (the kernels and everything they call): the .py
-    files of ``folder``, this package by default."""
-    digest = hashlib.sha256()
-    for path in sorted(Path(folder or Path(__file__).resolve().parent).glob("*.py")):
-        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+def sources_hash(folder=None, pattern="*.py", salt=""):
+    """A digest of the fast path's sources (the kernels and everything they call): the files
+    ``pattern`` of ``folder``, this package's .py files by default, and ``salt``."""
+    folder = Path(folder or Path(__file__).resolve().parent)
+    digest = hashlib.sha256(salt.encode())
+    for path in sorted(folder.glob(pattern)):
+        digest.update(path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes())
     return digest.hexdigest()[:16]
 
 

@@ -5,6 +5,7 @@ Expressions are parsed by ``mbsynth.expressions`` (never evaluated as code).
 """
 
 import difflib
+import functools
 import keyword
 from dataclasses import replace
 
@@ -329,11 +330,11 @@ class _Builder:
                 self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
                           f"joint '{joint.name}' has the name of part '{joint.name}': joints and parts share one "
                           f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
-            values = _Deferred(value_expressions, joint)
-            symbols = _Deferred(constraint_symbols, joint)
+            values = functools.cache(functools.partial(value_expressions, joint))
+            symbols = functools.cache(functools.partial(constraint_symbols, joint))
             for key in value_names(joint):  # derived when an expression uses them (sympy: tenths of a second)
-                self.global_symbols[f"{joint.name}.{key}"] = values.entry(key)
-                self.constraint_symbols[f"{joint.name}.{key}"] = symbols.entry(key)
+                self.global_symbols[f"{joint.name}.{key}"] = _Deferred(values, key)
+                self.constraint_symbols[f"{joint.name}.{key}"] = _Deferred(symbols, key)
 
     def coordinate_names(self):
         return (str(s) for s in self.q)
@@ -421,33 +422,18 @@ def _stem(name):
 
 
 class Names(dict):
-    """The names expressions may use (expressions.parse's ``symbols``): a value that is a
-    ``_Deferred`` entry is derived at its first use."""
+    """The names expressions may use (expressions.parse's ``symbols``): a ``_Deferred``
+    value is derived at its first use."""
 
     def __getitem__(self, name):
         value = super().__getitem__(name)
-        if isinstance(value, _Entry):
-            value = value.resolve()
-            self[name] = value
+        if isinstance(value, _Deferred):
+            value = self[name] = value.derive()[value.key]
         return value
 
 
 class _Deferred:
-    """``derive(*args)``, a dict, computed once when one of its entries is first used."""
+    """Entry ``key`` of the dict ``derive()`` returns (``derive`` caches it)."""
 
-    def __init__(self, derive, *args):
-        self.derive, self.args, self.value = derive, args, None
-
-    def entry(self, key):
-        return _Entry(self, key)
-
-
-class _Entry:
-    def __init__(self, deferred, key):
-        self.deferred, self.key = deferred, key
-
-    def resolve(self):
-        d = self.deferred
-        if d.value is None:
-            d.value = d.derive(*d.args)
-        return d.value[self.key]
+    def __init__(self, derive, key):
+        self.derive, self.key = derive, key
