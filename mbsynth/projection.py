@@ -117,8 +117,9 @@ def _accepted(z, G, norm_G, r, size):
     return bool(np.all(np.isfinite(z)) and well_posed and np.linalg.norm(G @ z - r) <= SPARSE_ACCEPT * size)
 
 
-def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
-    """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices).
+def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE, arrays=None):
+    """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices);
+    ``arrays``: the ConstraintArrays at q (any q̇), if at hand.
 
     Gauss–Newton in the equilibrated metric of ``_correction``; where its residual grows,
     again from q with every column scale at least COLUMN_FLOOR × the largest entry of the
@@ -128,17 +129,20 @@ def project_positions(system, t, q, fixed=None, tolerance=TOLERANCE):
     even from a state on the manifold to rounding."""
     start = np.array(q, dtype=float)
     free = _free_columns(start.size, fixed)
-    q = _newton(system, t, start, free, tolerance, floor=0.0)
-    return q if q is not None else _newton(system, t, start, free, tolerance, floor=COLUMN_FLOOR, last=True)
+    q = _newton(system, t, start, free, tolerance, floor=0.0, arrays=arrays)
+    return q if q is not None else _newton(system, t, start, free, tolerance, floor=COLUMN_FLOOR, last=True,
+                                           arrays=arrays)
 
 
-def _newton(system, t, q, free, tolerance, floor, last=False):
+def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
     """Gauss–Newton steps from q (a copy is changed) until every position row is met; None
-    when the residual grows (unless ``last``: then a SolveError names the unmet rows)."""
+    when the residual grows (unless ``last``: then a SolveError names the unmet rows).
+    ``arrays``: the ConstraintArrays at q, if at hand (φ and A do not depend on q̇)."""
     q, qd = q.copy(), np.zeros_like(q)
     previous = np.inf
     for _ in range(MAX_ITERATIONS):
-        arrays = system.constraint_arrays(t, q, qd, sparse=None)
+        if arrays is None:
+            arrays = system.constraint_arrays(t, q, qd, sparse=None)
         phi = arrays.phi
         rows = np.isfinite(phi)
         A = arrays.A[rows]
@@ -150,6 +154,7 @@ def _newton(system, t, q, free, tolerance, floor, last=False):
             return None
         previous = size
         q[free] -= _correction(A[:, free], phi[rows], system.coordinate_groups[free], floor)
+        arrays = None
         if not np.all(np.isfinite(q)):
             break
     if not last:
@@ -161,11 +166,13 @@ def _newton(system, t, q, free, tolerance, floor, last=False):
                                   if abs(r) > tolerance * s])
 
 
-def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
-    """q̇ on the velocity-level rows (φ̇ = 0, ψ = 0), changing only free velocities."""
+def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE, arrays=None):
+    """q̇ on the velocity-level rows (φ̇ = 0, ψ = 0), changing only free velocities;
+    ``arrays``: the ConstraintArrays at (q, q̇), if at hand."""
     qd = np.array(qd, dtype=float)
     free = _free_columns(qd.size, fixed)
-    arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    if arrays is None:
+        arrays = system.constraint_arrays(t, q, qd, sparse=None)
     psi = arrays.psi
     rows = np.isfinite(psi)
     A = arrays.A[rows]
@@ -188,25 +195,28 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE):
 DRIFT_FLOOR = 0.1
 
 
-def relative_drift(system, t, q, qd):
+def relative_drift(system, t, q, qd, arrays=None):
     """The largest residual of φ or ψ relative to its row's terms (module docstring), at
     least DRIFT_FLOOR of the row's norm times the largest coordinate (or rate): how far
-    the state lies off the manifold, alike at every scale."""
-    arrays = system.constraint_arrays(t, q, qd, sparse=None)
-    phi, psi, A = arrays.phi, arrays.psi, arrays.A
+    the state lies off the manifold, alike at every scale. ``arrays``: the
+    ConstraintArrays at (q, q̇), if at hand."""
+    if arrays is None:
+        arrays = system.constraint_arrays(t, q, qd, sparse=None)
     worst = 0.0
-    for residual, x in ((phi, q), (psi, qd)):
+    for residual, x in ((arrays.phi, q), (arrays.psi, qd)):
         rows = np.isfinite(residual)
-        scale = term_scales(A[rows], x, floor=DRIFT_FLOOR)
+        scale = term_scales(arrays.A[rows], x, floor=DRIFT_FLOOR)
         relative = np.abs(residual[rows]) / np.maximum(scale, np.finfo(float).tiny)
         worst = max(worst, float(relative.max(initial=0.0)))
     return worst
 
 
-def project(system, t, q, qd, fixed_q=None, fixed_qd=None):
-    """(q, q̇) on the constraint manifold: positions first, then velocities."""
-    q = project_positions(system, t, q, fixed_q)
-    return q, project_velocities(system, t, q, qd, fixed_qd)
+def project(system, t, q, qd, fixed_q=None, fixed_qd=None, arrays=None):
+    """(q, q̇) on the constraint manifold: positions first, then velocities. ``arrays``:
+    the ConstraintArrays at (q, q̇), if at hand (used while q is unchanged)."""
+    moved = project_positions(system, t, q, fixed_q, arrays=arrays)
+    same = arrays is not None and np.array_equal(moved, q)
+    return moved, project_velocities(system, t, moved, qd, fixed_qd, arrays=arrays if same else None)
 
 
 def consistent_initial_state(system, t=0.0):

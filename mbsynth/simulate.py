@@ -1,12 +1,15 @@
 """Motion over time: integrate (q, q̇) with q̈ from (2.14), keeping the constraints.
 
 The accelerations satisfy the constraints only at the acceleration level (2.4), so
-positions and velocities drift. ``simulate`` integrates with scipy's adaptive
-integrators between output times and, with the default ``stabilization="projection"``,
-projects (q, q̇) back onto the constraints at every output time (projection.py), and
-between output times as often as keeps the drift below DRIFT_TARGET; the integrator
-restarts there with its last step size. ``"baumgarte"`` instead replaces
-b by b − 2α φ̇ − β² φ (Baumgarte 1972) with no restart; ``"none"`` does neither.
+positions and velocities drift. ``simulate`` steps one of scipy's adaptive integrators
+(its OdeSolver classes, as ``solve_ivp`` would) to each output time, its last step there
+cut short, and, with the default ``stabilization="projection"``, projects (q, q̇) back
+onto the constraints at every output time (projection.py), and between output times as
+often as keeps the drift below DRIFT_TARGET. The integrator is not restarted there: an
+explicit Runge–Kutta pair goes on from the projected state, given its derivative, with
+the step it proposed before the cut (``_Run._resumed``); an implicit one (Radau, BDF,
+LSODA) starts afresh with that step. ``"baumgarte"`` instead replaces b by
+b − 2α φ̇ − β² φ (Baumgarte 1972); ``"none"`` does neither.
 
 Consistency is judged where it means something. The integrator's stages lie off the
 manifold by the integration error, so the motion there follows the drift rule of
@@ -29,7 +32,7 @@ import logging
 import time
 
 import numpy as np
-from scipy.integrate import solve_ivp
+import scipy.integrate
 
 from .control import SampledControl
 from .errors import SimulationError, SolveError
@@ -58,6 +61,11 @@ MIN_SPAN = 1e-6  # of the output interval: the shortest span that is redone
 CRAWL_CALLS = 240
 RELAXED_RTOL = 1e-8
 RELAXED_MAX = 1e-7
+METHODS = {kind.__name__: kind for kind in (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853,
+                                            scipy.integrate.Radau, scipy.integrate.BDF, scipy.integrate.LSODA)}
+# integrators that go on from a moved (projected) state given its derivative: an explicit
+# Runge–Kutta pair carries nothing else from one step to the next
+RESUMABLE = (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853)
 
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
@@ -69,7 +77,8 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     q0, qd0: the initial state (default: the model's, made consistent by projection
     keeping every value the model sets; the changes are logged and kept in
     ``stats["initial_changes"]``). dt: output interval (default (t_end − t0)/500).
-    method, rtol, atol: scipy ``solve_ivp`` settings. out: a .npz or .csv path written as
+    method, rtol, atol: the integrator (a ``solve_ivp`` method name or a scipy OdeSolver class)
+    and its tolerances. out: a .npz or .csv path written as
     the run goes. progress: a callable(t) called at every output time.
     controller: ``f(t, joint_values) -> {parameter: value}``, called at t0 and every
     ``control_dt`` (default: the output interval), its values held in between (sampled
@@ -78,6 +87,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     """
     if stabilization not in STABILIZATIONS:
         raise ValueError(f"stabilization must be one of {STABILIZATIONS}, got {stabilization!r}")
+    method = _integrator(method)
     if not t_end > t0:
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0})")
     system = system.for_run()  # one motion path (tree or KKT) for the whole run
@@ -100,7 +110,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     status = "stopped"
     try:
         if control is not None:
-            run.system = control.apply(t0, q, qd)
+            run.restart(control.apply(t0, q, qd))
         run.record(t0, q, qd, writer)
         run.t_now = t0
         for t_next in sorted(outputs | samples)[1:]:
@@ -108,7 +118,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
             if t_next in samples:
                 run.restart(control.apply(t_next, q, qd))
             if t_next in outputs:
-                run.record(t_next, q, qd, writer)
+                run.record(t_next, q, qd, writer, None if t_next in samples else run.arrays)
                 if progress is not None:
                     progress(t_next)
         status = COMPLETED
@@ -129,6 +139,15 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     return traj
 
 
+def _integrator(method):
+    """The OdeSolver class of ``method``: a ``solve_ivp`` method name or such a class."""
+    if isinstance(method, type) and issubclass(method, scipy.integrate.OdeSolver):
+        return method
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)} (or a scipy OdeSolver class), got {method!r}")
+    return METHODS[method]
+
+
 def _output_times(t0, t_end, dt):
     if dt is None:
         return np.linspace(t0, t_end, DEFAULT_OUTPUTS + 1)
@@ -146,11 +165,14 @@ class _Run:
         self.outputs = OutputEvaluator(system)
         self.stabilization = stabilization
         self.baumgarte = baumgarte if stabilization == "baumgarte" else None
+        self.stage_motion = system.stage_motion(self.baumgarte, drift=True)
         self.n = system.n
         self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity",
                                      "outputs")}
         self.steps = self.evaluations = 0
-        self.first_step = None
+        self.solver = None  # the integrator, kept from span to span (``_resumed``)
+        self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
+        self.next_step = None  # the step it proposed after its last step not cut short at a span's end
         self.t_failed = float("nan")
         self.t_now = None  # the time the state has reached (outputs and control samples alike)
         self.non_unique = False
@@ -169,17 +191,19 @@ class _Run:
     def restart(self, system):
         """Go on with ``system`` (new parameter values at a control sample): the forces jump,
         so the integrator starts afresh."""
-        self.system, self.outputs.system, self.first_step = system, system, None
+        self.system, self.outputs.system, self.solver = system, system, None
+        self.stage_motion = system.stage_motion(self.baumgarte, drift=True)
 
     def rhs(self, t, y):
         self.t_failed = t
         self.calls += 1
+        self.evaluations += 1
         if self.calls % COLLAPSE_CALLS == 0:
             if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
                 raise self._collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
         q, qd = y[:self.n], y[self.n:]
-        motion = self.system.motion(t, q, qd, baumgarte=self.baumgarte, drift=True)
+        motion = self.stage_motion(t, q, qd)
         self.non_unique |= not motion.unique
         if motion.singular:
             self.singular.append((t, motion.singular))
@@ -201,19 +225,24 @@ class _Run:
         while t < t_next:
             t_to = t_next if self.drift_span is None or t + 1.5 * self.drift_span >= t_next else t + self.drift_span
             q_to, qd_to = self._integrate(t, t_to, q, qd)
+            arrays = None
             if self.stabilization == "projection":
                 self.t_failed = t_to
-                drift = relative_drift(self.system, t_to, q_to, qd_to)
+                arrays = self.system.constraint_arrays(t_to, q_to, qd_to, sparse=None)
+                drift = relative_drift(self.system, t_to, q_to, qd_to, arrays)
                 if drift > DRIFT_REDO * DRIFT_TARGET and t_to - t > MIN_SPAN * interval:
                     self.drift_span = (t_to - t) / 4
                     continue
                 self._adapt_span(drift, t_to - t, interval)
-                q_to, qd_to = project(self.system, t_to, q_to, qd_to)
+                q_on, qd_on = project(self.system, t_to, q_to, qd_to, arrays=arrays)
+                if not (np.array_equal(q_on, q_to) and np.array_equal(qd_on, qd_to)):
+                    q_to, qd_to, arrays = q_on, qd_on, None
             t, q, qd = t_to, q_to, qd_to
         self._note_singular()
         if self.stabilization == "projection":
             self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
         self.t_now = t_next
+        self.arrays = arrays  # the ConstraintArrays at the state reached, if at hand (for ``record``)
         return q, qd
 
     def _adapt_span(self, drift, span, interval):
@@ -223,42 +252,57 @@ class _Run:
             self.drift_span = None if 2 * self.drift_span >= interval else 2 * self.drift_span
 
     def _integrate(self, t, t_next, q, qd):
-        """solve_ivp from (t, q, q̇) to t_next; the state at t_next, checked. A span that
+        """The integrator from (t, q, q̇) to t_next; the state at t_next, checked. A span that
         crawls near a singular position (CRAWL_CALLS) is integrated again at a looser
         tolerance: RELAXED_RTOL, then ten times looser each time, up to RELAXED_MAX."""
-        rtol, atol = self.rtol, self.atol
+        rtol, atol, proposed = self.rtol, self.atol, self.next_step
         while True:
             try:
-                sol = self._solve_ivp(t, t_next, q, qd, rtol, atol)
+                y = self._span(t, t_next, np.concatenate([q, qd]), rtol, atol)
                 break
             except _Crawl:
+                self.solver, self.next_step = None, proposed  # stopped within a step; its steps are no guide
                 looser = min(max(RELAXED_RTOL, 10 * rtol), RELAXED_MAX)
                 rtol, atol = looser, atol * looser / rtol
         if rtol != self.rtol:
             self.relaxed_spans.append(dict(t_from=t, t_to=t_next, rtol=rtol, atol=atol))
             log.info("near a singular position between t = %.6g and %.6g: integrated at rtol %g, atol %g",
                      t, t_next, rtol, atol)
-        self.evaluations += sol.nfev
-        self.steps += len(sol.t) - 1
-        if sol.status != 0:
-            self.t_failed = sol.t[-1]
-            raise self._collapse(sol.t[-1], sol.y[:, -1], sol.message.rstrip("."))
-        steps = np.diff(sol.t)
-        self.first_step = steps[-2] if steps.size > 1 else self.first_step  # the last step was cut short
-        y = sol.y[:, -1]
         self._check(t_next, y)
         return y[:self.n], y[self.n:]
 
-    def _solve_ivp(self, t, t_next, q, qd, rtol, atol):
+    def _span(self, t, t_next, y, rtol, atol):
+        """The integrator's steps from (t, y) to t_next (its last step cut short there)."""
         self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
         self.singular_call, self.span_rtol = None, rtol
-        first_step = min(self.first_step, t_next - t) if self.first_step else None
-        try:
-            return solve_ivp(self.rhs, (t, t_next), np.concatenate([q, qd]), method=self.method, rtol=rtol,
-                             atol=atol, first_step=first_step)
-        except _Crawl:
-            self.evaluations += self.calls
-            raise
+        solver = self._resumed(t, y, t_next, rtol, atol)
+        while solver.status == "running":
+            message = solver.step()
+            if solver.status == "failed":
+                self.t_failed = solver.t
+                raise self._collapse(solver.t, solver.y, (message or "the integrator failed").rstrip("."))
+            self.steps += 1
+            if solver.t != t_next:
+                self.next_step = solver.h_abs
+        return solver.y.copy()
+
+    def _resumed(self, t, y, t_bound, rtol, atol):
+        """The integrator at (t, y), bound for t_bound, its first step the one it proposed
+        before the last span's end cut its step short: the same integrator where it can go
+        on from there (RESUMABLE, at the same tolerances; given y's derivative where the
+        state was moved, by a projection), else a new one, as ``solve_ivp`` would start it."""
+        first = None if self.next_step is None else min(self.next_step, t_bound - t)
+        solver = self.solver
+        if isinstance(solver, RESUMABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
+            if not np.array_equal(solver.y, y):
+                solver.y, solver.f = y, self.rhs(t, y)
+            solver.t_bound, solver.status = t_bound, "running"
+            if first is not None:
+                solver.h_abs = first
+            return solver
+        self.solver = self.method(self.rhs, t, y, t_bound, rtol=rtol, atol=atol, first_step=first)
+        self.solver_tolerances = (rtol, atol)
+        return self.solver
 
     def _note_singular(self):
         """One entry of ``singular_positions`` for the stages of the interval just done."""
@@ -288,9 +332,10 @@ class _Run:
             raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
                              f"{', '.join(culprits[:6])}", coordinates=culprits)
 
-    def record(self, t, q, qd, writer):
+    def record(self, t, q, qd, writer, arrays=None):
+        """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, if at hand."""
         kinetic, potential = self.system.energy(t, q, qd)
-        phi, psi = self.system.constraint_residuals(t, q, qd)
+        phi, psi = self.system.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
         row = dict(t=t, q=np.array(q), qd=np.array(qd), energy=kinetic + potential, kinetic=kinetic,
                    residual_position=_max_abs(phi), residual_velocity=_max_abs(psi),
                    outputs=self.outputs.evaluate(t, q, qd) if self.outputs else np.zeros(0))
