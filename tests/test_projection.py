@@ -1,12 +1,15 @@
 """projection._correction: the least-norm step of a sparse J, checked against dense least
 squares (numpy's SVD-based lstsq, an independent computation)."""
 
+from pathlib import Path
+
 import numpy as np
 import scipy.sparse
 
 from mbsynth.projection import _correction
 
 RNG = np.random.default_rng(3)
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def tree_rows(count, width=5):
@@ -103,3 +106,33 @@ def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near
     projected = project_velocities(system, 0.0, q, qd)
     assert abs(q[u] @ projected[u]) < 1e-15
     assert np.abs(projected - qd).max() < 1.5e-9
+
+
+def test_a_pendulum_bob_near_the_vertical_is_moved_along_its_rod():
+    """A01's bob (an energy-defined part, T = ½ m (ẋ² + ẏ²)) near the bottom, x = −0.0127,
+    its rod 1e-9 too long: x and y have equal M_ii, hence the same units, and share one
+    scale (subsystems.lagrangian.same_units), so the least change moves the bob along the
+    rod, Δ ∥ (x, y). With a scale per coordinate the step went on x almost alone, by
+    φ/(2 ∂φ/∂x) ≈ 20 φ, and its velocity projection changed the energy by 4e-7 of mg L."""
+    import mbsynth as mb
+    from mbsynth.projection import project
+
+    system = mb.load(ROOT / "models" / "mechanisms" / "simple_pendulum.yaml")
+    q = np.array([-0.0126790881960727, -0.9999196171187412]) * (1 + 5e-10)
+    qd = np.array([-4.428912801894245, 0.05615909025580679])
+    projected, _ = project(system, 0.0, q, qd)
+    step = projected - q
+    assert abs(np.hypot(*projected) - 1.0) < 1e-15
+    assert abs(step[0] * q[1] - step[1] * q[0]) < 1e-6 * np.linalg.norm(step) * np.linalg.norm(q)
+
+
+def test_coordinates_of_equal_mass_entries_share_a_scale_and_others_do_not():
+    """same_units: x, y under ½ m (ẋ² + ẏ²) together; r, θ under ½ m (ṙ² + r² θ̇²) apart."""
+    import mbsynth as mb
+
+    cartesian = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x, y], "
+                         "T: 0.5*(x_dot**2 + y_dot**2)}\n")
+    polar = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [r, th], "
+                     "T: 0.5*(r_dot**2 + r**2*th_dot**2)}\n")
+    assert len(set(cartesian.coordinate_groups)) == 1
+    assert len(set(polar.coordinate_groups)) == 2
