@@ -145,15 +145,14 @@ def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
             arrays = system.constraint_arrays(t, q, qd, sparse=None)
         phi = arrays.phi
         rows = np.isfinite(phi)
-        A = arrays.A[rows]
-        unmet = np.abs(phi[rows]) > tolerance * term_scales(A, q)
+        unmet = np.abs(phi[rows]) > tolerance * term_scales(arrays.A, q)[rows]
         if not unmet.any():
             return q
         size = np.abs(phi[rows]).max()
         if not last and size > 2 * previous:
             return None
         previous = size
-        q[free] -= _correction(A[:, free], phi[rows], system.coordinate_groups[free], floor)
+        q[free] -= _correction(arrays.A[rows][:, free], phi[rows], system.coordinate_groups[free], floor)
         arrays = None
         if not np.all(np.isfinite(q)):
             break
@@ -175,9 +174,9 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=TOLERANCE, arrays
         arrays = system.constraint_arrays(t, q, qd, sparse=None)
     psi = arrays.psi
     rows = np.isfinite(psi)
-    A = arrays.A[rows]
-    if not (np.abs(psi[rows]) > tolerance * term_scales(A, qd)).any():
+    if not (np.abs(psi[rows]) > tolerance * term_scales(arrays.A, qd)[rows]).any():
         return qd
+    A = arrays.A[rows]
     qd[free] -= _correction(A[:, free], psi[rows], system.coordinate_groups[free])  # ψ is affine in q̇, slope A
     _, psi = system.constraint_residuals(t, q, qd)
     unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
@@ -205,7 +204,7 @@ def relative_drift(system, t, q, qd, arrays=None):
     worst = 0.0
     for residual, x in ((arrays.phi, q), (arrays.psi, qd)):
         rows = np.isfinite(residual)
-        scale = term_scales(arrays.A[rows], x, floor=DRIFT_FLOOR)
+        scale = term_scales(arrays.A, x, floor=DRIFT_FLOOR)[rows]
         relative = np.abs(residual[rows]) / np.maximum(scale, np.finfo(float).tiny)
         worst = max(worst, float(relative.max(initial=0.0)))
     return worst

@@ -136,3 +136,20 @@ def test_coordinates_of_equal_mass_entries_share_a_scale_and_others_do_not():
                      "T: 0.5*(r_dot**2 + r**2*th_dot**2)}\n")
     assert len(set(cartesian.coordinate_groups)) == 1
     assert len(set(polar.coordinate_groups)) == 2
+
+
+def test_term_scales_of_a_sparse_matrix_equal_the_sum_of_its_terms():
+    """term_scales from a CSR matrix's arrays (rows without entries included) equals
+    Σ_j |A_ij x_j| + floor Σ_j |A_ij| max|x| summed entry by entry."""
+    from mbsynth.equations import term_scales
+
+    A = scipy.sparse.random(40, 60, density=0.1, random_state=5, format="lil")
+    A[7, :] = 0.0
+    A = A.tocsr()
+    A.data -= 0.5
+    x = RNG.normal(size=60)
+    dense = A.toarray()
+    expected = [sum(abs(a * b) for a, b in zip(row, x)) + 1e-3 * sum(abs(row)) * max(abs(x)) for row in dense]
+    np.testing.assert_allclose(term_scales(A, x), expected, rtol=1e-14)
+    np.testing.assert_allclose(term_scales(dense, x), expected, rtol=1e-14)
+    assert term_scales(A, x)[7] == 0.0
