@@ -15,6 +15,8 @@ row's residual is judged against the size of its terms, estimated from the row o
 ``TOLERANCE``.
 """
 
+import functools
+
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
@@ -82,10 +84,13 @@ def _correction(J, r, groups, floor=0.0):
 
 def _dense_correction(J, r, groups, floor=0.0):
     """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
-    magnitude = np.abs(J)
-    touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True, initial=0.0), 0.0)
     columns = _grouped(np.einsum("ij,ij->j", J, J), groups)
-    d = 1.0 / _floored(columns, floor * touched.max(axis=0, initial=0.0))
+    least = 0.0
+    if floor:
+        magnitude = np.abs(J)
+        touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True, initial=0.0), 0.0)
+        least = floor * touched.max(axis=0, initial=0.0)
+    d = 1.0 / _floored(columns, least)
     G = J * d
     size = np.linalg.norm(r) + 1e-300
     try:
@@ -100,8 +105,17 @@ def _dense_correction(J, r, groups, floor=0.0):
 
 def _grouped(squares, groups):
     """Column scales from the squared column norms: per group, the root mean square."""
-    labels, inverse, counts = np.unique(groups, return_inverse=True, return_counts=True)
-    return np.sqrt(np.bincount(inverse, weights=squares, minlength=labels.size)[inverse] / counts[inverse])
+    labels, inverse, counts = _labelled(np.asarray(groups).tobytes(), np.asarray(groups).dtype.str)
+    return np.sqrt(np.bincount(inverse, weights=squares, minlength=labels)[inverse] / counts[inverse])
+
+
+@functools.lru_cache(maxsize=64)
+def _labelled(groups, dtype):
+    """(number of groups, each column's group index, each group's size) of the group labels
+    (as bytes: a System's labels are the same at every projection of a run)."""
+    labels, inverse, counts = np.unique(np.frombuffer(groups, dtype=dtype), return_inverse=True,
+                                        return_counts=True)
+    return labels.size, inverse, counts
 
 
 def _floored(columns, least):
