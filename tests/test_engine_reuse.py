@@ -91,6 +91,22 @@ def test_with_parameters_shares_the_compiled_code(model, background_mode):
     assert rel(engine.motion(0.5, q, qd).qdd, derived.motion(0.5, q, qd).qdd) > 1e-3  # the numbers differ
 
 
+def test_a_force_parameter_keeps_the_layout_and_moves_the_motion(model, background_mode):
+    """k enters only the push on the bob (an argument of the generated code), not the
+    Layout's numbers (masses, inertias, frames, lengths, gravity: m, L, mb, Ib, R, g): a
+    System differing only in k shares its parent's Layout as it is (a controller's torques
+    at every sample), and its motion is the literal (2.14)'s with the new k."""
+    engine = engine_for(model, wait=True)
+    assert {list(model.parameters)[i] for i in engine.template.number_parameters} == {"m", "L", "mb", "Ib", "R", "g"}
+    pushed = model.with_parameters(k=-7.0)
+    derived = engine_for(pushed)
+    assert derived.L is engine.L
+    q, qd = a_state(pushed)
+    assert rel(derived.motion(1.0, q, qd).qdd, pushed.motion(1.0, q, qd, method="reference").qdd) < 1e-10
+    assert rel(derived.motion(1.0, q, qd).qdd, engine.motion(1.0, q, qd).qdd) > 1e-3  # k does act
+    assert engine_for(model.with_parameters(mb=0.9)).L is not engine.L
+
+
 def test_a_massless_body_from_a_parameter(model, background_mode):
     """b1 welded to b0 loses its mass and inertia: M gets a zero block (a structural change
     of (2.14)'s problem), which the reused Engine meets with the numbers a fresh build has."""

@@ -5,7 +5,8 @@ function (codegen.py), or returns None when the kernels cover no part of it. Sys
 differ only in parameter values (``System.with_parameters``) share one Template: the
 parameters are arguments of the generated function, and the Layout's numbers (masses,
 inertias, frame offsets) are re-evaluated per System (layout.with_parameters), which costs
-no compilation. ``Template.engine(system)`` makes a System's Engine: its numbers and work
+no compilation, and only where a parameter they depend on changed (a controller's
+torques do not: ``Template.number_parameters``). ``Template.engine(system)`` makes a System's Engine: its numbers and work
 buffers. An Engine holds no reference to its System.
 
 ``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
@@ -39,6 +40,11 @@ class Template:
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
+        names = list(system.parameters)
+        # the parameters the Layout's numbers depend on (masses, inertias, frames): a System
+        # that differs only in others (a controller's torques) shares the Layout as it is
+        self.number_parameters = np.array([names.index(n) for n in sorted(layout.number_parameters(L, system))],
+                                          dtype=np.int64)
 
     @classmethod
     def build(cls, system):
@@ -48,7 +54,7 @@ class Template:
     def engine(self, system):
         """The Engine of ``system``: this Template's structure and code, its own numbers."""
         p = system.parameter_values
-        same = p.shape == self.p.shape and np.array_equal(p, self.p)
+        same = p.shape == self.p.shape and np.array_equal(p[self.number_parameters], self.p[self.number_parameters])
         return Engine(self, self.L if same else layout.with_parameters(self.L, system), p)
 
 

@@ -97,6 +97,20 @@ class _Numbers:
         return np.array(matrix.xreplace(self.values).tolist(), dtype=float)
 
 
+class _Symbols(_Numbers):
+    """The names of the parameters that numbers depend on (``used``), each expression's free
+    symbols recorded; zeros of its shape returned."""
+
+    def __init__(self, system):
+        super().__init__(system)
+        self.used = set()
+
+    def __call__(self, expr):
+        matrix = expr if isinstance(expr, sp.MatrixBase) else sp.Matrix([[sp.sympify(expr)]])
+        self.used |= {s.name for s in matrix.free_symbols if s in self.values}
+        return np.zeros(matrix.shape)
+
+
 def build(system):
     """(Layout, generated expressions) of ``system``, or None when no part is a kernel node
     or a joint has Coulomb friction (its C depends on q̈: system.motion iterates)."""
@@ -171,12 +185,24 @@ def _tree(count, joints, node_of):
 def with_parameters(L, system):
     """``L``, built from a System with the parts and constraints of ``system`` (other
     parameter values: ``System.with_parameters``), with the numbers of ``system``."""
+    return L._replace(**_numbers(*_sources(L, system), _Numbers(system)))
+
+
+def number_parameters(L, system):
+    """The names of the parameters that ``L``'s numbers (``_numbers``) depend on: a System
+    that differs from ``system`` only in others shares ``L`` as it is."""
+    symbols = _Symbols(system)
+    _numbers(*_sources(L, system), symbols)
+    return frozenset(symbols.used)
+
+
+def _sources(L, system):
+    """(the parts of ``L``'s nodes, the constraints of its kernel joints) in ``system``."""
     starts = np.cumsum([0] + [len(p.coordinates) for p in system.subsystems])
     rows = np.cumsum([0] + [c.size for c in system.constraints])
     part_at = {int(s): part for part, s in zip(system.subsystems, starts)}
     con_at = {int(r): con for con, r in zip(system.constraints, rows)}
-    return L._replace(**_numbers([part_at[int(c)] for c in L.node_q], [con_at[int(r)] for r in L.joint_row],
-                                 _Numbers(system)))
+    return [part_at[int(c)] for c in L.node_q], [con_at[int(r)] for r in L.joint_row]
 
 
 def _numbers(parts, joints, number):
