@@ -171,6 +171,7 @@ class _Run:
                                      "outputs")}
         self.steps = self.evaluations = 0
         self.solver = None  # the integrator, kept from span to span (``_resumed``)
+        self.solver_tolerances = None  # its (rtol, atol)
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
         self.next_step = None  # the step it proposed after its last step not cut short at a span's end
         self.t_failed = float("nan")
