@@ -61,12 +61,12 @@ SEED = 7
 class Case:
     """One simulation timed in both codes: the mbsynth System, its Pinocchio model (the
     robot's URDF, or ``twin.Twin``), and the state both start from: Pinocchio's (q, v)
-    and mbsynth's (q, q̇) of it by forward kinematics (``Twin.to_maximal``); ``q0`` None:
+    and mbsynth's (q, q̇) of it by forward kinematics (``Twin.to_maximal``); no ``twin``:
     mbsynth's own initial state made consistent by ``simulate`` (as a user calls it)."""
 
-    def __init__(self, name, system, model, q, v, q0=None, qd0=None, t_end=T_END):
-        self.name, self.system, self.model, self.q, self.v = name, system, model, q, v
-        self.start = {} if q0 is None else dict(q0=q0, qd0=qd0)
+    def __init__(self, name, system, model, q, v, twin=None, t_end=T_END):
+        self.name, self.system, self.model, self.q, self.v, self.twin = name, system, model, q, v, twin
+        self.start = {} if twin is None else dict(zip(("q0", "qd0"), twin.to_maximal(q, v)))
         self.t_end = t_end
 
 
@@ -76,24 +76,18 @@ def ur5_case():
                 np.zeros(model.nv))
 
 
-def twin_case(name, system, q, v, t_end=T_END):
-    """A Case of ``system`` through its Pinocchio twin, from Pinocchio's (q, v)."""
-    twin = Twin(system)
-    return Case(name, system, twin.model, q(twin.model), v, *twin.to_maximal(q(twin.model), v), t_end=t_end)
-
-
 def talos_case(rng):
-    system = mb.from_robot("talos", floating=True)
-    nv = Twin(system).model.nv
-    rates = np.concatenate([np.zeros(6), rng.uniform(-0.5, 0.5, nv - 6)])  # the base at rest, joints moving
-    return twin_case("talos, floating, joint rates in ±0.5 rad/s", system, pin.neutral, rates)
+    twin = Twin(mb.from_robot("talos", floating=True))
+    rates = np.concatenate([np.zeros(6), rng.uniform(-0.5, 0.5, twin.model.nv - 6)])  # the base at rest
+    return Case("talos, floating, joint rates in ±0.5 rad/s", twin.system, twin.model, pin.neutral(twin.model),
+                rates, twin)
 
 
 def chain_case(rng, count=100):
-    system = mb.loads(chain_yaml(count), name=f"chain_{count}")
+    twin = Twin(mb.loads(chain_yaml(count), name=f"chain_{count}"))
     angles, rates = rng.uniform(-0.3, 0.3, count), rng.uniform(-0.5, 0.5, count)
-    return twin_case(f"chain of {count} links, angles in ±0.3 rad, rates in ±0.5 rad/s", system,
-                     lambda model: angles, rates, t_end=CHAIN_T_END)
+    return Case(f"chain of {count} links, angles in ±0.3 rad, rates in ±0.5 rad/s", twin.system, twin.model,
+                angles, rates, twin, t_end=CHAIN_T_END)
 
 
 def pinocchio_rhs(model):
@@ -139,9 +133,9 @@ def disagreement(case, pinocchio_q, mbsynth_q):
     """The largest distance between the two codes' final positions of a body's reference
     point (``Twin.to_maximal`` of Pinocchio's q beside mbsynth's q; joint angles would differ
     by turns), or None when the case has no twin (the UR5 from its URDF)."""
-    if not case.start:
+    if case.twin is None:
         return None
-    reached = Twin(case.system).to_maximal(pinocchio_q, np.zeros(case.model.nv))[0]
+    reached = case.twin.to_maximal(pinocchio_q, np.zeros(case.model.nv))[0]
     return float(np.linalg.norm((reached - mbsynth_q).reshape(-1, 7)[:, :3], axis=1).max())
 
 

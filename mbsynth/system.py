@@ -275,6 +275,11 @@ class System:
             motion = self._tree_motion(t, q, qd, baumgarte, drift)
             if motion is not None:
                 return motion
+        return self._kkt_motion(t, q, qd, method, baumgarte, drift)
+
+    def _kkt_motion(self, t, q, qd, method, baumgarte, drift):
+        """The Motion of (2.14) (``method``: its KKT form or the literal pseudo-inverse)
+        from the assembled M, Q, A, b, C, without its multipliers."""
         arrays = self.evaluate(t, q, qd)
         b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
         off_manifold = self._off_manifold(t, q, qd) if drift else None
@@ -296,24 +301,30 @@ class System:
         rigid body or particle, Coulomb friction), a case for the exact treatment, or a
         state off the manifold of a model with loops (the kernel's Schur step drops
         dependent rows by its own rule, not by equations' drift rule)."""
-        engine = fast.engine_for(self)
-        if engine is None or (drift and engine.closes_loops):
+        engine = self._tree_engine(drift)
+        if engine is None:
             return None
         shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
         return engine.motion(t, q, qd, shift)
+
+    def _tree_engine(self, drift):
+        """The compiled Engine that serves ``motion``, or None: kernels not ready, model not
+        covered, or (``drift``) a state off the manifold of a model with loops."""
+        engine = fast.engine_for(self)
+        return None if engine is None or (drift and engine.closes_loops) else engine
 
     def stage_motion(self, baumgarte=None, drift=False):
         """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
         without ``lam``: the compiled engine's own call where ``motion`` would make it anyway
         (a System ``for_run``, its engine ready, no Baumgarte shift), skipping the checks
         and bookkeeping of each call (a fifth of a UR5's evaluation)."""
-        engine = fast.engine_for(self)
-        if engine is None or baumgarte is not None or (drift and engine.closes_loops):
+        engine = self._tree_engine(drift)
+        if engine is None or baumgarte is not None:
             return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
 
         def stage(t, q, qd):
             found = engine.motion(t, q, qd)
-            return found if found is not None else self._solved(t, q, qd, "fast", None, drift)
+            return found if found is not None else self._kkt_motion(t, q, qd, "fast", None, drift)
         return stage
 
     def motion_batch(self, t, q_batch, qd_batch):

@@ -40,11 +40,7 @@ class Template:
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
-        names = list(system.parameters)
-        # the parameters the Layout's numbers depend on (masses, inertias, frames): a System
-        # that differs only in others (a controller's torques) shares the Layout as it is
-        self.number_parameters = np.array([names.index(n) for n in sorted(layout.number_parameters(L, system))],
-                                          dtype=np.int64)
+        self.number_parameters = None  # indices into p of the parameters the Layout's numbers use (``engine``)
 
     @classmethod
     def build(cls, system):
@@ -54,7 +50,15 @@ class Template:
     def engine(self, system):
         """The Engine of ``system``: this Template's structure and code, its own numbers."""
         p = system.parameter_values
-        same = p.shape == self.p.shape and np.array_equal(p[self.number_parameters], self.p[self.number_parameters])
+        if p.shape != self.p.shape:
+            return Engine(self, layout.with_parameters(self.L, system), p)
+        if self.number_parameters is None and not np.array_equal(p, self.p):
+            # found once, from any System of this structure: a System that differs only in
+            # other parameters (a controller's torques) shares the Layout as it is
+            names, used = list(system.parameters), layout.number_parameters(self.L, system)
+            self.number_parameters = np.array([names.index(n) for n in sorted(used)], dtype=np.int64)
+        used = slice(None) if self.number_parameters is None else self.number_parameters
+        same = np.array_equal(p[used], self.p[used])
         return Engine(self, self.L if same else layout.with_parameters(self.L, system), p)
 
 
