@@ -119,7 +119,10 @@ def test_servo_constraints_give_the_inverse_dynamics(floating_ur5):
         reactions = servoed.reactions(time, q, qd, motion)
         found = np.array([reactions[f"{name}_servo"].multipliers[0] for name in targets])
         assert np.abs(found - torque).max() < 1e-9 * np.abs(torque).max()
-        assert np.array_equal(motion.lam[-len(servos):], found)
+        # the same formula (System._multipliers) from two evaluations of the rows, which may
+        # differ in the last bits: a plain System's groups move to their compiled kernels
+        # when these are ready (grouped.py), possibly between the two
+        assert np.abs(motion.lam[-len(servos):] - found).max() <= 1e-13 * np.abs(found).max()
 
 
 def test_pendulum_hinge_reaction_is_newtons():
