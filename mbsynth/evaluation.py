@@ -28,12 +28,36 @@ _evaluators = {}
 
 def evaluator(system):
     """The Evaluator of ``system``, made on first use and dropped when the System is."""
+    return _existing(system) or _keep(system, Evaluator(system))
+
+
+def share(parent, child):
+    """Let ``child`` — the same connectors, parts and forces as ``parent``, other parameter
+    values (``System.with_parameters``, ``System.for_run``) — use ``parent``'s Evaluator
+    once that one's path is fixed (``Evaluator.fixed``): its layout and groups, found at its
+    first call, hold for every parameter value (p is an argument of each call). A sampled
+    controller's System per sample then costs no new layout. Returns whether it shares."""
+    found = _existing(parent)
+    if found is None or not found.fixed:
+        return False
+    _keep(child, found)
+    return True
+
+
+def _existing(system):
     found = _evaluators.get(id(system))
-    if found is None or found[0]() is not system:
-        found = (weakref.ref(system), Evaluator(system))
-        _evaluators[id(system)] = found
-        weakref.finalize(system, _evaluators.pop, id(system), None)
-    return found[1]
+    return found[1] if found is not None and found[0]() is system else None
+
+
+def _keep(system, made):
+    _evaluators[id(system)] = (weakref.ref(system), made)
+    weakref.finalize(system, _forget, id(system), made)
+    return made
+
+
+def _forget(key, made):
+    if _evaluators.get(key, (None, None))[1] is made:
+        del _evaluators[key]
 
 
 class ConstraintArrays(NamedTuple):
@@ -82,11 +106,13 @@ class Evaluator:
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
+        self.fixed = False  # every group's path decided at its first call, for good (fix_kernels)
 
     def fix_kernels(self, wait):
         """Fix every group's path at its first evaluation (grouped.Batch.fix_kernels)."""
         for batch in (self.rows, self.blocks, self.energy, self.forces):
             batch.fix_kernels(wait)
+        self.fixed = True
 
     def constraints(self, t, q, qd, p, sparse=True):
         """ConstraintArrays at (t, q, q̇) with parameter values p; A sparse (CSR) or dense

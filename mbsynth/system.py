@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
-from . import equations, fast, friction, reactions, solvers
+from . import equations, evaluation, fast, friction, reactions, solvers
 from .connectors import Joint
 from .errors import ModelError, SolveError
 from .evaluation import evaluator
@@ -151,21 +151,24 @@ class System:
             if name in values:
                 new[name] = float(values[name])
             elif name in definitions:
-                new[name] = float(definitions[name].subs(subs))
+                new[name] = float(definitions[name].xreplace(subs))
             else:
                 new[name] = old
-            subs[sp.Symbol(name)] = new[name]
+            subs[sp.Symbol(name)] = sp.Float(new[name])
         q0, qd0 = self.initial_state()
         index = {c: i for i, c in enumerate(self.coordinates)}
         for key, expr in (self.initial_definitions or {}).items():
             target, i = (qd0, index[key[:-4]]) if key not in index else (q0, index[key])
-            target[i] = float(expr.subs(subs))
+            target[i] = float(expr.xreplace(subs))
         changed = replace(self, parameters=new, initial_q=q0, initial_qd=qd0)
-        problems = changed.part_problems()
+        moved = None if not (np.array_equal(q0, self.initial_q) and np.array_equal(qd0, self.initial_qd)) else \
+            {sp.Symbol(name) for name, value in new.items() if value != self.parameters[name]}
+        problems = changed.part_problems(moved)  # every part where the initial state moved
         if problems:
             given = values if len(values) <= 3 else f"{len(values)} new parameter values"
             raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
         fast.share(self, changed)
+        evaluation.share(self, changed)
         return changed
 
     def for_run(self):
@@ -176,16 +179,22 @@ class System:
         evaluation of connectors and parts (evaluation.py) is fixed the same way."""
         run = replace(self)
         fast.fix_path(self, run)
-        evaluator(run).fix_kernels(wait=fast.compiled())  # the connectors' kernels likewise
+        if not evaluation.share(self, run):  # a run's own, or this System's path already fixed
+            evaluator(run).fix_kernels(wait=fast.compiled())  # the connectors' kernels likewise
         return run
 
-    def part_problems(self):
+    def part_problems(self, parameters=None):
         """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
-        positive semi-definite, at the initial state — a model no equation of motion fits."""
+        positive semi-definite, at the initial state — a model no equation of motion fits.
+        ``parameters``: only the parts written in these parameter symbols (those whose values
+        changed: ``with_parameters``); every part by default."""
         q, qd = self.initial_state()
         problems, start = [], 0
         for part in self.subsystems:
             stop = start + len(part.coordinates)
+            if parameters is not None and not part.reads(parameters):
+                start = stop
+                continue
             with np.errstate(all="ignore"):
                 M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], self.parameter_values)
             if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):

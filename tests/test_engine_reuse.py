@@ -16,8 +16,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import mbsynth as mb
+from mbsynth import evaluation
 from mbsynth.fast import background, engine_for
 from mbsynth.fast.layout import build as build_layout
 
@@ -105,6 +107,33 @@ def test_a_force_parameter_keeps_the_layout_and_moves_the_motion(model, backgrou
     assert rel(derived.motion(1.0, q, qd).qdd, pushed.motion(1.0, q, qd, method="reference").qdd) < 1e-10
     assert rel(derived.motion(1.0, q, qd).qdd, engine.motion(1.0, q, qd).qdd) > 1e-3  # k does act
     assert engine_for(model.with_parameters(mb=0.9)).L is not engine.L
+    # Systems on the shared Layout share its work buffers too (Engine.at): one motion
+    # leaves no trace in the other's
+    assert derived.buffers is engine.buffers
+    assert rel(engine.motion(1.0, q, qd).qdd, model.motion(1.0, q, qd, method="reference").qdd) < 1e-10
+    assert rel(derived.motion(1.0, q, qd).qdd, pushed.motion(1.0, q, qd, method="reference").qdd) < 1e-10
+
+
+def test_a_runs_children_share_its_evaluation_layout(model):
+    """A run's children (a sampled controller's System at each sample) use the run's
+    Evaluator — its groups laid out once — and give the M, Q, A, b, C of a System loaded
+    with those values; a plain System's children get their own (its groups' path is not
+    fixed). Only parts written in a changed parameter are checked again."""
+    run = model.for_run()
+    q, qd = a_state(run)
+    run.evaluate(0.2, q, qd)
+    child = run.with_parameters(k=-7.0, m=1.1)
+    assert evaluation.evaluator(child) is evaluation.evaluator(run)
+    loaded = mb.loads(MODEL.replace("{m: 1.3,", "{m: 1.1,").replace("k: 2.0}", "k: -7.0}"), "loaded")
+    ours, theirs = child.evaluate(0.4, q, qd), loaded.evaluate(0.4, q, qd)
+    for name in ("M", "Q", "A", "b", "C"):
+        assert rel(getattr(ours, name), getattr(theirs, name)) < 1e-13, name
+    assert evaluation.evaluator(model.with_parameters(k=1.0)) is not evaluation.evaluator(model)
+    parts = {p.name: p for p in model.subsystems}
+    m, k = sp.Symbol("m"), sp.Symbol("k")
+    assert parts["b0"].reads({m}) and not parts["b1"].reads({m}) and not parts["b0"].reads({k})
+    with pytest.raises(mb.ModelError, match="subsystem 'b0': the mass matrix is not positive semi-definite"):
+        run.with_parameters(m=-1.0)
 
 
 def test_a_massless_body_from_a_parameter(model, background_mode):

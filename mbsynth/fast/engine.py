@@ -6,14 +6,16 @@ differ only in parameter values (``System.with_parameters``) share one Template:
 parameters are arguments of the generated function, and the Layout's numbers (masses,
 inertias, frame offsets) are re-evaluated per System (layout.with_parameters), which costs
 no compilation, and only where a parameter they depend on changed (a controller's
-torques do not: ``Template.number_parameters``). ``Template.engine(system)`` makes a System's Engine: its numbers and work
-buffers. An Engine holds no reference to its System.
+torques do not: ``Template.number_parameters``; those Systems' Engines share one set of
+buffers, ``Engine.at``). ``Template.engine(system)`` makes a System's Engine: its numbers
+and work buffers. An Engine holds no reference to its System.
 
 ``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
 send the problem to the exact treatment (kernel.py's status); ``motion_batch`` evaluates
 many states in parallel.
 """
 
+import copy
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
@@ -41,6 +43,7 @@ class Template:
                                                   system.parameter_symbols) if exprs else None
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
         self.number_parameters = None  # indices into p of the parameters the Layout's numbers use (``engine``)
+        self.on_layout = None  # the first Engine on L itself, whose buffers the later ones share
 
     @classmethod
     def build(cls, system):
@@ -58,8 +61,12 @@ class Template:
             names, used = list(system.parameters), layout.number_parameters(self.L, system)
             self.number_parameters = np.array([names.index(n) for n in sorted(used)], dtype=np.int64)
         used = slice(None) if self.number_parameters is None else self.number_parameters
-        same = np.array_equal(p[used], self.p[used])
-        return Engine(self, self.L if same else layout.with_parameters(self.L, system), p)
+        if not np.array_equal(p[used], self.p[used]):
+            return Engine(self, layout.with_parameters(self.L, system), p)
+        if self.on_layout is None:
+            self.on_layout = Engine(self, self.L, p)
+            return self.on_layout
+        return self.on_layout.at(p)
 
 
 class Engine:
@@ -78,6 +85,14 @@ class Engine:
         self.lock = threading.Lock()
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
+
+    def at(self, p):
+        """This Engine at other parameter values that its Layout's numbers do not use (a
+        controller's torques): the same buffers and locks, so a System per control sample
+        allocates nothing."""
+        other = copy.copy(self)
+        other.p = p
+        return other
 
     def new_work(self):
         """(packed buffers, Work of views into them)."""

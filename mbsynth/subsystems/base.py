@@ -58,6 +58,7 @@ class Part:
         args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
         self._evaluate = compile_function(args, template[:2], constants)
         self._energy = compile_function(args, template[2:], constants)
+        self._reads = None  # the symbols M and Q are written in (``reads``), once asked
 
     def _materialized(self):
         if self._symbolic is None:
@@ -70,6 +71,18 @@ class Part:
     Q = property(lambda self: self._materialized()[1], doc="force vector (2.1), sympy")
     T = property(lambda self: self._materialized()[2], doc="kinetic energy, sympy")
     V = property(lambda self: self._materialized()[3], doc="potential energy, sympy")
+
+    def reads(self, symbols):
+        """Whether M or Q (2.1) is written in any of ``symbols`` (parameter symbols: whether
+        new values of them can change this part; ``System.with_parameters``)."""
+        if self._reads is None:
+            if self._symbolic is None:
+                template, _, constants = self._shared
+                values = [sp.sympify(value) for _, value in constants]
+            else:
+                template, values = self._symbolic, []
+            self._reads = frozenset().union(*(x.free_symbols for x in (*template[:2], *values)))
+        return not self._reads.isdisjoint(symbols)
 
     def evaluate(self, t, q, qd, p):
         """(M, Q) of this part at its own coordinates q, velocities qd (2.1)."""
