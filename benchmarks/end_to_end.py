@@ -1,4 +1,4 @@
-"""Whole simulations against Pinocchio's ``aba`` inside scipy's ``solve_ivp``, in one process.
+"""Whole simulations against Pinocchio's ``aba`` or equations by hand, inside scipy's ``solve_ivp``.
 
     MBSYNTH_FAST=wait .venv/bin/python benchmarks/end_to_end.py [--rounds R] [--simulations-only] [--out FILE]
 
@@ -13,7 +13,11 @@ model, zero torques, under gravity:
 - talos, floating (a free-flyer root), 2 s from its neutral pose with the base at rest and
   joint rates drawn in ±0.5 rad/s (seed 7): it falls and flails;
 - the spatial pendulum chain of 100 links (benchmarks/fast_dynamics.py), 1 s from joint
-  angles in ±0.3 rad and rates in ±0.5 rad/s.
+  angles in ±0.3 rad and rates in ±0.5 rad/s;
+- Andrews' squeezer (models/mechanisms/andrews.yaml: IFToMM A03, the IVP test set's
+  ``andrews``), 0.03 s from the test set's initial state, against the test set's index-1
+  equations written by hand in numpy (``andrews_by_hand``: what one writes without
+  mbsynth) instead of Pinocchio; the table's energy is less the motor's work.
 
 The last two use Pinocchio's model of the mbsynth System (``twin.Twin``: talos's own URDF
 model with a free-flyer root, the chain's joints) and start both codes from the same state
@@ -55,39 +59,103 @@ from mbsynth.twin import Twin  # noqa: E402
 HERE = Path(__file__).resolve().parent
 T_END, OUTPUTS, TOL = 2.0, 500, 1e-10
 CHAIN_T_END = 1.0  # the 100-link chain's run (its motion costs ~0.4 ms an evaluation)
+ANDREWS_T_END = 0.03  # the test set's interval
+ANDREWS = HERE.parent / "models" / "mechanisms" / "andrews.yaml"
 SEED = 7
 
 
 class Case:
-    """One simulation timed in both codes: the mbsynth System, its Pinocchio model (the
-    robot's URDF, or ``twin.Twin``), and the state both start from: Pinocchio's (q, v)
-    and mbsynth's (q, q̇) of it by forward kinematics (``Twin.to_maximal``); no ``twin``:
-    mbsynth's own initial state made consistent by ``simulate`` (as a user calls it)."""
+    """One simulation timed in both codes: the mbsynth System, the reference code's
+    right-hand side ``rhs(t, y)`` and start ``y0`` (its first ``nq`` entries positions), and
+    mbsynth's start: with a ``twin`` (twin.Twin), (q, q̇) of Pinocchio's (q, v) by forward
+    kinematics (``Twin.to_maximal``); without, mbsynth's own initial state made consistent
+    by ``simulate`` (as a user calls it). ``gap(reference's final y[:nq], mbsynth's final
+    q)``: how far apart the two codes end (None: not comparable); ``energy(traj)``: what
+    the exact motion keeps (the total energy, less the work of a drive)."""
 
-    def __init__(self, name, system, model, q, v, twin=None, t_end=T_END):
-        self.name, self.system, self.model, self.q, self.v, self.twin = name, system, model, q, v, twin
-        self.start = {} if twin is None else dict(zip(("q0", "qd0"), twin.to_maximal(q, v)))
-        self.t_end = t_end
+    def __init__(self, name, system, code, rhs, y0, nq, twin=None, t_end=T_END, gap=None, energy=None):
+        self.name, self.system, self.code, self.rhs, self.y0, self.nq = name, system, code, rhs, y0, nq
+        self.twin, self.t_end = twin, t_end
+        self.start = {} if twin is None else dict(zip(("q0", "qd0"), twin.to_maximal(y0[:nq], y0[nq:])))
+        self.gap = gap or (lambda *_: None)
+        self.energy = energy or (lambda traj: traj.energy)
+
+
+def pinocchio_case(name, system, model, q, v, twin=None, t_end=T_END):
+    """A Case against (q̇, pin.aba) of ``model``."""
+    return Case(name, system, "Pinocchio", pinocchio_rhs(model), np.concatenate([q, v]), model.nq, twin, t_end,
+                gap=None if twin is None else lambda reached, ours: body_distance(twin, reached, ours))
 
 
 def ur5_case():
     model = pin.buildModelFromUrdf(robot_files()["ur5"])
-    return Case("UR5, fixed base, falling from rest", mb.from_robot("ur5"), model, pin.neutral(model),
-                np.zeros(model.nv))
+    return pinocchio_case("UR5, fixed base, falling from rest", mb.from_robot("ur5"), model, pin.neutral(model),
+                          np.zeros(model.nv))
 
 
 def talos_case(rng):
     twin = Twin(mb.from_robot("talos", floating=True))
     rates = np.concatenate([np.zeros(6), rng.uniform(-0.5, 0.5, twin.model.nv - 6)])  # the base at rest
-    return Case("talos, floating, joint rates in ±0.5 rad/s", twin.system, twin.model, pin.neutral(twin.model),
-                rates, twin)
+    return pinocchio_case("talos, floating, joint rates in ±0.5 rad/s", twin.system, twin.model,
+                          pin.neutral(twin.model), rates, twin)
 
 
 def chain_case(rng, count=100):
     twin = Twin(mb.loads(chain_yaml(count), name=f"chain_{count}"))
     angles, rates = rng.uniform(-0.3, 0.3, count), rng.uniform(-0.5, 0.5, count)
-    return Case(f"chain of {count} links, angles in ±0.3 rad, rates in ±0.5 rad/s", twin.system, twin.model,
-                angles, rates, twin, t_end=CHAIN_T_END)
+    return pinocchio_case(f"chain of {count} links, angles in ±0.3 rad, rates in ±0.5 rad/s", twin.system,
+                          twin.model, angles, rates, twin, t_end=CHAIN_T_END)
+
+
+def andrews_case():
+    """Andrews' squeezer (IFToMM A03, the IVP test set's ``andrews``), 0.03 s from the test
+    set's initial state, against its equations written by hand (``andrews_by_hand``)."""
+    system = mb.load(ANDREWS)
+    rhs, y0, names = andrews_by_hand(ANDREWS.read_text())
+    assert list(system.coordinates) == [f"sq.{c}" for c in names]
+    beta, mom = names.index("beta"), system.parameters["mom"]
+    return Case("Andrews' squeezer, 7 angles, 6 loop rows, driven", system, "by hand", rhs, y0, len(names),
+                t_end=ANDREWS_T_END, gap=lambda reached, ours: float(np.abs(reached - ours).max()),
+                energy=lambda traj: traj.energy - mom * (traj.q[:, beta] - traj.q[0, beta]))
+
+
+def andrews_by_hand(text):
+    """What an engineer writes without mbsynth: the test set's index-1 form of Andrews'
+    squeezer, [[M, Gᵀ], [G, 0]] (q̈, λ) = (f, γ) solved by numpy at every evaluation, with
+    M = ∂²T/∂q̇², f = Q − ∂V/∂q + ∂T/∂q − (∂²T/∂q̇∂q) q̇, G = ∂g/∂q and γ = −(∂(G q̇)/∂q) q̇
+    derived by sympy from the model file's T, V, loop rows g and parameters (the test
+    set's M, ff and g of andrews.f), lambdified. Returns (rhs(t, y), y0, coordinate names)."""
+    import sympy as sp
+    import yaml
+    spec = yaml.safe_load(text)
+    part = spec["subsystems"]["sq"]
+    names = part["coordinates"]
+    q, qd = sp.symbols(names), sp.symbols([f"{c}_dot" for c in names])
+    numbers = {sp.Symbol(k): v for k, v in spec["parameters"].items()}
+    known = {str(x): x for x in (*q, *qd, *numbers)}  # gamma is an angle here, not Euler's function
+
+    def read(text):
+        return sp.sympify(str(text).replace("sq.", ""), locals=known).xreplace(numbers)
+    T, V = read(part["T"]), read(part["V"])
+    g = sp.Matrix([read(c["holonomic"]) for c in spec["constraints"]])
+    Q = sp.Matrix([read(part["forces"].get(c, 0)) for c in names])
+    rates = sp.Matrix(qd)
+    M = sp.hessian(T, qd)
+    momenta = sp.Matrix([T.diff(v) for v in qd])
+    f = Q - sp.Matrix([V.diff(c) for c in q]) + sp.Matrix([T.diff(c) for c in q]) - momenta.jacobian(q) * rates
+    G = g.jacobian(q)
+    gamma = -(G * rates).jacobian(q) * rates
+    n, m = len(names), g.shape[0]
+    terms = sp.lambdify([q, qd], [M, f, G, gamma], "numpy")
+    kkt, right = np.zeros((n + m, n + m)), np.zeros(n + m)
+
+    def rhs(_, y):
+        M_, f_, G_, gamma_ = terms(y[:n], y[n:])
+        kkt[:n, :n], kkt[:n, n:], kkt[n:, :n] = M_, np.transpose(G_), G_
+        right[:n], right[n:] = np.ravel(f_), np.ravel(gamma_)
+        return np.concatenate([y[n:], np.linalg.solve(kkt, right)[:n]])
+    y0 = np.array([float(spec["initial"][f"sq.{c}"]) for c in names] + [0.0] * n)
+    return rhs, y0, names
 
 
 def pinocchio_rhs(model):
@@ -111,13 +179,12 @@ def pinocchio_rhs(model):
     return f
 
 
-def pinocchio_run(case):
-    """(seconds, evaluations, final q) of the case with aba inside solve_ivp."""
-    f = pinocchio_rhs(case.model)
+def reference_run(case):
+    """(seconds, evaluations, final positions) of the case's reference code inside solve_ivp."""
     started = time.perf_counter()
-    sol = solve_ivp(f, (0.0, case.t_end), np.concatenate([case.q, case.v]), method="DOP853", rtol=TOL, atol=TOL,
+    sol = solve_ivp(case.rhs, (0.0, case.t_end), case.y0, method="DOP853", rtol=TOL, atol=TOL,
                     t_eval=np.linspace(0.0, case.t_end, OUTPUTS + 1))
-    return time.perf_counter() - started, sol.nfev, sol.y[:case.model.nq, -1]
+    return time.perf_counter() - started, sol.nfev, sol.y[:case.nq, -1]
 
 
 def mbsynth_run(case):
@@ -125,17 +192,15 @@ def mbsynth_run(case):
     started = time.perf_counter()
     traj = mb.simulate(case.system, case.t_end, method="DOP853", rtol=TOL, atol=TOL, **case.start)
     seconds = time.perf_counter() - started
-    return (seconds, traj.stats["evaluations"], float(traj.residual_position.max()), float(np.ptp(traj.energy)),
-            traj.q[-1])
+    return (seconds, traj.stats["evaluations"], float(traj.residual_position.max()),
+            float(np.ptp(case.energy(traj))), traj.q[-1])
 
 
-def disagreement(case, pinocchio_q, mbsynth_q):
+def body_distance(twin, pinocchio_q, mbsynth_q):
     """The largest distance between the two codes' final positions of a body's reference
     point (``Twin.to_maximal`` of Pinocchio's q beside mbsynth's q; joint angles would differ
-    by turns), or None when the case has no twin (the UR5 from its URDF)."""
-    if case.twin is None:
-        return None
-    reached = case.twin.to_maximal(pinocchio_q, np.zeros(case.model.nv))[0]
+    by turns)."""
+    reached = twin.to_maximal(pinocchio_q, np.zeros(twin.model.nv))[0]
     return float(np.linalg.norm((reached - mbsynth_q).reshape(-1, 7)[:, :3], axis=1).max())
 
 
@@ -193,29 +258,34 @@ def main():
     parser.add_argument("--out", default=str(HERE / "end_to_end_results.md"))
     args = parser.parse_args()
     rng = np.random.default_rng(SEED)
-    cases = [ur5_case(), talos_case(rng), chain_case(rng)]
+    cases = [ur5_case(), talos_case(rng), chain_case(rng), andrews_case()]
     for case in cases:
-        mb.simulate(case.system, 0.01, **case.start)  # compile or load the kernels before timing
+        mb.simulate(case.system, 0.01 * case.t_end, **case.start)  # compile or load the kernels before timing
     lines = ["# End to end: mbsynth against Pinocchio aba + solve_ivp", "",
              f"{datetime.date.today()} on {platform.node()} ({os.cpu_count()} cores, {platform.processor() or '?'}), "
-             f"`benchmarks/end_to_end.py`. Each simulation: DOP853, rtol = atol = {TOL:g}, {OUTPUTS + 1} outputs, "
-             f"zero torques, gravity; mbsynth's `simulate` (a projection onto the constraints at every output) "
-             f"against `solve_ivp` of (q̇, `pin.aba`) on the same model; best of {args.rounds} rounds, the two "
-             "alternating, the ratio to Pinocchio's time in the same run. *Δx*: the largest distance between the "
-             "two codes' final positions of a body (m), both from the same initial state. Model building not included.", "",
-             "| system | s | code | seconds | × Pinocchio | evaluations | max residual φ | energy spread (J) | Δx (m) |",
+             f"`benchmarks/end_to_end.py`. Each simulation: DOP853, rtol = atol = {TOL:g}, {OUTPUTS + 1} outputs; "
+             f"mbsynth's `simulate` (a projection onto the constraints at every output) against `solve_ivp` of the "
+             f"reference code on the same model: (q̇, `pin.aba`) for the robots and the chain (zero torques, "
+             f"gravity), and for Andrews' squeezer the IVP test set's index-1 equations by hand (numpy, "
+             f"`andrews_by_hand`); best of {args.rounds} rounds, the two alternating, the ratio to the reference's "
+             "time in the same run. *Energy spread*: of the total energy (Andrews: less the motor's work), zero for "
+             "the exact motion. *Δx*: how far apart the two codes end, from the same initial state: the largest "
+             "distance between their final positions of a body (m; Andrews: of the angles, rad). Model building "
+             "not included.", "",
+             "| system | s | code | seconds | × reference | evaluations | max residual φ | energy spread (J) | Δx |",
              "|---|---:|---|---:|---:|---:|---:|---:|---:|"]
     for case in cases:
-        pinocchio = mbsynth = None
+        reference = mbsynth = None
         for _ in range(args.rounds):
-            result = pinocchio_run(case)
-            pinocchio = result if pinocchio is None or result[0] < pinocchio[0] else pinocchio
+            result = reference_run(case)
+            reference = result if reference is None or result[0] < reference[0] else reference
             result = mbsynth_run(case)
             mbsynth = result if mbsynth is None or result[0] < mbsynth[0] else mbsynth
-        gap = disagreement(case, pinocchio[2], mbsynth[4])
+        gap = case.gap(reference[2], mbsynth[4])
         gap = "–" if gap is None else f"{gap:.1e}"
-        lines += [f"| {case.name} | {case.t_end:g} | Pinocchio | {pinocchio[0]:.3f} | 1 | {pinocchio[1]} | – | – | – |",
-                  f"| | | mbsynth | {mbsynth[0]:.3f} | {mbsynth[0] / pinocchio[0]:.1f} | {mbsynth[1]} | "
+        lines += [f"| {case.name} | {case.t_end:g} | {case.code} | {reference[0]:.3f} | 1 | {reference[1]} | – | – "
+                  "| – |",
+                  f"| | | mbsynth | {mbsynth[0]:.3f} | {mbsynth[0] / reference[0]:.1f} | {mbsynth[1]} | "
                   f"{mbsynth[2]:.1e} | {mbsynth[3]:.1e} | {gap} |"]
         print(lines[-2], lines[-1], sep="\n", flush=True)
     if not args.simulations_only:
