@@ -187,6 +187,7 @@ class _Run:
         self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
         self.singular_call = None  # the span's evaluation count at its first stage near a singular position
         self.span_rtol = rtol  # the rtol the span under way is integrated at
+        self.crawl_calls = CRAWL_CALLS  # the evaluations it may take near a singular position (_Crawl)
         self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
 
     @property
@@ -213,8 +214,7 @@ class _Run:
         if motion.singular:
             self.singular.append((t, motion.singular))
             self.singular_call = self.calls if self.singular_call is None else self.singular_call
-        allowed = CRAWL_CALLS if self.span_rtol == self.rtol else RELAXED_CRAWL_CALLS
-        if self.singular_call is not None and self.calls - self.singular_call > allowed \
+        if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls \
                 and self.span_rtol < RELAXED_MAX:
             raise _Crawl
         return np.concatenate([qd, motion.qdd])
@@ -281,6 +281,7 @@ class _Run:
         """The integrator's steps from (t, y) to t_next (its last step cut short there)."""
         self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
         self.singular_call, self.span_rtol = None, rtol
+        self.crawl_calls = CRAWL_CALLS if rtol == self.rtol else RELAXED_CRAWL_CALLS  # a relaxed span crawls longer
         solver = self._resumed(t, y, t_next, rtol, atol)
         while solver.status == "running":
             message = solver.step()

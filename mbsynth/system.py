@@ -161,9 +161,9 @@ class System:
             target, i = (qd0, index[key[:-4]]) if key not in index else (q0, index[key])
             target[i] = float(expr.xreplace(subs))
         changed = replace(self, parameters=new, initial_q=q0, initial_qd=qd0)
-        moved = None if not (np.array_equal(q0, self.initial_q) and np.array_equal(qd0, self.initial_qd)) else \
-            {sp.Symbol(name) for name, value in new.items() if value != self.parameters[name]}
-        problems = changed.part_problems(moved)  # every part where the initial state moved
+        same_start = np.array_equal(q0, self.initial_q) and np.array_equal(qd0, self.initial_qd)
+        moved = {sp.Symbol(name) for name, value in new.items() if value != self.parameters[name]}
+        problems = changed.part_problems(moved if same_start else None)  # a moved start: every part
         if problems:
             given = values if len(values) <= 3 else f"{len(values)} new parameter values"
             raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
