@@ -19,7 +19,7 @@ model, zero torques, under gravity:
   equations written by hand in numpy (``andrews_by_hand``: what one writes without
   mbsynth) instead of Pinocchio; the table's energy is less the motor's work.
 
-The last two use Pinocchio's model of the mbsynth System (``twin.Twin``: talos's own URDF
+Talos and the chain use Pinocchio's model of the mbsynth System (``twin.Twin``: talos's own URDF
 model with a free-flyer root, the chain's joints) and start both codes from the same state
 (``Twin.to_maximal`` of Pinocchio's); the table gives the largest difference of their final
 positions of the bodies. Each figure is the best of ``--rounds`` runs, the two codes alternating;
@@ -34,6 +34,14 @@ engine built from numba's cache), then with the derivation cache off
 ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process);
 Pinocchio's ``buildModelFromUrdf`` for scale. Writes benchmarks/end_to_end_results.md (or
 ``--out``).
+
+Beside Pinocchio, on the robots and the chain: MuJoCo's ``mj_forward`` on the same model
+(benchmarks/mujoco_twin.py: Pinocchio's model written as MJCF, its qacc equal to aba's to
+1e-11) in the same solve_ivp, the MJCF built inside the timing; and for the UR5 and the
+chain, Exudyn's kinematic tree with its own DOPRI5 at the same tolerances, no step longer
+than an output interval (benchmarks/exudyn_tree.py; one run: on the chain it takes about
+20 s). Their Δx: the largest distance between a joint's origin at their final configuration
+and at Pinocchio's; the count for Exudyn is its accepted steps.
 """
 
 import argparse
@@ -52,9 +60,11 @@ import pinocchio as pin  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
 import mbsynth as mb  # noqa: E402
+from exudyn_tree import ExudynTree  # noqa: E402
 from fast_dynamics import chain_yaml  # noqa: E402
 from mbsynth.robots import robot_files  # noqa: E402
 from mbsynth.twin import Twin  # noqa: E402
+from mujoco_twin import MujocoTwin  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 T_END, OUTPUTS, TOL = 2.0, 500, 1e-10
@@ -71,26 +81,55 @@ class Case:
     kinematics (``Twin.to_maximal``); without, mbsynth's own initial state made consistent
     by ``simulate`` (as a user calls it). ``gap(reference's final y[:nq], mbsynth's final
     q)``: how far apart the two codes end (None: not comparable); ``energy(traj)``: what
-    the exact motion keeps (the total energy, less the work of a drive)."""
+    the exact motion keeps (the total energy, less the work of a drive). ``others``: further
+codes on the same problem, (name, runs, run) with run(reference's final positions) giving
+(seconds, count, how far its end lies from the reference's), run ``runs`` times (None:
+``--rounds``)."""
 
-    def __init__(self, name, system, code, rhs, y0, nq, twin=None, t_end=T_END, gap=None, energy=None):
+    def __init__(self, name, system, code, rhs, y0, nq, twin=None, t_end=T_END, gap=None, energy=None, others=()):
         self.name, self.system, self.code, self.rhs, self.y0, self.nq = name, system, code, rhs, y0, nq
-        self.twin, self.t_end = twin, t_end
+        self.twin, self.t_end, self.others = twin, t_end, others
         self.start = {} if twin is None else dict(zip(("q0", "qd0"), twin.to_maximal(y0[:nq], y0[nq:])))
         self.gap = gap or (lambda *_: None)
         self.energy = energy or (lambda traj: traj.energy)
 
 
-def pinocchio_case(name, system, model, q, v, twin=None, t_end=T_END):
-    """A Case against (q̇, pin.aba) of ``model``."""
+def pinocchio_case(name, system, model, q, v, twin=None, t_end=T_END, exudyn=False):
+    """A Case against (q̇, pin.aba) of ``model``, with MuJoCo's forward dynamics of the same
+    model in the same integrator (benchmarks/mujoco_twin.py) and, with ``exudyn``, Exudyn's
+    kinematic tree with its own DOPRI5 (benchmarks/exudyn_tree.py, fixed base only: one run,
+    it is slow on the chain)."""
+    def mujoco_run(expected):
+        started = time.perf_counter()
+        mj = MujocoTwin(model)
+        sol = integrate(mj.rhs(), mj.state(q, v), t_end)
+        seconds = time.perf_counter() - started
+        return seconds, sol.nfev, frame_distance(model, mj.configuration(sol.y[:mj.nq, -1]), expected)
+
+    def exudyn_run(expected):
+        seconds, steps, reached = ExudynTree(model).run(q, v, t_end, TOL, steps=OUTPUTS)
+        return seconds, f"{steps} steps", frame_distance(model, reached, expected)
+    agreement = MujocoTwin(model).check(np.random.default_rng(SEED))
+    if agreement > 1e-9:
+        raise AssertionError(f"{name}: MuJoCo's qacc differs from aba by {agreement:.1e} (relative)")
+    others = [("MuJoCo", None, mujoco_run)] + ([("Exudyn", 1, exudyn_run)] if exudyn else [])
     return Case(name, system, "Pinocchio", pinocchio_rhs(model), np.concatenate([q, v]), model.nq, twin, t_end,
-                gap=None if twin is None else lambda reached, ours: body_distance(twin, reached, ours))
+                gap=None if twin is None else lambda reached, ours: body_distance(twin, reached, ours), others=others)
+
+
+def frame_distance(model, q, other):
+    """The largest distance between a joint's origin at two configurations of ``model``."""
+    data, positions = model.createData(), []
+    for config in (q, other):
+        pin.forwardKinematics(model, data, config)
+        positions.append(np.array([data.oMi[i].translation for i in range(1, model.njoints)]))
+    return float(np.linalg.norm(positions[0] - positions[1], axis=1).max())
 
 
 def ur5_case():
     model = pin.buildModelFromUrdf(robot_files()["ur5"])
     return pinocchio_case("UR5, fixed base, falling from rest", mb.from_robot("ur5"), model, pin.neutral(model),
-                          np.zeros(model.nv))
+                          np.zeros(model.nv), exudyn=True)
 
 
 def talos_case(rng):
@@ -104,7 +143,7 @@ def chain_case(rng, count=100):
     twin = Twin(mb.loads(chain_yaml(count), name=f"chain_{count}"))
     angles, rates = rng.uniform(-0.3, 0.3, count), rng.uniform(-0.5, 0.5, count)
     return pinocchio_case(f"chain of {count} links, angles in ±0.3 rad, rates in ±0.5 rad/s", twin.system,
-                          twin.model, angles, rates, twin, t_end=CHAIN_T_END)
+                          twin.model, angles, rates, twin, t_end=CHAIN_T_END, exudyn=True)
 
 
 def andrews_case():
@@ -179,11 +218,16 @@ def pinocchio_rhs(model):
     return f
 
 
+def integrate(rhs, y0, t_end):
+    """solve_ivp as every reference code is run: DOP853, TOL, OUTPUTS + 1 rows."""
+    return solve_ivp(rhs, (0.0, t_end), y0, method="DOP853", rtol=TOL, atol=TOL,
+                     t_eval=np.linspace(0.0, t_end, OUTPUTS + 1))
+
+
 def reference_run(case):
     """(seconds, evaluations, final positions) of the case's reference code inside solve_ivp."""
     started = time.perf_counter()
-    sol = solve_ivp(case.rhs, (0.0, case.t_end), case.y0, method="DOP853", rtol=TOL, atol=TOL,
-                    t_eval=np.linspace(0.0, case.t_end, OUTPUTS + 1))
+    sol = integrate(case.rhs, case.y0, case.t_end)
     return time.perf_counter() - started, sol.nfev, sol.y[:case.nq, -1]
 
 
@@ -261,14 +305,16 @@ def main():
     cases = [ur5_case(), talos_case(rng), chain_case(rng), andrews_case()]
     for case in cases:
         mb.simulate(case.system, 0.01 * case.t_end, **case.start)  # compile or load the kernels before timing
-    lines = ["# End to end: mbsynth against Pinocchio aba + solve_ivp", "",
+    lines = ["# End to end: mbsynth against Pinocchio aba + solve_ivp, MuJoCo and Exudyn", "",
              f"{datetime.date.today()} on {platform.node()} ({os.cpu_count()} cores, {platform.processor() or '?'}), "
              f"`benchmarks/end_to_end.py`. Each simulation: DOP853, rtol = atol = {TOL:g}, {OUTPUTS + 1} outputs; "
              f"mbsynth's `simulate` (a projection onto the constraints at every output) against `solve_ivp` of the "
              f"reference code on the same model: (q̇, `pin.aba`) for the robots and the chain (zero torques, "
              f"gravity), and for Andrews' squeezer the IVP test set's index-1 equations by hand (numpy, "
              f"`andrews_by_hand`); best of {args.rounds} rounds, the two alternating, the ratio to the reference's "
-             "time in the same run. *Energy spread*: of the total energy (Andrews: less the motor's work), zero for "
+             "time in the same run; MuJoCo (`mj_forward` in the same `solve_ivp`) and Exudyn (its kinematic tree "
+             "and its own DOPRI5) on the same models, their *Δx* the largest distance between a joint's origin at "
+             "their end and at Pinocchio's. *Energy spread*: of the total energy (Andrews: less the motor's work), zero for "
              "the exact motion. *Δx*: how far apart the two codes end, from the same initial state: the largest "
              "distance between their final positions of a body (m; Andrews: of the angles, rad). Model building "
              "not included.", "",
@@ -287,7 +333,12 @@ def main():
                   "| – |",
                   f"| | | mbsynth | {mbsynth[0]:.3f} | {mbsynth[0] / reference[0]:.1f} | {mbsynth[1]} | "
                   f"{mbsynth[2]:.1e} | {mbsynth[3]:.1e} | {gap} |"]
-        print(lines[-2], lines[-1], sep="\n", flush=True)
+        for code, runs, run in case.others:
+            seconds, count, distance = min((run(reference[2]) for _ in range(runs or args.rounds)),
+                                           key=lambda r: r[0])
+            lines.append(f"| | | {code} | {seconds:.3f} | {seconds / reference[0]:.1f} | {count} | – | – | "
+                         f"{distance:.1e} |")
+        print(*lines[-2 - len(case.others):], sep="\n", flush=True)
     if not args.simulations_only:
         lines += ["", "Building the model (numba's cache warm):", ""] + build_lines(args.rounds)
     text = "\n".join(lines) + "\n"

@@ -45,6 +45,7 @@ ROBOTS = [("ur5", False), ("panda", False), ("solo12", True), ("talos", True)]
 # killed on this 24 GiB machine; under `ulimit -v 8000000` it raises MemoryError)
 PINOCCHIO_MAX_CHAIN = 100
 ROUNDS = 5  # motion() and aba are timed in alternating rounds; each keeps its best
+BATCH_ROUNDS = 9  # motion_batch and aba: the median of alternating rounds
 
 
 # ----------------------------------------------------------------------------- the chain
@@ -196,19 +197,11 @@ class Case:
         return row
 
     def batch(self, rng, count=1024):
-        """(per-state time of System.motion_batch over ``count`` states, aba's time), in
-        alternating rounds like ``run``: the batch needs every core, so load from other
-        tenants shows in it first."""
-        states = [self.to_maximal(*self.draw(rng)) for _ in range(count)]
-        q, qd = np.array([s[0] for s in states]), np.array([s[1] for s in states])
-        self.system.motion_batch(0.0, q[:8], qd[:8])
-        qa, va = self.draw(rng)
-        tau = np.zeros(self.model.nv)
-        per_state = aba = float("inf")
-        for _ in range(ROUNDS):
-            per_state = min(per_state, best(lambda: self.system.motion_batch(0.0, q, qd), seconds=0.5, repeats=2) / count)
-            aba = min(aba, best(lambda: pin.aba(self.model, self.data, qa, va, tau), seconds=0.2))
-        return per_state, aba
+        """(per-state time of System.motion_batch over ``count`` states, aba's time): the
+        medians of BATCH_ROUNDS alternating rounds (benchmarks/motion_batch.py): the batch
+        needs every core, so load from other tenants shows in it first."""
+        from motion_batch import batch_rounds
+        return tuple(np.median(batch_rounds(self, rng, count, BATCH_ROUNDS), axis=0))
 
 
 def chain_case(count):
@@ -342,7 +335,8 @@ def write(rows, batch, startups, compiled, memory):
     lines += ["", f"Growth exponent of motion() from N = 100 to 1000: **{exponent(rows):.2f}**.", ""]
     if batch:
         lines += ["Batched, 1024 states (`System.motion_batch`: one thread per core, taking chunks of rows in turn; "
-                  "aba timed in alternating rounds with it):", "",
+                  f"aba timed in alternating rounds with it, the median of {BATCH_ROUNDS} rounds each; the spread "
+                  "over rounds: benchmarks/motion_batch.py):", "",
                   "| system | per state µs | aba µs | ratio |", "|---|---:|---:|---:|"]
         lines += [f"| {label} | {us(t)} | {us(a)} | {t / a:.1f} |" for label, (t, a) in batch.items()]
         lines.append("")
