@@ -85,9 +85,9 @@ class Case:
     by ``simulate`` (as a user calls it). ``gap(reference's final y[:nq], mbsynth's final
     q)``: how far apart the two codes end (None: not comparable); ``energy(traj)``: what
     the exact motion keeps (the total energy, less the work of a drive). ``others``: further
-codes on the same problem, (name, runs, run) with run(reference's final positions) giving
-(seconds, count, how far its end lies from the reference's), run ``runs`` times (None:
-``--rounds``)."""
+    codes on the same problem, (name, runs, run) with run(reference's final positions)
+    giving (seconds, count, how far its end lies from the reference's), run ``runs`` times
+    (None: ``--rounds``)."""
 
     def __init__(self, name, system, code, rhs, y0, nq, twin=None, t_end=T_END, gap=None, energy=None, others=()):
         self.name, self.system, self.code, self.rhs, self.y0, self.nq = name, system, code, rhs, y0, nq
