@@ -28,7 +28,7 @@ class ExudynTree:
         kinds = [model.joints[i].shortname() for i in range(1, model.njoints)]
         if any(kind not in JOINTS for kind in kinds):
             raise ValueError("Exudyn's kinematic tree here takes revolute joints about x, y or z only")
-        self.pinocchio, self.nv = model, model.nv
+        self.nv = model.nv
         links = range(1, model.njoints)
         self.tree = dict(
             jointTypes=[JOINTS[kind] for kind in kinds],

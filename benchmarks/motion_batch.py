@@ -16,27 +16,16 @@ import argparse
 import datetime
 import os
 import platform
-import time
 from pathlib import Path
 
 os.environ.setdefault("MBSYNTH_FAST", "wait")  # the compiled kernels, not the KKT path while they build
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
+from fast_dynamics import best, robot_case  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROBOTS = [("ur5", False), ("talos", True)]
-
-
-def mean_time(fn, seconds):
-    """Mean seconds of one call of ``fn`` over a loop of about ``seconds``."""
-    started = time.perf_counter()
-    fn()
-    count = max(1, int(seconds / max(time.perf_counter() - started, 1e-7)))
-    started = time.perf_counter()
-    for _ in range(count):
-        fn()
-    return (time.perf_counter() - started) / count
 
 
 def batch_rounds(case, rng, count, rounds):
@@ -48,8 +37,9 @@ def batch_rounds(case, rng, count, rounds):
     case.system.motion_batch(times[:8], q[:8], qd[:8])  # the engine and its threads' buffers
     qa, va = case.draw(rng)
     tau = np.zeros(case.model.nv)
-    return [(mean_time(lambda: case.system.motion_batch(times, q, qd), 0.3) / count,
-             mean_time(lambda: pin.aba(case.model, case.data, qa, va, tau), 0.2)) for _ in range(rounds)]
+    return [(best(lambda: case.system.motion_batch(times, q, qd), seconds=0.3, repeats=1) / count,
+             best(lambda: pin.aba(case.model, case.data, qa, va, tau), seconds=0.2, repeats=1))
+            for _ in range(rounds)]
 
 
 def summary(label, results):
@@ -62,7 +52,6 @@ def summary(label, results):
 
 
 def main():
-    from fast_dynamics import robot_case
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=15)
     parser.add_argument("--count", type=int, default=1024)
