@@ -2,14 +2,26 @@
 
 The accelerations satisfy the constraints only at the acceleration level (2.4), so
 positions and velocities drift. ``simulate`` steps one of scipy's adaptive integrators
-(its OdeSolver classes, as ``solve_ivp`` would) to each output time, its last step there
-cut short, and, with the default ``stabilization="projection"``, projects (q, q̇) back
-onto the constraints at every output time (projection.py), and between output times as
-often as keeps the drift below DRIFT_TARGET. The integrator is not restarted there: an
-explicit Runge–Kutta pair goes on from the projected state, given its derivative, with
-the step it proposed before the cut (``_Run._resumed``); an implicit one (Radau, BDF,
-LSODA) starts afresh with that step. ``"baumgarte"`` instead replaces b by
-b − 2α φ̇ − β² φ (Baumgarte 1972); ``"none"`` does neither.
+(its OdeSolver classes, as ``solve_ivp`` would) in one of two ways.
+
+Continuously, where the compiled kernel can put a state back on the constraints itself
+(fast/correction.py: a tree of kernel joints and bodies, no loops) and the default
+``stabilization="projection"`` asks for it, with an explicit Runge–Kutta pair (RK23, RK45,
+DOP853): the steps are chosen by the error control alone, up to the next control sample
+or the end; each accepted step is corrected and the integrator goes on from there, given
+the corrected state's derivative, its steps capped (``max_step``) to keep the drift
+between corrections below DRIFT_TARGET; each output row is read from the step's dense
+output (the interpolant ``solve_ivp`` gives at ``t_eval``) and corrected (a copy: the
+integrator goes on from its own state).
+
+Cut at each output time otherwise: the integrator's last step is cut short there and,
+with projection, (q, q̇) projected back onto the constraints (projection.py), there and
+between output times as often as keeps the drift below DRIFT_TARGET. The integrator is
+not restarted: an explicit pair goes on from the projected state, given its derivative,
+with the step it proposed before the cut (``_Run._resumed``); an implicit one (Radau,
+BDF, LSODA) starts afresh with that step. ``"baumgarte"`` replaces b by
+b − 2α φ̇ − β² φ (Baumgarte 1972), its drift growing with the step; ``"none"`` does
+neither.
 
 Consistency is judged where it means something. The integrator's stages lie off the
 manifold by the integration error, so the motion there follows the drift rule of
@@ -22,9 +34,9 @@ stage came near a singular position (σ < 1e-5 σ₁ of the equilibrated A: the 
 zone); a crossing whose stages all stay farther from it needs no special treatment and
 may go unlisted. There the stages' accelerations carry noise of about |q̇| ψ / σ² (ψ the
 velocity drift the projection leaves, about 1e-12): a tolerance tighter than that noise
-allows makes the integrator crawl. A span that takes more than CRAWL_CALLS evaluations
-after its first stage near a singular position is integrated again at RELAXED_RTOL (atol
-relaxed by the same factor; ten times looser again while it crawls still — RELAXED_CRAWL_CALLS
+allows makes the integrator crawl. A span (a continuous run: its output interval) that
+takes more than CRAWL_CALLS evaluations after its first stage near a singular position is
+integrated again, cut, at RELAXED_RTOL (atol relaxed by the same factor; ten times looser again while it crawls still — RELAXED_CRAWL_CALLS
 evaluations after its first stage there — up to RELAXED_MAX) and listed in
 ``stats["relaxed_spans"]``.
 """
@@ -117,8 +129,9 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
             run.restart(control.apply(t0, q, qd))
         run.record(t0, q, qd, writer)
         run.t_now = t0
+        stops = sorted(samples | {times[-1]})  # where a continuous integrator stops: the forces jump, or the run ends
         for t_next in sorted(outputs | samples)[1:]:
-            q, qd = run.advance(t_next, q, qd)
+            q, qd = run.advance(t_next, q, qd, stops[np.searchsorted(stops, t_next)])
             if t_next in samples:
                 run.restart(control.apply(t_next, q, qd))
             if t_next in outputs:
@@ -169,12 +182,13 @@ class _Run:
         self.outputs = OutputEvaluator(system)
         self.stabilization = stabilization
         self.baumgarte = baumgarte if stabilization == "baumgarte" else None
-        self.stage_motion = system.stage_motion(self.baumgarte, drift=True)
+        self._use(system)
         self.n = system.n
         self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity",
                                      "outputs")}
         self.steps = self.evaluations = 0
-        self.solver = None  # the integrator, kept from span to span (``_resumed``)
+        self.solver = None  # the integrator, kept from span to span (``_resumed``, ``_reach``)
+        self.dense = None  # a continuous integrator's interpolant of its last step, when it passed an output time
         self.solver_tolerances = None  # its (rtol, atol)
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
         self.next_step = None  # the step it proposed after its last step not cut short at a span's end
@@ -197,8 +211,19 @@ class _Run:
     def restart(self, system):
         """Go on with ``system`` (new parameter values at a control sample): the forces jump,
         so the integrator starts afresh."""
-        self.system, self.outputs.system, self.solver = system, system, None
+        self.outputs.system, self.solver = system, None
+        self._use(system)
+
+    def _use(self, system):
+        """Integrate ``system``: its stages' motion, and its compiled correction where the
+        kernel covers it (then integrated continuously, with an explicit pair and projection)."""
+        self.system = system
         self.stage_motion = system.stage_motion(self.baumgarte, drift=True)
+        engine = system._tree_engine(True)
+        self.correction = None if engine is None else engine.correction()
+        self.continuous = self.correction is not None and issubclass(self.method, RESUMABLE) \
+            and self.stabilization == "projection"
+        self.compiled_energy = self.correction is not None and all(f.V == 0 for f in system.forces)
 
     def rhs(self, t, y):
         self.t_failed = t
@@ -219,7 +244,82 @@ class _Run:
             raise _Crawl
         return np.concatenate([qd, motion.qdd])
 
-    def advance(self, t_next, q, qd):
+    def advance(self, t_next, q, qd, t_stop):
+        """The state at t_next from (q, q̇) at the time reached (``t_now``), checked and
+        projected if asked. A continuous integrator (``_reach``) may go on to t_stop (the
+        next control sample or the end), (q, q̇) only starting it; an output interval in
+        which it crawls near a singular position, or fails, is integrated again from
+        (q, q̇), cut at t_next (``_advance_cut``): a failure is then reported in the interval
+        it happens in, the rows before it kept."""
+        if not self.continuous:
+            return self._advance_cut(t_next, q, qd)
+        try:
+            y = self._reach(t_next, q, qd, t_stop)
+        except (_Crawl, SolveError) as stop:
+            self.solver = None  # stopped within a step
+            q, qd = self._advance_cut(t_next, q, qd, loosen=isinstance(stop, _Crawl))
+            self.solver = None  # the continuous integrator starts afresh from t_next
+            return q, qd
+        self._check(t_next, y)
+        q, qd, corrected = self._corrected(t_next, y[:self.n], y[self.n:])
+        return self._arrived(t_next, q, qd, None, judged=corrected)
+
+    def _reach(self, t_next, q, qd, t_stop):
+        """The continuous integrator's state at t_next: its steps (``_step``) taken until one
+        reaches or passes t_next, the state read from that step's interpolant. A new
+        integrator (at the start, after a control sample or a cut interval) starts from
+        (q, q̇) at ``t_now``, its first step the one last proposed."""
+        self._begin_interval(self.t_now, t_next, self.rtol)
+        solver = self.solver
+        if solver is None:
+            first = None if self.next_step is None else min(self.next_step, t_stop - self.t_now)
+            solver = self.solver = self.method(self.rhs, self.t_now, np.concatenate([q, qd]), t_stop,
+                                               rtol=self.rtol, atol=self.atol, first_step=first)
+            self.solver_tolerances, self.dense = (self.rtol, self.atol), None
+        while solver.t < t_next:
+            self._step(solver, t_next)
+        return solver.y.copy() if solver.t == t_next else self.dense(t_next)
+
+    def _step(self, solver, t_next):
+        """One accepted step of the continuous integrator (its interpolant kept in ``dense``
+        when it passed t_next), its state then corrected. The step is capped (``max_step``)
+        to keep the drift between corrections below DRIFT_TARGET: halved after a larger
+        drift, doubled after one below a hundredth of it; a step that drifted more than
+        DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length."""
+        start = (solver.t, solver.y, solver.f, solver.h_abs)
+        message = solver.step()
+        if solver.status == "failed":
+            self.t_failed = solver.t
+            raise self._collapse(solver.t, solver.y, (message or "the integrator failed").rstrip("."))
+        self.steps += 1
+        taken = solver.t - start[0]
+        if solver.t != solver.t_bound:
+            self.next_step = solver.h_abs
+        self.dense = solver.dense_output() if solver.t > t_next else None  # before the state is corrected
+        self._check(solver.t, solver.y)
+        q, qd = solver.y[:self.n], solver.y[self.n:]
+        drift = self.correction.drift(q, qd)
+        if drift > DRIFT_REDO * DRIFT_TARGET and taken > MIN_SPAN * self.span:
+            solver.t, solver.y, solver.f, solver.h_abs = start
+            solver.status, solver.max_step, self.dense = "running", taken / 4, None
+            self.steps -= 1
+            return
+        if drift > DRIFT_TARGET:
+            solver.max_step = taken / 2
+        elif drift < DRIFT_TARGET / 100 and np.isfinite(solver.max_step):
+            solver.max_step = np.inf if 2 * solver.max_step >= solver.t_bound - solver.t else 2 * solver.max_step
+        q_on, qd_on, _ = self._corrected(solver.t, q, qd)
+        if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
+            solver.y = np.concatenate([q_on, qd_on])
+            solver.f = self.rhs(solver.t, solver.y)
+
+    def _corrected(self, t, q, qd):
+        """(q, q̇) on the constraints, and whether the kernel's correction put it there (else
+        projection.py did: the kernel declined the state)."""
+        corrected = self.correction(q, qd)
+        return (*corrected, True) if corrected is not None else (*project(self.system, t, q, qd), False)
+
+    def _advance_cut(self, t_next, q, qd, loosen=False):
         """Integrate to t_next, check the state, project it if asked. With projection the
         interval is cut into spans short enough that the state drifts off the manifold by
         at most DRIFT_TARGET (relative, projection.relative_drift) between projections: the
@@ -230,7 +330,7 @@ class _Run:
         interval = t_next - t
         while t < t_next:
             t_to = t_next if self.drift_span is None or t + 1.5 * self.drift_span >= t_next else t + self.drift_span
-            q_to, qd_to = self._integrate(t, t_to, q, qd)
+            q_to, qd_to = self._integrate(t, t_to, q, qd, loosen)
             arrays = None
             if self.stabilization == "projection":
                 self.t_failed = t_to
@@ -244,8 +344,13 @@ class _Run:
                 if not (np.array_equal(q_on, q_to) and np.array_equal(qd_on, qd_to)):
                     q_to, qd_to, arrays = q_on, qd_on, None
             t, q, qd = t_to, q_to, qd_to
+        return self._arrived(t_next, q, qd, arrays)
+
+    def _arrived(self, t_next, q, qd, arrays, judged=False):
+        """The state reached at t_next (``arrays``: its ConstraintArrays, if at hand), judged
+        strictly there with projection (``judged``: the kernel's checks passed there already)."""
         self._note_singular()
-        if self.stabilization == "projection":
+        if self.stabilization == "projection" and not judged:
             self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
         self.t_now = t_next
         self.arrays = arrays  # the ConstraintArrays at the state reached, if at hand (for ``record``)
@@ -257,19 +362,21 @@ class _Run:
         elif drift < DRIFT_TARGET / 100 and self.drift_span is not None:
             self.drift_span = None if 2 * self.drift_span >= interval else 2 * self.drift_span
 
-    def _integrate(self, t, t_next, q, qd):
+    def _integrate(self, t, t_next, q, qd, loosen=False):
         """The integrator from (t, q, q̇) to t_next; the state at t_next, checked. A span that
         crawls near a singular position (CRAWL_CALLS) is integrated again at a looser
-        tolerance: RELAXED_RTOL, then ten times looser each time, up to RELAXED_MAX."""
+        tolerance: RELAXED_RTOL, then ten times looser each time, up to RELAXED_MAX
+        (``loosen``: it crawled already, integrated continuously)."""
         rtol, atol, proposed = self.rtol, self.atol, self.next_step
+        if loosen:
+            rtol, atol = _looser(rtol, atol)
         while True:
             try:
                 y = self._span(t, t_next, np.concatenate([q, qd]), rtol, atol)
                 break
             except _Crawl:
                 self.solver, self.next_step = None, proposed  # stopped within a step; its steps are no guide
-                looser = min(max(RELAXED_RTOL, 10 * rtol), RELAXED_MAX)
-                rtol, atol = looser, atol * looser / rtol
+                rtol, atol = _looser(rtol, atol)
         if rtol != self.rtol:
             self.relaxed_spans.append(dict(t_from=t, t_to=t_next, rtol=rtol, atol=atol))
             log.info("near a singular position between t = %.6g and %.6g: integrated at rtol %g, atol %g",
@@ -277,11 +384,16 @@ class _Run:
         self._check(t_next, y)
         return y[:self.n], y[self.n:]
 
-    def _span(self, t, t_next, y, rtol, atol):
-        """The integrator's steps from (t, y) to t_next (its last step cut short there)."""
-        self.calls, self.t_mark, self.span = 0, t, t_next - t  # the collapse check counts within this interval
+    def _begin_interval(self, t, t_next, rtol):
+        """Count the evaluations from here (the collapse and crawl checks): an interval from t
+        to t_next, integrated at rtol."""
+        self.calls, self.t_mark, self.span = 0, t, t_next - t
         self.singular_call, self.span_rtol = None, rtol
         self.crawl_calls = CRAWL_CALLS if rtol == self.rtol else RELAXED_CRAWL_CALLS  # a relaxed span crawls longer
+
+    def _span(self, t, t_next, y, rtol, atol):
+        """The integrator's steps from (t, y) to t_next (its last step cut short there)."""
+        self._begin_interval(t, t_next, rtol)
         solver = self._resumed(t, y, t_next, rtol, atol)
         while solver.status == "running":
             message = solver.step()
@@ -340,9 +452,14 @@ class _Run:
                              f"{', '.join(culprits[:6])}", coordinates=culprits)
 
     def record(self, t, q, qd, writer, arrays=None):
-        """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, if at hand."""
-        kinetic, potential = self.system.energy(t, q, qd)
-        phi, psi = self.system.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
+        """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, if at hand. The residuals
+        and energies are the compiled ones where the kernel covers them (fast/rows.py)."""
+        if self.correction is not None:
+            phi, psi, kinetic, potential = self.correction.residuals_energy(q, qd)
+        else:
+            phi, psi = self.system.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
+        if not self.compiled_energy:
+            kinetic, potential = self.system.energy(t, q, qd)
         row = dict(t=t, q=np.array(q), qd=np.array(qd), energy=kinetic + potential, kinetic=kinetic,
                    residual_position=_max_abs(phi), residual_velocity=_max_abs(psi),
                    outputs=self.outputs.evaluate(t, q, qd) if self.outputs else np.zeros(0))
@@ -364,6 +481,13 @@ class _Run:
             log.warning("the motion was not unique somewhere on this run; the free directions got zero "
                         "acceleration (η = 0 in (2.14))")
         return traj
+
+
+def _looser(rtol, atol):
+    """The next tolerances of a span that crawls: RELAXED_RTOL, then ten times looser, up to
+    RELAXED_MAX (atol alike)."""
+    looser = min(max(RELAXED_RTOL, 10 * rtol), RELAXED_MAX)
+    return looser, atol * looser / rtol
 
 
 class _Crawl(Exception):

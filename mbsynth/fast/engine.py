@@ -25,6 +25,7 @@ import numpy as np
 from ..equations import Motion
 from . import codegen, kernel, layout
 from .assembly import Work, make_work
+from .correction import Correction
 from .packing import pack, views
 
 EMPTY = np.zeros(0)
@@ -85,6 +86,7 @@ class Engine:
         self.lock = threading.Lock()
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
+        self.corrections = []  # the Correction, once made (a list: ``at``'s copies share it)
 
     def at(self, p):
         """This Engine at other parameter values that its Layout's numbers do not use (a
@@ -93,6 +95,17 @@ class Engine:
         other = copy.copy(self)
         other.p = p
         return other
+
+    def at_rest(self):
+        """This Engine with no gravity, for calls at q̇ = 0 with no generated forces (correction.py)."""
+        return Engine(self.template, self.L._replace(node_mg=np.zeros_like(self.L.node_mg)), self.p)
+
+    def correction(self):
+        """The kernel's projection on this Engine's Layout (correction.py), or None where the
+        kernel does not cover the System."""
+        if not self.corrections:
+            self.corrections.append(Correction.build(self))
+        return self.corrections[0]
 
     def new_work(self):
         """(packed buffers, Work of views into them)."""
