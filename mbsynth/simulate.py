@@ -36,9 +36,9 @@ may go unlisted. There the stages' accelerations carry noise of about |q̇| ψ /
 velocity drift the projection leaves, about 1e-12): a tolerance tighter than that noise
 allows makes the integrator crawl. A span (a continuous run: its output interval) that
 takes more than CRAWL_CALLS evaluations after its first stage near a singular position is
-integrated again, cut, at RELAXED_RTOL (atol relaxed by the same factor; ten times looser again while it crawls still — RELAXED_CRAWL_CALLS
-evaluations after its first stage there — up to RELAXED_MAX) and listed in
-``stats["relaxed_spans"]``.
+integrated again, cut, at RELAXED_RTOL (atol relaxed by the same factor; ten times
+looser again while it crawls still — RELAXED_CRAWL_CALLS evaluations after its first
+stage there — up to RELAXED_MAX) and listed in ``stats["relaxed_spans"]``.
 """
 
 import logging
@@ -443,6 +443,8 @@ class _Run:
                           coordinates=[c for c, _ in fastest])
 
     def _check(self, t, y):
+        if np.abs(y).max(initial=0.0) <= MAX_STATE:  # false where any is NaN
+            return
         bad = ~np.isfinite(y) | (np.abs(y) > MAX_STATE)
         if bad.any():
             self.t_failed = t
@@ -495,6 +497,9 @@ class _Crawl(Exception):
 
 
 def _max_abs(values):
+    largest = np.abs(values).max(initial=0.0)
+    if np.isfinite(largest):
+        return float(largest)
     finite = values[np.isfinite(values)]
     return float(np.abs(finite).max()) if finite.size else 0.0
 

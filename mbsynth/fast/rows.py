@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from .bodies import OPTIONS
-from .joints import COMPONENT, D, DOT, JAC, VALUE, VELOCITY, XA, XB, ZA, ZB, _end, vector_work
+from .joints import COMPONENT, D, DOT, VALUE, VELOCITY, XA, XB, ZA, ZB, _end, vector_work
 
 
 @njit(**OPTIONS)
