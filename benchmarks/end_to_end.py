@@ -323,9 +323,10 @@ def main():
     lines = ["# End to end: mbsynth against Pinocchio aba + solve_ivp, MuJoCo and Exudyn", "",
              f"{datetime.date.today()} on {platform.node()} ({os.cpu_count()} cores, {platform.processor() or '?'}), "
              f"`benchmarks/end_to_end.py`. Each simulation: DOP853, rtol = atol = {TOL:g}, {OUTPUTS + 1} outputs; "
-             f"mbsynth's `simulate` (a projection onto the constraints at every output) against `solve_ivp` of the "
-             f"reference code on the same model: (q̇, `pin.aba`) for the robots and the chain (zero torques, "
-             f"gravity), and for Andrews' squeezer the IVP test set's index-1 equations by hand (numpy, "
+             f"mbsynth's `simulate` (its state put back on the constraints at every accepted step and output row) "
+             f"against `solve_ivp` of the reference code on the same model: (q̇, `pin.aba`) for the robots and "
+             f"the chain (zero torques, gravity), and for Andrews' squeezer the IVP test set's index-1 equations "
+             f"by hand (numpy, "
              f"`andrews_by_hand`); best of {args.rounds} rounds, the two alternating, the ratio to the reference's "
              "time in the same run; MuJoCo (`mj_forward` in the same `solve_ivp`) and Exudyn (its kinematic tree "
              "and its own DOPRI5) on the same models, their *Δx* the largest distance between a joint's origin at "

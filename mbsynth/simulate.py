@@ -41,6 +41,7 @@ looser again while it crawls still — RELAXED_CRAWL_CALLS evaluations after its
 stage there — up to RELAXED_MAX) and listed in ``stats["relaxed_spans"]``.
 """
 
+import bisect
 import logging
 import time
 
@@ -130,8 +131,9 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         run.record(t0, q, qd, writer)
         run.t_now = t0
         stops = sorted(samples | {times[-1]})  # where a continuous integrator stops: the forces jump, or the run ends
-        for t_next in sorted(outputs | samples)[1:]:
-            q, qd = run.advance(t_next, q, qd, stops[np.searchsorted(stops, t_next)])
+        run.times = sorted(outputs | samples)
+        for t_next in run.times[1:]:
+            q, qd = run.advance(t_next, q, qd, stops[bisect.bisect_left(stops, t_next)])
             if t_next in samples:
                 run.restart(control.apply(t_next, q, qd))
             if t_next in outputs:
@@ -188,7 +190,8 @@ class _Run:
                                      "outputs")}
         self.steps = self.evaluations = 0
         self.solver = None  # the integrator, kept from span to span (``_resumed``, ``_reach``)
-        self.dense = None  # a continuous integrator's interpolant of its last step, when it passed an output time
+        self.times = []  # the times ``advance`` is called for, in order (outputs and control samples)
+        self.passed = {}  # a continuous integrator's states at the times its last step passed ({t: y})
         self.solver_tolerances = None  # its (rtol, atol)
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
         self.next_step = None  # the step it proposed after its last step not cut short at a span's end
@@ -275,14 +278,14 @@ class _Run:
             first = None if self.next_step is None else min(self.next_step, t_stop - self.t_now)
             solver = self.solver = self.method(self.rhs, self.t_now, np.concatenate([q, qd]), t_stop,
                                                rtol=self.rtol, atol=self.atol, first_step=first)
-            self.solver_tolerances, self.dense = (self.rtol, self.atol), None
+            self.solver_tolerances, self.passed = (self.rtol, self.atol), {}
         while solver.t < t_next:
             self._step(solver, t_next)
-        return solver.y.copy() if solver.t == t_next else self.dense(t_next)
+        return solver.y.copy() if solver.t == t_next else self.passed[t_next]
 
     def _step(self, solver, t_next):
-        """One accepted step of the continuous integrator (its interpolant kept in ``dense``
-        when it passed t_next), its state then corrected. The step is capped (``max_step``)
+        """One accepted step of the continuous integrator (the states at the times it passed,
+        t_next first, kept in ``passed``), its state then corrected. The step is capped (``max_step``)
         to keep the drift between corrections below DRIFT_TARGET: halved after a larger
         drift, doubled after one below a hundredth of it; a step that drifted more than
         DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length."""
@@ -295,13 +298,16 @@ class _Run:
         taken = solver.t - start[0]
         if solver.t != solver.t_bound:
             self.next_step = solver.h_abs
-        self.dense = solver.dense_output() if solver.t > t_next else None  # before the state is corrected
+        self.passed = {}
+        if solver.t > t_next:  # the times it passed, from its interpolant (one call), before the state is corrected
+            times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
+            self.passed = dict(zip(times, solver.dense_output()(times).T.copy()))
         self._check(solver.t, solver.y)
         q, qd = solver.y[:self.n], solver.y[self.n:]
         drift = self.correction.drift(q, qd)
         if drift > DRIFT_REDO * DRIFT_TARGET and taken > MIN_SPAN * self.span:
             solver.t, solver.y, solver.f, solver.h_abs = start
-            solver.status, solver.max_step, self.dense = "running", taken / 4, None
+            solver.status, solver.max_step, self.passed = "running", taken / 4, {}
             self.steps -= 1
             return
         if drift > DRIFT_TARGET:
