@@ -22,9 +22,10 @@ def main():
     print(f"mbsynth fast path compiled into {cache.cache_dir()} in {time.perf_counter() - started:.1f} s")
 
 
-# A body on a spherical joint and a loop (a second, redundant hinge): every kernel runs;
-# the same without the loop: the correction's (the kernel at rest, the compiled rows).
-WARM_MODELS = ["""
+# A body on a spherical joint with a particle on a rod, without and with a loop (a second,
+# redundant hinge) and a generated force: every kernel runs, and the correction's (the
+# kernel at rest, the compiled rows) on the tree.
+WARM_TREE = """
 name: warm_up
 gravity: [0, 0, -9.81]
 subsystems:
@@ -34,20 +35,11 @@ subsystems:
 joints:
   - {name: pivot, type: spherical, parent: world, child: link.top}
   - {name: rod, type: distance, parent: link, child: bob, length: 0.5}
-  - {name: again, type: spherical, parent: world, child: link.top}
+"""
+WARM_MODELS = [WARM_TREE + """  - {name: again, type: spherical, parent: world, child: link.top}
 forces:
   - {name: push, type: force, at: bob, value: ["sin(t)", 0, 0]}
-""", """
-name: warm_up_tree
-gravity: [0, 0, -9.81]
-subsystems:
-  link: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5]}},
-         initial: {angular_velocity: [0.1, 0.2, 0.3]}}
-  bob: {type: particle, mass: 0.5, initial: {position: [0, 0, -0.5]}}
-joints:
-  - {name: pivot, type: spherical, parent: world, child: link.top}
-  - {name: rod, type: distance, parent: link, child: bob, length: 0.5}
-"""]
+""", WARM_TREE]
 
 if __name__ == "__main__":
     main()

@@ -88,18 +88,25 @@ def _end(e, kind, o, s, Rf, axes, q, qd, V, R, Jt):
 
 
 @njit(**OPTIONS)
-def joint_rows(program, k, kinds, starts, s, Rf, length, q, qd, V, R, Jt, A, b):
-    """Rows A[:k] (k × 14: end A's 7 coordinates, then end B's) and b[:k] of one joint.
-
-    program: k × 3 (operation, vector, vector or component); kinds, starts: per end, what it
-    sits on and its first coordinate; s, Rf: per end, the frame's offset and rotation in
-    its part (in the world for a world end); length: a distance joint's L."""
+def uses_axes(program, k):
+    """Whether the k rows of ``program`` use end A's axes, and end B's (dot rows only)."""
     axes_a = axes_b = False
     for r in range(k):
         if program[r, 0] == DOT:
             for x in (program[r, 1], program[r, 2]):
                 axes_a |= XA <= x <= ZA
                 axes_b |= XB <= x <= ZB
+    return axes_a, axes_b
+
+
+@njit(**OPTIONS)
+def joint_rows(program, k, kinds, starts, s, Rf, length, q, qd, V, R, Jt, A, b):
+    """Rows A[:k] (k × 14: end A's 7 coordinates, then end B's) and b[:k] of one joint.
+
+    program: k × 3 (operation, vector, vector or component); kinds, starts: per end, what it
+    sits on and its first coordinate; s, Rf: per end, the frame's offset and rotation in
+    its part (in the world for a world end); length: a distance joint's L."""
+    axes_a, axes_b = uses_axes(program, k)
     _end(0, kinds[0], starts[0], s[0], Rf[0], axes_a, q, qd, V, R, Jt)
     _end(1, kinds[1], starts[1], s[1], Rf[1], axes_b, q, qd, V, R, Jt)
     for i in range(3):  # d = p_B − p_A: value, velocity, bias and Jacobian alike

@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from .bodies import OPTIONS
-from .joints import COMPONENT, D, DOT, VALUE, VELOCITY, XA, XB, ZA, ZB, _end, vector_work
+from .joints import COMPONENT, D, DOT, VALUE, VELOCITY, _end, uses_axes, vector_work
 
 
 @njit(**OPTIONS)
@@ -41,12 +41,7 @@ def residuals_energy(q, qd, node_kind, node_q, node_mass, node_mg, node_J, quat_
                           + o2 * (J[2, 0] * o0 + J[2, 1] * o1 + J[2, 2] * o2))
     for k in range(joint_k.shape[0]):
         program, count, row = joint_program[k], joint_k[k], joint_row[k]
-        axes_a = axes_b = False
-        for r in range(count):
-            if program[r, 0] == DOT:
-                for v in (program[r, 1], program[r, 2]):
-                    axes_a |= XA <= v <= ZA
-                    axes_b |= XB <= v <= ZB
+        axes_a, axes_b = uses_axes(program, count)
         _end(0, joint_kinds[k, 0], joint_start[k, 0], joint_s[k, 0], joint_R[k, 0], axes_a, q, qd, V, R, Jt)
         _end(1, joint_kinds[k, 1], joint_start[k, 1], joint_s[k, 1], joint_R[k, 1], axes_b, q, qd, V, R, Jt)
         for i in range(3):
