@@ -11,8 +11,8 @@ rank 3, and the unit-norm row the body adds itself closes it, so [M; A] has full
 Nothing dissipates, so three quantities must stay constant: the energy, the angular
 momentum about the vertical through the fixed point, and the spin about the top's own
 axis (its two equal moments make it a Lagrange top). The quaternion's norm must stay 1;
-drift control projects the state back onto the constraints (unit norm included) at every
-output time.
+drift control puts the state back onto the constraints (unit norm included) at every
+accepted step of the integrator and every output row (a tree: the compiled kernel does it).
 """
 
 # %%
