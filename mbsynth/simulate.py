@@ -451,13 +451,11 @@ class _Run:
     def _check(self, t, y):
         if np.abs(y).max(initial=0.0) <= MAX_STATE:  # false where any is NaN
             return
-        bad = ~np.isfinite(y) | (np.abs(y) > MAX_STATE)
-        if bad.any():
-            self.t_failed = t
-            names = [c for c in self.system.coordinates] + [c + "_dot" for c in self.system.coordinates]
-            culprits = [names[i] for i in np.flatnonzero(bad)]
-            raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
-                             f"{', '.join(culprits[:6])}", coordinates=culprits)
+        self.t_failed = t
+        names = [c for c in self.system.coordinates] + [c + "_dot" for c in self.system.coordinates]
+        culprits = [names[i] for i in np.flatnonzero(~np.isfinite(y) | (np.abs(y) > MAX_STATE))]
+        raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
+                         f"{', '.join(culprits[:6])}", coordinates=culprits)
 
     def record(self, t, q, qd, writer, arrays=None):
         """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, if at hand. The residuals

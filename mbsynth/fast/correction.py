@@ -71,6 +71,7 @@ class Correction:
     def drift(self, q, qd):
         """The largest |φ| relative to the largest coordinate (at least 1: a quaternion's
         unit), or |φ̇| relative to the largest rate."""
-        phi, psi, _, _ = self.residuals_energy(q, qd)
-        return max(np.abs(phi).max(initial=0.0) / max(np.abs(q).max(initial=0.0), 1.0),
-                   np.abs(psi).max(initial=0.0) / max(np.abs(qd).max(initial=0.0), np.finfo(float).tiny))
+        with self.lock:
+            phi, psi, _, _ = self.rows(q, qd)
+            return max(np.abs(phi).max(initial=0.0) / max(np.abs(q).max(initial=0.0), 1.0),
+                       np.abs(psi).max(initial=0.0) / max(np.abs(qd).max(initial=0.0), np.finfo(float).tiny))
