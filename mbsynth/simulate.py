@@ -137,7 +137,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
             if t_next in samples:
                 run.restart(control.apply(t_next, q, qd))
             if t_next in outputs:
-                run.record(t_next, q, qd, writer, None if t_next in samples else run.arrays)
+                run.record(t_next, q, qd, writer, *((None, None) if t_next in samples else (run.arrays, run.corrected)))
                 if progress is not None:
                     progress(t_next)
         status = COMPLETED
@@ -194,6 +194,7 @@ class _Run:
         self.passed = {}  # a continuous integrator's states at the times its last step passed ({t: y})
         self.solver_tolerances = None  # its (rtol, atol)
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
+        self.corrected = None  # the kernel's correction.Corrected there, if at hand
         self.next_step = None  # the step it proposed after its last step not cut short at a span's end
         self.t_failed = float("nan")
         self.t_now = None  # the time the state has reached (outputs and control samples alike)
@@ -264,8 +265,8 @@ class _Run:
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
         self._check(t_next, y)
-        q, qd, corrected = self._corrected(t_next, y[:self.n], y[self.n:])
-        return self._arrived(t_next, q, qd, None, judged=corrected)
+        q, qd, measured = self._corrected(t_next, y[:self.n], y[self.n:])
+        return self._arrived(t_next, q, qd, None, measured)
 
     def _reach(self, t_next, q, qd, t_stop):
         """The continuous integrator's state at t_next: its steps (``_step``) taken until one
@@ -320,10 +321,11 @@ class _Run:
             solver.f = self.rhs(solver.t, solver.y)
 
     def _corrected(self, t, q, qd):
-        """(q, q̇) on the constraints, and whether the kernel's correction put it there (else
-        projection.py did: the kernel declined the state)."""
+        """(q, q̇) on the constraints and, where the kernel's correction put it there, its
+        ``Corrected`` (rows and energies there); None where projection.py did (the kernel
+        declined the state)."""
         corrected = self.correction(q, qd)
-        return (*corrected, True) if corrected is not None else (*project(self.system, t, q, qd), False)
+        return (*project(self.system, t, q, qd), None) if corrected is None else (*corrected[:2], corrected)
 
     def _advance_cut(self, t_next, q, qd, loosen=False):
         """Integrate to t_next, check the state, project it if asked. With projection the
@@ -352,14 +354,16 @@ class _Run:
             t, q, qd = t_to, q_to, qd_to
         return self._arrived(t_next, q, qd, arrays)
 
-    def _arrived(self, t_next, q, qd, arrays, judged=False):
+    def _arrived(self, t_next, q, qd, arrays, corrected=None):
         """The state reached at t_next (``arrays``: its ConstraintArrays, if at hand), judged
-        strictly there with projection (``judged``: the kernel's checks passed there already)."""
+        strictly there with projection, unless the kernel ``corrected`` it (its checks passed
+        there already; correction.Corrected, with the rows there)."""
         self._note_singular()
-        if self.stabilization == "projection" and not judged:
+        if self.stabilization == "projection" and corrected is None:
             self.system.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
         self.t_now = t_next
         self.arrays = arrays  # the ConstraintArrays at the state reached, if at hand (for ``record``)
+        self.corrected = corrected  # its Corrected, if at hand (for ``record``)
         return q, qd
 
     def _adapt_span(self, drift, span, interval):
@@ -457,17 +461,22 @@ class _Run:
         raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
                          f"{', '.join(culprits[:6])}", coordinates=culprits)
 
-    def record(self, t, q, qd, writer, arrays=None):
-        """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, if at hand. The residuals
-        and energies are the compiled ones where the kernel covers them (fast/rows.py)."""
-        if self.correction is not None:
-            phi, psi, kinetic, potential = self.correction.residuals_energy(q, qd)
+    def record(self, t, q, qd, writer, arrays=None, corrected=None):
+        """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, ``corrected``: its
+        correction.Corrected, if at hand. The residuals and energies are the compiled ones
+        where the kernel covers them (fast/rows.py)."""
+        if corrected is None:
+            if self.correction is not None:
+                phi, psi, kinetic, potential = self.correction.residuals_energy(q, qd)
+            else:
+                phi, psi = self.system.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
+            residuals = _max_abs(phi), _max_abs(psi)
         else:
-            phi, psi = self.system.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
+            kinetic, potential, *residuals = corrected[2:]
         if not self.compiled_energy:
             kinetic, potential = self.system.energy(t, q, qd)
         row = dict(t=t, q=np.array(q), qd=np.array(qd), energy=kinetic + potential, kinetic=kinetic,
-                   residual_position=_max_abs(phi), residual_velocity=_max_abs(psi),
+                   residual_position=residuals[0], residual_velocity=residuals[1],
                    outputs=self.outputs.evaluate(t, q, qd) if self.outputs else np.zeros(0))
         for k, v in row.items():
             self.rows[k].append(v)

@@ -124,7 +124,8 @@ class Engine:
         with self.lock:
             if self.module is not None:
                 self.module.evaluate(t, q, qd, self.p, self.gen)
-            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.buffers)
+            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.buffers,
+                                             kernel.CHECKED)
             if status != kernel.OK:
                 return None
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")

@@ -36,6 +36,7 @@ from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
+CHECKED, UNCHECKED, REUSED = range(3)  # modes of ``motion``: what a call factors and checks
 EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of max(the largest, 1) count as zero
 CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions, relative to b's
 NULL_RTOL = 1e-8  # largest acceleration a dropped (unit) direction may move
@@ -272,11 +273,14 @@ def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx,
 
 
 @njit(**OPTIONS)
-def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
+def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode):
     """(status, residual) at one state; on OK, the Work's qdd holds q̈ and its Qc M q̈ − Q.
     gen: the generated function's outputs at (t, q, q̇) — time enters only there; bshift:
     added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
-    Layout and the Work packed (packing.py)."""
+    Layout and the Work packed (packing.py). ``mode``: CHECKED factors the tree and checks
+    the residual; UNCHECKED skips the check (residual 0: a caller that checks the result
+    itself, correction.py); REUSED also keeps the factorization the last call on this Work
+    left, for a call with the same M and A (the same q) and another right side."""
     q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
     mass, mg, inertia = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), view3(LF, LX, LAYOUT.node_J)
@@ -326,7 +330,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
                joints[4], Rs, factored[8])
     tree_rhs(v, k, yoff, rows, F, rb, ry)
 
-    if factor(topology, H, J, P, factored, view2(WF, WX, WORK.G), view1(WI, WX, WORK.pivot)) >= 0:
+    if mode != REUSED and factor(topology, H, J, P, factored, view2(WF, WX, WORK.G), view1(WI, WX, WORK.pivot)) >= 0:
         return SINGULAR, 0.0
     _copy(ry, y)
     bordered = x_coord.shape[0] + xb.shape[0] > 0
@@ -337,7 +341,9 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX):
         if status != OK:
             return status, 0.0
     _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc)
-    residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn)
+    residual = 0.0
+    if mode == CHECKED:
+        residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn)
     for c in range(qdd.shape[0]):
         if not (math.isfinite(qdd[c]) and math.isfinite(Qc[c])):
             return NOT_FINITE, residual
@@ -353,5 +359,5 @@ def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, qdd, status):
     empty = np.zeros(0)
     qdd_view = view1(WF, WX, WORK.qdd)
     for row in range(q.shape[0]):
-        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX)[0]
+        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED)[0]
         _copy(qdd_view, qdd[row])

@@ -4,20 +4,36 @@ rows and corrections: fast/correction.py).
 The rows are those of kernel.py: each rigid body's unit-norm row φ = (uᵀu − 1)/2,
 φ̇ = uᵀu̇, and each kernel joint's rows from the vectors of joints.py (value and velocity):
 component φ = d_k, φ̇ = ḋ_k; dot φ = v·w, φ̇ = v̇·w + v·ẇ; distance φ = (d·d − L²)/2L,
-φ̇ = d·ḋ/L. Energies: T = ½ m ṙᵀṙ + 2 u̇ᵀEᵀJEu̇, V = −m gᵀr (rigid_body.py).
+φ̇ = d·ḋ/L. Energies: T = ½ m ṙᵀṙ + 2 u̇ᵀEᵀJEu̇, V = −m gᵀr (rigid_body.py). Only values
+and velocities: a frame's vector R(u)c moves at Ṙ(u, u̇)c (no Jacobians, unlike joints.py).
 """
 
 import numpy as np
 from numba import njit
 
-from .bodies import OPTIONS
-from .joints import COMPONENT, D, DOT, VALUE, VELOCITY, _end, uses_axes, vector_work
+from .bodies import OPTIONS, rotation, rotation_rate
+from .layout import Layout
+from .packing import borrowed, fields, view1, view2, view3, view4
+from .joints import COMPONENT, D, DOT, PARTICLE, VALUE, VELOCITY, WORLD, uses_axes
+
+LAYOUT = fields(Layout)
 
 
 @njit(**OPTIONS)
-def residuals_energy(q, qd, node_kind, node_q, node_mass, node_mg, node_J, quat_row, joint_kinds, joint_start,
-                     joint_s, joint_R, joint_length, joint_program, joint_k, joint_row, phi, psi, V, R, Jt):
-    """φ, φ̇ into phi, psi (rows of the kernel; others untouched); returns (T, V)."""
+def residuals_energy(q, qd, LI, LF, LX, phi, psi, V, R):
+    """φ, φ̇ into phi, psi (rows of the kernel; others untouched); returns (T, V, max|φ|,
+    max|φ̇|, max|q|, max|q̇|), the maxima over the whole arrays. LI, LF, LX: the Layout
+    packed (packing.py); V, R: work space (``Rows``)."""
+    q, qd, phi, psi, V, R = borrowed(q), borrowed(qd), borrowed(phi), borrowed(psi), borrowed(V), borrowed(R)
+    node_kind, node_q, quat_row = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q), \
+        view1(LI, LX, LAYOUT.quat_row)
+    node_mass, node_mg, node_J = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), \
+        view3(LF, LX, LAYOUT.node_J)
+    joint_kinds, joint_start, joint_program = view2(LI, LX, LAYOUT.joint_kinds), view2(LI, LX, LAYOUT.joint_start), \
+        view3(LI, LX, LAYOUT.joint_program)
+    joint_k, joint_row = view1(LI, LX, LAYOUT.joint_k), view1(LI, LX, LAYOUT.joint_row)
+    joint_s, joint_R, joint_length = view3(LF, LX, LAYOUT.joint_s), view4(LF, LX, LAYOUT.joint_R), \
+        view1(LF, LX, LAYOUT.joint_length)
     kinetic = potential = 0.0
     for i in range(node_kind.shape[0]):
         o = node_q[i]
@@ -42,8 +58,8 @@ def residuals_energy(q, qd, node_kind, node_q, node_mass, node_mg, node_J, quat_
     for k in range(joint_k.shape[0]):
         program, count, row = joint_program[k], joint_k[k], joint_row[k]
         axes_a, axes_b = uses_axes(program, count)
-        _end(0, joint_kinds[k, 0], joint_start[k, 0], joint_s[k, 0], joint_R[k, 0], axes_a, q, qd, V, R, Jt)
-        _end(1, joint_kinds[k, 1], joint_start[k, 1], joint_s[k, 1], joint_R[k, 1], axes_b, q, qd, V, R, Jt)
+        _frame(0, joint_kinds[k, 0], joint_start[k, 0], joint_s[k, 0], joint_R[k, 0], axes_a, q, qd, V, R)
+        _frame(1, joint_kinds[k, 1], joint_start[k, 1], joint_s[k, 1], joint_R[k, 1], axes_b, q, qd, V, R)
         for i in range(3):
             V[D, i, VALUE] = V[8, i, VALUE] - V[7, i, VALUE]
             V[D, i, VELOCITY] = V[8, i, VELOCITY] - V[7, i, VELOCITY]
@@ -68,27 +84,65 @@ def residuals_energy(q, qd, node_kind, node_q, node_mass, node_mg, node_J, quat_
                     rate += X[i, VALUE] * X[i, VELOCITY]
                 phi[row + r] = (value - L * L) / (2 * L)
                 psi[row + r] = rate / L
-    return kinetic, potential
+    return kinetic, potential, _largest(phi), _largest(psi), _largest(q), _largest(qd)
+
+
+@njit(**OPTIONS)
+def _largest(x):
+    """max |x| (0 for none; nan if any is)."""
+    top = 0.0
+    for i in range(x.shape[0]):
+        a = abs(x[i])
+        if a > top or a != a:
+            top = a
+    return top
+
+
+@njit(**OPTIONS)
+def _frame(e, kind, o, s, Rf, axes, q, qd, V, R):
+    """The value and velocity of end e's origin (record 7 + e) and, when ``axes``, of its
+    three axes (records 1 + 3e ...) into V, as joints._end has them."""
+    P = V[7 + e]
+    for a in range(4 if axes else 1):  # a = 0: the origin's offset s; a = 1, 2, 3: the frame's axes
+        X = P if a == 0 else V[3 * e + a]
+        c = (s[0], s[1], s[2]) if a == 0 else (Rf[0, a - 1], Rf[1, a - 1], Rf[2, a - 1])
+        for i in range(3):
+            X[i, VALUE], X[i, VELOCITY] = c[i], 0.0
+    if kind == WORLD:
+        return
+    for i in range(3):
+        P[i, VALUE], P[i, VELOCITY] = q[o + i], qd[o + i]
+    if kind == PARTICLE:
+        return
+    rotation(q[o + 3:o + 7], R[0])
+    rotation_rate(q[o + 3:o + 7], qd[o + 3:o + 7], R[1])
+    for a in range(4 if axes else 1):
+        X = P if a == 0 else V[3 * e + a]
+        c = (s[0], s[1], s[2]) if a == 0 else (Rf[0, a - 1], Rf[1, a - 1], Rf[2, a - 1])
+        for i in range(3):
+            X[i, VALUE] = (P[i, VALUE] if a == 0 else 0.0) + R[0, i, 0] * c[0] + R[0, i, 1] * c[1] + R[0, i, 2] * c[2]
+            X[i, VELOCITY] = (P[i, VELOCITY] if a == 0 else 0.0) \
+                + R[1, i, 0] * c[0] + R[1, i, 1] * c[1] + R[1, i, 2] * c[2]
 
 
 class Rows:
-    """The compiled φ, φ̇ and energies on an Engine's Layout ``L`` of a System with ``m`` rows.
+    """The compiled φ, φ̇ and energies on an Engine's Layout ``L`` (``packed``: packing.pack(L))
+    of a System with ``m`` rows.
     ``covers``: whether the kernel's rows are all of the System's rows and its nodes all of
     its coordinates (no extra rows or coordinates), so that these are the System's φ, φ̇
     and its parts' energies."""
 
-    def __init__(self, L, m):
-        self.args = (L.node_kind, L.node_q, L.node_mass, L.node_mg, L.node_J, L.quat_row, L.joint_kinds,
-                     L.joint_start, L.joint_s, L.joint_R, L.joint_length, L.joint_program, L.joint_k, L.joint_row)
+    def __init__(self, L, packed, m):
+        self.packed = packed
         covered = np.zeros(m, dtype=bool)
         covered[L.quat_row[L.quat_row >= 0]] = True
         for row, count in zip(L.joint_row, L.joint_k):
             covered[row:row + count] = True
         self.covers = bool(covered.all()) and L.x_coord.size == 0
-        self.work = vector_work()
+        self.work = np.zeros((9, 3, 2)), np.zeros((2, 3, 3))  # joints.py's vectors (value, velocity); R, Ṙ
         self.phi, self.psi = np.zeros(m), np.zeros(m)
 
     def __call__(self, q, qd):
-        """(φ, φ̇, T, V) at (q, q̇): the arrays are this object's, overwritten by the next call."""
-        T, V = residuals_energy(q, qd, *self.args, self.phi, self.psi, *self.work)
-        return self.phi, self.psi, T, V
+        """(φ, φ̇, T, V, max|φ|, max|φ̇|, max|q|, max|q̇|) at (q, q̇): the arrays are this
+        object's, overwritten by the next call."""
+        return (self.phi, self.psi, *residuals_energy(q, qd, *self.packed, self.phi, self.psi, *self.work))
