@@ -61,20 +61,25 @@ def same_packing(old):
         [list(f.__members__) for f in (kernel.LAYOUT, kernel.WORK)]
 
 
+def _checked(module):
+    """The mode argument of a kernel whose ``motion`` takes one (its checked call), else none."""
+    return (module.CHECKED,) if hasattr(module, "CHECKED") else ()
+
+
 def compare(label, old, new):
     case = chain_case(int(label)) if label.isdigit() else robot_case(label, label in ("talos", "solo12"))
     engine = engine_for(case.system, wait=True)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
-    args = (qm, qdm, engine.gen, np.zeros(0), *engine.buffers)
+    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module)) for module in (old, new)}
     results = []
     for module in (old, new):
-        module.motion(*args)
+        module.motion(*args[module])
         results.append(engine.W.qdd.copy())
     times = {old: [], new: []}
     for _ in range(ROUNDS):
         for module in (old, new):
-            times[module].append(best(lambda: module.motion(*args), seconds=0.2))
+            times[module].append(best(lambda: module.motion(*args[module]), seconds=0.2))
     before, after = min(times[old]), min(times[new])
     paired = np.median(np.array(times[new]) / np.array(times[old]))
     return (f"| {label} | {before * 1e6:.2f} | {after * 1e6:.2f} | {after / before:.3f} | {paired:.3f} | "

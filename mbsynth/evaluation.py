@@ -26,9 +26,26 @@ DENSE_ENTRIES = 40000  # rows × coordinates up to which dense arrays beat scipy
 _evaluators = {}
 
 
+class _FixWhenMade(NamedTuple):
+    """In place of a run's Evaluator until its first use (``fix_when_made``)."""
+
+    wait: bool
+
+
 def evaluator(system):
     """The Evaluator of ``system``, made on first use and dropped when the System is."""
-    return _existing(system) or _keep(system, Evaluator(system))
+    found = _existing(system)
+    if isinstance(found, _FixWhenMade):
+        return _keep(system, Evaluator(system).fix_kernels(found.wait))
+    return found or _keep(system, Evaluator(system))
+
+
+def fix_when_made(system, wait):
+    """Let ``system``'s Evaluator fix its paths (``Evaluator.fix_kernels(wait)``) as it is
+    made, on first use: a run (System.for_run) that never evaluates the System's
+    connectors one by one (the compiled kernel covers them) never lays them out."""
+    if _existing(system) is None:
+        _keep(system, _FixWhenMade(wait))
 
 
 def share(parent, child):
@@ -38,6 +55,8 @@ def share(parent, child):
     first call, hold for every parameter value (p is an argument of each call). A sampled
     controller's System per sample then costs no new layout. Returns whether it shares."""
     found = _existing(parent)
+    if isinstance(found, _FixWhenMade):
+        found = evaluator(parent)
     if found is None or not found.fixed:
         return False
     _keep(child, found)
@@ -109,10 +128,11 @@ class Evaluator:
         self.fixed = False  # every group's path decided at its first call, for good (fix_kernels)
 
     def fix_kernels(self, wait):
-        """Fix every group's path at its first evaluation (grouped.Batch.fix_kernels)."""
+        """Fix every group's path at its first evaluation (grouped.Batch.fix_kernels); returns self."""
         for batch in (self.rows, self.blocks, self.energy, self.forces):
             batch.fix_kernels(wait)
         self.fixed = True
+        return self
 
     def constraints(self, t, q, qd, p, sparse=True):
         """ConstraintArrays at (t, q, q̇) with parameter values p; A sparse (CSR) or dense
