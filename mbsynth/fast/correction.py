@@ -11,9 +11,9 @@ REUSE of the coordinates' size, with φ̇ at most REUSE of the rates, the veloci
 reuses that step's factorization: A at the uncorrected q leaves φ̇ off by about
 |Δq| |Δq̇|, REUSE² relative. The kernel's own residual check is skipped (kernel.UNCHECKED):
 the rows after each step check it, and a velocity step that does not cut φ̇ sends the
-state to projection.py. A correction costs about one kernel evaluation and three passes
-of the rows (60 µs on talos), where projection.py's sparse factorization costs a
-millisecond (UR5) to ten (talos).
+state to projection.py. A correction costs a kernel call with its factorization, one
+that reuses it and three passes of the rows (on talos about 45, 31 and 3 × 11 µs), where
+projection.py's sparse factorization costs a millisecond (UR5) to ten (talos).
 
 Only for Systems all of whose rows and coordinates the kernel's tree covers (rows.py's
 ``covers``; no loops, no extra coordinates); elsewhere, and at any state the kernel
