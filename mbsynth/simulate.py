@@ -137,7 +137,8 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
             if t_next in samples:
                 run.restart(control.apply(t_next, q, qd))
             if t_next in outputs:
-                run.record(t_next, q, qd, writer, *((None, None) if t_next in samples else (run.arrays, run.corrected)))
+                at_hand = () if t_next in samples else (run.arrays, run.corrected)  # a sample's System is new
+                run.record(t_next, q, qd, writer, *at_hand)
                 if progress is not None:
                     progress(t_next)
         status = COMPLETED
@@ -265,8 +266,8 @@ class _Run:
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
         self._check(t_next, y)
-        q, qd, measured = self._corrected(t_next, y[:self.n], y[self.n:])
-        return self._arrived(t_next, q, qd, None, measured)
+        q, qd, corrected = self._corrected(t_next, y[:self.n], y[self.n:])
+        return self._arrived(t_next, q, qd, None, corrected)
 
     def _reach(self, t_next, q, qd, t_stop):
         """The continuous integrator's state at t_next: its steps (``_step``) taken until one

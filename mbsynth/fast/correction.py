@@ -33,9 +33,7 @@ MAX_STEPS = 3  # position steps before the state goes to projection.py
 REUSE = 1e-8  # the largest position step and φ̇ (relative) for which the velocity step reuses a factorization
 SHRINK = 1e-3  # a velocity step must cut φ̇ by this much at least ...
 ROUNDING = 1e-12  # ... or to this, relative to the largest coordinate (at least 1) times the largest rate
-
-
-TINY = np.finfo(float).tiny
+TINY = np.finfo(float).tiny  # the largest rate's floor
 
 
 class Corrected(NamedTuple):
