@@ -23,7 +23,9 @@ Talos and the chain use Pinocchio's model of the mbsynth System (``twin.Twin``: 
 model with a free-flyer root, the chain's joints) and start both codes from the same state
 (``Twin.to_maximal`` of Pinocchio's); the table gives the largest difference of their final
 positions of the bodies. Each figure is the best of ``--rounds`` runs, the two codes alternating;
-the ratio is to Pinocchio's time in the same run. Also: the evaluations of the right-hand
+the ratio is to Pinocchio's time in the same run. mbsynth runs twice a round: as a user
+gets it, the corrections of the output rows a step passed split among the cores
+(mbsynth/fast/threads.py), and on one thread, as Pinocchio runs. Also: the evaluations of the right-hand
 side, and for mbsynth the largest position residual of the outputs and the spread of the
 total energy (zero for the exact motion). Model building is not timed in that table; the
 second table times it, each figure in a fresh process (best of ``--rounds``): ``import
@@ -63,6 +65,7 @@ import pinocchio as pin  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
 import mbsynth as mb  # noqa: E402
+import mbsynth.fast.threads as threads  # noqa: E402
 from exudyn_tree import ExudynTree  # noqa: E402
 from fast_dynamics import chain_yaml  # noqa: E402
 from mbsynth.robots import robot_files  # noqa: E402
@@ -234,11 +237,16 @@ def reference_run(case):
     return time.perf_counter() - started, sol.nfev, sol.y[:case.nq, -1]
 
 
-def mbsynth_run(case):
-    """(seconds, evaluations, largest position residual, energy spread, final q) of mb.simulate."""
-    started = time.perf_counter()
-    traj = mb.simulate(case.system, case.t_end, method="DOP853", rtol=TOL, atol=TOL, **case.start)
-    seconds = time.perf_counter() - started
+def mbsynth_run(case, cores=None):
+    """(seconds, evaluations, largest position residual, energy spread, final q) of
+    mb.simulate; ``cores``: the threads its corrections may take (default: one per core)."""
+    default, threads.THREADS = threads.THREADS, cores or threads.THREADS
+    try:
+        started = time.perf_counter()
+        traj = mb.simulate(case.system, case.t_end, method="DOP853", rtol=TOL, atol=TOL, **case.start)
+        seconds = time.perf_counter() - started
+    finally:
+        threads.THREADS = default
     return (seconds, traj.stats["evaluations"], float(traj.residual_position.max()),
             float(np.ptp(case.energy(traj))), traj.q[-1])
 
@@ -323,7 +331,8 @@ def main():
     lines = ["# End to end: mbsynth against Pinocchio aba + solve_ivp, MuJoCo and Exudyn", "",
              f"{datetime.date.today()} on {platform.node()} ({os.cpu_count()} cores, {platform.processor() or '?'}), "
              f"`benchmarks/end_to_end.py`. Each simulation: DOP853, rtol = atol = {TOL:g}, {OUTPUTS + 1} outputs; "
-             f"mbsynth's `simulate` (its state put back on the constraints at every accepted step and output row) "
+             f"mbsynth's `simulate` (its state put back on the constraints at every accepted step and output row, "
+             f"the rows of a step on every core; *one thread*: on one) "
              f"against `solve_ivp` of the reference code on the same model: (q̇, `pin.aba`) for the robots and "
              f"the chain (zero torques, gravity), and for Andrews' squeezer the IVP test set's index-1 equations "
              f"by hand (numpy, "
@@ -337,24 +346,28 @@ def main():
              "| system | s | code | seconds | × reference | evaluations | max residual φ | energy spread (J) | Δx |",
              "|---|---:|---|---:|---:|---:|---:|---:|---:|"]
     for case in cases:
-        reference = mbsynth = None
+        reference = mbsynth = alone = None
         for _ in range(args.rounds):
             result = reference_run(case)
             reference = result if reference is None or result[0] < reference[0] else reference
             result = mbsynth_run(case)
             mbsynth = result if mbsynth is None or result[0] < mbsynth[0] else mbsynth
+            result = mbsynth_run(case, cores=1)
+            alone = result if alone is None or result[0] < alone[0] else alone
         gap = case.gap(reference[2], mbsynth[4])
         gap = "–" if gap is None else f"{gap:.1e}"
         lines += [f"| {case.name} | {case.t_end:g} | {case.code} | {reference[0]:.3f} | 1 | {reference[1]} | – | – "
                   "| – |",
                   f"| | | mbsynth | {mbsynth[0]:.3f} | {mbsynth[0] / reference[0]:.1f} | {mbsynth[1]} | "
-                  f"{mbsynth[2]:.1e} | {mbsynth[3]:.1e} | {gap} |"]
+                  f"{mbsynth[2]:.1e} | {mbsynth[3]:.1e} | {gap} |",
+                  f"| | | mbsynth, one thread | {alone[0]:.3f} | {alone[0] / reference[0]:.1f} | {alone[1]} | "
+                  f"{alone[2]:.1e} | {alone[3]:.1e} | – |"]
         for code, runs, run in case.others:
             seconds, count, distance = min((run(reference[2]) for _ in range(runs or args.rounds)),
                                            key=lambda r: r[0])
             lines.append(f"| | | {code} | {seconds:.3f} | {seconds / reference[0]:.1f} | {count} | – | – | "
                          f"{distance:.1e} |")
-        print(*lines[-2 - len(case.others):], sep="\n", flush=True)
+        print(*lines[-3 - len(case.others):], sep="\n", flush=True)
     if not args.simulations_only:
         lines += ["", "Building the model (numba's cache warm, but in the row that says otherwise):", ""] + build_lines(args.rounds)
     text = "\n".join(lines) + "\n"

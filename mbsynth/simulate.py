@@ -12,7 +12,8 @@ or the end; each accepted step is corrected and the integrator goes on from ther
 the corrected state's derivative, its steps capped (``max_step``) to keep the drift
 between corrections below DRIFT_TARGET; each output row is read from the step's dense
 output (the interpolant ``solve_ivp`` gives at ``t_eval``) and corrected (a copy: the
-integrator goes on from its own state).
+integrator goes on from its own state), the rows a step passed in one block with its
+end (correction.Correction.block, on all cores).
 
 Cut at each output time otherwise: the integrator's last step is cut short there and,
 with projection, (q, q̇) projected back onto the constraints (projection.py), there and
@@ -259,21 +260,21 @@ class _Run:
         if not self.continuous:
             return self._advance_cut(t_next, q, qd)
         try:
-            y = self._reach(t_next, q, qd, t_stop)
+            y, corrected = self._reach(t_next, q, qd, t_stop)
         except (_Crawl, SolveError) as stop:
             self.solver = None  # stopped within a step
             q, qd = self._advance_cut(t_next, q, qd, loosen=isinstance(stop, _Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
         self._check(t_next, y)
-        q, qd, corrected = self._corrected(t_next, y[:self.n], y[self.n:])
+        q, qd = self._on_constraints(t_next, y, corrected)
         return self._arrived(t_next, q, qd, None, corrected)
 
     def _reach(self, t_next, q, qd, t_stop):
-        """The continuous integrator's state at t_next: its steps (``_step``) taken until one
-        reaches or passes t_next, the state read from that step's interpolant. A new
-        integrator (at the start, after a control sample or a cut interval) starts from
-        (q, q̇) at ``t_now``, its first step the one last proposed."""
+        """The continuous integrator's state at t_next and its correction (``_step``): its
+        steps taken until one reaches or passes t_next. A new integrator (at the start,
+        after a control sample or a cut interval) starts from (q, q̇) at ``t_now``, its
+        first step the one last proposed."""
         self._begin_interval(self.t_now, t_next, self.rtol)
         solver = self.solver
         if solver is None:
@@ -283,14 +284,16 @@ class _Run:
             self.solver_tolerances, self.passed = (self.rtol, self.atol), {}
         while solver.t < t_next:
             self._step(solver, t_next)
-        return solver.y.copy() if solver.t == t_next else self.passed[t_next]
+        return self.passed[t_next]
 
     def _step(self, solver, t_next):
-        """One accepted step of the continuous integrator (the states at the times it passed,
-        t_next first, kept in ``passed``), its state then corrected. The step is capped (``max_step``)
-        to keep the drift between corrections below DRIFT_TARGET: halved after a larger
-        drift, doubled after one below a hundredth of it; a step that drifted more than
-        DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length."""
+        """One accepted step of the continuous integrator, its state then corrected, and with
+        it, in one block (correction.Correction.block), the states at the times from t_next
+        to where it reached, read from its interpolant: ``passed`` keeps (state, Corrected
+        or None) per time. The step is capped (``max_step``) to keep the drift between
+        corrections below DRIFT_TARGET: halved after a larger drift, doubled after one below
+        a hundredth of it; a step that drifted more than DRIFT_REDO × DRIFT_TARGET is taken
+        again at a quarter of its length."""
         start = (solver.t, solver.y, solver.f, solver.h_abs)
         message = solver.step()
         if solver.status == "failed":
@@ -300,33 +303,31 @@ class _Run:
         taken = solver.t - start[0]
         if solver.t != solver.t_bound:
             self.next_step = solver.h_abs
-        self.passed = {}
-        if solver.t > t_next:  # the times it passed, from its interpolant (one call), before the state is corrected
-            times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
-            self.passed = dict(zip(times, solver.dense_output()(times).T.copy()))
         self._check(solver.t, solver.y)
         q, qd = solver.y[:self.n], solver.y[self.n:]
         drift = self.correction.drift(q, qd)
         if drift > DRIFT_REDO * DRIFT_TARGET and taken > MIN_SPAN * self.span:
             solver.t, solver.y, solver.f, solver.h_abs = start
-            solver.status, solver.max_step, self.passed = "running", taken / 4, {}
+            solver.status, solver.max_step = "running", taken / 4
             self.steps -= 1
             return
         if drift > DRIFT_TARGET:
             solver.max_step = taken / 2
         elif drift < DRIFT_TARGET / 100 and np.isfinite(solver.max_step):
             solver.max_step = np.inf if 2 * solver.max_step >= solver.t_bound - solver.t else 2 * solver.max_step
-        q_on, qd_on, _ = self._corrected(solver.t, q, qd)
+        times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
+        states = np.vstack([solver.dense_output()(times).T, solver.y]) if times else solver.y[None, :]
+        corrected = self.correction.block(states[:, :self.n], states[:, self.n:])
+        self.passed = dict(zip([*times, solver.t], zip(states, corrected)))
+        q_on, qd_on = self._on_constraints(solver.t, solver.y, corrected[-1])
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
             solver.y = np.concatenate([q_on, qd_on])
             solver.f = self.rhs(solver.t, solver.y)
 
-    def _corrected(self, t, q, qd):
-        """(q, q̇) on the constraints and, where the kernel's correction put it there, its
-        ``Corrected`` (rows and energies there); None where projection.py did (the kernel
-        declined the state)."""
-        corrected = self.correction(q, qd)
-        return (*project(self.system, t, q, qd), None) if corrected is None else (*corrected[:2], corrected)
+    def _on_constraints(self, t, y, corrected):
+        """(q, q̇) of the state y on the constraints: ``corrected``'s where the kernel's
+        correction put it there (correction.Corrected), else projected (projection.py)."""
+        return project(self.system, t, y[:self.n], y[self.n:]) if corrected is None else corrected[:2]
 
     def _advance_cut(self, t_next, q, qd, loosen=False):
         """Integrate to t_next, check the state, project it if asked. With projection the

@@ -238,7 +238,8 @@ def _runs(system, params, samples):
 
 
 class _client:
-    """A Dask client on the user's scheduler, or on a local cluster started and stopped here."""
+    """A Dask client on the user's scheduler, or on a local cluster started and stopped here (its
+    worker processes, one per core, run the compiled kernels on one thread each: MBSYNTH_THREADS)."""
 
     def __init__(self, scheduler, workers):
         self.scheduler, self.workers = scheduler, workers
@@ -252,7 +253,7 @@ class _client:
         else:
             self.cluster = LocalCluster(n_workers=self.workers or os.cpu_count(), threads_per_worker=1,
                                         processes=True, host=LOCALHOST, dashboard_address=f"{LOCALHOST}:0",
-                                        silence_logs=logging.ERROR)
+                                        silence_logs=logging.ERROR, env={"MBSYNTH_THREADS": "1"})
             self.client = Client(self.cluster)
         return self.client
 

@@ -16,6 +16,8 @@ from mbsynth.twin import Twin
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ["rigid/double_pendulum_3d.yaml", "rigid/tennis_racket.yaml", "robots/ur5_payload.yaml"]
+# joint ends on particles too: the rows read a particle's frame origin at its position
+WITH_PARTICLES = ["mechanisms/massless_link.yaml", "mechanisms/double_pendulum_rods.yaml"]
 
 
 @pytest.fixture(autouse=True)
@@ -39,7 +41,7 @@ def drifted_state(system, rng, size=1e-6, rate_size=1.0):
     return q + size * rng.standard_normal(q.size), qd + rate_size * rng.standard_normal(qd.size)
 
 
-@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("model", MODELS + WITH_PARTICLES)
 def test_compiled_rows_equal_the_systems_residuals_and_energies(model):
     system = mb.load(ROOT / "models" / model)
     rng = np.random.default_rng(3)
@@ -74,6 +76,26 @@ def test_a_correction_is_the_least_mass_norm_step_onto_the_constraints(model, dr
         rounding = len(step) * np.finfo(float).eps * np.abs(start).max()
         assert np.abs(step).max() > 0
         assert np.abs(N.T @ M @ step).max() < np.abs(M).max() * (1e-9 * np.abs(step).max() + rounding)
+
+
+def test_a_block_of_states_is_corrected_as_each_state_alone():
+    """Correction.block splits the states among threads, each with its own Work and rows:
+    every state comes out bit for bit as a correction of that state alone, and one the
+    kernel declines (not finite) comes out None without disturbing the others."""
+    system = mb.load(ROOT / "models" / "robots/ur5_payload.yaml")
+    rng = np.random.default_rng(6)
+    states = [drifted_state(system, rng, 1e-9, 1e-9) for _ in range(11)]
+    states[7] = (np.full_like(states[7][0], np.nan), states[7][1])
+    correction = correction_of(system)
+    block = correction.block(np.array([q for q, _ in states]), np.array([qd for _, qd in states]))
+    assert len(block) == len(states) and block[7] is None
+    for (q, qd), together in zip(states, block):
+        alone = correction(q, qd)
+        if alone is None:
+            assert together is None
+            continue
+        for a, b in zip(alone, together):
+            np.testing.assert_array_equal(a, b)
 
 
 def test_a_ur5_falls_as_pinocchio_integrates_it_with_as_many_evaluations():

@@ -8,6 +8,8 @@ import importlib
 import json
 import os
 import signal
+import subprocess
+import sys
 from pathlib import Path
 from urllib.parse import urlparse
 
@@ -232,3 +234,17 @@ def test_the_local_cluster_listens_on_127_0_0_1_only():
         scheduler = urlparse(client.scheduler.address).port
     assert {dashboard, scheduler} <= {port for _, port in opened}
     assert {ip for ip, _ in opened} == {"127.0.0.1"}, opened
+
+
+def test_the_local_clusters_workers_run_the_kernels_on_one_thread_each():
+    """One worker process per core, each kernel on one thread (fast/threads.py): the
+    workers' threads of the compiled kernels, seen from inside a worker."""
+    with _client(None, 2) as client:
+        counts = client.run(lambda: __import__("mbsynth.fast.threads", fromlist=["THREADS"]).THREADS)
+    assert sorted(counts.values()) == [1, 1]
+
+
+def test_a_bad_thread_count_is_refused_by_name():
+    done = subprocess.run([sys.executable, "-c", "import mbsynth.fast.threads"], capture_output=True, text=True,
+                          env={**os.environ, "MBSYNTH_THREADS": "two"})
+    assert done.returncode != 0 and "MBSYNTH_THREADS must be a positive whole number, got 'two'" in done.stderr

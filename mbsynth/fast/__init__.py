@@ -11,7 +11,8 @@
     kernel.py      the whole evaluation and its checks
     engine.py      a Template per model structure, an Engine per System: motion, motion_batch
     rows.py        φ, φ̇ of the kernel's rows and its nodes' energies (simulate's rows)
-    correction.py  a state put back on the constraints by the kernel, in the mass metric
+    correction.py  states put back on the constraints by the kernel, in the mass metric
+    threads.py     the threads compiled kernels share (motion_batch, corrections)
     background.py  building Engines off the caller's thread, shared and freed; MBSYNTH_FAST
     batch.py       System.motion_batch
     cache.py       where compiled code is kept

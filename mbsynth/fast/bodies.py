@@ -46,6 +46,13 @@ def dot3(x, w):
 
 
 @njit(**INLINE)
+def times3(M, c):
+    """M c for a 3 × 3 M and a 3-tuple c."""
+    return (M[0, 0] * c[0] + M[0, 1] * c[1] + M[0, 2] * c[2], M[1, 0] * c[0] + M[1, 1] * c[1] + M[1, 2] * c[2],
+            M[2, 0] * c[0] + M[2, 1] * c[1] + M[2, 2] * c[2])
+
+
+@njit(**INLINE)
 def rotation(u, R):
     """R(u) into R (3 × 3)."""
     w, x, y, z = u[0], u[1], u[2], u[3]

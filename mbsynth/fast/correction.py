@@ -12,8 +12,11 @@ reuses that step's factorization: A at the uncorrected q leaves φ̇ off by abou
 |Δq| |Δq̇|, REUSE² relative. The kernel's own residual check is skipped (kernel.UNCHECKED):
 the rows after each step check it, and a velocity step that does not cut φ̇ sends the
 state to projection.py. A correction costs a kernel call with its factorization, one
-that reuses it and three passes of the rows (on talos about 45, 31 and 3 × 11 µs), where
+that reuses it and three passes of the rows (on talos about 45, 31 and 3 × 8 µs), where
 projection.py's sparse factorization costs a millisecond (UR5) to ten (talos).
+``correct`` does it in one compiled call for each state of a block; ``Correction.block``
+splits a block among the cores (``simulate``: the output times a step passed, with its
+end), each thread with its own Work.
 
 Only for Systems all of whose rows and coordinates the kernel's tree covers (rows.py's
 ``covers``; no loops, no extra coordinates); elsewhere, and at any state the kernel
@@ -24,9 +27,13 @@ import threading
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
-from . import kernel
-from .rows import Rows
+from .bodies import OPTIONS
+from . import threads
+from .kernel import OK, REUSED, UNCHECKED, WORK, motion
+from .packing import view1
+from .rows import Rows, largest, residuals_energy
 
 TOLERANCE = 1e-14  # largest |φ| left, relative to the largest coordinate (at least 1): about 50 ε
 MAX_STEPS = 3  # position steps before the state goes to projection.py
@@ -34,6 +41,8 @@ REUSE = 1e-8  # the largest position step and φ̇ (relative) for which the velo
 SHRINK = 1e-3  # a velocity step must cut φ̇ by this much at least ...
 ROUNDING = 1e-12  # ... or to this, relative to the largest coordinate (at least 1) times the largest rate
 TINY = np.finfo(float).tiny  # the largest rate's floor
+PER_THREAD = 4  # fewest states a thread of ``Correction.block`` takes (a thread's start costs about 50 µs)
+KINETIC, POTENTIAL, PHI_MAX, PSI_MAX, DONE = range(5)  # the columns of ``correct``'s ``found``
 
 
 class Corrected(NamedTuple):
@@ -48,14 +57,78 @@ class Corrected(NamedTuple):
     psi_max: float
 
 
+@njit(nogil=True, **OPTIONS)
+def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, work):
+    """Each state (row of Q, Q̇) corrected into Q_on, Q̇_on (module docstring), found's row
+    (PER_THREAD = 4  # fewest states a thread of ``Correction.block`` takes (a thread's start costs about 50 µs)
+KINETIC, POTENTIAL, PHI_MAX, PSI_MAX there, DONE = 1), or DONE = 0 where the kernel
+    declines it or the rows' checks fail. LI, LF, LX: the Layout packed; LF_rest: its
+    floats with no gravity (Engine.at_rest); WI, WF, WX: a Work packed; gen: zeros for
+    the generated function's outputs; work: ``Correction.work``'s arrays (rows.py's φ, φ̇,
+    Rs; the right side; the factored q; q̇ = 0)."""
+    phi, psi, Rs, shift, factored, rest = work
+    qdd = view1(WF, WX, WORK.qdd)
+    for b in range(Q.shape[0]):
+        found[b, DONE] = 0.0
+        q, qd = Q_on[b], QD_on[b]
+        for c in range(q.shape[0]):
+            q[c], qd[c] = Q[b, c], QD[b, c]
+        _, _, phi_max, psi_max, q_max, qd_max = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        size, reuse, declined = max(q_max, 1.0), False, False
+        for step in range(MAX_STEPS + 1):
+            if phi_max <= TOLERANCE * size:
+                break
+            _negated(phi, shift)
+            if step == MAX_STEPS or motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED)[0] != OK:
+                declined = True
+                break
+            reuse = step == 0 and largest(qdd) <= REUSE * size  # the Work keeps q's factorization
+            for c in range(q.shape[0]):
+                factored[c] = q[c] if reuse else factored[c]
+                q[c] += qdd[c]
+            _, _, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        if declined:
+            continue
+        rates = max(qd_max, TINY)
+        _negated(psi, shift)
+        if reuse and psi_max <= REUSE * rates:
+            status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED)[0]
+        else:
+            status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED)[0]
+        if status != OK:
+            continue
+        before = psi_max
+        for c in range(qd.shape[0]):
+            qd[c] += qdd[c]
+        kinetic, potential, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        if psi_max <= max(SHRINK * before, ROUNDING * size * rates):
+            found[b, KINETIC], found[b, POTENTIAL], found[b, PHI_MAX], found[b, PSI_MAX] = \
+                kinetic, potential, phi_max, psi_max
+            found[b, DONE] = 1.0
+
+
+@njit(**OPTIONS)
+def _negated(x, out):
+    for i in range(x.shape[0]):
+        out[i] = -x[i]
+
+
 class Correction:
-    """The kernel's projection: ``rows`` (rows.py) on an Engine's Layout and ``at_rest``, that
-    Engine with no gravity (Engine.at_rest)."""
+    """The kernel's projection: ``rows`` (rows.py) on an Engine's Layout, and ``at_rest``,
+    that Engine with no gravity (Engine.at_rest)."""
 
     def __init__(self, rows, at_rest):
         self.rows, self.at_rest = rows, at_rest
-        self.rest, self.no_forces = np.zeros(at_rest.n), np.zeros(at_rest.outputs)
+        self.gen = np.zeros(at_rest.outputs)
+        self.arguments = [self._arguments(at_rest.work, (rows.phi, rows.psi, *rows.work))]  # one per thread
         self.lock = threading.Lock()  # Systems that differ in parameters only share it (Engine.at)
+
+    def _arguments(self, packed_work, rows_work):
+        """``correct``'s arguments after ``found``, for one thread: its Work (packed) and the
+        rows' work arrays (φ, φ̇, Rs) its own."""
+        n = self.at_rest.n
+        work = (*rows_work, np.zeros(rows_work[0].shape), np.zeros(n), np.zeros(n))
+        return (*self.rows.packed, self.at_rest.packed[1], *packed_work, self.gen, work)
 
     @classmethod
     def build(cls, engine):
@@ -65,39 +138,31 @@ class Correction:
 
     def __call__(self, q, qd):
         """``Corrected`` (q, q̇) on the constraints (new arrays) with their rows, or None where
-        the kernel declines a state, MAX_STEPS position steps leave φ above TOLERANCE, or the
-        velocity step leaves φ̇ above SHRINK of what it was (and above rounding)."""
-        with self.lock:
-            phi, psi, _, _, phi_max, psi_max, q_max, qd_max = self.rows(q, qd)
-            size = max(q_max, 1.0)
-            factored = None  # the q of a single small position step: its factorization the Work holds
-            for step in range(MAX_STEPS + 1):
-                if phi_max <= TOLERANCE * size:
-                    break
-                delta = None if step == MAX_STEPS else self._delta(q, phi, kernel.UNCHECKED)
-                if delta is None:
-                    return None
-                small = step == 0 and np.abs(delta).max(initial=0.0) <= REUSE * size
-                factored, q = (q if small else None), q + delta
-                phi, psi, _, _, phi_max, psi_max, _, _ = self.rows(q, qd)
-            rates = max(qd_max, TINY)
-            if factored is None or psi_max > REUSE * rates:
-                delta = self._delta(q, psi, kernel.UNCHECKED)
-            else:
-                delta = self._delta(factored, psi, kernel.REUSED)
-            if delta is None:
-                return None
-            before, qd = psi_max, qd + delta
-            _, _, kinetic, potential, phi_max, psi_max, _, _ = self.rows(q, qd)
-            if not psi_max <= max(SHRINK * before, ROUNDING * size * rates):
-                return None
-            return Corrected(q, qd, kinetic, potential, phi_max, psi_max)
+        the kernel declines the state, MAX_STEPS position steps leave φ above TOLERANCE, or
+        the velocity step leaves φ̇ above SHRINK of what it was (and above rounding)."""
+        return self.block(q[None, :], qd[None, :])[0]
 
-    def _delta(self, q, r, mode):
-        """The least-M-norm Δ with A(q) Δ = −r, or None where the kernel declines (``mode``:
-        kernel.motion's; the caller checks the result through the rows)."""
-        status, _ = kernel.motion(q, self.rest, self.no_forces, -r, *self.at_rest.buffers, mode)
-        return None if status != kernel.OK else self.at_rest.W.qdd.copy()
+    def block(self, Q, QD):
+        """``__call__`` of each state (row of Q, Q̇), in compiled calls on up to threads.THREADS
+        threads (at least PER_THREAD states each): a list."""
+        Q, QD = np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(QD, dtype=float)
+        count = Q.shape[0]
+        Q_on, QD_on, found = np.empty(Q.shape), np.empty(QD.shape), np.empty((count, DONE + 1))
+        parts = max(1, min(threads.THREADS, count // PER_THREAD))  # read here: a benchmark may lower it
+        bounds = [count * k // parts for k in range(parts + 1)]
+
+        def part(k):
+            a, b = bounds[k], bounds[k + 1]
+            correct(Q[a:b], QD[a:b], Q_on[a:b], QD_on[a:b], found[a:b], *self.arguments[k])
+
+        with self.lock:
+            while len(self.arguments) < parts:
+                self.arguments.append(self._arguments(self.at_rest.new_work()[0], self.rows.new_work(*self.rows.sizes)))
+            if parts == 1:
+                part(0)
+            else:
+                list(threads.pool().map(part, range(parts)))
+        return [Corrected(q, qd, *info[:DONE]) if info[DONE] else None for q, qd, info in zip(Q_on, QD_on, found)]
 
     def residuals_energy(self, q, qd):
         """(φ, φ̇, T, V) at (q, q̇): the System's residuals and its parts' energies."""

@@ -16,9 +16,7 @@ many states in parallel.
 """
 
 import copy
-import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -27,9 +25,9 @@ from . import codegen, kernel, layout
 from .assembly import Work, make_work
 from .correction import Correction
 from .packing import pack, views
+from .threads import THREADS, pool
 
 EMPTY = np.zeros(0)
-THREADS = os.cpu_count() or 1
 CHUNK = 16  # fewest rows a thread takes at a time
 
 
@@ -152,17 +150,8 @@ class Engine:
             while len(self.batch_works) < threads:
                 self.batch_works.append(self.new_work()[0])
             if threads > 1:
-                list(_pool().map(worker, self.batch_works[:threads]))
+                list(pool().map(worker, self.batch_works[:threads]))
             else:
                 worker(self.batch_works[0])
         return qdd, status
 
-
-_threads = None
-
-
-def _pool():
-    global _threads
-    if _threads is None:
-        _threads = ThreadPoolExecutor(THREADS, thread_name_prefix="mbsynth-batch")
-    return _threads

@@ -27,17 +27,10 @@ import math
 
 from numba import njit
 
-from .bodies import INLINE, cross3, dot3
+from .bodies import INLINE, cross3, dot3, times3
 from .joints import COMPONENT, D, DOT, WORLD
 
 ZERO = (0.0, 0.0, 0.0)
-
-
-@njit(**INLINE)
-def _times(M, c):
-    """M c for a 3 × 3 M and a 3-tuple c."""
-    return (M[0, 0] * c[0] + M[0, 1] * c[1] + M[0, 2] * c[2], M[1, 0] * c[0] + M[1, 1] * c[1] + M[1, 2] * c[2],
-            M[2, 0] * c[0] + M[2, 1] * c[1] + M[2, 2] * c[2])
 
 
 @njit(**INLINE)
@@ -51,9 +44,9 @@ def _origin(kind, node, o, s, q, qd, Rs):
     """(ρ = R s, p = r + ρ, ṗ, the bias Rb s of p̈) of a frame origin at s on its end; the
     world's slot of Rs (I, 0, 0) and a factor 0 on its r make the world's (s, s, 0, 0)."""
     c, f = (s[0], s[1], s[2]), 0.0 if kind == WORLD else 1.0
-    rho, vel = _times(Rs[node, 0], c), _times(Rs[node, 1], c)
+    rho, vel = times3(Rs[node, 0], c), times3(Rs[node, 1], c)
     return (rho, (f * q[o] + rho[0], f * q[o + 1] + rho[1], f * q[o + 2] + rho[2]),
-            (f * qd[o] + vel[0], f * qd[o + 1] + vel[1], f * qd[o + 2] + vel[2]), _times(Rs[node, 2], c))
+            (f * qd[o] + vel[0], f * qd[o + 1] + vel[1], f * qd[o + 2] + vel[2]), times3(Rs[node, 2], c))
 
 
 @njit(**INLINE)
@@ -62,7 +55,7 @@ def _axis(x, nodes, Rf, Rs):
     e = 0 if x <= 3 else 1
     col = x - 1 - 3 * e
     c, M = (Rf[e, 0, col], Rf[e, 1, col], Rf[e, 2, col]), Rs[nodes[e]]
-    return _times(M[0], c), _times(M[1], c), _times(M[2], c)
+    return times3(M[0], c), times3(M[1], c), times3(M[2], c)
 
 
 @njit(**INLINE)
