@@ -3,7 +3,9 @@
 (fast/correction.py) against the least-mass-norm step's defining identity, and a whole
 run against Pinocchio's aba in the same scipy integrator."""
 
+import multiprocessing
 from pathlib import Path
+from queue import Empty
 
 import numpy as np
 import pinocchio as pin
@@ -12,6 +14,7 @@ import scipy.integrate
 import scipy.linalg
 
 import mbsynth as mb
+import mbsynth.fast.correction as correction_module
 from mbsynth.twin import Twin
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -79,23 +82,49 @@ def test_a_correction_is_the_least_mass_norm_step_onto_the_constraints(model, dr
 
 
 def test_a_block_of_states_is_corrected_as_each_state_alone():
-    """Correction.block splits the states among threads, each with its own Work and rows:
+    """Correction.block splits many states among threads, each with its own Work and rows:
     every state comes out bit for bit as a correction of that state alone, and one the
     kernel declines (not finite) comes out None without disturbing the others."""
     system = mb.load(ROOT / "models" / "robots/ur5_payload.yaml")
     rng = np.random.default_rng(6)
-    states = [drifted_state(system, rng, 1e-9, 1e-9) for _ in range(11)]
-    states[7] = (np.full_like(states[7][0], np.nan), states[7][1])
+    q, qd = drifted_state(system, rng, 0.0, 0.0)
+    count = 2 * correction_module.PER_THREAD // q.size + 2  # enough for two threads
+    Q, QD = q + 1e-9 * rng.standard_normal((count, q.size)), qd + 1e-9 * rng.standard_normal((count, q.size))
+    Q[7] = np.nan
     correction = correction_of(system)
-    block = correction.block(np.array([q for q, _ in states]), np.array([qd for _, qd in states]))
-    assert len(block) == len(states) and block[7] is None
-    for (q, qd), together in zip(states, block):
+    block = correction.block(Q, QD)
+    assert len(block) == count and block[7] is None
+    for q, qd, together in zip(Q, QD, block):
         alone = correction(q, qd)
         if alone is None:
             assert together is None
             continue
         for a, b in zip(alone, together):
             np.testing.assert_array_equal(a, b)
+
+
+def _simulate_into(queue, system):
+    queue.put(mb.simulate(system, 0.02, dt=1e-4).q)
+
+
+def test_a_forked_process_corrects_in_threads_of_its_own():
+    """Each step of a UR5 passes tens of output rows (every 0.1 ms), corrected in blocks
+    on the shared threads (fast/threads.py); a process forked after that has none of the
+    parent's threads, makes its own and gives the parent's trajectory to the bit."""
+    system = mb.load(ROOT / "models" / "robots/ur5_payload.yaml")
+    expected = mb.simulate(system, 0.02, dt=1e-4)
+    assert len(expected.t) * system.n > expected.stats["steps"] * 2 * correction_module.PER_THREAD
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_simulate_into, args=(queue, system))
+    child.start()
+    try:
+        reached = queue.get(timeout=120)
+    except Empty:
+        child.kill()
+        pytest.fail("the forked process hung or failed")
+    child.join(10)
+    np.testing.assert_array_equal(reached, expected.q)
 
 
 def test_a_ur5_falls_as_pinocchio_integrates_it_with_as_many_evaluations():

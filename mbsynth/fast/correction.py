@@ -41,7 +41,9 @@ REUSE = 1e-8  # the largest position step and φ̇ (relative) for which the velo
 SHRINK = 1e-3  # a velocity step must cut φ̇ by this much at least ...
 ROUNDING = 1e-12  # ... or to this, relative to the largest coordinate (at least 1) times the largest rate
 TINY = np.finfo(float).tiny  # the largest rate's floor
-PER_THREAD = 4  # fewest states a thread of ``Correction.block`` takes (a thread's start costs about 50 µs)
+# a thread of ``Correction.block`` takes states of this many coordinates in all at least: handing
+# work to a thread costs about 150 µs on a 2-core VM, about what correcting states of 700 coordinates costs
+PER_THREAD = 1500
 KINETIC, POTENTIAL, PHI_MAX, PSI_MAX, DONE = range(5)  # the columns of ``correct``'s ``found``
 
 
@@ -60,12 +62,11 @@ class Corrected(NamedTuple):
 @njit(nogil=True, **OPTIONS)
 def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, work):
     """Each state (row of Q, Q̇) corrected into Q_on, Q̇_on (module docstring), found's row
-    (PER_THREAD = 4  # fewest states a thread of ``Correction.block`` takes (a thread's start costs about 50 µs)
-KINETIC, POTENTIAL, PHI_MAX, PSI_MAX there, DONE = 1), or DONE = 0 where the kernel
+    (KINETIC, POTENTIAL, PHI_MAX, PSI_MAX there, DONE = 1), or DONE = 0 where the kernel
     declines it or the rows' checks fail. LI, LF, LX: the Layout packed; LF_rest: its
     floats with no gravity (Engine.at_rest); WI, WF, WX: a Work packed; gen: zeros for
-    the generated function's outputs; work: ``Correction.work``'s arrays (rows.py's φ, φ̇,
-    Rs; the right side; the factored q; q̇ = 0)."""
+    the generated function's outputs; work: a thread's arrays (``Correction._arguments``: rows.py's
+    φ, φ̇, Rs; the right side; the factored q; q̇ = 0)."""
     phi, psi, Rs, shift, factored, rest = work
     qdd = view1(WF, WX, WORK.qdd)
     for b in range(Q.shape[0]):
@@ -144,11 +145,11 @@ class Correction:
 
     def block(self, Q, QD):
         """``__call__`` of each state (row of Q, Q̇), in compiled calls on up to threads.THREADS
-        threads (at least PER_THREAD states each): a list."""
+        threads (states of PER_THREAD coordinates in all at least each): a list."""
         Q, QD = np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(QD, dtype=float)
         count = Q.shape[0]
         Q_on, QD_on, found = np.empty(Q.shape), np.empty(QD.shape), np.empty((count, DONE + 1))
-        parts = max(1, min(threads.THREADS, count // PER_THREAD))  # read here: a benchmark may lower it
+        parts = max(1, min(threads.THREADS, count * Q.shape[1] // PER_THREAD))  # read here: a benchmark may lower it
         bounds = [count * k // parts for k in range(parts + 1)]
 
         def part(k):
@@ -158,10 +159,10 @@ class Correction:
         with self.lock:
             while len(self.arguments) < parts:
                 self.arguments.append(self._arguments(self.at_rest.new_work()[0], self.rows.new_work(*self.rows.sizes)))
-            if parts == 1:
-                part(0)
-            else:
-                list(threads.pool().map(part, range(parts)))
+            others = [threads.pool().submit(part, k) for k in range(1, parts)]
+            part(0)  # on this thread meanwhile
+            for other in others:
+                other.result()
         return [Corrected(q, qd, *info[:DONE]) if info[DONE] else None for q, qd, info in zip(Q_on, QD_on, found)]
 
     def residuals_energy(self, q, qd):

@@ -18,12 +18,14 @@ def _count():
 
 THREADS = _count()
 
-_threads = None
+_threads, _owner = None, None  # the pool and the process that made it
 
 
 def pool():
-    """The shared ThreadPoolExecutor, THREADS threads."""
-    global _threads
-    if _threads is None:
-        _threads = ThreadPoolExecutor(THREADS, thread_name_prefix="mbsynth-batch")
+    """The shared ThreadPoolExecutor, THREADS threads: a new one in a process forked from the
+    one that made it (a fork copies the pool but not its threads: work handed to it would
+    wait forever)."""
+    global _threads, _owner
+    if _owner != os.getpid():
+        _threads, _owner = ThreadPoolExecutor(THREADS, thread_name_prefix="mbsynth-batch"), os.getpid()
     return _threads
