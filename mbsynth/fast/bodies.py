@@ -31,21 +31,25 @@ cache.configure()  # every kernel module imports this one before it compiles: nu
 from numba import njit  # noqa: E402
 
 OPTIONS = dict(cache=True, error_model="numpy")  # fastmath (contract, reassoc) measured 9–17 % slower
-INLINE = dict(OPTIONS, inline="always")  # small helpers: numba inlines them (a call costs as much)
+# numba inlines INLINE functions into each caller (its own IR, retyped per call site): for the
+# steps whose constant sizes or tuples must meet the caller's (tree.py's node steps). Small pure
+# helpers (cross3, the packed views) stay OPTIONS: LLVM inlines them just as well, and numba
+# inlining every call site had doubled the cold compile (97 s -> 50 s for python -m mbsynth.fast).
+INLINE = dict(OPTIONS, inline="always")
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def cross3(x, w):
     """x × w of two 3-tuples (or arrays), as a 3-tuple."""
     return (x[1] * w[2] - x[2] * w[1], x[2] * w[0] - x[0] * w[2], x[0] * w[1] - x[1] * w[0])
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def dot3(x, w):
     return x[0] * w[0] + x[1] * w[1] + x[2] * w[2]
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def times3(M, c):
     """M c for a 3 × 3 M and a 3-tuple c."""
     return (M[0, 0] * c[0] + M[0, 1] * c[1] + M[0, 2] * c[2], M[1, 0] * c[0] + M[1, 1] * c[1] + M[1, 2] * c[2],

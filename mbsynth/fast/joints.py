@@ -106,9 +106,9 @@ def joint_rows(program, k, kinds, starts, s, Rf, length, q, qd, V, R, Jt, A, b):
     program: k × 3 (operation, vector, vector or component); kinds, starts: per end, what it
     sits on and its first coordinate; s, Rf: per end, the frame's offset and rotation in
     its part (in the world for a world end); length: a distance joint's L."""
-    axes_a, axes_b = uses_axes(program, k)
-    _end(0, kinds[0], starts[0], s[0], Rf[0], axes_a, q, qd, V, R, Jt)
-    _end(1, kinds[1], starts[1], s[1], Rf[1], axes_b, q, qd, V, R, Jt)
+    axes_a, axes_b = uses_axes(program, k)  # the ends as np.int64: _end compiled once, not per literal
+    _end(np.int64(0), kinds[0], starts[0], s[0], Rf[0], axes_a, q, qd, V, R, Jt)
+    _end(np.int64(1), kinds[1], starts[1], s[1], Rf[1], axes_b, q, qd, V, R, Jt)
     for i in range(3):  # d = p_B − p_A: value, velocity, bias and Jacobian alike
         for col in range(17):
             V[D, i, col] = V[8, i, col] - V[7, i, col]

@@ -36,7 +36,8 @@ from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
-CHECKED, UNCHECKED, REUSED = range(3)  # modes of ``motion``: what a call factors and checks
+CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
+# checks): numpy integers, which numba types as int64 rather than as a literal per value (one compilation)
 EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of max(the largest, 1) count as zero
 CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions, relative to b's
 NULL_RTOL = 1e-8  # largest acceleration a dropped (unit) direction may move

@@ -21,7 +21,7 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from .bodies import INLINE
+from .bodies import OPTIONS
 
 MAX_NDIM = 4
 
@@ -78,22 +78,22 @@ def _view(typingctx, buf, offset, shape):
     return layout(buf, types.intp, types.UniTuple(types.intp, ndim)), codegen
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view1(buf, index, k):
     return _view(buf, index[k, 0], (index[k, 1],))
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view2(buf, index, k):
     return _view(buf, index[k, 0], (index[k, 3], index[k, 4]))
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view3(buf, index, k):
     return _view(buf, index[k, 0], (index[k, 3], index[k, 4], index[k, 5]))
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def view4(buf, index, k):
     return _view(buf, index[k, 0], (index[k, 3], index[k, 4], index[k, 5], index[k, 6]))
 

@@ -26,11 +26,14 @@ exact treatment. ``solve`` returns the λ_i too (λ_i = Jr_iᵀ (f^A_i − H^A_i
 
 The per-node steps are inlined helpers called with constant sizes for a rigid body on a
 revolute (v = 6, k = 5) or a fixed joint (6, 6) and with the node's sizes otherwise: numba
-unrolls the constant loops (about a third off the elimination and the solve).
+unrolls the constant loops (about a third off the elimination and the solve). What they
+call (null spaces, inverses) takes the sizes as np.int64, which numba types as int64 rather
+than as literals, so it is compiled once rather than once per constant.
 """
 
 import math
 
+import numpy as np
 from numba import njit
 
 from .bodies import INLINE, OPTIONS, cross3, dot3
@@ -154,13 +157,13 @@ def _null_space_components(J, r0, k, S, Jr, G):
     return True
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _row3(J, r, o):
     """J[r, o:o + 3] as a 3-tuple."""
     return (J[r, o], J[r, o + 1], J[r, o + 2])
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _components_closed(J, r0, k, S, Jr):
     """_null_space_components in closed form for a revolute (k = 5: two dot rows N_0, N_1,
     T = N_0 × N_1) or a fixed joint (k = 6: N invertible, Nᵀ(NNᵀ)⁻¹ = N⁻¹ by cross
@@ -208,7 +211,7 @@ def _components_closed(J, r0, k, S, Jr):
     return True
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
@@ -241,7 +244,7 @@ def _spd_inverse(A, m, scale, L):
     return True
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _cross_into(x, z, out, o):
     """out[o:o + 3] += x × z."""
     out[o] += x[1] * z[2] - x[2] * z[1]
@@ -249,7 +252,7 @@ def _cross_into(x, z, out, o):
     out[o + 2] += x[0] * z[1] - x[1] * z[0]
 
 
-@njit(**INLINE)
+@njit(**OPTIONS)
 def _add_rigid_transport(Ia, z, Hp):
     """Hp += Xᵀ Ia X for X = [[I, [ζ]×], [0, I]]: with Ia = [[A, B], [Bᵀ, D]] and
     M = A [ζ]× + B, Xᵀ Ia X = [[A, M], [Mᵀ, [ζ]×ᵀ M + Bᵀ [ζ]× + D]] (rows of A [ζ]× and
@@ -283,11 +286,11 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
     m = vi - ki
     if transport[i] == RIGID_COMPONENTS:
         if ki == 5 or ki == 6:
-            if not _components_closed(J, rows[i], ki, S[i], Jr[i]):
+            if not _components_closed(J, rows[i], np.int64(ki), S[i], Jr[i]):
                 return False
-        elif not _null_space_components(J, rows[i], ki, S[i], Jr[i], G):
+        elif not _null_space_components(J, rows[i], np.int64(ki), S[i], Jr[i], G):
             return False
-    elif not _null_space(J, rows[i], ki, vi, S[i], Jr[i], G, pivot):
+    elif not _null_space(J, rows[i], np.int64(ki), np.int64(vi), S[i], Jr[i], G, pivot):
         return False
     Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
     top = 0.0
