@@ -31,25 +31,26 @@ cache.configure()  # every kernel module imports this one before it compiles: nu
 from numba import njit  # noqa: E402
 
 OPTIONS = dict(cache=True, error_model="numpy")  # fastmath (contract, reassoc) measured 9–17 % slower
-# numba inlines INLINE functions into each caller (its own IR, retyped per call site): for the
-# steps whose constant sizes or tuples must meet the caller's (tree.py's node steps). Small pure
-# helpers (cross3, the packed views) stay OPTIONS: LLVM inlines them just as well, and numba
-# inlining every call site had doubled the cold compile (97 s -> 50 s for python -m mbsynth.fast).
+# numba inlines INLINE functions into each caller (their IR retyped at every call site, which
+# costs compile time): for the node steps, whose constant sizes must meet the caller's, and the
+# 3-tuple helpers (cross3, dot3, times3: left to LLVM they cost the kernel 10 %). The rest
+# (the packed views, the closed-form null space, the SPD inverse, the rigid transport) stays
+# OPTIONS: LLVM inlines what pays, at no cost in time measured (benchmarks/fast_ab.py).
 INLINE = dict(OPTIONS, inline="always")
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def cross3(x, w):
     """x × w of two 3-tuples (or arrays), as a 3-tuple."""
     return (x[1] * w[2] - x[2] * w[1], x[2] * w[0] - x[0] * w[2], x[0] * w[1] - x[1] * w[0])
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def dot3(x, w):
     return x[0] * w[0] + x[1] * w[1] + x[2] * w[2]
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def times3(M, c):
     """M c for a 3 × 3 M and a 3-tuple c."""
     return (M[0, 0] * c[0] + M[0, 1] * c[1] + M[0, 2] * c[2], M[1, 0] * c[0] + M[1, 1] * c[1] + M[1, 2] * c[2],

@@ -27,13 +27,13 @@ import math
 
 from numba import njit
 
-from .bodies import INLINE, OPTIONS, cross3, dot3, times3
+from .bodies import INLINE, cross3, dot3, times3
 from .joints import COMPONENT, D, DOT, WORLD
 
 ZERO = (0.0, 0.0, 0.0)
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _axpy(f, x, y):
     """f x + y."""
     return (f * x[0] + y[0], f * x[1] + y[1], f * x[2] + y[2])

@@ -157,7 +157,7 @@ def _null_space_components(J, r0, k, S, Jr, G):
     return True
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _row3(J, r, o):
     """J[r, o:o + 3] as a 3-tuple."""
     return (J[r, o], J[r, o + 1], J[r, o + 2])
@@ -244,7 +244,7 @@ def _spd_inverse(A, m, scale, L):
     return True
 
 
-@njit(**OPTIONS)
+@njit(**INLINE)
 def _cross_into(x, z, out, o):
     """out[o:o + 3] += x × z."""
     out[o] += x[1] * z[2] - x[2] * z[1]
