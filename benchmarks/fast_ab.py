@@ -61,9 +61,11 @@ def same_packing(old):
         [list(f.__members__) for f in (kernel.LAYOUT, kernel.WORK)]
 
 
-def _checked(module):
-    """The mode argument of a kernel whose ``motion`` takes one (its checked call), else none."""
-    return (module.CHECKED,) if hasattr(module, "CHECKED") else ()
+def _checked(module, engine):
+    """The mode argument of a kernel whose ``motion`` takes one (its checked call), then its
+    ``general`` where it takes that, else none."""
+    mode = (module.CHECKED,) if hasattr(module, "CHECKED") else ()
+    return mode + ((engine.general,) if hasattr(module, "GENERAL") else ())
 
 
 def compare(label, old, new):
@@ -71,7 +73,7 @@ def compare(label, old, new):
     engine = engine_for(case.system, wait=True)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
-    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module)) for module in (old, new)}
+    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module, engine)) for module in (old, new)}
     results = []
     for module in (old, new):
         module.motion(*args[module])

@@ -87,9 +87,9 @@ def variant(span=None):
     motion = njit(namespace["motion"])
 
     @njit
-    def loop(count, q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode):
+    def loop(count, q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general):
         for _ in range(count):
-            motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode)
+            motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general)
     return loop
 
 
@@ -98,7 +98,7 @@ def profile(label):
     engine = engine_for(case.system, wait=True)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
-    args = (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, kernel.CHECKED)
+    args = (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, kernel.CHECKED, engine.general)
     body = ast.parse(textwrap.dedent(inspect.getsource(kernel.motion.py_func))).body[0].body
     loops = {None: variant()}
     for name, function in STAGES.items():

@@ -515,6 +515,44 @@ def test_kernels_imported_first_still_cache_per_version(tmp_path):
         assert Path(path).is_relative_to(tmp_path / "numba" / digest)
 
 
+@pytest.mark.parametrize("name", ["rigid tree", "general"])
+def test_helpers_compile_the_argument_types_motion_passes(name, all_joints):
+    """ahead.py's helpers compile the kernel's largest parts ahead, each for argument types
+    it names: a fresh compilation of kernel.motion (its callees loaded from the cache) asks
+    each of them for exactly those, for a rigid tree and for the general variant."""
+    from numba import njit
+
+    from mbsynth.fast import ahead, kernel
+    system = mb.load(MODELS[0].parent.parent / "rigid" / "double_pendulum_3d.yaml") if name == "rigid tree" \
+        else all_joints
+    engine = engine_for(system, wait=True)
+    assert engine.general is (kernel.RIGID_TREE if name == "rigid tree" else kernel.GENERAL)
+    fresh = njit(error_model="numpy")(kernel.motion.py_func)  # not cached: compiled here
+    q, qd = random_state(system, np.random.default_rng(3))
+    assert fresh(q, qd, engine.gen, np.zeros(0), *engine.buffers, kernel.CHECKED, engine.general)[0] == kernel.OK
+    for group in range(len(ahead.GROUPS)):
+        for dispatcher, types in ahead.functions(group, engine.general):
+            assert types in dispatcher.overloads, (dispatcher.py_func.__name__, list(dispatcher.overloads))
+    assert rel(engine.W.qdd, system.motion(0.0, q, qd, method="reference").qdd) < 1e-10
+
+
+def test_helper_processes_finish_and_failures_are_only_logged(monkeypatch, caplog):
+    """``python -m mbsynth.fast.ahead`` runs in this environment (here every group is in the
+    cache already); a helper that fails is logged, not raised: numba compiles what it left."""
+    import logging
+
+    from mbsynth.fast import ahead, kernel
+    monkeypatch.setattr(ahead, "_started", set())
+    helpers = ahead.start(kernel.RIGID_TREE)
+    assert len(helpers) == len(ahead.GROUPS) and ahead.start(kernel.RIGID_TREE) == []
+    ahead.wait(helpers)
+    assert [h.returncode for h in helpers] == [0] * len(helpers)
+    failing = subprocess.Popen([sys.executable, "-c", "import sys; sys.exit('no luck')"], stderr=subprocess.PIPE)
+    with caplog.at_level(logging.INFO, logger="mbsynth.fast.ahead"):
+        ahead.wait([failing])
+    assert "failed (1)" in caplog.text and "no luck" in caplog.text
+
+
 def test_borrowed_arrays_share_the_callers_memory():
     """packing.borrowed drops only the reference count: its views read and write the
     caller's buffer, which numpy sees afterwards."""

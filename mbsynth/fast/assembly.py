@@ -177,9 +177,10 @@ def _normalize(row, count):
 
 @njit(**OPTIONS)
 def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, Rs, joints, joint_row, scratch,
-              J, P, rb):
+              J, P, rb, general):
     """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated.
-    Joints between rigid bodies or the world: rate_rows.py; others: joints.py, reduced."""
+    Joints between rigid bodies or the world: rate_rows.py; others: joints.py, reduced
+    (``general`` None: there are none, and numba compiles without them)."""
     program, count, kinds, starts, offset, frame, length, ends = joints
     A, b = scratch[3], scratch[4]
     for i in range(kind.shape[0]):
@@ -187,7 +188,7 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
         if j < 0:
             continue
         me, p, r0 = node_end[i], parent[i], rows[i]
-        if kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE:
+        if general is None or (kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE):
             equilibrated_rows(program[j], count[j], kinds[j], ends[j], starts[j], offset[j], frame[j], length[j], q,
                               qd, Rs, me, bshift, joint_row[j], J, P, rb, r0)
             continue

@@ -31,7 +31,7 @@ import threading
 import weakref
 from concurrent.futures import Future
 
-from . import cache
+from . import ahead, cache
 
 log = logging.getLogger(__name__)
 MODES = ("background", "wait", "off")
@@ -199,7 +199,8 @@ def _build(system):
     if template is None:
         return None, None
     engine = template.engine(system)
-    engine.warm(*system.initial_state())
+    helpers = () if compiled() else ahead.start(template.general)  # the kernel's largest parts, alongside
+    engine.warm(*system.initial_state(), helpers)
     if not _compiled:
         _compiled = True
         try:

@@ -60,13 +60,14 @@ class Corrected(NamedTuple):
 
 
 @njit(nogil=True, **OPTIONS)
-def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, work):
+def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, general, work):
     """Each state (row of Q, Q̇) corrected into Q_on, Q̇_on (module docstring), found's row
     (KINETIC, POTENTIAL, PHI_MAX, PSI_MAX there, DONE = 1), or DONE = 0 where the kernel
     declines it or the rows' checks fail. LI, LF, LX: the Layout packed; LF_rest: its
     floats with no gravity (Engine.at_rest); WI, WF, WX: a Work packed; gen: zeros for
-    the generated function's outputs; work: a thread's arrays (``Correction._arguments``: rows.py's
-    φ, φ̇, Rs; the right side; the factored q; q̇ = 0)."""
+    the generated function's outputs; general: kernel.motion's (Template.general); work:
+    a thread's arrays (``Correction._arguments``: rows.py's φ, φ̇, Rs; the right side; the
+    factored q; q̇ = 0)."""
     phi, psi, Rs, shift, factored, rest = work
     qdd = view1(WF, WX, WORK.qdd)
     for b in range(Q.shape[0]):
@@ -80,7 +81,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, wor
             if phi_max <= TOLERANCE * size:
                 break
             _negated(phi, shift)
-            if step == MAX_STEPS or motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED)[0] != OK:
+            if step == MAX_STEPS or motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0] != OK:
                 declined = True
                 break
             reuse = step == 0 and largest(qdd) <= REUSE * size  # the Work keeps q's factorization
@@ -93,9 +94,9 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, wor
         rates = max(qd_max, TINY)
         _negated(psi, shift)
         if reuse and psi_max <= REUSE * rates:
-            status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED)[0]
+            status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED, general)[0]
         else:
-            status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED)[0]
+            status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0]
         if status != OK:
             continue
         before = psi_max
@@ -129,7 +130,7 @@ class Correction:
         rows' work arrays (φ, φ̇, Rs) its own."""
         n = self.at_rest.n
         work = (*rows_work, np.zeros(rows_work[0].shape), np.zeros(n), np.zeros(n))
-        return (*self.rows.packed, self.at_rest.packed[1], *packed_work, self.gen, work)
+        return (*self.rows.packed, self.at_rest.packed[1], *packed_work, self.gen, self.at_rest.general, work)
 
     @classmethod
     def build(cls, engine):

@@ -21,7 +21,7 @@ import threading
 import numpy as np
 
 from ..equations import Motion
-from . import codegen, kernel, layout
+from . import ahead, codegen, kernel, layout
 from .assembly import Work, make_work
 from .correction import Correction
 from .packing import pack, views
@@ -41,6 +41,7 @@ class Template:
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
+        self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
         self.number_parameters = None  # indices into p of the parameters the Layout's numbers use (``engine``)
         self.on_layout = None  # the first Engine on L itself, whose buffers the later ones share
 
@@ -74,7 +75,7 @@ class Engine:
     def __init__(self, template, L, p):
         self.template, self.L, self.p = template, L, p
         self.n, self.outputs, self.module = template.n, template.outputs, template.module
-        self.closes_loops = template.closes_loops
+        self.closes_loops, self.general = template.closes_loops, template.general
         self.gen = np.zeros(self.outputs)
         self.packed = pack(L)
         self.work, self.W = self.new_work()
@@ -111,8 +112,13 @@ class Engine:
         packed = pack(work)
         return packed, views(Work, work, *packed)
 
-    def warm(self, q, qd):
-        """Compile (or load from the cache) everything ``motion`` calls, at the state (q, q̇)."""
+    def warm(self, q, qd, helpers=()):
+        """Compile (or load from the cache) everything ``motion`` calls, at the state (q, q̇):
+        the generated function first, then, once ``helpers`` (ahead.py) have put their parts
+        of the kernel into the cache, the kernel."""
+        if self.module is not None:
+            self.module.evaluate(0.0, q, qd, self.p, self.gen)
+        ahead.wait(helpers)
         self.motion(0.0, q, qd)
 
     def motion(self, t, q, qd, bshift=None):
@@ -123,7 +129,7 @@ class Engine:
             if self.module is not None:
                 self.module.evaluate(t, q, qd, self.p, self.gen)
             status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.buffers,
-                                             kernel.CHECKED)
+                                             kernel.CHECKED, self.general)
             if status != kernel.OK:
                 return None
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
@@ -143,7 +149,7 @@ class Engine:
                 b = min(a + size, count)
                 if self.module is not None:
                     self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
-                kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *work, qdd[a:b], status[a:b])
+                kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *work, self.general, qdd[a:b], status[a:b])
 
         threads = max(1, min(THREADS, -(-count // size)))
         with self.batch_lock:

@@ -38,6 +38,8 @@ from .tree import factor, solve
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
 # checks): numpy integers, which numba types as int64 rather than as a literal per value (one compilation)
+RIGID_TREE, GENERAL = None, True  # ``motion``'s ``general``: numba prunes the branches on ``general is None``, so
+# a rigid tree's motion compiles without particle joints, extra rows and extra coordinates (Layout.general)
 EIG_RTOL = 1e-10  # Schur eigenvalues below this fraction of max(the largest, 1) count as zero
 CONSISTENCY_RTOL = 1e-10  # largest part of the right side along dropped directions, relative to b's
 NULL_RTOL = 1e-8  # largest acceleration a dropped (unit) direction may move
@@ -274,14 +276,16 @@ def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx,
 
 
 @njit(**OPTIONS)
-def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode):
+def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general):
     """(status, residual) at one state; on OK, the Work's qdd holds q̈ and its Qc M q̈ − Q.
     gen: the generated function's outputs at (t, q, q̇) — time enters only there; bshift:
     added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
     Layout and the Work packed (packing.py). ``mode``: CHECKED factors the tree and checks
     the residual; UNCHECKED skips the check (residual 0: a caller that checks the result
     itself, correction.py); REUSED also keeps the factorization the last call on this Work
-    left, for a call with the same M and A (the same q) and another right side."""
+    left, for a call with the same M and A (the same q) and another right side. ``general``:
+    RIGID_TREE for a Layout of rigid bodies on tree joints only (compiled without the rest),
+    else GENERAL."""
     q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
     mass, mg, inertia = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), view3(LF, LX, LAYOUT.node_J)
@@ -322,8 +326,8 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode):
     mu = mu if mu > 0 else 1.0
     divide_masses(mu, H, F, Mx, Fx)
     tree_rows(q, qd, bshift, kind, start, view1(LI, LX, LAYOUT.node_joint), view1(LI, LX, LAYOUT.node_end), parent,
-              rows, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_row), scratch, J, P, rb)
-    if xb.shape[0]:
+              rows, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_row), scratch, J, P, rb, general)
+    if general is not None and xb.shape[0]:
         extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_xrow),
                    view2(LI, LX, LAYOUT.joint_xseg), view1(LI, LX, LAYOUT.xrow_row), xseg_ptr, xseg_node, gen_rows,
                    scratch, seg7, seg6, xb, Ax)
@@ -334,13 +338,14 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode):
     if mode != REUSED and factor(topology, H, J, P, factored, view2(WF, WX, WORK.G), view1(WI, WX, WORK.pivot)) >= 0:
         return SINGULAR, 0.0
     _copy(ry, y)
-    bordered = x_coord.shape[0] + xb.shape[0] > 0
-    solve(topology, factored, y, z0 if bordered else z)  # _close solves again into z
-    if bordered:
+    if general is not None and x_coord.shape[0] + xb.shape[0] > 0:
+        solve(topology, factored, y, z0)  # _close solves again into z
         status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
                         view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam)
         if status != OK:
             return status, 0.0
+    else:
+        solve(topology, factored, y, z)
     _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc)
     residual = 0.0
     if mode == CHECKED:
@@ -354,11 +359,11 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, qdd, status):
+def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, qdd, status):
     """q̈ of each state (row of q, q̇, gen) into qdd and its status into status. Releases
     the GIL: engine.py runs blocks of rows in threads, each with its own Work."""
     empty = np.zeros(0)
     qdd_view = view1(WF, WX, WORK.qdd)
     for row in range(q.shape[0]):
-        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED)[0]
+        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED, general)[0]
         _copy(qdd_view, qdd[row])

@@ -182,6 +182,12 @@ def _tree(count, joints, node_of):
     return parent, pjoint, order
 
 
+def rigid_tree(L):
+    """Whether ``L`` is rigid bodies on tree joints only: no joint with a particle end, no
+    extra rows, no extra coordinates (the kernel then compiles without them: kernel.RIGID_TREE)."""
+    return not (np.any(L.joint_kinds == PARTICLE) or L.xrow_row.size or L.x_coord.size)
+
+
 def with_parameters(L, system):
     """``L``, built from a System with the parts and constraints of ``system`` (other
     parameter values: ``System.with_parameters``), with the numbers of ``system``."""
