@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
+from . import fast
 from .connectors import Joint
 from .errors import ModelError
 from .joint_forces import actuation
@@ -193,6 +194,7 @@ def from_robot(name_or_urdf, floating=False, *, base=None, gravity=GRAVITY, pref
     one rigid body per link, one joint per URDF joint, one torque parameter per movable
     joint (``tau_<joint>``, set with ``System.with_parameters``). ``floating``: a free
     root link instead of a fixed base; ``base``: the root link's (position, rotation)."""
+    fast.compile_ahead("rigid_tree")  # a robot is a rigid tree: a cold compile starts beside the derivation
     description = describe(name_or_urdf, package_dirs)
     robot = Robot.plan(description, prefix, floating, base)
     params = [sp.Symbol(p) for p in robot.parameters]

@@ -543,9 +543,11 @@ def test_helper_processes_finish_and_failures_are_only_logged(monkeypatch, caplo
 
     from mbsynth.fast import ahead, kernel
     monkeypatch.setattr(ahead, "_started", set())
+    monkeypatch.setattr(ahead, "_running", [])
     helpers = ahead.start(kernel.RIGID_TREE)
     assert len(helpers) == len(ahead.GROUPS) and ahead.start(kernel.RIGID_TREE) == []
-    ahead.wait(helpers)
+    ahead.finish()
+    assert ahead._running == []
     assert [h.returncode for h in helpers] == [0] * len(helpers)
     failing = subprocess.Popen([sys.executable, "-c", "import sys; sys.exit('no luck')"], stderr=subprocess.PIPE)
     with caplog.at_level(logging.INFO, logger="mbsynth.fast.ahead"):

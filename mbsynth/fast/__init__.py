@@ -14,13 +14,14 @@
     correction.py  states put back on the constraints by the kernel, in the mass metric
     threads.py     the threads compiled kernels share (motion_batch, corrections)
     background.py  building Engines off the caller's thread, shared and freed; MBSYNTH_FAST
+    ahead.py       a cold compile's largest parts in helper processes, on the other core
     batch.py       System.motion_batch
     cache.py       where compiled code is kept
 
 Importing this package does not import numba (``mbsynth check`` never needs it).
 """
 
-from .background import compiled, engine_for, fix_path, share
+from .background import compile_ahead, compiled, engine_for, fix_path, share
 from .batch import motion_batch
 
-__all__ = ["compiled", "engine_for", "fix_path", "motion_batch", "share"]
+__all__ = ["compile_ahead", "compiled", "engine_for", "fix_path", "motion_batch", "share"]

@@ -37,7 +37,8 @@ def main():
     from . import ahead, background, kernel
     rigid = []
     if not background.compiled():
-        ahead.wait(ahead.start(kernel.RIGID_TREE, kernel.GENERAL))
+        ahead.start(kernel.RIGID_TREE, kernel.GENERAL)
+        ahead.finish()
         rigid = ahead.spawn(__spec__.name, "rigid")
     warm(WARM_MODELS)
     ahead.wait(rigid)

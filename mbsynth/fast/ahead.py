@@ -6,8 +6,9 @@ few callees. When the cache holds no kernels yet (background.compiled()), ``star
 launches helper processes (``python -m mbsynth.fast.ahead GROUP VARIANT...``), each
 compiling one of GROUPS, for the argument types ``motion`` hands those functions in each
 variant, into numba's on-disk cache, while this process compiles the model's generated
-function; ``wait`` lets them finish, and compiling ``motion`` then loads them from the
-cache. The groups are balanced for two cores. A helper that fails costs time only: numba
+function; ``finish`` lets them finish, and compiling ``motion`` then loads them from the
+cache (Engine.warm). A caller that knows the variant of a System it is about to build (a
+robot is a rigid tree) may start them earlier, beside the derivation (background.compile_ahead). The groups are balanced for two cores. A helper that fails costs time only: numba
 compiles whatever the cache lacks.
 
 Each function is named with the types of its arguments in a short notation: ``f2`` a
@@ -22,6 +23,7 @@ import logging
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 log = logging.getLogger(__name__)
@@ -47,6 +49,8 @@ GENERAL_ONLY = (  # what a rigid tree's motion leaves out, per group
 VARIANTS = {"rigid_tree": None, "general": True}  # kernel.RIGID_TREE, kernel.GENERAL
 TIMEOUT = 600  # seconds a helper may take before it is stopped
 _started = set()  # the variants whose helpers this process has started
+_running = []  # those helpers, until ``finish``
+_lock = threading.Lock()
 HELPER = "MBSYNTH_AHEAD_HELPER"  # set in a helper's environment
 
 
@@ -96,11 +100,22 @@ def start(*generals):
     """Helper processes compiling every group for each of ``generals`` (values of
     ``motion``'s ``general``) but those this process started helpers for before. numba's
     cache directory is this process's (cache.configure). A helper starts none."""
-    variants = [name for name, value in VARIANTS.items() if value in generals and name not in _started]
-    if not variants or os.environ.get(HELPER):
-        return []
-    _started.update(variants)
-    return [helper for group in range(len(GROUPS)) for helper in spawn(__name__, str(group), *variants)]
+    with _lock:
+        variants = [name for name, value in VARIANTS.items() if value in generals and name not in _started]
+        if not variants or os.environ.get(HELPER):
+            return []
+        _started.update(variants)
+        helpers = [helper for group in range(len(GROUPS)) for helper in spawn(__name__, str(group), *variants)]
+        _running.extend(helpers)
+        return helpers
+
+
+def finish():
+    """Wait for every helper ``start`` started in this process (none left: at once)."""
+    with _lock:
+        helpers = list(_running)
+        _running.clear()
+    wait(helpers)
 
 
 def spawn(module, *args):

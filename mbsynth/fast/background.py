@@ -136,6 +136,15 @@ def fix_path(system, run):
     return engine
 
 
+def compile_ahead(variant):
+    """Start compiling the kernel's largest parts for ``variant`` ("rigid_tree" or
+    "general": ahead.VARIANTS) in helper processes now, when the kernels are not compiled and
+    the fast path is on: a caller about to build a System of that variant (a robot: a rigid
+    tree) lets them run beside its derivation."""
+    if mode() != "off" and not compiled():
+        ahead.start(ahead.VARIANTS[variant])
+
+
 def compiled():
     """Whether the kernels are compiled: in this process, or in the cache on disk."""
     return _compiled or cache.compiled_mark().exists()
@@ -199,8 +208,9 @@ def _build(system):
     if template is None:
         return None, None
     engine = template.engine(system)
-    helpers = () if compiled() else ahead.start(template.general)  # the kernel's largest parts, alongside
-    engine.warm(*system.initial_state(), helpers)
+    if not compiled():
+        ahead.start(template.general)  # the kernel's largest parts, alongside (none if started already)
+    engine.warm(*system.initial_state())
     if not _compiled:
         _compiled = True
         try:

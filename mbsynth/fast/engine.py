@@ -112,13 +112,13 @@ class Engine:
         packed = pack(work)
         return packed, views(Work, work, *packed)
 
-    def warm(self, q, qd, helpers=()):
+    def warm(self, q, qd):
         """Compile (or load from the cache) everything ``motion`` calls, at the state (q, q̇):
-        the generated function first, then, once ``helpers`` (ahead.py) have put their parts
-        of the kernel into the cache, the kernel."""
+        the generated function first, then, once the helpers this process started (ahead.py)
+        have put their parts of the kernel into the cache, the kernel."""
         if self.module is not None:
             self.module.evaluate(0.0, q, qd, self.p, self.gen)
-        ahead.wait(helpers)
+        ahead.finish()
         self.motion(0.0, q, qd)
 
     def motion(self, t, q, qd, bshift=None):
