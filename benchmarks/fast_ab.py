@@ -73,7 +73,8 @@ def compare(label, old, new):
     engine = engine_for(case.system, wait=True)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
-    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module, engine)) for module in (old, new)}
+    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module, engine))
+            for module in (old, new)}
     results = []
     for module in (old, new):
         module.motion(*args[module])

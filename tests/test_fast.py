@@ -525,6 +525,7 @@ def test_helpers_compile_the_argument_types_motion_passes(name, all_joints):
     from mbsynth.fast import ahead, kernel
     system = mb.load(MODELS[0].parent.parent / "rigid" / "double_pendulum_3d.yaml") if name == "rigid tree" \
         else all_joints
+    assert ahead.VARIANTS == {"rigid_tree": kernel.RIGID_TREE, "general": kernel.GENERAL}  # the helpers' names
     engine = engine_for(system, wait=True)
     assert engine.general is (kernel.RIGID_TREE if name == "rigid tree" else kernel.GENERAL)
     fresh = njit(error_model="numpy")(kernel.motion.py_func)  # not cached: compiled here
