@@ -425,6 +425,8 @@ def test_batch_equals_single_states(all_joints):
         arrays = system.evaluate(t[row], q[row], qd[row])
         literal = constrained_acceleration(arrays.M, arrays.Q, arrays.A, arrays.b, arrays.C).qdd
         assert rel(qdd[row], literal) < 1e-9
+    column_major = np.asfortranarray(q)  # made row-contiguous for the kernels, the caller's array untouched
+    assert np.array_equal(system.motion_batch(t, column_major, qd)[0], qdd) and np.array_equal(column_major, q)
     q[5, 3] = np.nan  # a quaternion component: M is not finite
     with pytest.raises(SolveError, match="state 5 of the batch"):
         system.motion_batch(t, q, qd)

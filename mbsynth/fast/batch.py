@@ -15,7 +15,8 @@ from .background import engine_for
 
 def motion_batch(system, t, q, qd):
     """(qdd (B × n), unique (B,)) for states q, q̇ (B × n) at times t (a number or B)."""
-    q, qd = (np.array(x, dtype=float, ndmin=2) for x in (q, qd))
+    # no copy of states already in float64 rows (a copy of a large batch costs page faults, serially)
+    q, qd = (np.atleast_2d(np.ascontiguousarray(x, dtype=float)) for x in (q, qd))
     if q.ndim != 2 or q.shape != qd.shape or q.shape[1] != system.n:
         raise ValueError(f"model '{system.name}' has {system.n} coordinates: q_batch and qd_batch must both "
                          f"have shape (B, {system.n}), got {q.shape} and {qd.shape}")

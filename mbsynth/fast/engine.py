@@ -140,16 +140,17 @@ class Engine:
         other load does fewer), the kernels running without the GIL."""
         count = q.shape[0]
         qdd, status = np.zeros((count, self.n)), np.zeros(count, dtype=np.int64)
-        gen = np.zeros((count, self.outputs))
         size = max(CHUNK, -(-count // (THREADS * 8)))
         chunks = iter(range(0, count, size))  # next() on it is atomic under the GIL
 
         def worker(work):
+            gen = np.zeros((size, self.outputs))  # the generated outputs of one chunk, reused chunk after chunk
             for a in chunks:
                 b = min(a + size, count)
                 if self.module is not None:
-                    self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[a:b])
-                kernel.motion_rows(q[a:b], qd[a:b], gen[a:b], *self.packed, *work, self.general, qdd[a:b], status[a:b])
+                    self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[:b - a])
+                kernel.motion_rows(q[a:b], qd[a:b], gen[:b - a], *self.packed, *work, self.general, qdd[a:b],
+                                   status[a:b])
 
         threads = max(1, min(THREADS, -(-count // size)))
         with self.batch_lock:
