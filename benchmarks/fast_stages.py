@@ -61,11 +61,13 @@ def _stage_lines(body, function):
     raise SystemExit(f"fast_stages: kernel.motion no longer calls {function}; update STAGES")
 
 
-def _repeated(statements):
-    """The statements as a loop of REPEAT runs (an ``if f(...) >= 0: return`` as its call alone)."""
+def _repeated(statements, function):
+    """The statements as a loop of REPEAT runs: an ``if`` that calls ``function`` in its test
+    (``if ... f(...) >= 0: return``) as that test alone; one that calls it in a branch
+    whole, so that the branch this Layout takes runs."""
     body = []
     for statement in statements:
-        if isinstance(statement, ast.If):
+        if isinstance(statement, ast.If) and function in _calls(statement.test):
             test = statement.test
             statement = ast.Expr(test.left if isinstance(test, ast.Compare) else test)
         body.append(statement)
@@ -73,14 +75,15 @@ def _repeated(statements):
                    iter=ast.Call(ast.Name("range", ast.Load()), [ast.Constant(REPEAT)], []), body=body, orelse=[])
 
 
-def variant(span=None):
-    """A numba loop of kernel.motion's source, with the statements in ``span`` repeated."""
+def variant(span=None, called=None):
+    """A numba loop of kernel.motion's source, with the statements in ``span`` (the stage
+    calling the function named ``called``) repeated."""
     tree = ast.parse(textwrap.dedent(inspect.getsource(kernel.motion.py_func)))
     function = tree.body[0]
     function.decorator_list = []
     if span is not None:
         start, stop = span
-        function.body[start:stop] = [_repeated(function.body[start:stop])]
+        function.body[start:stop] = [_repeated(function.body[start:stop], called)]
     ast.fix_missing_locations(tree)
     namespace = dict(vars(kernel))
     exec(compile(tree, "<fast_stages>", "exec"), namespace)
@@ -102,7 +105,7 @@ def profile(label):
     body = ast.parse(textwrap.dedent(inspect.getsource(kernel.motion.py_func))).body[0].body
     loops = {None: variant()}
     for name, function in STAGES.items():
-        loops[name] = variant(_stage_lines(body, function))
+        loops[name] = variant(_stage_lines(body, function), function)
     times = {name: [] for name in loops}
     for name, loop in loops.items():
         loop(1, *args)
