@@ -50,23 +50,27 @@ class Connector:
         slots, q̇ slots) standing for the model's coordinates ``coordinates`` (indices),
         and ``constants`` (placeholder, value) pairs. They are compiled once for all such
         connectors; their sympy form over the model's symbols is built only when asked."""
-        a, b, phi, psi = rows
-        self._name_rows(name, kind, len(b), row_labels)
+        self._name_rows(name, kind, len(rows[1]), row_labels)
         q_slots, qd_slots = slots
         free = _slots_in(rows, slots)
         used = sorted({coordinates[j] for j in free})
         slot_of = {c: j for j, c in enumerate(coordinates)}
         local = [slot_of[i] for i in used]
         self.indices = np.array(used, dtype=int)
-        k = len(b)
         self._symbolic = None
         self._levels = (True, True)
         self._placed = (rows, slots, coordinates, dict(constants), q, qd)
         self._zero_C = sp.SparseMatrix(len(q), 1, {})
         self._rows = compile_function(
             (T_SYMBOL, [q_slots[j] for j in local], [qd_slots[j] for j in local], list(params)),
-            [sp.Matrix(k, len(local), [a[r][j] for r in range(k) for j in local]), sp.Matrix(b),
-             sp.zeros(len(local), 1), sp.Matrix(phi), sp.Matrix(psi)], constants=constants)
+            _placed_rows(rows, tuple(local)), constants=constants)
+
+    @classmethod
+    def placed(cls, name, kind, rows, slots, coordinates, q, qd, params, constants=(), row_labels=None):
+        """A connector of rows given in placeholder symbols (``_place``)."""
+        connector = cls.__new__(cls)
+        connector._place(name, kind, rows, slots, coordinates, constants, q, qd, params, row_labels)
+        return connector
 
     def _materialized(self):
         """(a, b, C, φ, ψ) as sympy expressions of the model's symbols."""
@@ -131,6 +135,16 @@ def _slots_in(rows, slots):
     a, b, phi, psi = rows
     free = set().union(*(x.free_symbols for x in (*b, *phi, *psi, *(e for row in a for e in row))))
     return [j for j, (s, sd) in enumerate(zip(*slots)) if s in free or sd in free]
+
+
+@functools.lru_cache(maxsize=256)
+def _placed_rows(rows, local):
+    """[a, b, C, φ, ψ] of ``Connector._rows`` for rows (a, b, φ, ψ) over the slots at
+    ``local``: once per template and selection (connectors alike share it)."""
+    a, b, phi, psi = rows
+    k = len(b)
+    return [sp.Matrix(k, len(local), [a[r][j] for r in range(k) for j in local]), sp.Matrix(b),
+            sp.zeros(len(local), 1), sp.Matrix(phi), sp.Matrix(psi)]
 
 
 def mixed(holonomic, nonholonomic, q, qd):

@@ -247,8 +247,9 @@ def compile_function(args, exprs, constants=(), dtype=float):
     ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
     values (numbers or expressions of ``args``) are put in at each evaluation, so that
     expressions shared by many instances (connectors.joints) are compiled once."""
-    shapes = [sp.Matrix(e).shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
-    flat = [sp.sympify(x) for e in exprs for x in (e if isinstance(e, sp.MatrixBase) else [e])]
+    shapes = [e.shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
+    flat = [x if isinstance(x, sp.Basic) else sp.sympify(x)
+            for e in exprs for x in (e.flat() if isinstance(e, sp.MatrixBase) else [e])]
     if not flat:
         def empty(*_):
             return tuple(np.zeros(s) for s in shapes)

@@ -41,3 +41,23 @@ def test_joints_alike_share_one_derivation_and_keep_their_own_rows():
             for i in joint.indices:
                 assert abs(float(joint.a[r, int(i)].subs(state)) - float(a[0, int(i)].subs(state))) < 1e-12
             assert abs(float(joint.b[r].subs(state)) - float(b.subs(state))) < 1e-10
+
+
+def test_a_bodys_unit_norm_row_is_the_derivative_of_its_own_constraint():
+    """The placed row uᵀü = −u̇ᵀu̇ (rigid_body.own_constraints) against differentiating
+    φ = (uᵀu − 1)/2 in the body's own symbols, at a state off the unit sphere."""
+    q, qd, (_, body) = two_bodies(2)
+    (row,) = body.own_constraints(q, qd, [])
+    u, ud = sp.Matrix(body.q[3:]), sp.Matrix(body.qd[3:])
+    phi = ((u.T * u)[0] - 1) / 2
+    a, b, psi = differentiate(phi, q, qd)
+    x, xd = RNG.normal(size=len(q)), RNG.normal(size=len(q))
+    state = dict(zip(q + qd, [*x, *xd]))
+    got_a, got_b, _ = row.evaluate(0.0, x, xd, np.array([]))
+    got_phi, got_psi = row.residuals(0.0, x, xd, np.array([]))
+    assert list(row.indices) == [10, 11, 12, 13]
+    assert np.allclose(got_a.ravel(), [float(a[0, i].subs(state)) for i in row.indices], rtol=1e-14)
+    assert np.isclose(got_b[0], float(b.subs(state)), rtol=1e-14)
+    assert np.isclose(got_phi[0], float(phi.subs(state)), rtol=1e-14)
+    assert np.isclose(got_psi[0], float(psi.subs(state)), rtol=1e-14)
+    assert row.row_names == ["b1.unit_quaternion"] and sp.simplify(row.phi[0] - phi) == 0

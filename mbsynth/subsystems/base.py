@@ -51,7 +51,7 @@ class Part:
         self.frames = {f.name: f for f in frames}
         self.geometry = tuple(geometry)
         self.initial = dict(initial or {})
-        template = (sp.Matrix(M), sp.Matrix(Q), sp.sympify(T), sp.sympify(V))
+        template = (_matrix(M), _matrix(Q), sp.sympify(T), sp.sympify(V))
         q_slots, qd_slots, constants = shared or (self.q, self.qd, ())
         self._symbolic = None if shared else template
         self._shared = shared and (template, (q_slots, qd_slots), constants)
@@ -114,6 +114,11 @@ class Part:
         """Orthonormal columns (over the part's coordinates, at its coordinates ``q``) of
         the directions that move nothing: none for most parts."""
         return np.zeros((len(self.coordinates), 0))
+
+
+def _matrix(x):
+    """``x`` as a sympy matrix; one already (a template shared by all parts alike) as it is."""
+    return x if isinstance(x, sp.MatrixBase) else sp.Matrix(x)
 
 
 def frame_velocity(position, q, qd):

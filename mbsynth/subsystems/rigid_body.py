@@ -9,6 +9,7 @@ import sympy as sp
 from ..constraint import Connector
 from ..derivation_cache import placeholder, remembered
 from ..kinematics import body_rate_matrix, rotation, world_rate_matrix
+from ..symbolic import differentiate, positions
 from .base import Part
 
 COORDINATES = ("x", "y", "z", "qw", "qx", "qy", "qz")
@@ -37,9 +38,12 @@ class RigidBody(Part):
                          shared=(*slots, constants))
 
     def own_constraints(self, q, qd, params):
-        """uᵀu = 1, differentiated: uᵀü = −u̇ᵀu̇."""
-        u = sp.Matrix(self.q[3:])
-        return [Connector.holonomic(f"{self.name}.unit_quaternion", [((u.T * u)[0] - 1) / 2], q, qd, params)]
+        """φ = (uᵀu − 1)/2 = 0, differentiated: uᵀü = −u̇ᵀu̇ — one row placed from the rows
+        every body shares (``_unit_norm_rows``), derived once per process."""
+        where = positions(q, qd)
+        rows, slots = _unit_norm_rows()
+        return [Connector.placed(f"{self.name}.unit_quaternion", "holonomic", rows, slots,
+                                 [where[s] for s in self.q[3:]], q, qd, params)]
 
     def pose(self, frame):
         R = rotation(self.q[3:])
@@ -61,6 +65,20 @@ def _template():
     """(coordinate slots (q, q̇), placeholders (m, J row by row, g), (M, Q, T, V)): the
     body's equations derived once, for every body (base.Part's ``shared``)."""
     return remembered("rigid-body", (), _derive_template)
+
+
+@functools.lru_cache(maxsize=1)
+def _unit_norm_rows():
+    """((a over the slots, b, φ, φ̇), slots) of φ = (uᵀu − 1)/2 in four quaternion slots
+    (symbolic.differentiate), derived once and kept on disk (derivation_cache.py)."""
+    return remembered("unit-norm", (), _derive_unit_norm)
+
+
+def _derive_unit_norm():
+    u, ud = tuple(placeholder(f"unit_q{i}") for i in range(4)), tuple(placeholder(f"unit_q{i}_dot") for i in range(4))
+    phi = (sum(x * x for x in u) - 1) / 2
+    a, b, psi = differentiate(phi, list(u), list(ud))
+    return ((tuple(a),), (b,), (phi,), (psi,)), (u, ud)
 
 
 def _derive_template():
