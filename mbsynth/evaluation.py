@@ -30,22 +30,48 @@ class _FixWhenMade(NamedTuple):
     """In place of a run's Evaluator until its first use (``fix_when_made``)."""
 
     wait: bool
+    origin: object  # a weak reference to the System the run was made from, or None
 
 
 def evaluator(system):
     """The Evaluator of ``system``, made on first use and dropped when the System is."""
     found = _existing(system)
     if isinstance(found, _FixWhenMade):
-        return _keep(system, Evaluator(system).fix_kernels(found.wait))
+        return _keep(system, _fixed(system, found))
     return found or _keep(system, Evaluator(system))
 
 
-def fix_when_made(system, wait):
+def fix_when_made(system, wait, origin=None):
     """Let ``system``'s Evaluator fix its paths (``Evaluator.fix_kernels(wait)``) as it is
     made, on first use: a run (System.for_run) that never evaluates the System's
-    connectors one by one (the compiled kernel covers them) never lays them out."""
+    connectors one by one (the compiled kernel covers them) never lays them out.
+    ``origin``: the System the run was made from; the Evaluator made is kept with it, for
+    its later runs with the same ``wait`` (their layout and groups found once)."""
     if _existing(system) is None:
-        _keep(system, _FixWhenMade(wait))
+        _keep(system, _FixWhenMade(wait, None if origin is None else weakref.ref(origin)))
+
+
+_for_runs = {}  # id(System) -> (weak reference, wait, the Evaluator its runs share)
+
+
+def _fixed(system, pending):
+    """The Evaluator, paths fixed, of ``system`` (a run, ``pending`` its _FixWhenMade): the one
+    its origin's earlier runs made with the same ``wait``, else a new one, kept for the later."""
+    origin = None if pending.origin is None else pending.origin()
+    found = None if origin is None else _for_runs.get(id(origin))
+    if found is not None and found[0]() is origin and found[1] == pending.wait:
+        return found[2]
+    made = Evaluator(system).fix_kernels(pending.wait)
+    if origin is not None:
+        key = id(origin)
+        _for_runs[key] = (pending.origin, pending.wait, made)
+        weakref.finalize(origin, _forget_runs, key, made)
+    return made
+
+
+def _forget_runs(key, made):
+    if _for_runs.get(key, (None, None, None))[2] is made:
+        del _for_runs[key]
 
 
 def share(parent, child):
@@ -53,11 +79,16 @@ def share(parent, child):
     values (``System.with_parameters``, ``System.for_run``) — use ``parent``'s Evaluator
     once that one's path is fixed (``Evaluator.fixed``): its layout and groups, found at its
     first call, hold for every parameter value (p is an argument of each call). A sampled
-    controller's System per sample then costs no new layout. Returns whether it shares."""
+    controller's System per sample then costs no new layout. Returns whether it shares.
+    Where it does not, ``child``'s runs share the Evaluator ``parent``'s runs made."""
     found = _existing(parent)
     if isinstance(found, _FixWhenMade):
         found = evaluator(parent)
     if found is None or not found.fixed:
+        runs = _for_runs.get(id(parent))
+        if runs is not None and runs[0]() is parent and id(child) not in _for_runs:
+            _for_runs[id(child)] = (weakref.ref(child), *runs[1:])
+            weakref.finalize(child, _forget_runs, id(child), runs[2])
         return False
     _keep(child, found)
     return True

@@ -180,7 +180,7 @@ class System:
         run = replace(self)
         fast.fix_path(self, run)
         if not evaluation.share(self, run):  # a run's own, or this System's path already fixed
-            evaluation.fix_when_made(run, wait=fast.compiled())  # the connectors' kernels likewise
+            evaluation.fix_when_made(run, fast.compiled(), self)  # the connectors' kernels likewise
         return run
 
     def part_problems(self, parameters=None):

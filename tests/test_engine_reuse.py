@@ -136,6 +136,28 @@ def test_a_runs_children_share_its_evaluation_layout(model):
         run.with_parameters(m=-1.0)
 
 
+def test_the_runs_of_a_system_share_one_evaluation_layout(background_mode):
+    """Each run (``for_run``) of a System, and of its ``with_parameters`` children, uses the
+    Evaluator the first run made (its groups laid out once, not once per simulate), with
+    its own parameter values: the arrays equal a fresh load's. It dies with the System."""
+    system = mb.loads(MODEL, "reuse")
+    first, second = system.for_run(), system.for_run()
+    q, qd = a_state(first)
+    first.constraint_arrays(0.2, q, qd)
+    assert evaluation.evaluator(second) is evaluation.evaluator(first)
+    child = system.with_parameters(L=0.45)
+    run = child.for_run()
+    assert evaluation.evaluator(run) is evaluation.evaluator(first)
+    loaded = mb.loads(MODEL.replace("L: 0.4,", "L: 0.45,"), "loaded")
+    ours, theirs = run.constraint_arrays(0.3, q, qd, sparse=False), loaded.constraint_arrays(0.3, q, qd, sparse=False)
+    for k in range(5):
+        assert rel(ours[k], theirs[k]) < 1e-13, k
+    made = weakref.ref(evaluation.evaluator(first))
+    del system, first, second, child, run
+    gc.collect()
+    assert made() is None
+
+
 def test_a_massless_body_from_a_parameter(model, background_mode):
     """b1 welded to b0 loses its mass and inertia: M gets a zero block (a structural change
     of (2.14)'s problem), which the reused Engine meets with the numbers a fresh build has."""

@@ -122,3 +122,22 @@ def test_frame_rotations_of_the_branch_check_equal_the_poses_sympy_gives(model):
             np.testing.assert_allclose(_rotation_at(part, frame, values), expected, atol=1e-14)
             compared += 1
     assert compared >= 2
+
+
+@pytest.mark.parametrize("scale", [1.0, 3.0, 0.2])
+def test_the_turn_is_judged_alike_for_scaled_rotations(scale):
+    """R_Aᵀ R_B of unnormalized quaternions is a turn scaled by |u_A|² |u_B|²: the quick test
+    on its trace (no turn well below 90°) and the full one (the rotation vector) agree at any
+    scale — 60° passes, 100° and 180° are refused."""
+    from types import SimpleNamespace
+
+    from mbsynth.connectors.joints import _turned
+    joint = SimpleNamespace(joint_kind="fixed", name="weld", parts=(None, SimpleNamespace(name="block")))
+    axis = np.array([1.0, 2.0, 2.0]) / 3
+    for degrees, refused in ((60, False), (89, False), (100, True), (180, True)):
+        from scipy.spatial.transform import Rotation
+        relative = scale * Rotation.from_rotvec(np.radians(degrees) * axis).as_matrix()
+        message = _turned(joint, relative)
+        assert (message is not None) == refused, (degrees, message)
+        if refused:
+            assert f"{degrees:.3g}°" in message

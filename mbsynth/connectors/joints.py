@@ -199,7 +199,7 @@ def _rotation_at(part, frame, values):
     per check on talos; other parts by substitution."""
     if part is not None and not isinstance(part, SHARED_PARTS):
         return _numeric(_pose(part, frame)[1], values)
-    own = _numeric(frame.rotation, values)
+    own = _frame_rotation(frame, values)
     if own is None or part is None or isinstance(part, Particle):
         return own
     if any(x not in values for x in part.q):
@@ -211,11 +211,24 @@ def _rotation_at(part, frame, values):
     return quaternion_rotation([float(values[x]) for x in part.q[3:]]) @ own
 
 
+def _frame_rotation(frame, values):
+    """``frame.rotation`` at ``values`` as floats (or None), kept on the frame where it is
+    made of numbers alone (a robot's frames): the branch check of every run reads it."""
+    found = frame.__dict__.get("_numeric_rotation")
+    if found is None:
+        found = _numeric(frame.rotation, values)
+        if found is not None and not sp.Matrix(frame.rotation).free_symbols:
+            object.__setattr__(frame, "_numeric_rotation", found)
+    return found
+
+
 def _turned(joint, relative):
     """The message for frames turned 90° or more apart (``relative`` = R_Aᵀ R_B), else None
     (also when ``relative`` is no turn at all: a zero quaternion, left to other checks)."""
     if not (np.all(np.isfinite(relative)) and np.linalg.det(relative) > 0):
         return None
+    if np.trace(relative) * np.sqrt(3) > 1.5 * np.linalg.norm(relative):  # well below 90°: for a turn R scaled
+        return None  # by s (unnormalized quaternions), tr = s (1 + 2 cos θ) and |sR| = s √3, so cos θ > 0.25
     from scipy.spatial.transform import Rotation  # scipy.spatial: a tenth of a second, only here
 
     turn = Rotation.from_matrix(relative).as_rotvec()
