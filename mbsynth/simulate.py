@@ -226,6 +226,8 @@ class _Run:
         self.system = system
         self.stage_motion = system.stage_motion(self.baumgarte, drift=True)
         engine = system._tree_engine(True)
+        # the compiled engine's (q̇, q̈) where stage_motion would call it anyway: no Motion per stage
+        self.derivative = None if engine is None or self.baumgarte is not None else engine.derivative
         self.correction = None if engine is None else engine.correction()
         self.continuous = self.correction is not None and issubclass(self.method, RESUMABLE) \
             and self.stabilization == "projection"
@@ -239,16 +241,19 @@ class _Run:
             if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
                 raise self._collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
-        q, qd = y[:self.n], y[self.n:]
-        motion = self.stage_motion(t, q, qd)
-        self.non_unique |= not motion.unique
-        if motion.singular:
-            self.singular.append((t, motion.singular))
-            self.singular_call = self.calls if self.singular_call is None else self.singular_call
+        found = None if self.derivative is None else self.derivative(t, y)  # unique, far from singular
+        if found is None:
+            q, qd = y[:self.n], y[self.n:]
+            motion = self.stage_motion(t, q, qd)
+            self.non_unique |= not motion.unique
+            if motion.singular:
+                self.singular.append((t, motion.singular))
+                self.singular_call = self.calls if self.singular_call is None else self.singular_call
+            found = np.concatenate([qd, motion.qdd])
         if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls \
                 and self.span_rtol < RELAXED_MAX:
             raise _Crawl
-        return np.concatenate([qd, motion.qdd])
+        return found
 
     def advance(self, t_next, q, qd, t_stop):
         """The state at t_next from (q, q̇) at the time reached (``t_now``), checked and

@@ -134,6 +134,17 @@ class Engine:
                 return None
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
 
+    def derivative(self, t, y):
+        """(q̇, q̈) stacked at the state y = (q, q̇) (a contiguous float array), as an
+        integrator's stage wants it, or None for the exact path: ``motion`` without a Motion."""
+        y = np.ascontiguousarray(y, dtype=float)
+        q, qd = y[:self.n], y[self.n:]
+        with self.lock:
+            if self.module is not None:
+                self.module.evaluate(float(t), q, qd, self.p, self.gen)
+            status, _ = kernel.motion(q, qd, self.gen, EMPTY, *self.buffers, kernel.CHECKED, self.general)
+            return np.concatenate((qd, self.W.qdd)) if status == kernel.OK else None
+
     def motion_batch(self, t, q, qd):
         """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread
         per core, each with its own Work, taking chunks of rows in turn (a thread slowed by
