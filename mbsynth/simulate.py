@@ -48,6 +48,7 @@ import time
 
 import numpy as np
 import scipy.integrate
+from scipy.integrate._ivp.rk import Dop853DenseOutput  # its coefficients F (``_interpolated``)
 
 from .control import SampledControl
 from .errors import SimulationError, SolveError
@@ -190,6 +191,7 @@ class _Run:
         self.n = system.n
         self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity",
                                      "outputs")}
+        self.columns = tuple(self.rows.values())  # in that order (``record``)
         self.steps = self.evaluations = 0
         self.solver = None  # the integrator, kept from span to span (``_resumed``, ``_reach``)
         self.times = []  # the times ``advance`` is called for, in order (outputs and control samples)
@@ -321,7 +323,7 @@ class _Run:
         elif drift < DRIFT_TARGET / 100 and np.isfinite(solver.max_step):
             solver.max_step = np.inf if 2 * solver.max_step >= solver.t_bound - solver.t else 2 * solver.max_step
         times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
-        states = np.vstack([solver.dense_output()(times).T, solver.y]) if times else solver.y[None, :]
+        states = np.vstack([_interpolated(solver, times), solver.y]) if times else solver.y[None, :]
         corrected = self.correction.block(states[:, :self.n], states[:, self.n:])
         self.passed = dict(zip([*times, solver.t], zip(states, corrected)))
         q_on, qd_on = self._on_constraints(solver.t, solver.y, corrected[-1])
@@ -482,13 +484,12 @@ class _Run:
             kinetic, potential, *residuals = corrected[2:]
         if not self.compiled_energy:
             kinetic, potential = self.system.energy(t, q, qd)
-        row = dict(t=t, q=np.array(q), qd=np.array(qd), energy=kinetic + potential, kinetic=kinetic,
-                   residual_position=residuals[0], residual_velocity=residuals[1],
-                   outputs=self.outputs.evaluate(t, q, qd) if self.outputs else np.zeros(0))
-        for k, v in row.items():
-            self.rows[k].append(v)
+        values = (t, np.array(q), np.array(qd), kinetic + potential, kinetic, *residuals,
+                  self.outputs.evaluate(t, q, qd) if self.outputs else _NO_OUTPUTS)
+        for column, value in zip(self.columns, values):
+            column.append(value)
         if writer is not None:
-            writer.append(_chunk(self.system.coordinates, row, self.outputs.names))
+            writer.append(_chunk(self.system.coordinates, dict(zip(self.rows, values)), self.outputs.names))
 
     def trajectory(self, status):
         r = self.rows
@@ -505,6 +506,20 @@ class _Run:
         return traj
 
 
+def _interpolated(solver, times):
+    """The states (a row per time) at ``times`` within the solver's last step, from its
+    interpolant. DOP853's (scipy's Dop853DenseOutput: y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + …))),
+    x the step's fraction) as one product y_old + P F, P[j, k] = x_jᵏ′⁺¹ (1 − x_j)⁽ᵏ⁺¹⁾′, k′ = ⌊k/2⌋,
+    (k+1)′ = ⌊(k+1)/2⌋: what scipy's seven passes over the rows cost the output rows of a
+    long step, several times over; other interpolants through scipy."""
+    dense = solver.dense_output()
+    if not isinstance(dense, Dop853DenseOutput):
+        return dense(times).T
+    x = (np.asarray(times, dtype=float)[:, None] - dense.t_old) / dense.h
+    k = np.arange(len(dense.F))
+    return dense.y_old + (x ** (k // 2 + 1) * (1 - x) ** ((k + 1) // 2)) @ dense.F
+
+
 def _looser(rtol, atol):
     """The next tolerances of a span that crawls: RELAXED_RTOL, then ten times looser, up to
     RELAXED_MAX (atol alike)."""
@@ -514,6 +529,10 @@ def _looser(rtol, atol):
 
 class _Crawl(Exception):
     """A span's stages near a singular position take too many evaluations (CRAWL_CALLS)."""
+
+
+_NO_OUTPUTS = np.zeros(0)  # a row's outputs where the model declares none (read-only)
+_NO_OUTPUTS.flags.writeable = False
 
 
 def _max_abs(values):

@@ -200,3 +200,23 @@ def test_cli_simulate_writes_files_and_a_json_summary(tmp_path, capsys):
         assert list(data["coordinates"]) == ["body1.x1", "body2.q1", "body2.q2"]
         assert data["q"].shape == (501, 3) and data["t"][-1] == 2.0
     assert plot.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("method", ["DOP853", "RK45"])
+def test_output_rows_read_the_integrators_own_interpolant(method):
+    """simulate's rows within a step (``_interpolated``: DOP853's interpolant as one matrix
+    product) equal scipy's dense output of that step, at its ends too."""
+    import importlib
+
+    import scipy.integrate
+    run = importlib.import_module("mbsynth.simulate")
+
+    def damped(t, y):
+        return np.array([y[1], -np.sin(y[0]) - 0.1 * y[1], np.cos(3 * t) * y[0]])
+    solver = getattr(scipy.integrate, method)(damped, 0.0, np.array([1.0, 0.3, 0.2]), 10.0, rtol=1e-10, atol=1e-10)
+    for _ in range(5):
+        solver.step()
+    times = np.linspace(solver.t_old, solver.t, 17)
+    rows = run._interpolated(solver, list(times))
+    assert np.abs(rows - solver.dense_output()(times).T).max() <= 4 * np.finfo(float).eps
+    assert np.array_equal(rows[-1], solver.y) or np.abs(rows[-1] - solver.y).max() <= 4 * np.finfo(float).eps
