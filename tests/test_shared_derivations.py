@@ -48,7 +48,7 @@ def test_a_bodys_unit_norm_row_is_the_derivative_of_its_own_constraint():
     φ = (uᵀu − 1)/2 in the body's own symbols, at a state off the unit sphere."""
     q, qd, (_, body) = two_bodies(2)
     (row,) = body.own_constraints(q, qd, [])
-    u, ud = sp.Matrix(body.q[3:]), sp.Matrix(body.qd[3:])
+    u = sp.Matrix(body.q[3:])
     phi = ((u.T * u)[0] - 1) / 2
     a, b, psi = differentiate(phi, q, qd)
     x, xd = RNG.normal(size=len(q)), RNG.normal(size=len(q))
