@@ -267,18 +267,20 @@ class _Run:
         if not self.continuous:
             return self._advance_cut(t_next, q, qd)
         try:
-            y, corrected = self._reach(t_next, q, qd, t_stop)
+            y, corrected, bounded = self._reach(t_next, q, qd, t_stop)
         except (_Crawl, SolveError) as stop:
             self.solver = None  # stopped within a step
             q, qd = self._advance_cut(t_next, q, qd, loosen=isinstance(stop, _Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
-        self._check(t_next, y)
+        if not bounded:
+            self._check(t_next, y)
         q, qd = self._on_constraints(t_next, y, corrected)
         return self._arrived(t_next, q, qd, None, corrected)
 
     def _reach(self, t_next, q, qd, t_stop):
-        """The continuous integrator's state at t_next and its correction (``_step``): its
+        """The continuous integrator's state at t_next, its correction and whether it is
+        finite and within MAX_STATE (``_step``): its
         steps taken until one reaches or passes t_next. A new integrator (at the start,
         after a control sample or a cut interval) starts from (q, q̇) at ``t_now``, its
         first step the one last proposed."""
@@ -297,7 +299,7 @@ class _Run:
         """One accepted step of the continuous integrator, its state then corrected, and with
         it, in one block (correction.Correction.block), the states at the times from t_next
         to where it reached, read from its interpolant: ``passed`` keeps (state, Corrected
-        or None) per time. The step is capped (``max_step``) to keep the drift between
+        or None, whether the state is within MAX_STATE: ``_check``) per time. The step is capped (``max_step``) to keep the drift between
         corrections below DRIFT_TARGET: halved after a larger drift, doubled after one below
         a hundredth of it; a step that drifted more than DRIFT_REDO × DRIFT_TARGET is taken
         again at a quarter of its length."""
@@ -325,7 +327,8 @@ class _Run:
         times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
         states = np.vstack([_interpolated(solver, times), solver.y]) if times else solver.y[None, :]
         corrected = self.correction.block(states[:, :self.n], states[:, self.n:])
-        self.passed = dict(zip([*times, solver.t], zip(states, corrected)))
+        bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
+        self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
         q_on, qd_on = self._on_constraints(solver.t, solver.y, corrected[-1])
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
             solver.y = np.concatenate([q_on, qd_on])

@@ -13,8 +13,8 @@ robot is a rigid tree) may start them earlier, beside the derivation
 costs time only: numba compiles whatever the cache lacks.
 
 Each function is named with the types of its arguments in a short notation: ``f2`` a
-C-contiguous 2-d float64 array, ``i1`` a 1-d int64 array, ``(...)`` a tuple, ``int64`` and
-``float64`` scalars, ``general`` the type of ``motion``'s last argument for the variant
+C-contiguous 2-d float64 array, ``i1`` a 1-d int64 array, ``(...)`` a tuple, ``int64``,
+``float64`` and ``boolean`` scalars, ``general`` the type of ``motion``'s last argument for the variant
 (kernel.RIGID_TREE: none; kernel.GENERAL: bool). ``test_fast`` checks that they are the
 types ``motion`` passes.
 """
@@ -35,7 +35,7 @@ GROUPS = (
     (("tree", "factor", f"{TOPOLOGY} f3 f2 f2 {FACTORED} f2 i1"),
      ("kernel", "_residual", f"{TOPOLOGY} i1 (i1 i1 i1 i1) f2 f3 f2 f2 f2 f1 f1 f1 f1 f1 f2 f2 f1 f2"),
      ("kernel", "_recover", "f1 i1 i1 f1 f3 i1 i1 f1 f1 f4 f1 f1 f2 f1 float64 f1 f1")),
-    (("tree", "solve", f"{TOPOLOGY} {FACTORED} f1 f1"),
+    (("tree", "solve", f"{TOPOLOGY} {FACTORED} f1 f1 boolean"),
      ("assembly", "tree_rows", "f1 f1 f1 i1 i1 i1 i1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 (f3 f3 f2 f2 f1) "
                                "f2 f2 f1 general"),
      ("assembly", "nodes", "f1 f1 f1 i1 i1 f1 f2 f3 i1 f1 f1 f3 f2 f1 f1 f1 f4"),
@@ -43,7 +43,7 @@ GROUPS = (
 )
 SEGMENTS = "(i1 i1 i1 i1)"
 GENERAL_ONLY = (  # what a rigid tree's motion leaves out, per group
-    (("kernel", "_close", f"{TOPOLOGY} {SEGMENTS} f2 {FACTORED} f2 f2 f1 f1 f1 f1 f1 f1 f1 f2 f2 f1 f1"),),
+    (("kernel", "_close", f"{TOPOLOGY} {SEGMENTS} f2 {FACTORED} f2 f2 f1 f1 f1 f1 f1 f1 f1 f2 f2 f1 f1 boolean"),),
     (("assembly", "extra_rows", "f1 f1 f1 f1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 i2 i1 i1 i1 "
                                 f"{SEGMENTS} (f3 f3 f2 f2 f1) f2 f2 f1 f2"),),
 )
@@ -70,7 +70,7 @@ def argument_types(spec, general):
             return types.Tuple(items) if len(set(items)) > 1 else types.UniTuple(items[0], len(items)), at + 1
         if token == "general":
             return typeof(general), at + 1
-        if token in ("int64", "float64"):
+        if token in ("int64", "float64", "boolean"):
             return getattr(types, token), at + 1
         dtype = {"i": types.int64, "f": types.float64}[token[0]]
         return types.Array(dtype, int(token[1:]), "C"), at + 1

@@ -82,7 +82,7 @@ def _moves(vec, nx, topology, segs, seg6, factored, y, w):
     y[:] = 0.0
     for x in range(vec.shape[0] - nx):
         _scatter(x, -vec[nx + x], segs, seg6, y)
-    solve(topology, factored, y, w)
+    solve(topology, factored, y, w, False)
     total = 0.0
     for x in range(nx):
         total += vec[x] * vec[x]
@@ -94,9 +94,10 @@ def _moves(vec, nx, topology, segs, seg6, factored, y, w):
 
 
 @njit(**OPTIONS)
-def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam):
+def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam, multipliers):
     """Solve the Schur system of the extra rows and coordinates into lam (extra
-    accelerations, then extra multipliers), then the tree into z. Returns a status."""
+    accelerations, then extra multipliers), then the tree into z (its multipliers too
+    where ``multipliers``: tree.solve). Returns a status."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     S[:, :] = 0.0
     for x in range(nx):
@@ -111,7 +112,7 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     for x in range(mx):
         y[:] = 0.0
         _scatter(x, 1.0, segs, seg6, y)
-        solve(topology, factored, y, w)
+        solve(topology, factored, y, w, False)
         for r in range(mx):
             S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
     values = np.zeros(mx + nx)
@@ -139,7 +140,7 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     _copy(ry, y)
     for x in range(mx):
         _scatter(x, -lam[nx + x], segs, seg6, y)
-    solve(topology, factored, y, z)
+    solve(topology, factored, y, z, multipliers)
     return OK
 
 
@@ -339,13 +340,13 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general):
         return SINGULAR, 0.0
     _copy(ry, y)
     if general is not None and x_coord.shape[0] + xb.shape[0] > 0:
-        solve(topology, factored, y, z0)  # _close solves again into z
+        solve(topology, factored, y, z0, False)  # _close solves again into z
         status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
-                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam)
+                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED)
         if status != OK:
             return status, 0.0
     else:
-        solve(topology, factored, y, z)
+        solve(topology, factored, y, z, mode == CHECKED)
     _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc)
     residual = 0.0
     if mode == CHECKED:

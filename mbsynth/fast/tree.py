@@ -430,9 +430,9 @@ def _backward(i, vi, ki, topology, factored, y, x):
 
 
 @njit(**INLINE)
-def _forward(i, vi, ki, topology, factored, y, x):
+def _forward(i, vi, ki, topology, factored, y, x, multipliers):
     """Node i of the roots-to-leaves pass of ``solve``: y_i = c + X y_p + S (x0 − N Uᵀ X y_p),
-    then λ_i = Jrᵀ (f^A − H^A y_i)."""
+    then (``multipliers``) λ_i = Jrᵀ (f^A − H^A y_i)."""
     parent, v, yoff, transport = topology[1], topology[2], topology[4], topology[6]
     HA, S, Jr, X, U, N, c, x0, zeta = factored
     m, o, p = vi - ki, yoff[i], parent[i]
@@ -465,6 +465,8 @@ def _forward(i, vi, ki, topology, factored, y, x):
         for e in range(m):
             t += S[i, a, e] * x0[i, e]
         x[o + a] += t
+    if not multipliers:
+        return
     for a in range(vi):  # c ← f^A − H^A y, then λ = Jrᵀ c
         t = y[o + a]
         for e in range(vi):
@@ -478,9 +480,10 @@ def _forward(i, vi, ki, topology, factored, y, x):
 
 
 @njit(**OPTIONS)
-def solve(topology, factored, y, x):
+def solve(topology, factored, y, x, multipliers):
     """x = K⁻¹ y for the factored tree (y is overwritten): per node, the accelerations,
-    then the multipliers of its parent joint."""
+    then (``multipliers``; else they are left as they were) the multipliers of its parent
+    joint — only the residual check reads them."""
     order, v, k = topology[0], topology[2], topology[3]
     n = order.shape[0]
     for idx in range(n - 1, -1, -1):
@@ -494,8 +497,8 @@ def solve(topology, factored, y, x):
     for idx in range(n):
         i = order[idx]
         if v[i] == 6 and k[i] == 6:
-            _forward(i, 6, 6, topology, factored, y, x)
+            _forward(i, 6, 6, topology, factored, y, x, multipliers)
         elif v[i] == 6 and k[i] == 5:
-            _forward(i, 6, 5, topology, factored, y, x)
+            _forward(i, 6, 5, topology, factored, y, x, multipliers)
         else:
-            _forward(i, v[i], k[i], topology, factored, y, x)
+            _forward(i, v[i], k[i], topology, factored, y, x, multipliers)
