@@ -511,10 +511,10 @@ class _Run:
 
 def _interpolated(solver, times):
     """The states (a row per time) at ``times`` within the solver's last step, from its
-    interpolant. DOP853's (scipy's Dop853DenseOutput: y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + …))),
-    x the step's fraction) as one product y_old + P F, P[j, k] = x_jᵏ′⁺¹ (1 − x_j)⁽ᵏ⁺¹⁾′, k′ = ⌊k/2⌋,
-    (k+1)′ = ⌊(k+1)/2⌋: what scipy's seven passes over the rows cost the output rows of a
-    long step, several times over; other interpolants through scipy."""
+    interpolant. DOP853's, y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…)))) with x the
+    step's fraction (scipy's Dop853DenseOutput, which makes seven passes over the rows), is
+    one product here: y_old + P F with P[j, k] = x_j^(⌊k/2⌋ + 1) (1 − x_j)^⌊(k + 1)/2⌋.
+    Other interpolants through scipy."""
     dense = solver.dense_output()
     if not isinstance(dense, Dop853DenseOutput):
         return dense(times).T

@@ -124,12 +124,8 @@ class Engine:
     def motion(self, t, q, qd, bshift=None):
         """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
         bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ)."""
-        t = float(t)
         with self.lock:
-            if self.module is not None:
-                self.module.evaluate(t, q, qd, self.p, self.gen)
-            status, residual = kernel.motion(q, qd, self.gen, EMPTY if bshift is None else bshift, *self.buffers,
-                                             kernel.CHECKED, self.general)
+            status, residual = self._solved(t, q, qd, EMPTY if bshift is None else bshift)
             if status != kernel.OK:
                 return None
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
@@ -140,10 +136,15 @@ class Engine:
         y = np.ascontiguousarray(y, dtype=float)
         q, qd = y[:self.n], y[self.n:]
         with self.lock:
-            if self.module is not None:
-                self.module.evaluate(float(t), q, qd, self.p, self.gen)
-            status, _ = kernel.motion(q, qd, self.gen, EMPTY, *self.buffers, kernel.CHECKED, self.general)
+            status, _ = self._solved(t, q, qd, EMPTY)
             return np.concatenate((qd, self.W.qdd)) if status == kernel.OK else None
+
+    def _solved(self, t, q, qd, bshift):
+        """kernel.motion's (status, residual) at (t, q, q̇), its q̈ and Qc left in this
+        Engine's Work (the caller holds the lock): the generated function, then the kernel."""
+        if self.module is not None:
+            self.module.evaluate(float(t), q, qd, self.p, self.gen)
+        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, kernel.CHECKED, self.general)
 
     def motion_batch(self, t, q, qd):
         """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread
