@@ -399,7 +399,8 @@ def equilibrate_rows(X):
 def _names(names, count, label, pattern):
     if names is None:
         return tuple(pattern.format(i) for i in range(count))
-    names = tuple(str(x) for x in names)
+    if not (isinstance(names, tuple) and all(type(x) is str for x in names)):  # a System's are
+        names = tuple(str(x) for x in names)
     if len(names) != count:
         raise ValueError(f"{label} must name {count} entries, got {len(names)}")
     return names

@@ -118,8 +118,13 @@ class System:
 
     @property
     def constraint_names(self):
-        """One name per row of A (a joint with k rows names them ``joint[label]``)."""
-        return [row for c in self.constraints for row in c.row_names]
+        """One name per row of A (a joint with k rows names them ``joint[label]``): a tuple,
+        made once (every KKT evaluation hands it on)."""
+        found = self.__dict__.get("_constraint_names")
+        if found is None:
+            found = tuple(row for c in self.constraints for row in c.row_names)
+            object.__setattr__(self, "_constraint_names", found)
+        return found
 
     @property
     def parameter_values(self):
@@ -296,9 +301,18 @@ class System:
         def solve(C):
             return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=self.coordinates,
                                    constraints=self.constraint_names, drift=off_manifold)
-        if any(getattr(con, "coulomb", None) for con in self.constraints):  # C depends on q̈ (friction.py)
+        if self._coulomb:  # C depends on q̈ (friction.py)
             return friction.coulomb_motion(self.constraints, arrays, solve, t, q, qd, self.parameter_values)
         return solve(arrays.C)
+
+    @property
+    def _coulomb(self):
+        """Whether a constraint has Coulomb friction (its C depends on q̈), found once."""
+        found = self.__dict__.get("_has_coulomb")
+        if found is None:
+            found = any(getattr(con, "coulomb", None) for con in self.constraints)
+            object.__setattr__(self, "_has_coulomb", found)
+        return found
 
     def _off_manifold(self, t, q, qd):
         """The drift measure of ``equations.constrained_acceleration``: a callable giving φ

@@ -157,7 +157,7 @@ def base():
 
 def test_the_model_to_break_loads():
     system = loads(BASE)
-    assert system.n == 7 and system.constraint_names == ["c1", "rod[length]"]
+    assert system.n == 7 and system.constraint_names == ("c1", "rod[length]")
 
 
 def test_an_empty_constraint_entry_is_refused_by_line():
