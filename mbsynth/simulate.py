@@ -48,13 +48,17 @@ import time
 
 import numpy as np
 import scipy.integrate
-from scipy.integrate._ivp.rk import Dop853DenseOutput  # its coefficients F (``_interpolated``)
 
 from .control import SampledControl
 from .errors import SimulationError, SolveError
 from .outputs import OutputEvaluator
 from .projection import consistent_initial_state, project, relative_drift
 from .trajectory import COMPLETED, Trajectory, TrajectoryWriter
+
+try:  # DOP853's interpolant and its coefficients F (``_interpolated``): scipy's, not public
+    from scipy.integrate._ivp.rk import Dop853DenseOutput
+except ImportError:  # a scipy that moved it: every interpolant through scipy's own call
+    Dop853DenseOutput = None
 
 log = logging.getLogger(__name__)
 
@@ -516,7 +520,7 @@ def _interpolated(solver, times):
     one product here: y_old + P F with P[j, k] = x_j^(⌊k/2⌋ + 1) (1 − x_j)^⌊(k + 1)/2⌋.
     Other interpolants through scipy."""
     dense = solver.dense_output()
-    if not isinstance(dense, Dop853DenseOutput):
+    if Dop853DenseOutput is None or not isinstance(dense, Dop853DenseOutput):
         return dense(times).T
     x = (np.asarray(times, dtype=float)[:, None] - dense.t_old) / dense.h
     k = np.arange(len(dense.F))
