@@ -51,27 +51,27 @@ def fix_when_made(system, wait, origin=None):
         _keep(system, _FixWhenMade(wait, None if origin is None else weakref.ref(origin)))
 
 
-_for_runs = {}  # id(System) -> (weak reference, wait, the Evaluator its runs share)
+_for_runs = {}  # as _evaluators: per System, the Evaluator its runs share (a _RunsShare)
+
+
+class _RunsShare(NamedTuple):
+    """The Evaluator a System's runs share, and the ``wait`` its paths were fixed with."""
+
+    wait: bool
+    evaluator: object
 
 
 def _fixed(system, pending):
     """The Evaluator, paths fixed, of ``system`` (a run, ``pending`` its _FixWhenMade): the one
     its origin's earlier runs made with the same ``wait``, else a new one, kept for the later."""
     origin = None if pending.origin is None else pending.origin()
-    found = None if origin is None else _for_runs.get(id(origin))
-    if found is not None and found[0]() is origin and found[1] == pending.wait:
-        return found[2]
+    found = None if origin is None else _existing(origin, _for_runs)
+    if found is not None and found.wait == pending.wait:
+        return found.evaluator
     made = Evaluator(system).fix_kernels(pending.wait)
     if origin is not None:
-        key = id(origin)
-        _for_runs[key] = (pending.origin, pending.wait, made)
-        weakref.finalize(origin, _forget_runs, key, made)
+        _keep(origin, _RunsShare(pending.wait, made), _for_runs)
     return made
-
-
-def _forget_runs(key, made):
-    if _for_runs.get(key, (None, None, None))[2] is made:
-        del _for_runs[key]
 
 
 def share(parent, child):
@@ -85,29 +85,30 @@ def share(parent, child):
     if isinstance(found, _FixWhenMade):
         found = evaluator(parent)
     if found is None or not found.fixed:
-        runs = _for_runs.get(id(parent))
-        if runs is not None and runs[0]() is parent and id(child) not in _for_runs:
-            _for_runs[id(child)] = (weakref.ref(child), *runs[1:])
-            weakref.finalize(child, _forget_runs, id(child), runs[2])
+        runs = _existing(parent, _for_runs)
+        if runs is not None and _existing(child, _for_runs) is None:
+            _keep(child, runs, _for_runs)
         return False
     _keep(child, found)
     return True
 
 
-def _existing(system):
-    found = _evaluators.get(id(system))
+def _existing(system, table=_evaluators):
+    """What ``table`` keeps for ``system`` (by id, checked against a weak reference), or None."""
+    found = table.get(id(system))
     return found[1] if found is not None and found[0]() is system else None
 
 
-def _keep(system, made):
-    _evaluators[id(system)] = (weakref.ref(system), made)
-    weakref.finalize(system, _forget, id(system), made)
+def _keep(system, made, table=_evaluators):
+    """Keep ``made`` for ``system`` in ``table`` until the System is dropped; returns it."""
+    table[id(system)] = (weakref.ref(system), made)
+    weakref.finalize(system, _forget, table, id(system), made)
     return made
 
 
-def _forget(key, made):
-    if _evaluators.get(key, (None, None))[1] is made:
-        del _evaluators[key]
+def _forget(table, key, made):
+    if table.get(key, (None, None))[1] is made:
+        del table[key]
 
 
 class ConstraintArrays(NamedTuple):

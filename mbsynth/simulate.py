@@ -303,10 +303,10 @@ class _Run:
         """One accepted step of the continuous integrator, its state then corrected, and with
         it, in one block (correction.Correction.block), the states at the times from t_next
         to where it reached, read from its interpolant: ``passed`` keeps (state, Corrected
-        or None, whether the state is within MAX_STATE: ``_check``) per time. The step is capped (``max_step``) to keep the drift between
-        corrections below DRIFT_TARGET: halved after a larger drift, doubled after one below
-        a hundredth of it; a step that drifted more than DRIFT_REDO × DRIFT_TARGET is taken
-        again at a quarter of its length."""
+        or None, whether the state is within MAX_STATE: ``_check``) per time. The step is
+        capped (``max_step``) to keep the drift between corrections below DRIFT_TARGET:
+        halved after a larger drift, doubled after one below a hundredth of it; a step that
+        drifted more than DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length."""
         start = (solver.t, solver.y, solver.f, solver.h_abs)
         message = solver.step()
         if solver.status == "failed":

@@ -5,6 +5,7 @@ assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 ``motion(t, q, qd)`` solves them with the singular-mass equation (2.14).
 """
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -116,15 +117,11 @@ class System:
             object.__setattr__(self, "_coordinate_groups", found)
         return found
 
-    @property
+    @functools.cached_property
     def constraint_names(self):
         """One name per row of A (a joint with k rows names them ``joint[label]``): a tuple,
         made once (every KKT evaluation hands it on)."""
-        found = self.__dict__.get("_constraint_names")
-        if found is None:
-            found = tuple(row for c in self.constraints for row in c.row_names)
-            object.__setattr__(self, "_constraint_names", found)
-        return found
+        return tuple(row for c in self.constraints for row in c.row_names)
 
     @property
     def parameter_values(self):
@@ -305,14 +302,10 @@ class System:
             return friction.coulomb_motion(self.constraints, arrays, solve, t, q, qd, self.parameter_values)
         return solve(arrays.C)
 
-    @property
+    @functools.cached_property
     def _coulomb(self):
         """Whether a constraint has Coulomb friction (its C depends on q̈), found once."""
-        found = self.__dict__.get("_has_coulomb")
-        if found is None:
-            found = any(getattr(con, "coulomb", None) for con in self.constraints)
-            object.__setattr__(self, "_has_coulomb", found)
-        return found
+        return any(getattr(con, "coulomb", None) for con in self.constraints)
 
     def _off_manifold(self, t, q, qd):
         """The drift measure of ``equations.constrained_acceleration``: a callable giving φ

@@ -199,7 +199,8 @@ def _rotation_at(part, frame, values):
     per check on talos; other parts by substitution."""
     if part is not None and not isinstance(part, SHARED_PARTS):
         return _numeric(_pose(part, frame)[1], values)
-    own = _frame_rotation(frame, values)
+    own = frame.constant_rotation
+    own = _numeric(frame.rotation, values) if own is None else own
     if own is None or part is None or isinstance(part, Particle):
         return own
     if any(x not in values for x in part.q):
@@ -209,17 +210,6 @@ def _rotation_at(part, frame, values):
         c, s = np.cos(theta), np.sin(theta)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ own
     return quaternion_rotation([float(values[x]) for x in part.q[3:]]) @ own
-
-
-def _frame_rotation(frame, values):
-    """``frame.rotation`` at ``values`` as floats (or None), kept on the frame where it is
-    made of numbers alone (a robot's frames): the branch check of every run reads it."""
-    found = frame.__dict__.get("_numeric_rotation")
-    if found is None:
-        found = _numeric(frame.rotation, values)
-        if found is not None and not sp.Matrix(frame.rotation).free_symbols:
-            object.__setattr__(frame, "_numeric_rotation", found)
-    return found
 
 
 def _turned(joint, relative):

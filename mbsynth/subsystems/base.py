@@ -1,6 +1,7 @@
 """What every part shares: its unconstrained M q̈ = Q (2.1) as sympy expressions of its
 own coordinates, compiled once; its energies; its named frames."""
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,6 +24,16 @@ class Frame:
     @property
     def label(self):
         return f"{self.part}.{self.name}"
+
+    @functools.cached_property
+    def constant_rotation(self):
+        """``rotation`` as floats where it is made of real numbers alone (a robot's frames),
+        else None (it holds parameters or coordinates): read by every run's branch check."""
+        rotation = sp.Matrix(self.rotation)
+        try:
+            return None if rotation.free_symbols else np.array(rotation, dtype=float)
+        except TypeError:  # no real number
+            return None
 
 
 class Part:
