@@ -5,7 +5,8 @@ import functools
 import numpy as np
 import sympy as sp
 
-from .symbolic import T_SYMBOL, compile_function, differentiated, expand_joint_values, placed_values, positions
+from .symbolic import (T_SYMBOL, compile_function, differentiated, expand_joint_values, placed_values, positions,
+                       symbols_in)
 
 
 class Connector:
@@ -133,7 +134,7 @@ def _slots_in(rows, slots):
     """The positions j whose coordinate slot or velocity slot the rows (a, b, φ, ψ) hold:
     once per template (connectors alike share their rows)."""
     a, b, phi, psi = rows
-    free = set().union(*(x.free_symbols for x in (*b, *phi, *psi, *(e for row in a for e in row))))
+    free = symbols_in((*b, *phi, *psi, *(e for row in a for e in row)))
     return [j for j, (s, sd) in enumerate(zip(*slots)) if s in free or sd in free]
 
 

@@ -16,7 +16,6 @@ import weakref
 from typing import NamedTuple
 
 import numpy as np
-import scipy.sparse
 
 from .grouped import Batch
 from .subsystems.base import Part
@@ -173,6 +172,8 @@ class Evaluator:
         if sparse is None:
             sparse = self.m * self.n > DENSE_ENTRIES
         if sparse:
+            import scipy.sparse  # loaded with the first sparse A, not with mbsynth
+
             A = scipy.sparse.csr_matrix((a[self.a_order], self.a_indices, self.a_indptr), shape=(self.m, self.n))
         else:
             A = np.zeros((self.m, self.n))

@@ -7,9 +7,6 @@ against it; where its own method does not apply it falls back to the reference.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.linalg
-from scipy.linalg import lapack
 
 from . import equations
 from .equations import Motion
@@ -62,6 +59,8 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
 def _dense_solve(d):
     """(K, x, rcond) by LAPACK: LU (getrf), the 1-norm condition estimate (gecon), one step
     of iterative refinement; x None when K is singular."""
+    from scipy.linalg import lapack  # scipy loads with the first KKT solve, not with mbsynth
+
     n, m = d.n, d.m
     K = np.zeros((n + m, n + m))
     K[:n, :n], K[:n, n:], K[n:, :n] = d.M / d.mu, d.Ae.T, d.Ae
@@ -79,6 +78,8 @@ def _sparse_solve(d):
     """(K, x, rcond) by SuperLU on the sparse K, the 1-norm of K⁻¹ estimated by Higham's
     block algorithm (scipy's onenormest, a few solves with K and Kᵀ), one step of
     iterative refinement; x None when K is singular."""
+    import scipy.sparse.linalg
+
     Ae = scipy.sparse.csc_matrix(d.Ae)
     K = scipy.sparse.bmat([[scipy.sparse.csc_matrix(d.M / d.mu), Ae.T], [Ae, None]], format="csc")
     try:
@@ -96,4 +97,8 @@ def _sparse_solve(d):
 
 def _norm(K):
     """The Frobenius norm of a dense or sparse K."""
-    return scipy.sparse.linalg.norm(K) if scipy.sparse.issparse(K) else np.linalg.norm(K)
+    if isinstance(K, np.ndarray):
+        return np.linalg.norm(K)
+    import scipy.sparse.linalg
+
+    return scipy.sparse.linalg.norm(K)
