@@ -81,6 +81,39 @@ def test_a_correction_is_the_least_mass_norm_step_onto_the_constraints(model, dr
         assert np.abs(N.T @ M @ step).max() < np.abs(M).max() * (1e-9 * np.abs(step).max() + rounding)
 
 
+@pytest.mark.parametrize("model", MODELS + ["mechanisms/double_pendulum_rods.yaml"])
+def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
+    """kernel.motion's REUSED at rest (q̇ = 0, no gravity) with shifts on the joint rows
+    alone — a correction's velocity step — rebuilds only the right side (the shifts,
+    equilibrated) and solves with the factorization of the call before it: its q̈ equals
+    that of a full call at the same state and shifts (the reference); with a unit-norm
+    row shifted too it makes the full call itself. (A massless link at rest, with no gravity,
+    is a singular tree block: the kernel declines it.)"""
+    from mbsynth.fast import kernel
+    system = mb.load(ROOT / "models" / model)
+    rng = np.random.default_rng(8)
+    q = drifted_state(system, rng, 1e-6)[0]
+    rest = system._tree_engine(True).at_rest()
+    quat = [r for r in rest.L.quat_row if r >= 0]
+    gen, qd = np.zeros(rest.outputs), np.zeros(q.size)
+
+    def call(shift, mode):
+        status = kernel.motion(q, qd, gen, shift, *rest.buffers, mode, rest.general)[0]
+        assert status == kernel.OK
+        return rest.W.qdd.copy()
+
+    first, joint_rows = rng.standard_normal(len(system.constraint_names)), rng.standard_normal(len(system.constraint_names))
+    joint_rows[quat] = 0.0
+    unit_too = joint_rows.copy()
+    unit_too[quat] = rng.standard_normal(len(quat))
+    for shift in (joint_rows, unit_too):
+        call(first, kernel.UNCHECKED)  # factors the tree at q, for another right side
+        reused = call(shift, kernel.REUSED)
+        full = call(shift, kernel.UNCHECKED)
+        assert np.abs(full).max() > 0 or not shift.any()  # (a lone body has no joint rows)
+        np.testing.assert_allclose(reused, full, rtol=0, atol=1e-12 * np.abs(full).max())
+
+
 def test_a_block_of_states_is_corrected_as_each_state_alone():
     """Correction.block splits many states among threads, each with its own Work and rows:
     every state comes out bit for bit as a correction of that state alone, and one the

@@ -37,7 +37,7 @@ GROUPS = (
      ("kernel", "_recover", "f1 i1 i1 f1 f3 i1 i1 f1 f1 f4 f1 f1 f2 f1 float64 f1 f1")),
     (("tree", "solve", f"{TOPOLOGY} {FACTORED} f1 f1 boolean"),
      ("assembly", "tree_rows", "f1 f1 f1 i1 i1 i1 i1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 (f3 f3 f2 f2 f1) "
-                               "f2 f2 f1 general"),
+                               "f2 f2 f1 f1 general"),
      ("assembly", "nodes", "f1 f1 f1 i1 i1 f1 f2 f3 i1 f1 f1 f3 f2 f1 f1 f1 f4"),
      ("assembly", "transports", "f1 i1 i1 i1 i1 i1 f3 f4 f2")),
 )

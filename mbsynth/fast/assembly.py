@@ -48,6 +48,7 @@ class Work(NamedTuple):
     J: np.ndarray      # (tree rows, 6) parent-joint rows on the node
     P: np.ndarray      # (tree rows, 6) the same rows on the parent
     rb: np.ndarray     # (tree rows,) their right sides
+    rscale: np.ndarray  # (tree rows,) the factors that equilibrated them (1 / the row's 2-norm)
     ry: np.ndarray     # (tree unknowns,) right side of the tree system
     y: np.ndarray      # (tree unknowns,) work
     z: np.ndarray      # (tree unknowns,) solution
@@ -81,7 +82,7 @@ def make_work(L):
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
     shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N + 1, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
-                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
+                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, rscale=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
                   rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
     arrays["Rs"][N, 0] = np.eye(3)  # the world, as a body at rest in its own frame (rate_rows.py)
@@ -177,8 +178,9 @@ def _normalize(row, count):
 
 @njit(**OPTIONS)
 def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu, s, Rs, joints, joint_row, scratch,
-              J, P, rb, general):
-    """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated.
+              J, P, rb, rscale, general):
+    """Each node's parent-joint rows: J (on the node), P (on the parent), rb; equilibrated
+    (the factors in rscale).
     Joints between rigid bodies or the world: rate_rows.py; others: joints.py, reduced
     (``general`` None: there are none, and numba compiles without them)."""
     program, count, kinds, starts, offset, frame, length, ends = joints
@@ -190,7 +192,7 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
         me, p, r0 = node_end[i], parent[i], rows[i]
         if general is None or (kinds[j, 0] != PARTICLE and kinds[j, 1] != PARTICLE):
             equilibrated_rows(program[j], count[j], kinds[j], ends[j], starts[j], offset[j], frame[j], length[j], q,
-                              qd, Rs, me, bshift, joint_row[j], J, P, rb, r0)
+                              qd, Rs, me, bshift, joint_row[j], J, P, rb, rscale, r0)
             continue
         k = _joint(j, q, qd, joints, scratch)
         for r in range(k):
@@ -205,7 +207,7 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
             for a in range(6):
                 J[r0 + r, a] *= scale
                 P[r0 + r, a] *= scale
-            rb[r0 + r] = rhs * scale
+            rb[r0 + r], rscale[r0 + r] = rhs * scale, scale
 
 
 @njit(**OPTIONS)

@@ -31,7 +31,8 @@ from numba import njit
 
 from .bodies import OPTIONS
 from . import threads
-from .kernel import OK, REUSED, UNCHECKED, WORK, motion
+from .joints import RIGID
+from .kernel import LAYOUT, OK, REUSED, UNCHECKED, WORK, motion
 from .packing import view1
 from .rows import Rows, largest, residuals_energy
 
@@ -70,6 +71,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
     factored q; q̇ = 0)."""
     phi, psi, Rs, shift, factored, rest = work
     qdd = view1(WF, WX, WORK.qdd)
+    kind, start, quat_row = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q), view1(LI, LX, LAYOUT.quat_row)
     for b in range(Q.shape[0]):
         found[b, DONE] = 0.0
         q, qd = Q_on[b], QD_on[b]
@@ -89,12 +91,16 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             for c in range(q.shape[0]):
                 factored[c] = q[c] if reuse else factored[c]
                 q[c] += qdd[c]
+            _unit_rates(q, qd, kind, start)
             _, _, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
         if declined:
             continue
         rates = max(qd_max, TINY)
         _negated(psi, shift)
         if reuse and psi_max <= REUSE * rates:
+            for i in range(kind.shape[0]):
+                if kind[i] == RIGID:
+                    shift[quat_row[i]] = 0.0  # met by _unit_rates, to rounding: the kernel redoes only the solve
             status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED, general)[0]
         else:
             status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0]
@@ -108,6 +114,21 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             found[b, KINETIC], found[b, POTENTIAL], found[b, PHI_MAX], found[b, PSI_MAX] = \
                 kinetic, potential, phi_max, psi_max
             found[b, DONE] = 1.0
+
+
+@njit(**OPTIONS)
+def _unit_rates(q, qd, kind, start):
+    """Each body's quaternion rate u̇ less its part along u, (u·u̇/uᵀu) u: the velocity step's
+    own change along u (its unit-norm row uᵀΔu̇ = −uᵀu̇ moves u̇ only there, a direction
+    of no mass), made before it, so that the step's right side is the joint rows' alone
+    (kernel.motion's REUSED then redoes only the solve)."""
+    for i in range(kind.shape[0]):
+        if kind[i] == RIGID:
+            o = start[i] + 3
+            uu = q[o] * q[o] + q[o + 1] * q[o + 1] + q[o + 2] * q[o + 2] + q[o + 3] * q[o + 3]
+            f = (q[o] * qd[o] + q[o + 1] * qd[o + 1] + q[o + 2] * qd[o + 2] + q[o + 3] * qd[o + 3]) / uu
+            for a in range(4):
+                qd[o + a] -= f * q[o + a]
 
 
 @njit(**OPTIONS)

@@ -110,9 +110,11 @@ def rate_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs, A, b):
 
 
 @njit(**INLINE)
-def equilibrated_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs, me, bshift, brow, J, P, rb, r0):
+def equilibrated_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs, me, bshift, brow, J, P, rb, rscale,
+                      r0):
     """The rows of rate_rows divided by their 2-norms into J (on end ``me``) and P (on the
-    other end) from row r0, their b + bshift[brow:] into rb (bshift empty: none)."""
+    other end) from row r0, their b + bshift[brow:] into rb (bshift empty: none), the
+    factors into rscale."""
     A0 = _origin(kinds[0], nodes[0], starts[0], s[0], q, qd, Rs)
     B0 = _origin(kinds[1], nodes[1], starts[1], s[1], q, qd, Rs)
     for r in range(k):
@@ -123,4 +125,4 @@ def equilibrated_rows(program, k, kinds, nodes, starts, s, Rf, length, q, qd, Rs
         for a in range(3):
             J[r0 + r, a], J[r0 + r, 3 + a] = mr[a] * scale, ma[a] * scale
             P[r0 + r, a], P[r0 + r, 3 + a] = orr[a] * scale, oa[a] * scale
-        rb[r0 + r] = (beta + (bshift[brow + r] if bshift.shape[0] else 0.0)) * scale
+        rb[r0 + r], rscale[r0 + r] = (beta + (bshift[brow + r] if bshift.shape[0] else 0.0)) * scale, scale
