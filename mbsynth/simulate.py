@@ -329,7 +329,10 @@ class _Run:
         elif drift < DRIFT_TARGET / 100 and np.isfinite(solver.max_step):
             solver.max_step = np.inf if 2 * solver.max_step >= solver.t_bound - solver.t else 2 * solver.max_step
         times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
-        states = np.vstack([_interpolated(solver, times), solver.y]) if times else solver.y[None, :]
+        states = np.empty((len(times) + 1, solver.y.size))
+        if times:
+            _interpolated(solver, times, states[:-1])
+        states[-1] = solver.y
         corrected = self.correction.block(states[:, :self.n], states[:, self.n:])
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
@@ -513,18 +516,21 @@ class _Run:
         return traj
 
 
-def _interpolated(solver, times):
+def _interpolated(solver, times, out):
     """The states (a row per time) at ``times`` within the solver's last step, from its
-    interpolant. DOP853's, y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…)))) with x the
-    step's fraction (scipy's Dop853DenseOutput, which makes seven passes over the rows), is
-    one product here: y_old + P F with P[j, k] = x_j^(⌊k/2⌋ + 1) (1 − x_j)^⌊(k + 1)/2⌋.
-    Other interpolants through scipy."""
+    interpolant, into ``out``. DOP853's, y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…))))
+    with x the step's fraction (scipy's Dop853DenseOutput, which makes seven passes over the
+    rows), is one product here: y_old + P F with P[j, k] = x_j (1 − x_j) x_j … (k + 1
+    factors, alternating: a running product). Other interpolants through scipy."""
     dense = solver.dense_output()
     if Dop853DenseOutput is None or not isinstance(dense, Dop853DenseOutput):
-        return dense(times).T
-    x = (np.asarray(times, dtype=float)[:, None] - dense.t_old) / dense.h
-    k = np.arange(len(dense.F))
-    return dense.y_old + (x ** (k // 2 + 1) * (1 - x) ** ((k + 1) // 2)) @ dense.F
+        out[:] = dense(times).T
+        return
+    x = (np.asarray(times, dtype=float) - dense.t_old) / dense.h
+    factors = np.empty((x.size, len(dense.F)))
+    factors[:, 0::2], factors[:, 1::2] = x[:, None], 1 - x[:, None]
+    np.matmul(np.cumprod(factors, axis=1), dense.F, out=out)
+    out += dense.y_old
 
 
 def _looser(rtol, atol):

@@ -217,6 +217,7 @@ def test_output_rows_read_the_integrators_own_interpolant(method):
     for _ in range(5):
         solver.step()
     times = np.linspace(solver.t_old, solver.t, 17)
-    rows = run._interpolated(solver, list(times))
+    rows = np.full((times.size, 3), np.nan)
+    run._interpolated(solver, list(times), rows)
     assert np.abs(rows - solver.dense_output()(times).T).max() <= 4 * np.finfo(float).eps
     assert np.array_equal(rows[-1], solver.y) or np.abs(rows[-1] - solver.y).max() <= 4 * np.finfo(float).eps

@@ -77,7 +77,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
         q, qd = Q_on[b], QD_on[b]
         for c in range(q.shape[0]):
             q[c], qd[c] = Q[b, c], QD[b, c]
-        _, _, phi_max, psi_max, q_max, qd_max = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        _, _, phi_max, _, q_max, qd_max = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs, False)
         size, reuse, declined = max(q_max, 1.0), False, False
         for step in range(MAX_STEPS + 1):
             if phi_max <= TOLERANCE * size:
@@ -95,6 +95,8 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             _, _, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
         if declined:
             continue
+        if step == 0:  # on the constraints as it came: its φ̇ not read yet
+            _, _, _, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
         rates = max(qd_max, TINY)
         _negated(psi, shift)
         if reuse and psi_max <= REUSE * rates:

@@ -21,11 +21,12 @@ LAYOUT = fields(Layout)
 
 
 @njit(**OPTIONS)
-def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs):
+def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs, rates=True):
     """φ, φ̇ into phi, psi (rows of the kernel; others untouched); returns (T, V, max|φ|,
     max|φ̇|, max|q|, max|q̇|), the maxima over the whole arrays. LI, LF, LX: the Layout
     packed (packing.py); Rs: (N + 1, 2, 3, 3) work, R and Ṙ per node, a particle's and
-    the world's slot (N) (I, 0) (``Rows.new_work``)."""
+    the world's slot (N) (I, 0) (``Rows.new_work``). ``rates`` False: φ alone (psi
+    untouched, T and max|φ̇| 0), a third less work."""
     q, qd, phi, psi, Rs = borrowed(q), borrowed(qd), borrowed(phi), borrowed(psi), borrowed(Rs)
     node_kind, node_q, quat_row = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q), \
         view1(LI, LX, LAYOUT.quat_row)
@@ -41,17 +42,20 @@ def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs):
     for i in range(node_kind.shape[0]):
         o = node_q[i]
         m = node_mass[i]
-        kinetic += 0.5 * m * (qd[o] * qd[o] + qd[o + 1] * qd[o + 1] + qd[o + 2] * qd[o + 2])
         potential -= node_mg[i, 0] * q[o] + node_mg[i, 1] * q[o + 1] + node_mg[i, 2] * q[o + 2]
+        if node_kind[i] == RIGID:
+            rotation(q[o + 3:o + 7], Rs[i, 0])
+            w, x, y, z = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
+            phi[quat_row[i]] = 0.5 * (w * w + x * x + y * y + z * z - 1.0)
+        if not rates:
+            continue
+        kinetic += 0.5 * m * (qd[o] * qd[o] + qd[o + 1] * qd[o + 1] + qd[o + 2] * qd[o + 2])
         if node_kind[i] != RIGID:
             continue
-        rotation(q[o + 3:o + 7], Rs[i, 0])
         rotation_rate(q[o + 3:o + 7], qd[o + 3:o + 7], Rs[i, 1])
         w, x, y, z = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
         wd, xd, yd, zd = qd[o + 3], qd[o + 4], qd[o + 5], qd[o + 6]
-        r = quat_row[i]
-        phi[r] = 0.5 * (w * w + x * x + y * y + z * z - 1.0)
-        psi[r] = w * wd + x * xd + y * yd + z * zd
+        psi[quat_row[i]] = w * wd + x * xd + y * yd + z * zd
         # ω_body = 2 E(u) u̇, E = [−v, w I − [v]×]
         o0 = 2 * (-x * wd + w * xd + z * yd - y * zd)
         o1 = 2 * (-y * wd - z * xd + w * yd + x * zd)
@@ -60,7 +64,7 @@ def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs):
         kinetic += 0.5 * (o0 * (J[0, 0] * o0 + J[0, 1] * o1 + J[0, 2] * o2)
                           + o1 * (J[1, 0] * o0 + J[1, 1] * o1 + J[1, 2] * o2)
                           + o2 * (J[2, 0] * o0 + J[2, 1] * o1 + J[2, 2] * o2))
-    for k in range(joint_k.shape[0]):
+    for k in range(joint_k.shape[0]):  # without rates, Ṙ is stale and φ̇ left alone
         kinds, nodes, starts, s, Rf = joint_kinds[k], joint_node[k], joint_start[k], joint_s[k], joint_R[k]
         pA, vA = _origin(kinds[0], nodes[0], starts[0], s[0], q, qd, Rs)
         pB, vB = _origin(kinds[1], nodes[1], starts[1], s[1], q, qd, Rs)
@@ -70,18 +74,21 @@ def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs):
         for r in range(joint_k[k]):
             op, x, w = program[r, 0], program[r, 1], program[r, 2]
             if op == COMPONENT:
-                phi[row + r], psi[row + r] = (d[0], dd[0]) if w == 0 else (d[1], dd[1]) if w == 1 else (d[2], dd[2])
+                value, rate = (d[0], dd[0]) if w == 0 else (d[1], dd[1]) if w == 1 else (d[2], dd[2])
             elif op == DOT:
                 wv, wd = _axis(w, nodes, Rf, Rs)
                 if x == D:
-                    phi[row + r], psi[row + r] = dot3(d, wv), dot3(dd, wv) + dot3(d, wd)
+                    value, rate = dot3(d, wv), dot3(dd, wv) + dot3(d, wd)
                 else:
                     xv, xd = _axis(x, nodes, Rf, Rs)
-                    phi[row + r], psi[row + r] = dot3(xv, wv), dot3(xd, wv) + dot3(xv, wd)
+                    value, rate = dot3(xv, wv), dot3(xd, wv) + dot3(xv, wd)
             else:
                 L = joint_length[k]
-                phi[row + r], psi[row + r] = (dot3(d, d) - L * L) / (2 * L), dot3(d, dd) / L
-    return kinetic, potential, largest(phi), largest(psi), largest(q), largest(qd)
+                value, rate = (dot3(d, d) - L * L) / (2 * L), dot3(d, dd) / L
+            phi[row + r] = value
+            if rates:
+                psi[row + r] = rate
+    return kinetic, potential, largest(phi), largest(psi) if rates else 0.0, largest(q), largest(qd)
 
 
 @njit(**OPTIONS)
