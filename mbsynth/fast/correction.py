@@ -9,10 +9,12 @@ r = φ̇(q, q̇) = A q̇, a linear problem one step solves. From an integrator's
 5e-9 one step leaves rounding (2e-15 on a UR5). After a single position step of at most
 REUSE of the coordinates' size, with φ̇ at most REUSE of the rates, the velocity step
 reuses that step's factorization: A at the uncorrected q leaves φ̇ off by about
-|Δq| |Δq̇|, REUSE² relative. The kernel's own residual check is skipped (kernel.UNCHECKED):
+|Δq| |Δq̇|, REUSE² relative; each body's quaternion rate first loses its part along u
+(``_unit_rates``), so that the reusing call solves for the joint rows' right sides alone
+(kernel.motion's REUSED at rest). The kernel's own residual check is skipped (kernel.UNCHECKED):
 the rows after each step check it, and a velocity step that does not cut φ̇ sends the
 state to projection.py. A correction costs a kernel call with its factorization, one
-that reuses it and three passes of the rows (on talos about 45, 31 and 3 × 8 µs), where
+that reuses it and three passes of the rows (on talos about 28, 8 and 3 × 7 µs), where
 projection.py's sparse factorization costs a millisecond (UR5) to ten (talos).
 ``correct`` does it in one compiled call for each state of a block; ``Correction.block``
 splits a block among the cores (``simulate``: the output times a step passed, with its
