@@ -102,20 +102,16 @@ class System:
     def n(self):
         return len(self.coordinates)
 
-    @property
+    @functools.cached_property
     def coordinate_groups(self):
         """One label per coordinate, equal for the coordinates that move together (a part's
         ``groups``: a point's x, y, z, a quaternion's four numbers), for projection.py's metric."""
-        found = self.__dict__.get("_coordinate_groups")
-        if found is None:
-            labels, start = [], 0
-            for part in self.subsystems:
-                group = {c: start + k for k, members in enumerate(part.groups) for c in members}
-                labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
-                start += len(part.groups) + len(part.coordinates)
-            found = np.array(labels)
-            object.__setattr__(self, "_coordinate_groups", found)
-        return found
+        labels, start = [], 0
+        for part in self.subsystems:
+            group = {c: start + k for k, members in enumerate(part.groups) for c in members}
+            labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
+            start += len(part.groups) + len(part.coordinates)
+        return np.array(labels)
 
     @functools.cached_property
     def constraint_names(self):
@@ -383,21 +379,22 @@ class System:
         """{name: joint_values.JointKinematics} of every joint (reaction frames; fixed and
         distance joints have no values) and of each floating robot's root link
         (``<prefix>root_joint``, a free joint, as Pinocchio names it), compiled on first use."""
-        found = self.__dict__.get("_joint_kinematics")
-        if found is None:
-            from .robots import LINK_FRAME  # robots.py builds on this module
-            found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
-                                             c.report_frame, self)
-                     for c in self.constraints if isinstance(c, Joint)}
-            parts = {p.name: p for p in self.subsystems}
-            for robot in self.robots:
-                if robot.floating:
-                    root = parts[robot.parts[robot.description.root]]
-                    frame = root.frames[LINK_FRAME]
-                    world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
-                    name = f"{robot.prefix}root_joint"
-                    found[name] = JointKinematics(name, "free", None, world, root, frame, frame, self)
-            object.__setattr__(self, "_joint_kinematics", found)
+        return self._joint_kinematics
+
+    @functools.cached_property
+    def _joint_kinematics(self):
+        from .robots import LINK_FRAME  # robots.py builds on this module
+        found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
+                                         c.report_frame, self)
+                 for c in self.constraints if isinstance(c, Joint)}
+        parts = {p.name: p for p in self.subsystems}
+        for robot in self.robots:
+            if robot.floating:
+                root = parts[robot.parts[robot.description.root]]
+                frame = root.frames[LINK_FRAME]
+                world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
+                name = f"{robot.prefix}root_joint"
+                found[name] = JointKinematics(name, "free", None, world, root, frame, frame, self)
         return found
 
     def joint_values(self, t, q, qd, qdd=None):

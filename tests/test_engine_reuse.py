@@ -187,6 +187,24 @@ def test_engines_die_with_their_systems(background_mode):
     assert [r() for r in refs] == [None] * len(refs)
 
 
+def test_a_failed_build_leaves_the_kkt_path_and_holds_no_system(monkeypatch, background_mode, caplog):
+    """A build that raises is logged, its System's motion is the KKT path's ((2.14), the
+    reference) and the worker keeps no reference to the System."""
+    def broken(system):
+        raise RuntimeError("no kernel today")
+    monkeypatch.setattr(background, "_build", broken)
+    system = mb.loads(MODEL, "broken_build")
+    with caplog.at_level("WARNING", logger=background.__name__):
+        assert engine_for(system, wait=True) is None
+    assert "no kernel today" in caplog.text and "using the KKT path" in caplog.text
+    q, qd = a_state(system)
+    assert system.motion(0.0, q, qd).method != "tree (Baraff)"
+    ref = weakref.ref(system)
+    del system
+    gc.collect()
+    assert ref() is None
+
+
 def test_equal_systems_are_not_confused(model, background_mode):
     """A copy with other numbers but no ``with_parameters`` lineage, and a second load of
     the same text, get Engines of their own."""

@@ -112,10 +112,9 @@ def engine_for(system, wait=False):
     future = _submit(system, slot.shared)
     if not (wait or mode() == "wait" or future.done()):
         return None
-    try:
-        template = future.result()
-    except Exception:  # logged by the worker; the exact path serves
-        return None
+    if future.exception() is not None:  # logged by the worker; the exact path serves (the error is not
+        return None  # raised here: its traceback would keep this frame, and the System, with the future)
+    template = future.result()
     return None if template is None else _engine(slot, template, system)
 
 
@@ -192,11 +191,14 @@ def _build_task(system, shared):
     except Exception as err:
         log.warning("model %s: the fast path is unavailable (%s: %s); using the KKT path",
                     name, type(err).__name__, err)
-        del system
-        shared.future.set_exception(err.with_traceback(None))  # its frames would hold the System
-        return
+        failed, template, engine = err.with_traceback(None), None, None  # its frames would hold the System
+    else:
+        failed = None
     del system, engine
-    shared.future.set_result(template)
+    if failed is not None:
+        shared.future.set_exception(failed)
+    else:
+        shared.future.set_result(template)
 
 
 def _build(system):
