@@ -5,8 +5,8 @@ and connectors/joints.py hold them only for the process).
 ``remembered(kind, inputs, derive)`` returns ``derive()``, stored under a digest of
 ``kind``, ``inputs`` (nested tuples of sympy expressions, strings and numbers), this
 package's sources, sympy's version and Python's bytecode version (compiled functions are
-kept as code): any change of the code that derives them makes a new entry. Derivations work in placeholder symbols (coordinate slots, frame values);
-those made with ``placeholder(tag)`` are plain symbols whose names no model symbol can
+kept as code): any change of the code that derives them makes a new entry. Derivations
+work in placeholder symbols (coordinate slots, frame values); those made with ``placeholder(tag)`` are plain symbols whose names no model symbol can
 have (they start with a NUL), so they are the same in every process. A Dummy is equal
 only within its process: a derivation whose inputs or result hold one is not stored
 (it is derived as before).
@@ -128,7 +128,8 @@ def _cache_folder():
         if os.environ.get("MBSYNTH_DERIVATION_CACHE", "").lower() not in ("off", "0", "no"):
             try:
                 from .fast.cache import cache_dir, mark_and_prune, sources_hash
-                digest = sources_hash(Path(__file__).resolve().parent, "**/*.py", salt=sp.__version__ + MAGIC_NUMBER.hex())
+                salt = sp.__version__ + MAGIC_NUMBER.hex()
+                digest = sources_hash(Path(__file__).resolve().parent, "**/*.py", salt=salt)
                 folder = cache_dir() / "derivations" / digest
                 folder.mkdir(parents=True, exist_ok=True)
                 mark_and_prune(folder)  # and the entries of older sources removed

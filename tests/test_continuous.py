@@ -86,8 +86,9 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     """kernel.motion's REUSED at rest (q̇ = 0, no gravity) with shifts on the joint rows
     alone — a correction's velocity step — rebuilds only the right side (the shifts,
     equilibrated) and solves with the factorization of the call before it: its q̈ equals
-    that of a full call at the same state and shifts (the reference); with a unit-norm
-    row shifted too it makes the full call itself. (A massless link at rest, with no gravity,
+    that of a full call at the same state and shifts, and meets the rows as the System's
+    sympy derivation gives them (A q̈ = shift: b vanishes at rest); with a unit-norm row
+    shifted too it makes the full call itself. (A massless link at rest, with no gravity,
     is a singular tree block: the kernel declines it.)"""
     from mbsynth.fast import kernel
     system = mb.load(ROOT / "models" / model)
@@ -106,12 +107,14 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     joint_rows[quat] = 0.0
     unit_too = joint_rows.copy()
     unit_too[quat] = rng.standard_normal(len(quat))
+    A = np.asarray(system.evaluate(0.0, q, qd).A)  # the rows as sympy derived them; b = 0 at rest
     for shift in (joint_rows, unit_too):
         call(first, kernel.UNCHECKED)  # factors the tree at q, for another right side
         reused = call(shift, kernel.REUSED)
         full = call(shift, kernel.UNCHECKED)
         assert np.abs(full).max() > 0 or not shift.any()  # (a lone body has no joint rows)
         np.testing.assert_allclose(reused, full, rtol=0, atol=1e-12 * np.abs(full).max())
+        np.testing.assert_allclose(A @ reused, shift, rtol=0, atol=1e-10 * max(np.abs(shift).max(), 1))
 
 
 def test_a_block_of_states_is_corrected_as_each_state_alone():

@@ -11,7 +11,8 @@ REUSE of the coordinates' size, with φ̇ at most REUSE of the rates, the veloci
 reuses that step's factorization: A at the uncorrected q leaves φ̇ off by about
 |Δq| |Δq̇|, REUSE² relative; each body's quaternion rate first loses its part along u
 (``_unit_rates``), so that the reusing call solves for the joint rows' right sides alone
-(kernel.motion's REUSED at rest). The kernel's own residual check is skipped (kernel.UNCHECKED):
+(kernel.motion's REUSED at rest). The kernel's own residual check is skipped
+(kernel.UNCHECKED):
 the rows after each step check it, and a velocity step that does not cut φ̇ sends the
 state to projection.py. A correction costs a kernel call with its factorization, one
 that reuses it and three passes of the rows (on talos about 28, 8 and 3 × 7 µs), where
@@ -73,7 +74,8 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
     factored q; q̇ = 0)."""
     phi, psi, Rs, shift, factored, rest = work
     qdd = view1(WF, WX, WORK.qdd)
-    kind, start, quat_row = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q), view1(LI, LX, LAYOUT.quat_row)
+    kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
+    quat_row = view1(LI, LX, LAYOUT.quat_row)
     for b in range(Q.shape[0]):
         found[b, DONE] = 0.0
         q, qd = Q_on[b], QD_on[b]

@@ -205,6 +205,7 @@ def _shifted_rows(kind, node_joint, k, rows, joint_row, bshift, rscale, rb, s):
 
 @njit(**OPTIONS)
 def _finite(qdd, Qc):
+    """Whether every entry of q̈ and Qc is finite."""
     for c in range(qdd.shape[0]):
         if not (math.isfinite(qdd[c]) and math.isfinite(Qc[c])):
             return False

@@ -26,7 +26,7 @@ def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs, rates=True):
     max|φ̇|, max|q|, max|q̇|), the maxima over the whole arrays. LI, LF, LX: the Layout
     packed (packing.py); Rs: (N + 1, 2, 3, 3) work, R and Ṙ per node, a particle's and
     the world's slot (N) (I, 0) (``Rows.new_work``). ``rates`` False: φ alone (psi
-    untouched, T and max|φ̇| 0), a third less work."""
+    untouched, T and max|φ̇| 0), a fifth less work (talos: 5.4 µs against 6.6)."""
     q, qd, phi, psi, Rs = borrowed(q), borrowed(qd), borrowed(phi), borrowed(psi), borrowed(Rs)
     node_kind, node_q, quat_row = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q), \
         view1(LI, LX, LAYOUT.quat_row)
