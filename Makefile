@@ -16,8 +16,10 @@ test: $(TEST_STAMP)
 	$(PY) -m pytest -q
 
 # The documentation site (Sphinx), warnings as errors; the gallery's scripts run as it builds.
-docs: $(DOCS_STAMP)
+# Then the checks of the built pages (tests/test_docs.py: MathJax served from the site's _static).
+docs: $(DOCS_STAMP) $(TEST_STAMP)
 	MPLBACKEND=Agg $(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
+	$(PY) -m pytest -q tests/test_docs.py
 
 install: $(STAMP)
 

@@ -20,11 +20,17 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax 3 copied into _static/mathjax: the math typesets offline
     "sphinx.ext.viewcode",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "mbsynth_reference",  # docs/_ext: model-files.md and cli.md from the schema and the parsers
 ]
+
+# The pages load MathJax from the site itself (sphinx-mathjax-offline copies its files into
+# _build/html/_static/mathjax when a build succeeds), never from a CDN:
+# tests/test_docs.py checks the built pages.
+mathjax_path = "mathjax/tex-chtml.js"
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 exclude_patterns = ["_build", "gallery"]
