@@ -1,7 +1,7 @@
 """Seeing the motion in meshcat: a live viewer and self-contained HTML animations.
 
     mb.viewer.to_html(system, trajectory, "run.html")   # plays offline in any browser
-    mb.viewer.show(system, trajectory)                   # serves it live until interrupted
+    mb.viewer.show(system, trajectory, ready=print)      # serves it live until interrupted
 
 What is drawn and where comes from ``viewer_scene.build_scene``; this module turns it
 into meshcat objects and one animation (key times in seconds of the motion). The static
@@ -11,17 +11,19 @@ embedded), so the file needs no network.
 meshcat 0.3.2 quirks, handled here: importing it warns that zmq's ``eventloop.ioloop`` is
 deprecated (that warning alone is silenced); ``Visualizer.close()`` raises (its window has
 no ``close``), so ``MeshcatView.close`` closes the socket and stops the server process
-itself; it has no camera helpers (``set_cam_pos``/``set_cam_target``, which Pinocchio's
+itself; the server that ``Visualizer()`` starts outlives a killed parent, so
+``MeshcatView`` starts meshcat's server itself, with a thread that ends it when its stdin
+closes; it has no camera helpers (``set_cam_pos``/``set_cam_target``, which Pinocchio's
 viewer calls), so the camera is placed through the position property of
 ``/Cameras/default/rotated/<object>`` and the model is moved so that the middle of its
 motion sits at the origin the camera looks at.
 """
 
 import contextlib
-import io
+import select
 import signal
 import subprocess
-import time
+import sys
 import warnings
 from pathlib import Path
 
@@ -48,12 +50,13 @@ def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS):
     return path
 
 
-def show(system, trajectory, *, axes=False, joints=False, fps=FPS, block=True):
+def show(system, trajectory, *, axes=False, joints=False, fps=FPS, block=True, ready=None):
     """Serve the animation of ``trajectory`` in a live meshcat viewer on this machine.
 
-    block=True prints the URL and serves until interrupted (Ctrl-C or SIGTERM), then
-    stops the server and raises KeyboardInterrupt (the command exits 130). block=False returns the running ``MeshcatView`` (``.url``;
-    ``close()`` it, or use it in a ``with`` block).
+    block=True serves until interrupted (Ctrl-C or SIGTERM), calling ``ready(url)`` once
+    the scene is up, then stops the server and raises KeyboardInterrupt (the command
+    exits 130). block=False returns the running ``MeshcatView`` (``.url``; ``close()`` it,
+    or use it in a ``with`` block). The server also ends when this process dies.
     """
     scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps)
     if not block:
@@ -66,15 +69,15 @@ def show(system, trajectory, *, axes=False, joints=False, fps=FPS, block=True):
         return view
     with _sigterm_interrupts(), MeshcatView() as view:
         view.draw(scene)
-        print(f"meshcat viewer of {system.name}: {view.url}  (Ctrl-C stops it)", flush=True)
+        if ready is not None:
+            ready(view.url)
         view.serve()
     return None
 
 
 @contextlib.contextmanager
 def _sigterm_interrupts():
-    """Make SIGTERM a KeyboardInterrupt meanwhile: it would otherwise end this process
-    without stopping the server, which runs in a session of its own."""
+    """Make SIGTERM a KeyboardInterrupt meanwhile: it stops the viewer as Ctrl-C does."""
     def interrupt(signum, frame):
         raise KeyboardInterrupt
 
@@ -95,15 +98,33 @@ def import_meshcat():
     return meshcat
 
 
+# meshcat's server, ended by a thread of its own when its stdin closes: when its MeshcatView
+# closes it, or when the process holding the other end ends, even by SIGKILL.
+SERVER = ("import os, sys, threading\n"
+          "threading.Thread(target=lambda: (sys.stdin.buffer.read(), os._exit(0)), daemon=True).start()\n"
+          "from meshcat.servers.zmqserver import main\n"
+          "main()\n")
+
+
 class MeshcatView:
-    """A meshcat server of our own on 127.0.0.1 and the scene drawn in it (a context manager)."""
+    """A meshcat server of our own on 127.0.0.1 and the scene drawn in it (a context manager).
+
+    The server process ends when the view closes or when this process ends.
+    """
 
     def __init__(self):
         self.meshcat = import_meshcat()
-        with contextlib.redirect_stdout(io.StringIO()):  # it prints its URL; callers say it themselves
-            self.vis = self.meshcat.Visualizer()
-        self.url = self.vis.url()
-        self.process = self.vis.window.server_proc
+        self.process = subprocess.Popen([sys.executable, "-u", "-c", SERVER], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            zmq_url, self.url = _server_urls(self.process)
+        except BaseException:
+            self._stop()
+            raise
+        window = object.__new__(self.meshcat.visualizer.ViewerWindow)  # meshcat's, on our server
+        window.server_proc, window.zmq_url, window.web_url = self.process, zmq_url, self.url
+        window.connect_zmq()
+        self.vis = self.meshcat.Visualizer(window=window)
 
     def __enter__(self):
         return self
@@ -146,23 +167,27 @@ class MeshcatView:
         return self.vis.static_html()
 
     def serve(self):
-        """Wait while the server runs (until interrupted)."""
-        while self.process.poll() is None:
-            time.sleep(0.5)
+        """Wait until the server ends (its output closes) or a signal handler raises.
+
+        Not Popen.poll/wait, which a signal can interrupt while they hold its lock; a
+        select with a timeout, as a signal can reach another thread and not wake this one."""
+        out = self.process.stdout
+        while not select.select([out], [], [], 0.5)[0] or out.read1():
+            pass
 
     def close(self):
         """Close our socket and stop the server process (meshcat's own close() raises)."""
         self.vis.window.zmq_socket.close(linger=0)
-        if self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(STOP_SECONDS)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
-        for pipe in (self.process.stdout, self.process.stderr):
-            if pipe is not None:
-                pipe.close()
+        self._stop()
+
+    def _stop(self):
+        self.process.stdin.close()  # the server's cue to exit
+        try:
+            self.process.wait(STOP_SECONDS)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        self.process.stdout.close()
 
     def _animation(self, scene):
         """One clip per node: position, quaternion (and scale for lines) at each drawn time."""
@@ -177,6 +202,20 @@ class MeshcatView:
                 tracks["scale"] = animation.AnimationTrack("scale", "vector3", times, scale.tolist())
             clips[self.vis["model"][node.path].path] = animation.AnimationClip(tracks, fps=1)  # times in s
         return animation.Animation(clips)
+
+
+def _server_urls(process):
+    """(zmq URL, web URL) that a starting meshcat server prints; RuntimeError if it exits first."""
+    urls, said = {}, []
+    for line in process.stdout:
+        key, _, value = line.decode(errors="replace").strip().partition("=")
+        if key in ("zmq_url", "web_url"):
+            urls[key] = value
+        else:
+            said.append(line.decode(errors="replace").strip())
+        if len(urls) == 2:
+            return urls["zmq_url"], urls["web_url"]
+    raise RuntimeError(f"the meshcat server exited before serving: {' | '.join(said[-3:]) or 'no output'}")
 
 
 def decompose(transforms):

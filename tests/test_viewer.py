@@ -5,7 +5,9 @@ headless Chromium (installed by ``make test`` when run as root) and compared wit
 picture of the same scene without the model: the model must change many pixels.
 """
 
+import os
 import re
+import signal
 import socket
 import struct
 import subprocess
@@ -23,6 +25,7 @@ from mbsynth import screenshot as screenshot_module
 from mbsynth.screenshot import chromium, screenshot
 from mbsynth.trajectory import Trajectory
 from mbsynth.viewer_scene import build_scene, drawn_rows
+from test_cli_errors import HANG, ended_within, needs_proc, proc_stat, running
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE3 = ROOT / "models" / "paper" / "example3_two_masses.yaml"
@@ -193,6 +196,40 @@ def test_meshcat_imports_without_the_zmq_deprecation_warning():
     ours = subprocess.run([sys.executable, "-W", "error::DeprecationWarning", "-c",
                            "from mbsynth import viewer; viewer.import_meshcat()"], capture_output=True, text=True)
     assert ours.returncode == 0, ours.stderr  # ... and handled
+
+
+def test_an_interrupted_serve_still_lets_close_stop_the_server():
+    """Ctrl-C may land anywhere in serve(): close() then still stops the server."""
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        with viewer.MeshcatView() as view:
+            for k in range(100):
+                with pytest.raises(KeyboardInterrupt):
+                    signal.setitimer(signal.ITIMER_REAL, 1e-5 * (1 + k % 20))
+                    view.serve()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    assert view.process.returncode is not None
+
+
+@needs_proc
+def test_the_server_ends_with_a_process_that_never_closed_its_view():
+    code = "import os; from mbsynth import viewer; print(viewer.MeshcatView().process.pid, flush=True); os._exit(0)"
+    child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=HANG)
+    assert child.returncode == 0, child.stderr
+    pid = int(child.stdout)
+    stat = proc_stat(pid)
+    if stat is None:
+        return  # ended and reaped already
+    try:
+        assert ended_within((pid, stat[19]), HANG)
+    finally:
+        if running(pid, stat[19]):
+            os.kill(pid, signal.SIGKILL)
 
 
 # -- pictures in a real browser ------------------------------------------------------

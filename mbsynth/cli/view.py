@@ -27,5 +27,8 @@ def run(args):
         path = viewer.to_html(system, traj, args.html, **options)
         print(f"wrote {path}: {system.name}, t = {traj.t[0]:.6g} to {traj.t[-1]:.6g} s")
     else:
-        viewer.show(system, traj, **options)
+        def ready(url):  # the line that says the page is served
+            print(f"meshcat viewer of {system.name}: {url}  (Ctrl-C stops it)", flush=True)
+
+        viewer.show(system, traj, ready=ready, **options)
     return status
