@@ -1,6 +1,6 @@
 """A System's arrays at one state, evaluated a structure at a time (grouped.Batch).
 
-``evaluator(system)`` (made once per System, dropped with it) gives
+An ``Evaluator(system)`` (a Data's, data.py) gives
 
 - ``constraints(t, q, qd)``: one evaluation of every connector's rows: A (sparse CSR), b,
   C, and the residuals φ, φ̇ (NaN on rows without that level) — drift control and
@@ -12,7 +12,6 @@ The results equal those of calling each connector and part (``Connector.evaluate
 ``residuals``, ``Part.evaluate``, ``energy``), which remain the reference.
 """
 
-import weakref
 from typing import NamedTuple
 
 import numpy as np
@@ -22,92 +21,6 @@ from .subsystems.base import Part
 from .symbolic import Compiled
 
 DENSE_ENTRIES = 40000  # rows × coordinates up to which dense arrays beat scipy.sparse's overhead
-_evaluators = {}
-
-
-class _FixWhenMade(NamedTuple):
-    """In place of a run's Evaluator until its first use (``fix_when_made``)."""
-
-    wait: bool
-    origin: object  # a weak reference to the System the run was made from, or None
-
-
-def evaluator(system):
-    """The Evaluator of ``system``, made on first use and dropped when the System is."""
-    found = _existing(system)
-    if isinstance(found, _FixWhenMade):
-        return _keep(system, _fixed(system, found))
-    return found or _keep(system, Evaluator(system))
-
-
-def fix_when_made(system, wait, origin=None):
-    """Let ``system``'s Evaluator fix its paths (``Evaluator.fix_kernels(wait)``) as it is
-    made, on first use: a run (System.for_run) that never evaluates the System's
-    connectors one by one (the compiled kernel covers them) never lays them out.
-    ``origin``: the System the run was made from; the Evaluator made is kept with it, for
-    its later runs with the same ``wait`` (their layout and groups found once)."""
-    if _existing(system) is None:
-        _keep(system, _FixWhenMade(wait, None if origin is None else weakref.ref(origin)))
-
-
-_for_runs = {}  # as _evaluators: per System, the Evaluator its runs share (a _RunsShare)
-
-
-class _RunsShare(NamedTuple):
-    """The Evaluator a System's runs share, and the ``wait`` its paths were fixed with."""
-
-    wait: bool
-    evaluator: object
-
-
-def _fixed(system, pending):
-    """The Evaluator, paths fixed, of ``system`` (a run, ``pending`` its _FixWhenMade): the one
-    its origin's earlier runs made with the same ``wait``, else a new one, kept for the later."""
-    origin = None if pending.origin is None else pending.origin()
-    found = None if origin is None else _existing(origin, _for_runs)
-    if found is not None and found.wait == pending.wait:
-        return found.evaluator
-    made = Evaluator(system).fix_kernels(pending.wait)
-    if origin is not None:
-        _keep(origin, _RunsShare(pending.wait, made), _for_runs)
-    return made
-
-
-def share(parent, child):
-    """Let ``child`` — the same connectors, parts and forces as ``parent``, other parameter
-    values (``System.with_parameters``, ``System.for_run``) — use ``parent``'s Evaluator
-    once that one's path is fixed (``Evaluator.fixed``): its layout and groups, found at its
-    first call, hold for every parameter value (p is an argument of each call). A sampled
-    controller's System per sample then costs no new layout. Returns whether it shares.
-    Where it does not, ``child``'s runs share the Evaluator ``parent``'s runs made."""
-    found = _existing(parent)
-    if isinstance(found, _FixWhenMade):
-        found = evaluator(parent)
-    if found is None or not found.fixed:
-        runs = _existing(parent, _for_runs)
-        if runs is not None and _existing(child, _for_runs) is None:
-            _keep(child, runs, _for_runs)
-        return False
-    _keep(child, found)
-    return True
-
-
-def _existing(system, table=_evaluators):
-    """What ``table`` keeps for ``system`` (by id, checked against a weak reference), or None."""
-    found = table.get(id(system))
-    return found[1] if found is not None and found[0]() is system else None
-
-
-def _keep(system, made, table=_evaluators):
-    """Keep ``made`` for ``system`` in ``table`` until the System is dropped; returns it."""
-    table[id(system)] = (weakref.ref(system), made)
-    weakref.finalize(system, _forget, table, id(system), made)
-    return made
-
-
-def _forget(table, key, made):
-    if table.get(key, (None, None))[1] is made:
-        del table[key]
 
 
 class ConstraintArrays(NamedTuple):

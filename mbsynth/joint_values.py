@@ -31,6 +31,7 @@ import sympy as sp
 
 from .connectors.joints import SHARED_PARTS
 from .derivation_cache import placeholder, remembered
+from .grouped import Batch
 from .kinematics import matrix_quaternion
 from .subsystems.base import Frame
 from .symbolic import T_SYMBOL, JointValue, Slots, compile_function, jacobian, time_derivative
@@ -109,6 +110,44 @@ class JointKinematics:
         i = self.indices
         *_, pR, RR, _, _, J = self._evaluate(t, q[i], qd[i], p)
         return FramePose(pR.ravel(), RR, J)
+
+
+class JointValuesBatch:
+    """``JointKinematics.values`` of many joints at once: their compiled functions called a
+    shared structure at a time (grouped.Batch), the outputs then split per joint."""
+
+    SLOTS = 9  # the outputs of a JointKinematics' function (``_expressions``)
+
+    def __init__(self, kinematics):
+        self.kinematics = list(kinematics)
+        self.batch = Batch([k._evaluate for k in self.kinematics], [k.indices for k in self.kinematics], self.SLOTS)
+        self.shapes = None  # per joint, where each output lies in its slot (``_layout``, at the first call)
+
+    def __call__(self, t, q, qd, qdd, p):
+        """{joint name: JointValues} at (t, q, q̇) and, when given, q̈."""
+        if self.shapes is None:
+            self.shapes = self._layout(t, q, qd, p)
+        slots = self.batch(t, q, qd, p)
+        found = {}
+        for k, places in zip(self.kinematics, self.shapes):
+            scalars, rates, rate_a, rate_b, origin, _, RA, RB, _ = (slots[j][a:b].reshape(shape)
+                                                                     for j, (a, b, shape) in enumerate(places))
+            position = _positions(k.kind, scalars.ravel(), RA, RB, origin.ravel())
+            acceleration = None if qdd is None else rate_a @ qdd[k.indices] - rate_b.ravel()
+            found[k.name] = JointValues(position, rates.ravel().copy(), acceleration)
+        return found
+
+    def _layout(self, t, q, qd, p):
+        """Per joint, per output: (start, stop, shape) in the batch's slot of that output."""
+        starts, places = [0] * self.SLOTS, []
+        for k in self.kinematics:
+            outputs = k._evaluate(t, q[k.indices], qd[k.indices], p)
+            place = []
+            for j, x in enumerate(outputs):
+                place.append((starts[j], starts[j] + np.size(x), np.shape(x)))
+                starts[j] += np.size(x)
+            places.append(place)
+        return places
 
 
 def _expressions(kind, parent, child, frames, q, qd):

@@ -113,10 +113,10 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     method = _integrator(method)
     if not t_end > t0:
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0})")
-    system = system.for_run()  # one motion path (tree or KKT) for the whole run
-    run = _Run(system, method, rtol, atol, stabilization, baumgarte)
+    data = system.data()  # the run's workspace: one motion path (compiled or KKT) for the whole run
+    run = _Run(data, method, rtol, atol, stabilization, baumgarte)
     if q0 is None and qd0 is None:
-        q, qd, changes = consistent_initial_state(system, t0)
+        q, qd, changes = consistent_initial_state(data, t0)
         for name, (given, new) in changes.items():
             log.info("initial %s: %.12g -> %.12g (made consistent with the constraints)", name, given, new)
     else:
@@ -125,7 +125,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
         changes = {}
     times = _output_times(t0, t_end, dt)
-    control = None if controller is None else SampledControl(system, controller, control_dt or times[1] - times[0])
+    control = None if controller is None else SampledControl(controller, control_dt or times[1] - times[0])
     samples = set() if control is None else set(control.times(t0, t_end))
     outputs = set(times)
     writer = TrajectoryWriter(out, system.coordinates, run.outputs.names) if out is not None else None
@@ -133,7 +133,8 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     status = "stopped"
     try:
         if control is not None:
-            run.restart(control.apply(t0, q, qd))
+            control.apply(data, t0, q, qd)
+            run.restart()
         run.record(t0, q, qd, writer)
         run.t_now = t0
         stops = sorted(samples | {times[-1]})  # where a continuous integrator stops: the forces jump, or the run ends
@@ -141,9 +142,10 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         for t_next in run.times[1:]:
             q, qd = run.advance(t_next, q, qd, stops[bisect.bisect_left(stops, t_next)])
             if t_next in samples:
-                run.restart(control.apply(t_next, q, qd))
+                control.apply(data, t_next, q, qd)
+                run.restart()
             if t_next in outputs:
-                at_hand = () if t_next in samples else (run.arrays, run.corrected)  # a sample's System is new
+                at_hand = () if t_next in samples else (run.arrays, run.corrected)  # a sample's parameters are new
                 run.record(t_next, q, qd, writer, *at_hand)
                 if progress is not None:
                     progress(t_next)
@@ -184,15 +186,16 @@ def _output_times(t0, t_end, dt):
 
 
 class _Run:
-    """The state of one integration: settings, output rows and counters."""
+    """The state of one integration: settings, output rows and counters. ``system`` is the
+    run's Data (data.py), which reads as its System."""
 
-    def __init__(self, system, method, rtol, atol, stabilization, baumgarte):
-        self.system, self.method, self.rtol, self.atol = system, method, rtol, atol
-        self.outputs = OutputEvaluator(system)
+    def __init__(self, data, method, rtol, atol, stabilization, baumgarte):
+        self.system, self.method, self.rtol, self.atol = data, method, rtol, atol
+        self.outputs = OutputEvaluator(data)
         self.stabilization = stabilization
         self.baumgarte = baumgarte if stabilization == "baumgarte" else None
-        self._use(system)
-        self.n = system.n
+        self.restart()
+        self.n = data.n
         self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity",
                                      "outputs")}
         self.columns = tuple(self.rows.values())  # in that order (``record``)
@@ -220,18 +223,14 @@ class _Run:
     def t(self):
         return self.rows["t"]
 
-    def restart(self, system):
-        """Go on with ``system`` (new parameter values at a control sample): the forces jump,
-        so the integrator starts afresh."""
-        self.outputs.system, self.solver = system, None
-        self._use(system)
-
-    def _use(self, system):
-        """Integrate ``system``: its stages' motion, and its compiled correction where the
-        kernel covers it (then integrated continuously, with an explicit pair and projection)."""
-        self.system = system
+    def restart(self):
+        """Go on from the Data's parameter values (new at a control sample: the forces jump,
+        so the integrator starts afresh): its stages' motion, and its compiled correction
+        where the kernel covers it (then integrated continuously, with an explicit pair and
+        projection)."""
+        system, self.forces_jumped = self.system, True  # the integrator's f at its state is stale
         self.stage_motion = system.stage_motion(self.baumgarte, drift=True)
-        engine = system._tree_engine(True)
+        engine = system.tree_engine(True)
         # the compiled engine's (q̇, q̈) where stage_motion would call it anyway: no Motion per stage
         self.derivative = None if engine is None or self.baumgarte is not None else engine.derivative
         self.correction = None if engine is None else engine.correction()
@@ -290,11 +289,11 @@ class _Run:
         first step the one last proposed."""
         self._begin_interval(self.t_now, t_next, self.rtol)
         solver = self.solver
-        if solver is None:
+        if solver is None or self.forces_jumped:
             first = None if self.next_step is None else min(self.next_step, t_stop - self.t_now)
             solver = self.solver = self.method(self.rhs, self.t_now, np.concatenate([q, qd]), t_stop,
                                                rtol=self.rtol, atol=self.atol, first_step=first)
-            self.solver_tolerances, self.passed = (self.rtol, self.atol), {}
+            self.solver_tolerances, self.passed, self.forces_jumped = (self.rtol, self.atol), {}, False
         while solver.t < t_next:
             self._step(solver, t_next)
         return self.passed[t_next]
@@ -314,7 +313,7 @@ class _Run:
             raise self._collapse(solver.t, solver.y, (message or "the integrator failed").rstrip("."))
         self.steps += 1
         taken = solver.t - start[0]
-        if solver.t != solver.t_bound:
+        if solver.t != solver.t_bound or self.next_step is None:  # a step cut at the bound proposes less
             self.next_step = solver.h_abs
         self._check(solver.t, solver.y)
         q, qd = solver.y[:self.n], solver.y[self.n:]
@@ -438,9 +437,11 @@ class _Run:
         """The integrator at (t, y), bound for t_bound, its first step the one it proposed
         before the last span's end cut its step short: the same integrator where it can go
         on from there (RESUMABLE, at the same tolerances; given y's derivative where the
-        state was moved, by a projection), else a new one, as ``solve_ivp`` would start it."""
+        state was moved, by a projection), else (also where the forces jumped, at a control
+        sample) a new one, as ``solve_ivp`` would start it."""
         first = None if self.next_step is None else min(self.next_step, t_bound - t)
-        solver = self.solver
+        solver = None if self.forces_jumped else self.solver  # a control sample: a new integrator
+        self.forces_jumped = False
         if isinstance(solver, RESUMABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
             if not np.array_equal(solver.y, y):
                 solver.y, solver.f = y, self.rhs(t, y)

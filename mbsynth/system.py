@@ -1,25 +1,27 @@
-"""A System: parts, their coordinate layout, the constraints joining them, parameters.
+"""A System: the model — parts, their coordinate layout, the constraints joining them,
+the force elements, parameter names and default values.
 
-The System is built once and not changed afterwards. ``evaluate(t, q, qd)``
+A System is a value: built once, never changed, two equal Systems behave the same.
+What a computation keeps between calls (parameter values as an array, evaluators, the
+compiled engine and the path it takes) lives in a Data made from it (``system.data()``,
+data.py). The System's own methods (``evaluate``, ``motion``, ``reactions``, …) compute at
+its parameter values through a Data it makes on first use: ``evaluate(t, q, qd)``
 assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 ``motion(t, q, qd)`` solves them with the singular-mass equation (2.14).
 """
 
 import functools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import sympy as sp
 
-from . import equations, evaluation, fast, friction, reactions, solvers
 from .connectors import Joint
+from .data import Data, Shared
 from .errors import ModelError, SolveError
-from .evaluation import evaluator
 from .joint_values import JointKinematics, value_expressions
 from .subsystems import Frame
 from .symbolic import T_SYMBOL
-
-METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
 
 
 @dataclass(frozen=True)
@@ -66,6 +68,13 @@ class System:
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
+    # what Systems of this structure share (data.Shared: the compiled Template, evaluators): a
+    # cache of derived values, handed on by ``with_parameters``, no part of the System's value
+    shared: Shared = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self):
+        if self.shared is None or not self.shared.fits(self):  # built anew, or its structure replaced
+            object.__setattr__(self, "shared", Shared(self))
 
     @classmethod
     def build(cls, name, subsystems, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
@@ -137,22 +146,11 @@ class System:
         Parameters defined by expressions of others, and initial values written as
         expressions of parameters, follow the new values. Closure balances appended at
         load time are kept as derived; they stay valid while the masses that were zero
-        stay zero. The new System shares this one's compiled fast path (``mbsynth.fast``:
+        stay zero. The new System shares this one's compiled path (``mbsynth.fast``:
         parameters are arguments of its code), so a sweep compiles once."""
-        unknown = sorted(set(values) - set(self.parameters))
-        if unknown:
-            raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
-                             f"it has {sorted(self.parameters)}")
-        definitions = self.definitions or {}
-        new, subs = {}, {}
-        for name, old in self.parameters.items():
-            if name in values:
-                new[name] = float(values[name])
-            elif name in definitions:
-                new[name] = float(definitions[name].xreplace(subs))
-            else:
-                new[name] = old
-            subs[sp.Symbol(name)] = sp.Float(new[name])
+        p = self.resolved_parameters(values, check_parts=False)
+        new = dict(zip(self.parameters, p.tolist()))
+        subs = {sp.Symbol(name): sp.Float(value) for name, value in new.items()}
         q0, qd0 = self.initial_state()
         index = {c: i for i, c in enumerate(self.coordinates)}
         for key, expr in (self.initial_definitions or {}).items():
@@ -165,28 +163,57 @@ class System:
         if problems:
             given = values if len(values) <= 3 else f"{len(values)} new parameter values"
             raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
-        fast.share(self, changed)
-        evaluation.share(self, changed)
         return changed
 
-    def for_run(self):
-        """This System, for one run (``simulate``), with the path of ``motion`` fixed for the
-        whole run: the compiled tree path when it is ready or its kernels are compiled (it
-        is waited for), else the KKT path throughout — never a switch midway, so a run's
-        result does not depend on when a background compilation finishes. The grouped
-        evaluation of connectors and parts (evaluation.py) is fixed the same way."""
-        run = replace(self)
-        fast.fix_path(self, run)
-        if not evaluation.share(self, run):  # a run's own, or this System's path already fixed
-            evaluation.fix_when_made(run, fast.compiled(), self)  # the connectors' kernels likewise
-        return run
+    def resolved_parameters(self, values, p=None, check_parts=True):
+        """The parameter values (an array in the model's order) with ``values`` ({name:
+        value}) set over ``p`` (default: the model's): parameters defined by expressions of
+        others follow. Raises ModelError for a name the model has no parameter of, a
+        non-finite value, or (``check_parts``) a part that reads a changed parameter and
+        whose M or Q is then not finite or M not positive semi-definite at the initial state."""
+        unknown = sorted(set(values) - set(self.parameters))
+        if unknown:
+            raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
+                             f"it has {sorted(self.parameters)}")
+        bad = sorted(name for name, x in values.items() if not np.isfinite(float(x)))
+        if bad:
+            raise ModelError(f"model '{self.name}': non-finite values for parameter(s) {bad}")
+        old = self.parameter_values if p is None else np.asarray(p, dtype=float)
+        new = old.copy()
+        for i, name in enumerate(self.parameters):
+            if name in values:
+                new[i] = float(values[name])
+        if self.definitions:  # parameters defined by expressions of earlier ones follow, in order
+            subs = {}
+            for i, name in enumerate(self.parameters):
+                if name in self.definitions and name not in values:
+                    new[i] = float(self.definitions[name].xreplace(subs))
+                subs[sp.Symbol(name)] = sp.Float(new[i])
+        if check_parts:
+            moved = {sp.Symbol(name) for name, a, b in zip(self.parameters, old.tolist(), new.tolist()) if a != b}
+            problems = self.part_problems(moved, new) if moved else []
+            if problems:
+                raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")
+        return new
 
-    def part_problems(self, parameters=None):
+    def data(self):
+        """A new workspace for a run on this System (data.Data): its parameter values, its
+        evaluators and the compiled engine, the path fixed as it is made."""
+        return Data(self)
+
+    @functools.cached_property
+    def _data(self):
+        """The Data of this System's own methods, made on first use (data.Data, fixed=False)."""
+        return Data(self, fixed=False)
+
+    def part_problems(self, parameters=None, p=None):
         """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
         positive semi-definite, at the initial state — a model no equation of motion fits.
         ``parameters``: only the parts written in these parameter symbols (those whose values
-        changed: ``with_parameters``); every part by default."""
+        changed: ``with_parameters``); every part by default. ``p``: the parameter values
+        (default: the model's)."""
         q, qd = self.initial_state()
+        p = self.parameter_values if p is None else p
         problems, start = [], 0
         for part in self.subsystems:
             stop = start + len(part.coordinates)
@@ -194,7 +221,7 @@ class System:
                 start = stop
                 continue
             with np.errstate(all="ignore"):
-                M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], self.parameter_values)
+                M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], p)
             if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
                 problems.append((part.name, f"subsystem '{part.name}': M or Q is not finite at the initial state"))
             elif np.linalg.eigvalsh(M).min() < -1e-12 * max(np.abs(M).max(), 1e-300):
@@ -204,22 +231,20 @@ class System:
             start = stop
         return problems
 
-    def branch_problems(self, q=None, t=0.0):
+    def branch_problems(self, q=None, t=0.0, p=None):
         """[(joint name, message)] for each joint whose frames meet its rows at ``q`` (the
         initial state by default) in a pose it does not mean: a fixed joint's frames turned
-        180° (connectors/joints.py)."""
+        180° (connectors/joints.py). ``p``: the parameter values (default: the model's)."""
         q = self.initial_q if q is None else q
         values = dict(zip(self.q_symbols, np.asarray(q, dtype=float)))
-        values.update(zip(self.parameter_symbols, self.parameter_values))
+        values.update(zip(self.parameter_symbols, self.parameter_values if p is None else p))
         values[T_SYMBOL] = t
         return [(c.name, message) for c in self.constraints if (message := c.wrong_branch(values))]
 
     def check_branches(self, q, t=0.0):
         """Raise SolveError naming the first joint whose frames, at the state q, are in a
         pose the joint does not mean (``branch_problems``)."""
-        problems = self.branch_problems(q, t)
-        if problems:
-            raise SolveError(f"model '{self.name}': {problems[0][1]}", constraints=[problems[0][0]])
+        self._data.check_branches(q, t)
 
     def with_constraints(self, extra, closures=()):
         """A new System with ``extra`` constraints appended (the original is unchanged)."""
@@ -235,32 +260,26 @@ class System:
 
     def evaluate(self, t, q, qd):
         """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
-        q, qd = self._state(q, qd)
-        p = self.parameter_values
-        batches = evaluator(self)
-        return Assembly(*batches.parts(t, q, qd, p), *batches.dense_rows(t, q, qd, p))
+        return self._data.evaluate(t, q, qd)
 
     def constraint_rows(self, t, q, qd):
         """A (m × n, scipy.sparse CSR) and b at (t, q, q̇) — the rows alone, without M:
         what projection.py needs, in memory proportional to the rows' entries."""
-        arrays = self.constraint_arrays(t, q, qd)
-        return arrays.A, arrays.b
+        return self._data.constraint_rows(t, q, qd)
 
     def constraint_arrays(self, t, q, qd, sparse=True):
         """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
         (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
         dense where that is faster (sparse=None: few rows and coordinates)."""
-        q, qd = self._state(q, qd)
-        return evaluator(self).constraints(t, q, qd, self.parameter_values, sparse)
+        return self._data.constraint_arrays(t, q, qd, sparse)
 
     def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
         Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
-        (2.14)). "fast" is the linear-time tree path (``mbsynth.fast``) once its compiled
-        kernels are ready (they build in the background on first use; ``for_run`` fixes
-        the choice for a run) and where its checks
-        pass, else the KKT path; both fall back to the exact treatment when the problem is
-        not well posed.
+        (2.14)). "fast" is the linear-time compiled path (``mbsynth.fast``) once its kernels
+        are ready (they build in the background on first use; a run's Data fixes the
+        choice for the run: data.py) and where its checks pass, else the KKT path; both
+        fall back to the exact treatment when the problem is not well posed.
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
         residuals (drift control during integration; b itself when they are zero).
         Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``
@@ -270,93 +289,25 @@ class System:
         drift explains an inconsistency, near-singular directions the drift dominates set
         aside) instead of raising SolveError for contradictory constraints.
         The Motion's ``lam`` (the multipliers, reactions.py) is computed when first read."""
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
-        q, qd = self._state(q, qd)
-        motion = self._solved(t, q, qd, method, baumgarte, drift)
-        return motion.with_multipliers(lambda: self._multipliers(t, q, qd, motion)[0])
-
-    def _solved(self, t, q, qd, method, baumgarte, drift):
-        """The Motion of ``motion``, without its multipliers."""
-        if method == "fast":
-            motion = self._tree_motion(t, q, qd, baumgarte, drift)
-            if motion is not None:
-                return motion
-        return self._kkt_motion(t, q, qd, method, baumgarte, drift)
-
-    def _kkt_motion(self, t, q, qd, method, baumgarte, drift):
-        """The Motion of (2.14) (``method``: its KKT form or the literal pseudo-inverse)
-        from the assembled M, Q, A, b, C, without its multipliers."""
-        arrays = self.evaluate(t, q, qd)
-        b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
-        off_manifold = self._off_manifold(t, q, qd) if drift else None
-
-        def solve(C):
-            return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=self.coordinates,
-                                   constraints=self.constraint_names, drift=off_manifold)
-        if self._coulomb:  # C depends on q̈ (friction.py)
-            return friction.coulomb_motion(self.constraints, arrays, solve, t, q, qd, self.parameter_values)
-        return solve(arrays.C)
+        return self._data.motion(t, q, qd, method, baumgarte, drift)
 
     @functools.cached_property
-    def _coulomb(self):
+    def coulomb(self):
         """Whether a constraint has Coulomb friction (its C depends on q̈), found once."""
         return any(getattr(con, "coulomb", None) for con in self.constraints)
 
-    def _off_manifold(self, t, q, qd):
-        """The drift measure of ``equations.constrained_acceleration``: a callable giving φ
-        per row and q, evaluated only when its rule needs them."""
-        return lambda: (self.constraint_residuals(t, q, qd)[0], q)
-
-    def _tree_motion(self, t, q, qd, baumgarte, drift):
-        """The Motion from mbsynth.fast, or None: kernels not ready, model not covered (no
-        rigid body or particle, Coulomb friction), a case for the exact treatment, or a
-        state off the manifold of a model with loops (the kernel's Schur step drops
-        dependent rows by its own rule, not by equations' drift rule)."""
-        engine = self._tree_engine(drift)
-        if engine is None:
-            return None
-        shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
-        return engine.motion(t, q, qd, shift)
-
-    def _tree_engine(self, drift):
-        """The compiled Engine that serves ``motion``, or None: kernels not ready, model not
-        covered, or (``drift``) a state off the manifold of a model with loops."""
-        engine = fast.engine_for(self)
-        return None if engine is None or (drift and engine.closes_loops) else engine
-
-    def stage_motion(self, baumgarte=None, drift=False):
-        """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
-        without ``lam``: the compiled engine's own call where ``motion`` would make it anyway
-        (a System ``for_run``, its engine ready, no Baumgarte shift), skipping the checks
-        and bookkeeping of each call (a fifth of a UR5's evaluation)."""
-        engine = self._tree_engine(drift)
-        if engine is None or baumgarte is not None:
-            return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
-
-        def stage(t, q, qd):
-            found = engine.motion(t, q, qd)
-            return found if found is not None else self._kkt_motion(t, q, qd, "fast", None, drift)
-        return stage
-
     def motion_batch(self, t, q_batch, qd_batch):
         """q̈ at many states, one per row of ``q_batch`` and ``qd_batch`` (t: a number or one
-        per row), in parallel: (qdd (B × n), unique (B,)). See ``mbsynth.fast.batch``."""
-        return fast.motion_batch(self, t, q_batch, qd_batch)
-
-    def _stabilized(self, t, q, qd, b, alpha, beta):
-        phi, psi = self.constraint_residuals(t, q, qd)
-        return b - 2 * alpha * np.nan_to_num(psi) - beta**2 * np.nan_to_num(phi)
+        per row), in parallel: (qdd (B × n), unique (B,)); ``Data.motion_batch``."""
+        return self._data.motion_batch(t, q_batch, qd_batch)
 
     def energy(self, t, q, qd):
         """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
-        q, qd = self._state(q, qd)
-        return evaluator(self).energies(t, q, qd, self.parameter_values)
+        return self._data.energy(t, q, qd)
 
     def constraint_residuals(self, t, q, qd):
         """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
-        q, qd = self._state(q, qd)
-        return evaluator(self).residuals(t, q, qd, self.parameter_values)
+        return self._data.constraint_residuals(t, q, qd)
 
     def symbolic(self):
         """(M, Q, A, b, C) as sympy matrices in the model's symbols."""
@@ -368,12 +319,6 @@ class System:
         b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.constraints])
         C = sum((con.C for con in self.constraints), sp.zeros(n, 1))
         return M, Q, A, b, C
-
-    def _multipliers(self, t, q, qd, motion, arrays=None):
-        """(λ, dependent rows) of ``motion`` at (t, q, q̇): Qc − C = Aᵀλ (reactions.py)."""
-        arrays = self.evaluate(t, q, qd) if arrays is None else arrays
-        C = arrays.C if motion.C is None else motion.C
-        return reactions.multipliers(arrays.A, arrays.M @ motion.qdd - arrays.Q - C)
 
     def joint_kinematics(self):
         """{name: joint_values.JointKinematics} of every joint (reaction frames; fixed and
@@ -401,10 +346,7 @@ class System:
         """{joint name: JointValues(position, rate, acceleration)} of every joint that has
         values (joint_values.py: revolute ``angle``, prismatic ``displacement``, …, a
         floating robot's ``root_joint``), in model order; acceleration None without q̈."""
-        q, qd = self._state(q, qd)
-        qdd = None if qdd is None else np.asarray(qdd, dtype=float).ravel()
-        p = self.parameter_values
-        return {name: k.values(t, q, qd, qdd, p) for name, k in self.joint_kinematics().items() if k.position_names}
+        return self._data.joint_values(t, q, qd, qdd)
 
     def reactions(self, t, q, qd, motion=None):
         """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default
@@ -412,37 +354,7 @@ class System:
         joint the wrench (``force``, ``torque``) the parent exerts on the child through it —
         its rows, its friction, its actuation and spring — at the child's reaction frame
         (the frame B of the joint; a robot's child link frame), in that frame's axes."""
-        q, qd = self._state(q, qd)
-        motion = self.motion(t, q, qd) if motion is None else motion
-        arrays = self.evaluate(t, q, qd)
-        lam, dependent = self._multipliers(t, q, qd, motion, arrays)
-        kinematics, p = self.joint_kinematics(), self.parameter_values
-        out, row = {}, 0
-        for con in self.constraints:
-            rows = slice(row, row + con.size)
-            force = torque = None
-            if con.name in kinematics:
-                k = kinematics[con.name]
-                g = self._joint_force(con, lam[rows], t, q, qd, p)
-                force, torque = reactions.wrench(k.frame(t, q, qd, p), con.parts[1].idle_directions(q[k.child_indices]),
-                                                 g[k.child_indices])
-            out[con.name] = reactions.Reaction(lam[rows].copy(), bool(dependent[rows].any()), force, torque)
-            row += con.size
-        return out
-
-    def _joint_force(self, joint, lam, t, q, qd, p):
-        """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the
-        load λ gives, Coulomb friction: friction.py) and its force elements."""
-        g = np.zeros(self.n)
-        a, _, c = joint.evaluate(t, q, qd, p)
-        g[joint.indices] += a.T @ lam + c
-        if joint.coulomb is not None:
-            w, direction = joint.coulomb.evaluate(t, q, qd, p)
-            g[joint.coulomb.indices] -= np.sign(w) * np.linalg.norm(lam[joint.coulomb.load_rows]) * direction
-        for element in self.forces:
-            if element.joint == joint.name:
-                g[element.indices] += element.evaluate(t, q, qd, p)
-        return g
+        return self._data.reactions(t, q, qd, motion)
 
     def expression_names(self):
         """{name: sympy expression} of what expressions about this model may use: t, the

@@ -1,9 +1,10 @@
-"""Engines are reused, freed and chosen once per run (mbsynth.fast.background, engine.py).
+"""Engines are reused, freed and chosen once per run (data.py, mbsynth.fast.background, engine.py).
 
 A System from ``with_parameters`` shares its parent's compiled Template and gets its own
 numbers, which must equal those of a Layout built afresh for it, and motions equal to the
 literal (2.14) — also when a parameter makes a body massless. Engines die with their
-Systems. A run's path is fixed at its start, so runs are bit-identical.
+Systems. A run's Data fixes its path when it is made, so runs are bit-identical; a
+controller writes parameter values into the run's Data, and no System is built during a run.
 """
 
 import gc
@@ -19,8 +20,8 @@ import pytest
 import sympy as sp
 
 import mbsynth as mb
-from mbsynth import evaluation
 from mbsynth.fast import background, engine_for
+from mbsynth.system import System
 from mbsynth.fast.layout import build as build_layout
 
 # Parameters in a mass, an inertia, frame offsets, a rod's length, gravity and a force.
@@ -114,48 +115,62 @@ def test_a_force_parameter_keeps_the_layout_and_moves_the_motion(model, backgrou
     assert rel(derived.motion(1.0, q, qd).qdd, pushed.motion(1.0, q, qd, method="reference").qdd) < 1e-10
 
 
-def test_a_runs_children_share_its_evaluation_layout(model):
-    """A run's children (a sampled controller's System at each sample) use the run's
-    Evaluator — its groups laid out once — and give the M, Q, A, b, C of a System loaded
-    with those values; a plain System's children get their own (its groups' path is not
-    fixed). Only parts written in a changed parameter are checked again."""
-    run = model.for_run()
-    q, qd = a_state(run)
-    run.evaluate(0.2, q, qd)
-    child = run.with_parameters(k=-7.0, m=1.1)
-    assert evaluation.evaluator(child) is evaluation.evaluator(run)
+def test_parameters_written_into_a_data_give_a_loaded_systems_arrays(model):
+    """A controller's values written into a run's Data (``set_parameters``) give the M, Q, A,
+    b, C of a System loaded with those values, through the same Evaluator (its groups laid
+    out once). Only parts written in a changed parameter are checked again, and a value
+    that makes a part's mass matrix indefinite is refused, naming the part."""
+    data = model.data()
+    q, qd = a_state(model)
+    data.evaluate(0.2, q, qd)
+    evaluator = data.evaluator
+    data.set_parameters({"k": -7.0, "m": 1.1})
+    assert data.evaluator is evaluator and data.parameters["m"] == 1.1 and model.parameters["m"] == 1.3
     loaded = mb.loads(MODEL.replace("{m: 1.3,", "{m: 1.1,").replace("k: 2.0}", "k: -7.0}"), "loaded")
-    ours, theirs = child.evaluate(0.4, q, qd), loaded.evaluate(0.4, q, qd)
+    ours, theirs = data.evaluate(0.4, q, qd), loaded.evaluate(0.4, q, qd)
     for name in ("M", "Q", "A", "b", "C"):
         assert rel(getattr(ours, name), getattr(theirs, name)) < 1e-13, name
-    assert evaluation.evaluator(model.with_parameters(k=1.0)) is not evaluation.evaluator(model)
+    assert rel(data.motion(0.4, q, qd).qdd, loaded.motion(0.4, q, qd, method="reference").qdd) < 1e-10
     parts = {p.name: p for p in model.subsystems}
     m, k = sp.Symbol("m"), sp.Symbol("k")
     assert parts["b0"].reads({m}) and not parts["b1"].reads({m}) and not parts["b0"].reads({k})
     with pytest.raises(mb.ModelError, match="subsystem 'b0': the mass matrix is not positive semi-definite"):
-        run.with_parameters(m=-1.0)
+        data.set_parameters({"m": -1.0})
+    with pytest.raises(mb.ModelError, match=r"no parameter\(s\) \['mass'\]"):
+        data.set_parameters({"mass": 1.0})
 
 
 def test_the_runs_of_a_system_share_one_evaluation_layout(background_mode):
-    """Each run (``for_run``) of a System, and of its ``with_parameters`` children, uses the
-    Evaluator the first run made (its groups laid out once, not once per simulate), with
-    its own parameter values: the arrays equal a fresh load's. It dies with the System."""
+    """The Data of each run of a System, and of its ``with_parameters`` children, use one
+    Evaluator (its groups laid out once, not once per simulate), each with its own
+    parameter values: the arrays equal a fresh load's. It dies with the Systems."""
     system = mb.loads(MODEL, "reuse")
-    first, second = system.for_run(), system.for_run()
-    q, qd = a_state(first)
+    first, second = system.data(), system.data()
+    q, qd = a_state(system)
     first.constraint_arrays(0.2, q, qd)
-    assert evaluation.evaluator(second) is evaluation.evaluator(first)
+    assert second.evaluator is first.evaluator
     child = system.with_parameters(L=0.45)
-    run = child.for_run()
-    assert evaluation.evaluator(run) is evaluation.evaluator(first)
+    run = child.data()
+    assert run.evaluator is first.evaluator
     loaded = mb.loads(MODEL.replace("L: 0.4,", "L: 0.45,"), "loaded")
     ours, theirs = run.constraint_arrays(0.3, q, qd, sparse=False), loaded.constraint_arrays(0.3, q, qd, sparse=False)
     for k in range(5):
         assert rel(ours[k], theirs[k]) < 1e-13, k
-    made = weakref.ref(evaluation.evaluator(first))
+    made = weakref.ref(first.evaluator)
     del system, first, second, child, run
     gc.collect()
     assert made() is None
+
+
+def test_a_structural_replace_gets_a_cache_of_its_own(model):
+    """``dataclasses.replace`` with other parts or constraints (``with_constraints``) must not
+    inherit the compiled Template or Evaluators of another structure; other parameter
+    values keep them."""
+    assert replace(model, parameters={**model.parameters, "m": 2.0}).shared is model.shared
+    assert model.with_constraints([]).shared is model.shared  # nothing appended: the same structure
+    assert replace(model, constraints=model.constraints[:-1]).shared is not model.shared
+    renamed = {("mass" if k == "m" else k): v for k, v in model.parameters.items()}
+    assert replace(model, parameters=renamed).shared is not model.shared
 
 
 def test_a_massless_body_from_a_parameter(model, background_mode):
@@ -205,34 +220,50 @@ def test_a_failed_build_leaves_the_kkt_path_and_holds_no_system(monkeypatch, bac
     assert ref() is None
 
 
-def test_equal_systems_are_not_confused(model, background_mode):
-    """A copy with other numbers but no ``with_parameters`` lineage, and a second load of
-    the same text, get Engines of their own."""
+def test_equal_systems_behave_the_same(model, background_mode):
+    """A second load of the same text builds its own Template and takes the same path,
+    with bit-identical motions; a copy with other numbers shares the Template (parameters
+    are arguments of its code) with its own numbers."""
     engine = engine_for(model, wait=True)
     again = mb.loads(MODEL, "reuse")
-    assert engine_for(again, wait=True) is not engine
-    other = replace(model, parameters={**model.parameters, "m": 5.0})
-    theirs = engine_for(other, wait=True)
+    theirs = engine_for(again, wait=True)
     assert theirs is not engine and theirs.template is not engine.template
-    assert theirs.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
+    q, qd = a_state(model)
+    ours, other = model.data().motion(0.3, q, qd), again.data().motion(0.3, q, qd)
+    assert ours.method == other.method == "tree (Baraff)" and np.array_equal(ours.qdd, other.qdd)
+    heavier = engine_for(replace(model, parameters={**model.parameters, "m": 5.0}), wait=True)
+    assert heavier.template is engine.template
+    assert heavier.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
 
 
 def test_a_run_keeps_the_path_it_started_with(monkeypatch, background_mode):
-    """Kernels not compiled and the Engine not ready: the run takes the KKT path, and keeps it
-    after the Engine becomes ready; with them compiled, the run waits for the Engine."""
+    """Kernels not compiled and the Template not ready: a run's Data takes the KKT path, and
+    keeps it after the Template becomes ready; with them compiled, a new Data waits for it."""
     system = mb.loads(MODEL, "reuse")
     monkeypatch.setattr(background, "compiled", lambda: False)
-    monkeypatch.setattr(background, "_submit", lambda system, shared: shared.future)  # nothing builds
-    run = system.for_run()
-    assert engine_for(run) is None
+    monkeypatch.setattr(background, "_submit", lambda system, slot: slot.future)  # nothing builds
+    run = system.data()
+    assert run.engine is None
     monkeypatch.undo()
     monkeypatch.setenv("MBSYNTH_FAST", "background")
-    engine = engine_for(system, wait=True)
-    assert engine is not None
-    assert engine_for(run) is None and engine_for(run, wait=True) is None
+    assert engine_for(system, wait=True) is not None
+    assert run.engine is None and run.tree_engine() is None
     assert background.compiled()  # an Engine was warmed in this process
-    later = system.for_run()
-    assert engine_for(later) is engine
+    assert system.data().engine is not None
+
+
+def test_a_controlled_run_builds_no_system(monkeypatch, model):
+    """A sampled controller's values go into the run's Data: no System is made after the
+    run starts, and the run equals one whose controller's constant value is the model's."""
+    made = []
+    original = System.__post_init__
+    monkeypatch.setattr(System, "__post_init__", lambda self: (made.append(self), original(self)))
+    pushed = model.with_parameters(k=-3.0)
+    made.clear()
+    controlled = mb.simulate(model, 0.2, dt=0.05, controller=lambda t, values: {"k": -3.0}, control_dt=0.05)
+    assert made == []
+    held = mb.simulate(pushed, 0.2, dt=0.05)
+    assert rel(controlled.q, held.q) < 1e-8
 
 
 RUN = textwrap.dedent("""

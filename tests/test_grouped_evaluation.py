@@ -67,14 +67,14 @@ def test_batched_arrays_equal_the_loop_over_connectors(path):
 def test_a_robots_joints_share_one_call():
     """The UR5's links and joints are built from templates: far fewer raw calls than parts
     and connectors, and the same arrays."""
-    from mbsynth.evaluation import evaluator
     system = mb.from_robot("ur5")
+    data = system.data()
     q, qd = system.initial_state()
     qd = qd + 0.5
     M, Q, A, b, C, phi, psi, T, V = one_by_one(system, 0.0, q, qd)
-    rows = system.constraint_arrays(0.0, q, qd)
+    rows = data.constraint_arrays(0.0, q, qd)
     assert close(rows.A.toarray(), A) and close(rows.phi, phi) and close(rows.psi, psi)
-    batch = evaluator(system).rows
+    batch = data.evaluator.rows
     groups, singles = batch.layout[1], batch.layout[2]
     assert len(groups) + len(singles) < len(system.constraints) / 2
 
@@ -83,7 +83,6 @@ def test_a_robots_joint_torques_share_one_call_and_equal_their_sympy_force():
     """Talos's 32 actuations, each with its own torque parameter: one stacked call per joint
     template, and Q equal to the sum of the elements' sympy Q put in numbers by substitution."""
     import sympy as sp
-    from mbsynth.evaluation import evaluator
     system = mb.from_robot("talos", floating=True)
     torques = sorted(k for k in system.parameters if k.startswith("tau_"))
     system = system.with_parameters(**{k: 0.1 + 0.01 * i for i, k in enumerate(torques)})
@@ -95,7 +94,7 @@ def test_a_robots_joint_torques_share_one_call_and_equal_their_sympy_force():
     for element in system.forces:
         for (i, _), x in element.Q.todok().items():
             Q[i] += float(x.xreplace(values))
-    forces = evaluator(system)
+    forces = system.data().evaluator
     for _ in range(2):  # the first call lays the groups out, the second uses them
         stacked = np.bincount(forces.f_cols, weights=forces.forces(0.0, q, qd, system.parameter_values)[0],
                               minlength=system.n)

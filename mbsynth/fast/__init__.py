@@ -9,19 +9,17 @@
     tree.py        the tree's elimination in articulated form (null spaces, rigid transports)
     eigen.py       small symmetric eigendecomposition (the loops' Schur system)
     kernel.py      the whole evaluation and its checks
-    engine.py      a Template per model structure, an Engine per System: motion, motion_batch
+    engine.py      a Template per model structure, an Engine per parameter values: motion, motion_batch
     rows.py        φ, φ̇ of the kernel's rows and its nodes' energies (simulate's rows)
     correction.py  states put back on the constraints by the kernel, in the mass metric
     threads.py     the threads compiled kernels share (motion_batch, corrections)
-    background.py  building Engines off the caller's thread, shared and freed; MBSYNTH_FAST
+    background.py  building Templates off the caller's thread; MBSYNTH_FAST
     ahead.py       a cold compile's largest parts in helper processes, on the other core
-    batch.py       System.motion_batch
     cache.py       where compiled code is kept
 
 Importing this package does not import numba (``mbsynth check`` never needs it).
 """
 
-from .background import compile_ahead, compiled, engine_for, fix_path, share
-from .batch import motion_batch
+from .background import TemplateSlot, compile_ahead, compiled, engine_for, template
 
-__all__ = ["compile_ahead", "compiled", "engine_for", "fix_path", "motion_batch", "share"]
+__all__ = ["TemplateSlot", "compile_ahead", "compiled", "engine_for", "template"]

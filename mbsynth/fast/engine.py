@@ -2,13 +2,13 @@
 
 ``Template.build(system)`` lays the System out (layout.build) and compiles its generated
 function (codegen.py), or returns None when the kernels cover no part of it. Systems that
-differ only in parameter values (``System.with_parameters``) share one Template: the
-parameters are arguments of the generated function, and the Layout's numbers (masses,
-inertias, frame offsets) are re-evaluated per System (layout.with_parameters), which costs
-no compilation, and only where a parameter they depend on changed (a controller's
-torques do not: ``Template.number_parameters``; those Systems' Engines share one set of
-buffers, ``Engine.at``). ``Template.engine(system)`` makes a System's Engine: its numbers
-and work buffers. An Engine holds no reference to its System.
+differ only in parameter values (``System.with_parameters``, a Data's ``set_parameters``)
+share one Template: the parameters are arguments of the generated function, and the
+Layout's numbers (masses, inertias, frame offsets) are re-evaluated per parameter values
+(layout.with_parameters), which costs no compilation, and only where a parameter they
+depend on changed (a controller's torques do not: ``Template.number_parameters``; those
+Engines share one set of buffers, ``Engine.at``). ``Template.engine(p)`` makes the Engine
+at parameter values p: its numbers and work buffers. An Engine holds no reference to a System.
 
 ``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
 send the problem to the exact treatment (kernel.py's status); ``motion_batch`` evaluates
@@ -37,35 +37,36 @@ class Template:
 
     def __init__(self, system, L, exprs):
         self.L, self.n, self.p = L, system.n, system.parameter_values
+        self.names = tuple(system.parameters)
+        self.sources = layout.sources(L, system)  # the parts and joints its numbers are read from
         self.outputs = len(exprs)
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
         self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
-        self.number_parameters = None  # indices into p of the parameters the Layout's numbers use (``engine``)
+        used = layout.number_parameters(L, self.sources, system.parameters)
+        # the parameters the Layout's numbers use: values that differ only in others share L as it is
+        self.number_parameters = np.array([self.names.index(n) for n in sorted(used)], dtype=np.int64)
         self.on_layout = None  # the first Engine on L itself, whose buffers the later ones share
+        self.lock = threading.Lock()
 
     @classmethod
     def build(cls, system):
         found = layout.build(system)
         return None if found is None else cls(system, *found)
 
-    def engine(self, system):
-        """The Engine of ``system``: this Template's structure and code, its own numbers."""
-        p = system.parameter_values
-        if p.shape != self.p.shape:
-            return Engine(self, layout.with_parameters(self.L, system), p)
-        if self.number_parameters is None and not np.array_equal(p, self.p):
-            # found once, from any System of this structure: a System that differs only in
-            # other parameters (a controller's torques) shares the Layout as it is
-            names, used = list(system.parameters), layout.number_parameters(self.L, system)
-            self.number_parameters = np.array([names.index(n) for n in sorted(used)], dtype=np.int64)
-        used = slice(None) if self.number_parameters is None else self.number_parameters
-        if not np.array_equal(p[used], self.p[used]):
-            return Engine(self, layout.with_parameters(self.L, system), p)
-        if self.on_layout is None:
-            self.on_layout = Engine(self, self.L, p)
-            return self.on_layout
+    def engine(self, p):
+        """The Engine at parameter values ``p`` (an array in the model's parameter order): this
+        Template's structure and code, its own numbers where they differ from the Layout's
+        (masses, inertias, frames), else the buffers of the first Engine on the Layout (a
+        controller's torques: ``Engine.at``)."""
+        p = np.array(p, dtype=float)
+        if not np.array_equal(p[self.number_parameters], self.p[self.number_parameters]):
+            return Engine(self, layout.with_parameters(self.L, self.sources, dict(zip(self.names, p))), p)
+        with self.lock:
+            if self.on_layout is None:
+                self.on_layout = Engine(self, self.L, p)
+                return self.on_layout
         return self.on_layout.at(p)
 
 

@@ -1,7 +1,8 @@
 """What the fast path computes where: a System turned, once, into index and number arrays.
 
 Kernel nodes are the rigid bodies (with their own ``<body>.unit_quaternion`` row) and the
-particles; kernel joints are the holonomic ``Joint``s whose ends are nodes or the world and
+particles (their ``kind``); kernel joints are the holonomic joints (a ``joint_kind`` the
+kernel has a program for) whose ends are nodes or the world and
 whose frames are constant. A breadth-first search from the world (then from each body no
 joint path reaches) picks each node's parent joint: those joints form the tree
 (tree.py); the other kernel joints close loops, and their rows join the *extra rows*.
@@ -26,11 +27,12 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from ..connectors.joints import Joint
-from ..subsystems.particle import Particle
-from ..subsystems.rigid_body import RigidBody
 from .joints import COMPONENT, MAX_ROWS, PARTICLE, PROGRAMS, RIGID, WORLD
 from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
+
+# the parts' ``kind`` of the kernel's nodes: the model is read through its parts' and joints'
+# attributes (``kind``, ``joint_kind``, masses, frames), not their classes
+RIGID_BODY, PARTICLE_PART = "rigid_body", "particle"
 
 
 class Layout(NamedTuple):
@@ -83,10 +85,10 @@ def _ints(values, shape=None):
 
 
 class _Numbers:
-    """Float values of parameter expressions."""
+    """Float values of parameter expressions at ``parameters`` ({name: value})."""
 
-    def __init__(self, system):
-        self.values = {sp.Symbol(k): float(v) for k, v in system.parameters.items()}
+    def __init__(self, parameters):
+        self.values = {sp.Symbol(k): float(v) for k, v in parameters.items()}
 
     def constant(self, expr):
         return not (sp.sympify(expr).free_symbols - set(self.values))
@@ -101,8 +103,8 @@ class _Symbols(_Numbers):
     """The names of the parameters that numbers depend on (``used``), each expression's free
     symbols recorded; zeros of its shape returned."""
 
-    def __init__(self, system):
-        super().__init__(system)
+    def __init__(self, parameters):
+        super().__init__(parameters)
         self.used = set()
 
     def __call__(self, expr):
@@ -116,16 +118,16 @@ def build(system):
     or a joint has Coulomb friction (its C depends on q̈: system.motion iterates)."""
     if any(getattr(con, "coulomb", None) for con in system.constraints):
         return None
-    number = _Numbers(system)
+    number = _Numbers(system.parameters)
     starts = np.cumsum([0] + [len(p.coordinates) for p in system.subsystems])
     row_starts = np.cumsum([0] + [c.size for c in system.constraints])
     quat = {c.name: r for c, r in zip(system.constraints, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.subsystems, starts)
-             if (isinstance(part, RigidBody) and f"{part.name}.unit_quaternion" in quat) or isinstance(part, Particle)]
+             if (part.kind == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or part.kind == PARTICLE_PART]
     if not nodes:
         return None
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
-    quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if isinstance(part, RigidBody)}
+    quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if part.kind == RIGID_BODY}
     joints, others = [], []
     for con, row in zip(system.constraints, row_starts):
         if int(row) in quat_rows and con.size == 1:
@@ -136,7 +138,7 @@ def build(system):
 
 
 def _kernel_joint(con, node_of, number):
-    if not isinstance(con, Joint) or con.joint_kind not in PROGRAMS:
+    if getattr(con, "joint_kind", None) not in PROGRAMS:
         return False
     if any(part is not None and part.name not in node_of for part in con.parts):
         return False
@@ -188,21 +190,21 @@ def rigid_tree(L):
     return not (np.any(L.joint_kinds == PARTICLE) or L.xrow_row.size or L.x_coord.size)
 
 
-def with_parameters(L, system):
-    """``L``, built from a System with the parts and constraints of ``system`` (other
-    parameter values: ``System.with_parameters``), with the numbers of ``system``."""
-    return L._replace(**_numbers(*_sources(L, system), _Numbers(system)))
+def with_parameters(L, sources, parameters):
+    """``L`` with the numbers at ``parameters`` ({name: value}; the System ``L`` was built
+    from at other values), ``sources`` its nodes' parts and kernel joints (``sources``)."""
+    return L._replace(**_numbers(*sources, _Numbers(parameters)))
 
 
-def number_parameters(L, system):
-    """The names of the parameters that ``L``'s numbers (``_numbers``) depend on: a System
-    that differs from ``system`` only in others shares ``L`` as it is."""
-    symbols = _Symbols(system)
-    _numbers(*_sources(L, system), symbols)
+def number_parameters(L, sources, parameters):
+    """The names of the parameters that ``L``'s numbers (``_numbers``) depend on: parameter
+    values that differ only in others share ``L`` as it is."""
+    symbols = _Symbols(parameters)
+    _numbers(*sources, symbols)
     return frozenset(symbols.used)
 
 
-def _sources(L, system):
+def sources(L, system):
     """(the parts of ``L``'s nodes, the constraints of its kernel joints) in ``system``."""
     starts = np.cumsum([0] + [len(p.coordinates) for p in system.subsystems])
     rows = np.cumsum([0] + [c.size for c in system.constraints])
@@ -216,7 +218,7 @@ def _numbers(parts, joints, number):
     kernel ``joints``: node_mass, node_mg, node_J, joint_s, joint_R, joint_length."""
     masses, mg, inertia = [], [], []
     for part in parts:
-        if isinstance(part, RigidBody):
+        if part.kind == RIGID_BODY:
             masses.append(number(part.mass)[0, 0])
             inertia.append(number(part.inertia))
             mg.append(number(part.mass * part.gravity).ravel())
@@ -227,7 +229,7 @@ def _numbers(parts, joints, number):
     offsets, rotations, lengths = [], [], []
     for con in joints:
         for part, frame in zip(con.parts, con.frames):
-            offsets.append(np.zeros(3) if isinstance(part, Particle) else number(frame.position).ravel())
+            offsets.append(np.zeros(3) if part.kind == PARTICLE_PART else number(frame.position).ravel())
             rotations.append(number(frame.rotation))
         lengths.append(number(con.length)[0, 0] if con.joint_kind == "distance" else 1.0)
     N = len(parts)
@@ -253,7 +255,7 @@ class _Builder:
 
     def layout(self):
         nodes, joints = self.nodes, self.joints
-        rigid = [isinstance(part, RigidBody) for part, _ in nodes]
+        rigid = [part.kind == RIGID_BODY for part, _ in nodes]
         v = [6 if r else 3 for r in rigid]
         k = [joints[j][0].size if j >= 0 else 0 for j in self.pjoint]
         d = [a + b for a, b in zip(v, k)]
@@ -325,7 +327,7 @@ class _Builder:
                 starts.append(0)
             else:
                 i = self.node_of[part.name]
-                kinds.append(RIGID if isinstance(part, RigidBody) else PARTICLE)
+                kinds.append(RIGID if part.kind == RIGID_BODY else PARTICLE)
                 starts.append(self.nodes[i][1])
         program = np.zeros((MAX_ROWS, 3), dtype=np.int64)
         program[:con.size] = PROGRAMS[con.joint_kind]

@@ -11,7 +11,7 @@ one structure together. ``kernel(raw)`` turns that structure into
 
 written into the cache under the hash of its text and compiled by numba (``cache=True``:
 a structure seen before, by any model, loads its machine code from disk). Like the
-Engine (background.py), the kernel is built off the caller's thread unless
+Template (background.py), the kernel is built off the caller's thread unless
 ``MBSYNTH_FAST`` is "wait"; "off" never builds it; until it is ready, ``kernel`` answers
 None and grouped.py uses numpy.
 """
@@ -42,31 +42,34 @@ def evaluate(t, q, qd, p, columns, values, fixed, out):
 
 SIGNATURE = ("(float64, float64[::1], float64[::1], float64[::1], int64[:, ::1], float64[:, ::1], "
              "float64[:, ::1], float64[:, ::1])")
-_kernels = {}  # id(raw) -> (raw, evaluate or None while building / when it failed)
 _lock = threading.Lock()
 _tasks = queue.Queue()
 _worker = None
+UNSET = "unset"  # a raw function's ``kernel`` before its build was asked for
 
 
 def kernel(raw, wait=False):
     """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
     symbolic._lambdify), or None: not ready yet, MBSYNTH_FAST=off, or not compilable.
-    ``wait``: build it now if it is not ready (as MBSYNTH_FAST=wait does)."""
-    found = _kernels.get(id(raw))
-    if found is not None and found[0] is raw and (found[1] is not None or not wait):
-        return found[1]
+    ``wait``: build it now if it is not ready (as MBSYNTH_FAST=wait does). The kernel is
+    kept on ``raw`` itself (its attribute ``kernel``: None while building or failed)."""
+    found = getattr(raw, "kernel", UNSET)
+    if found is not None and found is not UNSET:
+        return found
+    if found is None and not wait:
+        return None
     setting = mode()
     if setting == "off" or not hasattr(raw, "structure"):
         return None
     with _lock:
-        building = id(raw) in _kernels and _kernels[id(raw)][0] is raw
+        building = getattr(raw, "kernel", UNSET) is not UNSET
         if not building:
-            _kernels[id(raw)] = (raw, None)
+            raw.kernel = None
     if setting == "wait" or wait:
         _build(raw)  # a background build of the same structure may run too: either result serves
     elif not building:
         _start(raw)
-    return _kernels[id(raw)][1]
+    return raw.kernel
 
 
 def _build(raw):
@@ -76,7 +79,7 @@ def _build(raw):
     except Exception as err:  # noqa: BLE001 - numpy serves
         log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
         return
-    _kernels[id(raw)] = (raw, evaluate)
+    raw.kernel = evaluate
 
 
 def _start(raw):
