@@ -35,6 +35,11 @@ from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
 RIGID_BODY, PARTICLE_PART = "rigid_body", "particle"
 
 
+def _kind(part):
+    """The ``kind`` of a part, None for the world (a joint's missing end)."""
+    return None if part is None else part.kind
+
+
 class Layout(NamedTuple):
     """Arrays read by the kernels (assembly.py, kernel.py). N nodes, K kernel joints."""
 
@@ -123,11 +128,11 @@ def build(system):
     row_starts = np.cumsum([0] + [c.size for c in system.constraints])
     quat = {c.name: r for c, r in zip(system.constraints, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.subsystems, starts)
-             if (part.kind == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or part.kind == PARTICLE_PART]
+             if (_kind(part) == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or _kind(part) == PARTICLE_PART]
     if not nodes:
         return None
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
-    quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if part.kind == RIGID_BODY}
+    quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _kind(part) == RIGID_BODY}
     joints, others = [], []
     for con, row in zip(system.constraints, row_starts):
         if int(row) in quat_rows and con.size == 1:
@@ -218,7 +223,7 @@ def _numbers(parts, joints, number):
     kernel ``joints``: node_mass, node_mg, node_J, joint_s, joint_R, joint_length."""
     masses, mg, inertia = [], [], []
     for part in parts:
-        if part.kind == RIGID_BODY:
+        if _kind(part) == RIGID_BODY:
             masses.append(number(part.mass)[0, 0])
             inertia.append(number(part.inertia))
             mg.append(number(part.mass * part.gravity).ravel())
@@ -229,7 +234,7 @@ def _numbers(parts, joints, number):
     offsets, rotations, lengths = [], [], []
     for con in joints:
         for part, frame in zip(con.parts, con.frames):
-            offsets.append(np.zeros(3) if part.kind == PARTICLE_PART else number(frame.position).ravel())
+            offsets.append(np.zeros(3) if _kind(part) == PARTICLE_PART else number(frame.position).ravel())
             rotations.append(number(frame.rotation))
         lengths.append(number(con.length)[0, 0] if con.joint_kind == "distance" else 1.0)
     N = len(parts)
@@ -255,7 +260,7 @@ class _Builder:
 
     def layout(self):
         nodes, joints = self.nodes, self.joints
-        rigid = [part.kind == RIGID_BODY for part, _ in nodes]
+        rigid = [_kind(part) == RIGID_BODY for part, _ in nodes]
         v = [6 if r else 3 for r in rigid]
         k = [joints[j][0].size if j >= 0 else 0 for j in self.pjoint]
         d = [a + b for a, b in zip(v, k)]
@@ -327,7 +332,7 @@ class _Builder:
                 starts.append(0)
             else:
                 i = self.node_of[part.name]
-                kinds.append(RIGID if part.kind == RIGID_BODY else PARTICLE)
+                kinds.append(RIGID if _kind(part) == RIGID_BODY else PARTICLE)
                 starts.append(self.nodes[i][1])
         program = np.zeros((MAX_ROWS, 3), dtype=np.int64)
         program[:con.size] = PROGRAMS[con.joint_kind]
