@@ -29,7 +29,7 @@ $(VENV)/bin/python:
 
 $(STAMP): pyproject.toml | $(VENV)/bin/python
 	$(PY) -m pip install --quiet -e .
-	$(PY) -m mbsynth.fast
+	$(PY) -m mbsynth.compiled
 	touch $@
 
 $(TEST_STAMP): pyproject.toml $(STAMP)

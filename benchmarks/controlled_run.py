@@ -30,7 +30,7 @@ CONTROL_DT = 0.01
 def pd_law(system):
     """PD towards TARGET, gains from the joint-space inertia there (as examples/pd_arm_payload.py)."""
     import pinocchio as pin
-    from mbsynth.robots import robot_files
+    from mbsynth.robots.build import robot_files
     model = pin.buildModelFromUrdf(robot_files()["ur5"])
     inertia = np.diag(pin.crba(model, model.createData(), TARGET))
     kp, kd = inertia * BANDWIDTH**2, 2 * DAMPING * inertia * BANDWIDTH

@@ -25,7 +25,7 @@ model with a free-flyer root, the chain's joints) and start both codes from the 
 positions of the bodies. Each figure is the best of ``--rounds`` runs, the two codes alternating;
 the ratio is to Pinocchio's time in the same run. mbsynth runs twice a round: as a user
 gets it, the corrections of the output rows a step passed split among the cores
-(mbsynth/fast/threads.py), and on one thread, as Pinocchio runs. Also: the evaluations of the right-hand
+(mbsynth/compiled/threads.py), and on one thread, as Pinocchio runs. Also: the evaluations of the right-hand
 side, and for mbsynth the largest position residual of the outputs and the spread of the
 total energy (zero for the exact motion). Model building is not timed in that table; the
 second table times it, each figure in a fresh process (best of ``--rounds``): ``import
@@ -65,11 +65,11 @@ import pinocchio as pin  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
 import mbsynth as mb  # noqa: E402
-import mbsynth.fast.threads as threads  # noqa: E402
+import mbsynth.compiled.threads as threads  # noqa: E402
 from exudyn_tree import ExudynTree  # noqa: E402
 from fast_dynamics import chain_yaml  # noqa: E402
-from mbsynth.robots import robot_files  # noqa: E402
-from mbsynth.twin import Twin  # noqa: E402
+from mbsynth.robots.build import robot_files  # noqa: E402
+from mbsynth.robots.twin import Twin  # noqa: E402
 from mujoco_twin import MujocoTwin  # noqa: E402
 
 HERE = Path(__file__).resolve().parent

@@ -7,7 +7,7 @@ motion on the tree path), for each model (``chain:N``: N links of ``chain_yaml``
 fast_dynamics.py), its first parameter m scaled by a random factor in [0.9, 1.1]:
 
 - *reuse*: ``base.with_parameters(m=…)`` and its first ``motion``: the new System shares
-  base's Template (mbsynth.fast.engine), only the Layout's numbers are evaluated;
+  base's Template (mbsynth.compiled.engine), only the Layout's numbers are evaluated;
 - *no reuse*: the same, on a copy of that System without the ``with_parameters`` lineage
   (``dataclasses.replace``), which builds its own Template (layout, generated source,
   warm-up), as every ``with_parameters`` System did before; the compiled generated module
@@ -33,7 +33,7 @@ os.environ["MBSYNTH_FAST"] = "wait"
 import numpy as np  # noqa: E402
 
 import mbsynth as mb  # noqa: E402
-from mbsynth.fast import engine_for  # noqa: E402
+from mbsynth.compiled import engine_for  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

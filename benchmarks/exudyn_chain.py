@@ -58,7 +58,7 @@ import exudyn as exu
 import exudyn.utilities as eu
 
 import mbsynth as mb
-from mbsynth.fast import engine_for
+from mbsynth.compiled import engine_for
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))

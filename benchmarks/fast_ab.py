@@ -31,7 +31,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from fast_dynamics import best, chain_case, robot_case  # noqa: E402
 
-from mbsynth.fast import cache, engine_for, kernel  # noqa: E402
+from mbsynth.compiled import cache, engine_for, kernel  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 ROUNDS = 15

@@ -1,11 +1,11 @@
-"""The tree path of mbsynth.fast on every robot of example-robot-data that mbsynth and
+"""The tree path of mbsynth.compiled on every robot of example-robot-data that mbsynth and
 Pinocchio load, with a floating base, against Pinocchio's ``aba`` (the exact motion, as in
 ``mbsynth validate``); writes benchmarks/fast_robots_results.md.
 
     .venv/bin/python benchmarks/fast_all_robots.py [--samples 3] [--only ur5 talos ...]
 
 At each state (Pinocchio's random configuration and velocity, mapped to maximal
-coordinates) the Engine's answer must exist and agree with ``aba`` to validate.TOLERANCE
+coordinates) the Engine's answer must exist and agree with ``aba`` to core.tolerances.VALIDATION_RTOL
 relative, or — where ``aba`` has no finite answer (massless links that a torque-free state
 leaves indeterminate) — the Engine must decline (its checks hand such states to the exact
 treatment). The difference from ``method="reference"`` is reported too: the literal
@@ -26,11 +26,12 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from mbsynth import robots  # noqa: E402
-from mbsynth.errors import ModelError  # noqa: E402
-from mbsynth.fast import engine_for  # noqa: E402
-from mbsynth.twin import Twin  # noqa: E402
-from mbsynth.validate import TOLERANCE, robot_table, sample_pinocchio_state  # noqa: E402
+from mbsynth.robots import build as robots  # noqa: E402
+from mbsynth.core.errors import ModelError  # noqa: E402
+from mbsynth.compiled import engine_for  # noqa: E402
+from mbsynth.robots.twin import Twin  # noqa: E402
+from mbsynth.robots.validate import robot_table, sample_pinocchio_state  # noqa: E402
+from mbsynth.core.tolerances import VALIDATION_RTOL
 
 HERE = Path(__file__).resolve().parent
 
@@ -55,26 +56,26 @@ def check(name, samples, rng):
         fast = engine.motion(0.0, qm, qdm)
         if not np.all(np.isfinite(exact)):
             if fast is not None:
-                return len(system.subsystems), None, None, compared, declined, "FAILED: answered where aba has none"
+                return len(system.parts), None, None, compared, declined, "FAILED: answered where aba has none"
             declined += 1
             continue
         if fast is None:
-            return len(system.subsystems), None, None, compared, declined, "FAILED: declined a determinate state"
+            return len(system.parts), None, None, compared, declined, "FAILED: declined a determinate state"
         error = np.abs(twin.to_pinocchio(qm, qdm, fast.qdd)[2] - exact).max()
         worst = max(worst, error / max(np.abs(exact).max(), 1e-300))
         ref = system.motion(0.0, qm, qdm, method="reference").qdd
         worst_ref = max(worst_ref, np.linalg.norm(fast.qdd - ref) / max(np.linalg.norm(ref), 1e-300))
         compared += 1
-    note = "" if worst <= TOLERANCE else "FAILED"
-    return len(system.subsystems), worst, worst_ref, compared, declined, note
+    note = "" if worst <= VALIDATION_RTOL else "FAILED"
+    return len(system.parts), worst, worst_ref, compared, declined, note
 
 
 def write(rows, path):
-    lines = ["# The tree path (mbsynth.fast) against Pinocchio on every robot", "",
+    lines = ["# The tree path (mbsynth.compiled) against Pinocchio on every robot", "",
              f"{datetime.date.today()}, {platform.machine()}, Python {platform.python_version()}; written by "
              "`benchmarks/fast_all_robots.py` (floating base, zero torques). *error*: the largest joint "
              f"acceleration error of `Engine.motion` against Pinocchio's `aba`, relative to the largest (must be "
-             f"≤ {TOLERANCE:g}); *vs (2.14)*: the relative difference of q̈ from `method=\"reference\"`; "
+             f"≤ {VALIDATION_RTOL:g}); *vs (2.14)*: the relative difference of q̈ from `method=\"reference\"`; "
              "*declined*: states where `aba` has no finite answer and the Engine, rightly, gives none.", "",
              "| robot | bodies | states | error | vs (2.14) | declined | note |",
              "|---|---:|---:|---:|---:|---:|---|"]

@@ -1,4 +1,4 @@
-"""The fast path (mbsynth.fast) against Pinocchio's ``aba`` on the same systems, in one process.
+"""The fast path (mbsynth.compiled) against Pinocchio's ``aba`` on the same systems, in one process.
 
     .venv/bin/python benchmarks/fast_dynamics.py [--quick]
 
@@ -6,7 +6,7 @@ Per evaluation of ``System.motion`` (assembly + solve, the Motion object include
 ``pinocchio.aba`` (both called from Python): spatial pendulum chains of N = 1, 10, 100,
 1000 rigid links on revolute joints whose axes alternate between x and y, and the robots
 ur5, panda, solo12 (floating) and talos (floating) from example-robot-data
-(``mbsynth.robots.from_robot``; Pinocchio reads the same URDF). Each state is drawn in
+(``mbsynth.robots.build.from_robot``; Pinocchio reads the same URDF). Each state is drawn in
 Pinocchio's coordinates and mapped to mbsynth's by forward kinematics, and the two
 accelerations are compared (the links' angular accelerations, world axes) — the same
 system, not just the same size. Also: the growth exponent from N = 100 to 1000, the
@@ -33,9 +33,10 @@ import numpy as np
 import pinocchio as pin
 
 import mbsynth as mb
-from mbsynth import robots, solvers
-from mbsynth.fast import engine_for
-from mbsynth.kinematics import matrix_quaternion
+from mbsynth.robots import build as robots
+from mbsynth.core import solvers
+from mbsynth.compiled import engine_for
+from mbsynth.core.kinematics import matrix_quaternion
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -219,8 +220,8 @@ def chain_case(count):
 
 
 def robot_case(name, floating):
-    from mbsynth.twin import Twin
-    from mbsynth.validate import sample_pinocchio_state
+    from mbsynth.robots.twin import Twin
+    from mbsynth.robots.validate import sample_pinocchio_state
     started = time.perf_counter()
     system = robots.from_robot(name, floating=floating)
     loaded = time.perf_counter() - started
@@ -229,7 +230,7 @@ def robot_case(name, floating):
     def angular(q, v, a):
         pin.forwardKinematics(twin.model, twin.data, q, v, a)
         out = []
-        for part in system.subsystems:
+        for part in system.parts:
             placed = twin.bodies[part.name]
             R = twin.data.oMi[placed.joint].rotation
             out.append(R @ twin.data.a[placed.joint].angular)  # a body's ω̇ is its joint's
@@ -243,7 +244,7 @@ def robot_case(name, floating):
 def peak_memory(case):
     """Peak traced allocation (MiB) of building an Engine (layout, buffers; kernels cached)
     and one motion()."""
-    from mbsynth.fast.engine import Engine
+    from mbsynth.compiled.engine import Engine
     q, qd = case.system.initial_state()
     tracemalloc.start()
     Engine.build(case.system).motion(0.0, q, qd)
@@ -264,7 +265,7 @@ def startup(cache):
 
 def compile_times(cache):
     """Seconds to build a first Engine (double pendulum) in a fresh process: (cold, warm)."""
-    code = ("import time, mbsynth as mb\nfrom mbsynth.fast import engine_for\n"
+    code = ("import time, mbsynth as mb\nfrom mbsynth.compiled import engine_for\n"
             "s = mb.load('models/rigid/double_pendulum_spatial.yaml')\nt = time.perf_counter()\n"
             "engine_for(s, wait=True)\nprint(time.perf_counter() - t)\n")
     env = dict(os.environ, MBSYNTH_CACHE_DIR=str(cache))
@@ -311,7 +312,7 @@ def us(seconds):
 
 
 def write(rows, batch, startups, compiled, memory):
-    lines = ["# mbsynth.fast against Pinocchio", "",
+    lines = ["# mbsynth.compiled against Pinocchio", "",
              f"{datetime.date.today()}, {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
              f"Python {platform.python_version()}, Pinocchio {pin.__version__}; written by "
              "`benchmarks/fast_dynamics.py` (best of several repeats, motion() and aba in alternating rounds; ratios within this run).", "",

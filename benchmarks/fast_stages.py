@@ -30,7 +30,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from fast_dynamics import best, chain_case, robot_case  # noqa: E402
 
-from mbsynth.fast import engine_for, kernel  # noqa: E402
+from mbsynth.compiled import engine_for, kernel  # noqa: E402
 
 REPEAT, CALLS, ROUNDS = 10, 2000, 7
 # stage label → the kernel function its statement calls (solve: with the copy of its right side)

@@ -7,7 +7,7 @@ Per robot (smallest first) and random configuration: τ = rnea(q, 0, 0) as its t
 parameters, `mbsynth.linearize` at rest in maximal coordinates (every link a rigid body in
 7 coordinates), and the eigenvalues of its A against those of [[0, I], [∂v̇/∂q, ∂v̇/∂v]],
 matched one to one and compared in s² (validate_modes.eigenvalue_error); B, mapped to the model's
-coordinates, against S M⁻¹ (mbsynth/validate_modes.py). "first s" includes deriving and
+coordinates, against S M⁻¹ (mbsynth/robots/validate_modes.py). "first s" includes deriving and
 compiling the block functions; "linearize s" is a later call at another configuration.
 Writes benchmarks/modes_results.md after every robot, so an interrupted run keeps what it
 measured. BLAS runs single-threaded (see validate_all_robots.py).
@@ -22,10 +22,10 @@ import platform  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from mbsynth.errors import ModelError, SolveError  # noqa: E402
-from mbsynth.robots import fix_base, from_robot  # noqa: E402
-from mbsynth.validate import robot_table  # noqa: E402
-from mbsynth.validate_modes import validate_modes  # noqa: E402
+from mbsynth.core.errors import ModelError, SolveError  # noqa: E402
+from mbsynth.robots.build import fix_base, from_robot  # noqa: E402
+from mbsynth.robots.validate import robot_table  # noqa: E402
+from mbsynth.robots.validate_modes import validate_modes  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 TOLERANCE = 1e-6  # relative, as issue 21 asks
@@ -69,7 +69,7 @@ def write(args, rows, elapsed):
              f"mapped to the model's coordinates) against S M⁻¹: {len(passed)} of {len(results)} robots within "
              f"{TOLERANCE:.0e} relative. Eigenvalues are compared in s², relative to max |s|² "
              "(at least 1 s⁻²): a zero-stiffness direction (a vertical joint axis) has a double zero eigenvalue "
-             "that a rounding error δ splits into ±√δ, while s² moves by δ (mbsynth/validate_modes.py).", "",
+             "that a rounding error δ splits into ±√δ, while s² moves by δ (mbsynth/robots/validate_modes.py).", "",
              "| robot | links | nv | eigenvalues rel error | B rel error | build s | first linearize s | "
              "linearize s | result |",
              "|---|---|---|---|---|---|---|---|---|"]

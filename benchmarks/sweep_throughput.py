@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from distributed import LocalCluster
 
-from mbsynth.sweep import sweep
+from mbsynth.studies.sweep import sweep
 
 HERE = Path(__file__).resolve().parent
 MODEL = HERE.parent / "models" / "paper" / "example3_two_masses.yaml"

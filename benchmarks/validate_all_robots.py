@@ -22,9 +22,10 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from mbsynth.cli.validate import figure, loop_figure  # noqa: E402
-from mbsynth.errors import ModelError, SolveError  # noqa: E402
+from mbsynth.core.errors import ModelError, SolveError  # noqa: E402
 from mbsynth.io import load  # noqa: E402
-from mbsynth.validate import TOLERANCE, Validation, robot_table, validate_robot, validate_system  # noqa: E402
+from mbsynth.robots.validate import Validation, robot_table, validate_robot, validate_system  # noqa: E402
+from mbsynth.core.tolerances import VALIDATION_RTOL
 
 HERE = Path(__file__).resolve().parent
 MODELS = [*(HERE.parent / "models" / "mechanisms" / f"{name}.yaml" for name in ("four_bar_3d", "bennett")),
@@ -48,7 +49,7 @@ def main():
             rows += [(name, r) for r in validate_robot(name, samples=args.samples)]
         except (ModelError, SolveError) as err:
             rows.append((name, Validation(name, "-", 0, 0, args.samples, float("nan"), float("nan"), False,
-                                          TOLERANCE, 0.0, 0.0, str(err))))
+                                          VALIDATION_RTOL, 0.0, 0.0, str(err))))
         write(args, rows, time.perf_counter() - started)
     for path in MODELS:
         if not args.only or path.stem in args.only:
@@ -81,7 +82,7 @@ def write(args, rows, elapsed):
              "(smallest first).", "",
              f"Joint accelerations v̇ of mbsynth (every link a rigid body in 7 coordinates, (2.14)) against "
              f"`pinocchio.aba` (`constraintDynamics` for loops) at {args.samples} random states and torques "
-             f"each: {passed} of {len(compared)} comparisons pass the relative tolerance {TOLERANCE:.0e}; the largest "
+             f"each: {passed} of {len(compared)} comparisons pass the relative tolerance {VALIDATION_RTOL:.0e}; the largest "
              f"relative error among them is {worst:.1e}. Not compared: {len(rows) - len(compared)} row(s) — files "
              "whose data no rigid body has (mbsynth refuses them by link; Pinocchio does not check), and robots "
              "with massless links on which `pinocchio.aba` returns NaN while mbsynth names the indeterminate "

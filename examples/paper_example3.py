@@ -16,7 +16,7 @@ import numpy as np
 
 import mbsynth as mb
 from mbsynth.cli.check import format_check
-from mbsynth.diagnose import diagnose
+from mbsynth.analysis.diagnose import diagnose
 
 MODELS = Path(__file__).resolve().parent.parent / "models" / "paper"
 OUT = Path(__file__).resolve().parent.parent / "out"

@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 import mbsynth as mb
-from mbsynth.constraint import Connector
-from mbsynth.joint_values import along, constraint_symbols
+from mbsynth.model.connectors.base import Connector
+from mbsynth.model.joint_values import along, constraint_symbols
 
 MODEL = Path(__file__).resolve().parent.parent / "models" / "robots" / "ur5_payload.yaml"
 JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
@@ -40,7 +40,7 @@ def gains():
     Pinocchio's crba): kp = I ω², kd = 2 ζ I ω. Equal gains on every joint would make the
     light wrist's sampled loop unstable (kd·dt/I ≫ 1 with a 10 ms hold)."""
     import pinocchio as pin
-    from mbsynth.robots import robot_files
+    from mbsynth.robots.build import robot_files
     model = pin.buildModelFromUrdf(robot_files()["ur5"])
     inertia = np.diag(pin.crba(model, model.createData(), TARGET))
     return inertia * BANDWIDTH**2, 2 * DAMPING * inertia * BANDWIDTH
@@ -49,7 +49,7 @@ def gains():
 def static_torques(system, names, t, q):
     """The joint torques that hold ``system`` at rest at the positions q: the multipliers
     of one servo row per joint angle (inverse statics by constraints, reactions.py)."""
-    joints = {c.name: c for c in system.constraints}
+    joints = {c.name: c for c in system.connectors}
     angles = system.joint_values(t, q, np.zeros(system.n))
     servos = [Connector.holonomic(f"{name}_servo", [constraint_symbols(joints[name])["angle"]
                                                     - angles[name].position[0]],

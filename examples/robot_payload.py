@@ -28,10 +28,10 @@ import pinocchio as pin
 import mbsynth as mb
 from mbsynth.cli.check import format_check
 from mbsynth.cli.validate import format_validation
-from mbsynth.diagnose import diagnose
-from mbsynth.robots import robot_files
-from mbsynth.twin import Twin
-from mbsynth.validate import sample_pinocchio_state, validate_system
+from mbsynth.analysis.diagnose import diagnose
+from mbsynth.robots.build import robot_files
+from mbsynth.robots.twin import Twin
+from mbsynth.robots.validate import sample_pinocchio_state, validate_system
 
 MODEL = Path(__file__).resolve().parent.parent / "models" / "robots" / "ur5_payload.yaml"
 
@@ -60,8 +60,8 @@ def main():
     build_s = time.perf_counter() - started
     q, qd = system.initial_state()
     M = system.evaluate(0.0, q, qd).M
-    massless = [p.name for p in system.subsystems if p.mass == 0]
-    print(f"{len(system.subsystems)} rigid bodies, {system.n} coordinates, {len(system.constraint_names)} constraint rows")
+    massless = [p.name for p in system.parts if p.mass == 0]
+    print(f"{len(system.parts)} rigid bodies, {system.n} coordinates, {len(system.constraint_names)} constraint rows")
     print("massless links (zero blocks of M):", ", ".join(massless))
     print("rank M =", np.linalg.matrix_rank(M), "of", system.n)
     print("joint torques (parameters):", ", ".join(p for p in system.parameters if p.startswith("tau_")))

@@ -25,12 +25,12 @@ import pinocchio as pin
 import sympy as sp
 
 import mbsynth as mb
-from mbsynth.connectors.joints import joint_equations
-from mbsynth.constraint import Connector
-from mbsynth.projection import project_velocities
-from mbsynth.robots import LINK_FRAME
-from mbsynth.symbolic import T_SYMBOL
-from mbsynth.twin import Twin
+from mbsynth.model.connectors.joints import joint_equations
+from mbsynth.model.connectors.base import Connector
+from mbsynth.analysis.projection import project_velocities
+from mbsynth.robots.build import LINK_FRAME
+from mbsynth.symbolic.derive import T_SYMBOL
+from mbsynth.robots.twin import Twin
 
 RADIUS, PERIOD = 0.10, 2.0  # m, s
 START = np.array([0.0, -1.2, 1.6, -1.97, -1.57, 0.0])  # joint angles: elbow up, tool pointing down
@@ -48,7 +48,7 @@ def tool_path_constraint(system, tool, p0, R0):
 
 def servo_rows(system, joints):
     """One row ``joint.angle`` per joint: its multiplier is the torque about the joint."""
-    by_name = {c.name: c for c in system.constraints}
+    by_name = {c.name: c for c in system.connectors}
     return [Connector.holonomic(f"{name}_servo", [by_name[name].angle], system.q_symbols, system.qd_symbols,
                                 system.parameter_symbols) for name in joints]
 
@@ -58,7 +58,7 @@ def main(picture="ur5_circle.png"):
     twin = Twin(arm)
     joints = [c.name for c in twin.coordinates]
     q0, _ = twin.to_maximal(START, np.zeros(twin.model.nv))
-    tool = next(p for p in arm.subsystems if p.name == "tool0")
+    tool = next(p for p in arm.parts if p.name == "tool0")
     at_start = dict(zip(arm.q_symbols, q0))
     p0, R0 = (np.array(x.xreplace(at_start), dtype=float) for x in tool.pose(tool.frames[LINK_FRAME]))
     drawing = arm.with_constraints([tool_path_constraint(arm, tool, p0, R0)])

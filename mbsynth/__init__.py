@@ -11,23 +11,22 @@ pinocchio and numba load when their feature is used.
 """
 
 import importlib
-import sys
-import types
 
-from .equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
-from .errors import ModelError, SimulationError, SolveError
+from .core.equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
+from .core.errors import ModelError, SimulationError, SolveError
 
 __version__ = "0.1.0"
 
 # Public names imported on first use: name -> the submodule that defines it.
 _LAZY = {
-    "load": "io", "loads": "io", "System": "system", "from_robot": "robots", "simulate": "simulate",
-    "sweep": "sweep", "Trajectory": "trajectory", "load_trajectory": "trajectory",
-    "equilibrium": "statics", "linearize": "linearization", "Linearization": "linearization",
-    "modes": "modal", "Modes": "modal",
+    "load": "io", "loads": "io", "System": "model.system", "from_robot": "robots.build",
+    "simulate": "analysis.simulate", "sweep": "studies.sweep", "Trajectory": "analysis.trajectory",
+    "load_trajectory": "analysis.trajectory", "equilibrium": "analysis.statics",
+    "linearize": "analysis.linearization", "Linearization": "analysis.linearization",
+    "modes": "analysis.modes", "Modes": "analysis.modes",
 }
 # Public submodules imported on first use: mb.viewer.show, mb.viewer.to_html.
-_SUBMODULES = ("viewer",)
+_SUBMODULES = {"viewer": "view.viewer"}
 
 __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
@@ -39,7 +38,7 @@ def __getattr__(name):
     if name in _LAZY:
         value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
     elif name in _SUBMODULES:
-        value = importlib.import_module(f"{__name__}.{name}")
+        value = importlib.import_module(f"{__name__}.{_SUBMODULES[name]}")
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value  # later look-ups do not come back here
@@ -48,16 +47,3 @@ def __getattr__(name):
 
 def __dir__():
     return sorted(set(globals()) | set(__all__))
-
-
-class _Package(types.ModuleType):
-    """The package's module type. Importing a submodule binds it as an attribute of the
-    package; ``mb.simulate`` and ``mb.sweep`` name functions that share their modules'
-    names, so that binding is skipped and the function stays what the name means."""
-
-    def __setattr__(self, name, value):
-        if not (name in _LAZY and isinstance(value, types.ModuleType)):
-            super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package

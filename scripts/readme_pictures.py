@@ -1,5 +1,5 @@
 """The README's pictures of the viewer, made the way a user sees them: the HTML animation
-written by ``mb.viewer.to_html``, photographed by headless Chromium (mbsynth.screenshot).
+written by ``mb.viewer.to_html``, photographed by headless Chromium (mbsynth.view.screenshot).
 
     .venv/bin/python scripts/readme_pictures.py        # writes docs/viewer_*.png
 """
@@ -11,7 +11,7 @@ from pathlib import Path
 from PIL import Image
 
 import mbsynth as mb
-from mbsynth.screenshot import screenshot
+from mbsynth.view.screenshot import screenshot
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
@@ -31,7 +31,7 @@ def main():
     DOCS.mkdir(exist_ok=True)
     system = mb.load(ROOT / "models" / "paper" / "example3_two_masses.yaml")
     picture(system, mb.simulate(system, 4.0, dt=1 / 30), "viewer_example3", budget_ms=1500)
-    from mbsynth.robots import from_robot
+    from mbsynth.robots.build import from_robot
 
     robot = from_robot("ur5")  # unpowered: it falls from its zero configuration
     picture(robot, mb.simulate(robot, 0.6, dt=1 / 30), "viewer_ur5", budget_ms=400)

@@ -1,5 +1,5 @@
 """Quaternion kinematics in numpy for the tests, written from the formulas (not from
-mbsynth.kinematics): u = (w, x, y, z) scalar-first, ω_body = 2 E(u) u̇, ω_world = 2 G(u) u̇."""
+mbsynth.core.kinematics): u = (w, x, y, z) scalar-first, ω_body = 2 E(u) u̇, ω_world = 2 G(u) u̇."""
 
 import numpy as np
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from mbsynth.cli import parser
-from mbsynth.robots import share_dir
+from mbsynth.robots.build import share_dir
 
 PACKAGE = Path(__file__).resolve().parent.parent / "mbsynth"
 
@@ -45,7 +45,7 @@ def module_names():
 
 def test_every_submodule_imports_first_in_a_fresh_interpreter():
     names = module_names()
-    assert "mbsynth.subsystems" in names and "mbsynth.connectors.joints" in names
+    assert "mbsynth.model.parts" in names and "mbsynth.model.connectors.joints" in names
     result = subprocess.run([sys.executable, "-c", FIRST_IMPORTS, str(PACKAGE), *names],
                             capture_output=True, text=True, timeout=600, check=False)
     assert result.returncode == 0, result.stderr
@@ -84,12 +84,12 @@ def test_check_loads_only_what_check_needs():
 def test_public_names_resolve_after_any_import_order():
     """``mb.simulate`` and ``mb.sweep`` stay the functions even when their modules were
     imported first (importing a submodule binds its name on the package)."""
-    out, _ = run_fresh("import types, mbsynth.sweep, mbsynth.simulate, mbsynth as mb\n"
+    out, _ = run_fresh("import types, mbsynth.studies.sweep, mbsynth.analysis.simulate, mbsynth as mb\n"
                        "for name in mb.__all__:\n"
                        "    value = getattr(mb, name)\n"
                        "    assert isinstance(value, types.ModuleType) == (name == 'viewer'), name\n"
-                       "assert mb.simulate is sys.modules['mbsynth.simulate'].simulate\n"
-                       "assert mb.sweep is sys.modules['mbsynth.sweep'].sweep\n"
+                       "assert mb.simulate is sys.modules['mbsynth.analysis.simulate'].simulate\n"
+                       "assert mb.sweep is sys.modules['mbsynth.studies.sweep'].sweep\n"
                        "print(sorted(set(mb.__all__) - set(dir(mb))))")
     assert out.strip() == "[]"
 

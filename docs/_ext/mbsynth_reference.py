@@ -37,7 +37,7 @@ def model_files_page():
              "Every key a model file (YAML) may hold, generated from `mbsynth/io/schema.py`: the same "
              "tables the loader checks files against, so a key listed here is accepted and any other "
              "is refused with a `ModelError` naming the file and line. Expressions are parsed by "
-             "`mbsynth.expressions` (never evaluated as code); an *expression of parameters* may use "
+             "`mbsynth.core.expressions` (never evaluated as code); an *expression of parameters* may use "
              "the model's `parameters` and the constants `pi`, `e`.", ""]
     for section in SECTIONS.values():
         lines += [f"(model-{section.name})=", f"## `{section.name}`", "", f"*Where:* {section.where}", ""]

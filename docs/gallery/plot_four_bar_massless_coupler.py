@@ -22,8 +22,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import mbsynth as mb
-from mbsynth.diagnose import diagnose
-from mbsynth.joint_values import along
+from mbsynth.analysis.diagnose import diagnose
+from mbsynth.model.joint_values import along
 
 MODELS = Path("../../models")  # sphinx-gallery runs each script in its own folder
 heavy = mb.load(MODELS / "mechanisms" / "four_bar.yaml")

@@ -25,7 +25,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import mbsynth as mb
-from mbsynth.diagnose import diagnose
+from mbsynth.analysis.diagnose import diagnose
 
 MODELS = Path("../../models")  # sphinx-gallery runs each script in its own folder
 text = (MODELS / "mechanisms" / "massless_link.yaml").read_text()

@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import mbsynth as mb
-from mbsynth.modal import format_modes
+from mbsynth.analysis.modes import format_modes
 
 double = mb.load(Path("../../models/mechanisms/double_pendulum_rods.yaml"))
 result = mb.modes(double, equilibrium=True)  # the rest position found from the initial one

@@ -21,7 +21,7 @@ import numpy as np
 
 import mbsynth as mb
 from mbsynth.cli.check import format_check
-from mbsynth.diagnose import diagnose
+from mbsynth.analysis.diagnose import diagnose
 
 MODELS = Path("../../models")  # sphinx-gallery runs each script in its own folder
 system = mb.load(MODELS / "paper" / "example2_massless_particle.yaml")

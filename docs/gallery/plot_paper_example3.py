@@ -30,7 +30,7 @@ import numpy as np
 
 import mbsynth as mb
 from mbsynth.cli.check import format_check
-from mbsynth.diagnose import diagnose
+from mbsynth.analysis.diagnose import diagnose
 
 MODELS = Path("../../models")  # sphinx-gallery runs each script in its own folder
 system = mb.load(MODELS / "paper" / "example3_m1_zero_auto.yaml")
@@ -82,10 +82,10 @@ fig.tight_layout()
 # -----------------------
 # ``mb.viewer.to_html`` writes the animation as one self-contained page that plays
 # offline: :download:`example3_m1_zero.html </gallery/example3_m1_zero.html>`. Below, a
-# still of it taken with headless Chromium (``mbsynth.screenshot``, as
+# still of it taken with headless Chromium (``mbsynth.view.screenshot``, as
 # ``scripts/readme_pictures.py`` takes the README's pictures; ``scripts/install-chromium.sh``
 # installs Chromium). Without Chromium the masses' positions are drawn instead.
-from mbsynth.screenshot import show_still
+from mbsynth.view.screenshot import show_still
 
 page = mb.viewer.to_html(system, traj, Path("example3_m1_zero.html"))
 fig, ax = plt.subplots(figsize=(7, 5))

@@ -7,7 +7,7 @@ BC = b, a slider C on a rail at height e (a prismatic joint), gravity along −y
 from rest with the crank at 1 rad. Three planar bodies, three revolute joints and a
 prismatic one: one degree of freedom, and a closed loop through the world.
 
-The joints' own values (``System.joint_values``, along a run ``mbsynth.joint_values.along``)
+The joints' own values (``System.joint_values``, along a run ``mbsynth.model.joint_values.along``)
 give the crank angle θ and the slider's displacement; the loop's geometry gives the
 slider's position in closed form, x(θ) = a cos θ + √(b² − (e − a sin θ)²), and the run
 must conserve energy. The reactions (``System.reactions``) give the rail's load on the
@@ -21,7 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import mbsynth as mb
-from mbsynth.joint_values import along
+from mbsynth.model.joint_values import along
 
 MODELS = Path("../../models")  # sphinx-gallery runs each script in its own folder
 system = mb.load(MODELS / "mechanisms" / "slider_crank.yaml")

@@ -10,7 +10,7 @@ Unpowered (all ``tau_<joint>`` = 0) it falls from its zero configuration.
 The reference is Pinocchio on Pinocchio's own model of the same URDF (its parser, not
 mbsynth's): the articulated-body algorithm ``pinocchio.aba`` integrated with scipy.
 mbsynth's joint angles are read off the links' coordinates by ``System.joint_values``
-(along a run: ``mbsynth.joint_values.along``); its joint reactions by
+(along a run: ``mbsynth.model.joint_values.along``); its joint reactions by
 ``System.reactions``, compared with the joint wrenches ``data.f`` of ``pinocchio.rnea``.
 """
 
@@ -23,10 +23,10 @@ import pinocchio as pin
 from scipy.integrate import solve_ivp
 
 import mbsynth as mb
-from mbsynth.joint_values import along
+from mbsynth.model.joint_values import along
 
 robot = mb.from_robot("ur5", floating=False)
-print(f"{robot.name}: {len(robot.subsystems)} parts, n = {robot.n} coordinates, {len(robot.constraints)} connectors")
+print(f"{robot.name}: {len(robot.parts)} parts, n = {robot.n} coordinates, {len(robot.connectors)} connectors")
 traj = mb.simulate(robot, 0.6, dt=0.02)
 values = along(robot, traj.t, traj.q, traj.qd)
 
@@ -81,11 +81,11 @@ for i, name in enumerate(joints, start=1):
 # The robot in the viewer
 # -----------------------
 # The offline animation: :download:`ur5_falling.html </gallery/ur5_falling.html>`; a still
-# of it from headless Chromium (``mbsynth.screenshot``; without Chromium, the joint
+# of it from headless Chromium (``mbsynth.view.screenshot``; without Chromium, the joint
 # angles are drawn instead).
 from pathlib import Path
 
-from mbsynth.screenshot import show_still
+from mbsynth.view.screenshot import show_still
 
 page = mb.viewer.to_html(robot, traj, Path("ur5_falling.html"))
 fig, ax = plt.subplots(figsize=(7, 5))

@@ -21,8 +21,8 @@ import importlib
 import json
 import sys
 
-from ..errors import ModelError, SolveError
-from ..trajectory import output_file
+from ..core.errors import ModelError, SolveError
+from ..analysis.trajectory import output_file
 from .parsers import UsageError, parser
 from .report import fail
 

@@ -2,8 +2,8 @@
 
 import json
 
-from ..diagnose import diagnose
-from ..fast.background import default_mode
+from ..analysis.diagnose import diagnose
+from ..compiled.background import default_mode
 from ..io import load
 
 

@@ -1,4 +1,4 @@
-"""``mbsynth modes MODEL``: natural frequencies, damping ratios and mode shapes (mbsynth.modal)."""
+"""``mbsynth modes MODEL``: natural frequencies, damping ratios and mode shapes (mbsynth.analysis.modes)."""
 
 import html
 import json
@@ -6,7 +6,7 @@ import tempfile
 from pathlib import Path
 
 from ..io import load
-from ..modal import format_modes, mode_motion, modes, to_dict
+from ..analysis.modes import format_modes, mode_motion, modes, to_dict
 from .parsers import check_flags
 
 
@@ -28,7 +28,7 @@ def run(args):
 def write_html(system, result, path):
     """One HTML page: each mode's animation (viewer.to_html, self-contained) in a frame,
     chosen with a selector."""
-    from ..viewer import to_html  # meshcat: only for --html
+    from ..view.viewer import to_html  # meshcat: only for --html
     pages = []
     with tempfile.TemporaryDirectory() as folder:
         for i, mode in enumerate(result.modes):

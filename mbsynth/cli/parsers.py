@@ -7,7 +7,7 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..errors import ModelError
+from ..core.errors import ModelError
 
 
 def parser():
@@ -57,7 +57,7 @@ def _simulate(commands):
     sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
     sim.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
     sim.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance (default 1e-10)")
-    sim.add_argument("--stabilization", choices=_Deferred("mbsynth.simulate", "STABILIZATIONS"), metavar="KIND",
+    sim.add_argument("--stabilization", choices=_Deferred("mbsynth.analysis.simulate", "STABILIZATIONS"), metavar="KIND",
                      default="projection", help="drift control: %(choices)s (default projection)")
     sim.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     return sim

@@ -2,7 +2,7 @@
 
 import json
 
-from ..validate import robot_table
+from ..robots.validate import robot_table
 
 
 def run(args):

@@ -4,10 +4,10 @@ import json
 import sys
 import time
 
-from ..errors import ModelError, SimulationError
+from ..core.errors import ModelError, SimulationError
 from ..io import load
-from ..simulate import simulate
-from ..trajectory import output_file
+from ..analysis.simulate import simulate
+from ..analysis.trajectory import output_file
 from .parsers import check_flags
 from .report import ProgressBar, on_terminal
 
@@ -45,7 +45,7 @@ def run(args):
     if error:
         summary["error"] = error
     if args.plot and traj.t.size:
-        from ..plot import plot_trajectory  # matplotlib: only for --plot
+        from ..view.plot import plot_trajectory  # matplotlib: only for --plot
 
         plot_trajectory(traj, args.plot, title=f"{system.name}", system=system, names=args.plot_vars)
     if args.json:

@@ -5,7 +5,7 @@ import json
 import sys
 import time
 
-from ..sweep import parse_range, sweep
+from ..studies.sweep import parse_range, sweep
 from .parsers import check_flags
 from .report import on_terminal
 

@@ -3,9 +3,9 @@
 import json
 import time
 
-from ..errors import ModelError
+from ..core.errors import ModelError
 from ..io import load
-from ..validate import validate_robot, validate_system
+from ..robots.validate import validate_robot, validate_system
 from .parsers import check_flags
 
 

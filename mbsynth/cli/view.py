@@ -2,11 +2,11 @@
 
 import sys
 
-from .. import viewer
-from ..errors import SimulationError
+from ..view import viewer
+from ..core.errors import SimulationError
 from ..io import load
-from ..simulate import simulate
-from ..trajectory import load_trajectory
+from ..analysis.simulate import simulate
+from ..analysis.trajectory import load_trajectory
 from .parsers import check_flags
 
 

@@ -1,4 +1,4 @@
-"""Reading the top-level ``forces:`` list into force elements (mbsynth.forces).
+"""Reading the top-level ``forces:`` list into force elements (mbsynth.model.forces).
 
     - {name: s, type: spring, between: [a.frame, b.frame], stiffness: k, rest_length: l0, damping: c}
     - {name: d, type: damper, between: [a.frame, world.anchor], damping: c}
@@ -10,7 +10,7 @@ rest length and damping are expressions of parameters, ≥ 0. ``name`` defaults 
 ``<type>_<index>``. (A torque names its body with ``part:``: YAML 1.1 reads ``on`` as true.)
 """
 
-from ..forces import AXES, applied_force, applied_torque, point_spring
+from ..model.forces import AXES, applied_force, applied_torque, point_spring
 from .joints import frame_reference
 from .parts import read_nonnegative
 from .schema import FORCE_SECTIONS

@@ -7,15 +7,15 @@
 
 Actuation efforts are expressions of t, parameters and coordinates; coefficients are
 expressions of parameters, ≥ 0 (rest: any value, an angle in [−π, π]). Actuation and
-springs become force elements (mbsynth.joint_forces), friction the joint's non-ideal C
-(mbsynth.friction).
+springs become force elements (mbsynth.model.joint_forces), friction the joint's non-ideal C
+(mbsynth.model.friction).
 """
 
 import sympy as sp
 
-from ..friction import KINDS as FRICTION_KINDS
-from ..friction import Friction
-from ..joint_forces import MOTIONS, actuation, joint_motion, joint_spring
+from ..model.friction import KINDS as FRICTION_KINDS
+from ..model.friction import Friction
+from ..model.joint_forces import MOTIONS, actuation, joint_motion, joint_spring
 from .parts import read_nonnegative
 from .schema import SECTIONS
 

@@ -4,9 +4,9 @@ A joint's ``actuation``, ``spring`` and ``friction`` keys are read by ``joint_fo
 
 import sympy as sp
 
-from ..connectors import JOINT_KINDS, Joint
-from ..connectors.rolling import KnifeEdge, RollingDisk
-from ..subsystems import Frame
+from ..model.connectors.joints import JOINT_KINDS, Joint
+from ..model.connectors.rolling import KnifeEdge, RollingDisk
+from ..model.parts import Frame
 from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
 

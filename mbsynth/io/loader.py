@@ -1,7 +1,7 @@
 """Model files (YAML) to Systems.
 
 Every mistake in a file raises ``ModelError`` reading ``file:line: at key.path: why``.
-Expressions are parsed by ``mbsynth.expressions`` (never evaluated as code).
+Expressions are parsed by ``mbsynth.core.expressions`` (never evaluated as code).
 """
 
 import difflib
@@ -12,14 +12,14 @@ from dataclasses import replace
 import numpy as np
 import sympy as sp
 
-from ..closure import close
-from ..connectors import Joint
-from ..constraint import Connector
-from ..joint_values import constraint_symbols, value_expressions, value_names
-from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
-from ..subsystems import LagrangianSubsystem
-from ..symbolic import T_SYMBOL, joint_values_in
-from ..system import System
+from ..model.balances import close
+from ..model.connectors.joints import Joint
+from ..model.connectors.base import Connector
+from ..model.joint_values import constraint_symbols, value_expressions, value_names
+from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
+from ..model.parts import LagrangianPart
+from ..symbolic.derive import T_SYMBOL, joint_values_in
+from ..model.system import System
 from .forces import read_forces
 from .joints import read_joints, read_world
 from .outputs import read_outputs
@@ -249,7 +249,7 @@ class _Builder:
         forces = [self.expression(forces_node[c], path + ("forces", c), symbols) if c in forces_node
                   else sp.S.Zero for c in coords]
         frames = read_frames(self, name, spec.get("frames"), path + ("frames",), True, symbols)
-        return LagrangianSubsystem(name, coords, q, qd, T, V, forces, self.param_symbols.values(), frames,
+        return LagrangianPart(name, coords, q, qd, T, V, forces, self.param_symbols.values(), frames,
                                    read_geometry(self, spec.get("geometry"), path + ("geometry",)))
 
     def read_constraints(self):

@@ -1,7 +1,7 @@
-"""Reading a model's ``outputs:`` mapping (the kinds are described in mbsynth.outputs)."""
+"""Reading a model's ``outputs:`` mapping (the kinds are described in mbsynth.model.outputs)."""
 
-from ..errors import ModelError
-from ..outputs import energy_output, expression_output, frame_output, reaction_output
+from ..core.errors import ModelError
+from ..model.outputs import energy_output, expression_output, frame_output, reaction_output
 from .joints import frame_reference
 from .schema import SECTIONS
 

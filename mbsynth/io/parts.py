@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from ..kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
-from ..subsystems import Frame, Particle, PlanarBody, RigidBody, Spring
+from ..core.kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
+from ..model.parts import Frame, Particle, PlanarBody, RigidBody, Spring
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
 SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None, "line": None}

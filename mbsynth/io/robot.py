@@ -20,8 +20,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import ModelError
-from ..robots import Robot, describe
+from ..core.errors import ModelError
+from ..robots.build import Robot, describe
 from .parts import read_rotation
 
 

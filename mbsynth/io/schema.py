@@ -11,7 +11,7 @@ their section's text and checked by the loader against those names.
 
 from dataclasses import dataclass
 
-from ..connectors import JOINT_KINDS
+from ..model.connectors.joints import JOINT_KINDS
 
 
 @dataclass(frozen=True)
@@ -103,7 +103,7 @@ SECTIONS = {section.name: section for section in (
                  "joints between named frames and ground contacts", "[{name: pin, type: revolute, parent: world, child: link.top}]",
                  default="[]"),
              Key("closure", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
-                 "part whose motion the model leaves open (closure.py)", "auto", default="none"),
+                 "part whose motion the model leaves open (model/balances.py)", "auto", default="none"),
              Key("initial", "mapping coordinate → " + _EXPR, "initial values by coordinate name "
                  "(``part.c``, velocities ``part.c_dot``)", "{wheel.theta: 0.0, wheel.theta_dot: 1.0}",
                  default="0 (orientations: identity)"),

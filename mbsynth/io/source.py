@@ -14,7 +14,7 @@ from pathlib import Path
 
 import yaml
 
-from ..errors import ModelError
+from ..core.errors import ModelError
 
 MAX_DEPTH = 64  # levels of nested mappings and lists
 MAX_NODES = 100_000  # nodes of a document with every alias expanded

@@ -1,0 +1,201 @@
+"""Modes of a model at rest: natural frequencies, damping ratios and mode shapes.
+
+The eigenvalues s of the linearization's A (linearization.py) at an equilibrium (q̇ = 0,
+q̈ = 0) give the modes: a complex pair s = −ζω ± iω√(1 − ζ²) is one vibration mode of
+natural frequency ω/2π (Hz) and damping ratio ζ = −Re s/|s|; a real s is an overdamped
+(s < 0) or unstable (s > 0) motion, s = 0 a free (rigid-body) one. A mode's shape is its
+eigenvector's position part mapped to the model's coordinates, δq = N x, scaled so that
+its largest component is 1, and in joint values: a joint's position changes at the rate
+its ``rate`` gives for q̇ = δq (System.joint_values; exact, the rates being linear in q̇).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from ..core.errors import SolveError
+from .linearization import linearize
+from .projection import project_positions
+from .statics import equilibrium as find_equilibrium
+from .trajectory import Trajectory
+from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL
+
+SHOWN = 3  # coordinates named per mode in the table
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One mode: ``eigenvalue`` s (rad/s), ``frequency`` |s|/2π (Hz), ``damping_ratio``
+    −Re s/|s| (NaN for a free mode), ``kind`` ("vibration", "overdamped", "unstable" or
+    "free"), ``shape`` (n complex, largest component 1) and ``joint_shape``
+    ({joint: complex array of its positions' changes})."""
+
+    eigenvalue: complex
+    frequency: float
+    damping_ratio: float
+    kind: str
+    shape: np.ndarray
+    joint_shape: dict
+
+
+@dataclass(frozen=True)
+class Modes:
+    """The modes of ``system_name`` at (t, q), lowest frequency first, and the linearization."""
+
+    system_name: str
+    coordinates: tuple
+    t: float
+    q: np.ndarray
+    modes: tuple
+    linearization: object
+
+    @property
+    def frequencies(self):
+        """The natural frequencies (Hz) of the modes, in order."""
+        return np.array([m.frequency for m in self.modes])
+
+    @property
+    def damping_ratios(self):
+        return np.array([m.damping_ratio for m in self.modes])
+
+    @property
+    def stable(self):
+        """Whether no eigenvalue has a positive real part (beyond rounding)."""
+        values = self.linearization.eigenvalues
+        scale = np.abs(values).max(initial=0.0)
+        return bool(np.all(values.real <= MODE_ZERO_RTOL * scale))
+
+
+def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL):
+    """The ``Modes`` of ``system`` at rest at ``q`` (default: the initial positions); with
+    ``equilibrium=True`` at the static equilibrium found from there (statics.py). Raises
+    SolveError when the model does not rest at q (q̈ ≠ 0 at q̇ = 0)."""
+    q = system.initial_state()[0] if q is None else np.array(q, dtype=float)
+    if equilibrium:
+        q = find_equilibrium(system, q, t)
+    lin = linearize(system, t, q, np.zeros(system.n))
+    k = lin.k
+    worst = int(np.argmax(np.abs(lin.qdd))) if lin.qdd.size else 0
+    if lin.qdd.size and abs(lin.qdd[worst]) > tolerance * (1 + np.abs(lin.A[k:, :k]).max(initial=0.0)):
+        raise SolveError(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
+                         f"along {system.coordinates[worst]}): modes are taken at an equilibrium "
+                         "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
+    values, vectors = scipy.linalg.eig(lin.A) if k else (np.zeros(0, complex), np.zeros((0, 0), complex))
+    scale = np.abs(values).max(initial=0.0)
+    free = np.abs(values) <= MODE_ZERO_RTOL * scale
+    found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
+    for s, v in zip(values[~free], vectors.T[~free]):
+        if s.imag >= -MODE_ZERO_RTOL * scale:  # one of each conjugate pair
+            found.append(_mode(system, t, q, lin, s, v[:k], scale))
+    found.sort(key=lambda m: (m.frequency, m.eigenvalue.real))
+    return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin)
+
+
+def _free_directions(lin, count):
+    """``count`` directions x of the independent coordinates along which nothing resists:
+    the right singular vectors of the stiffness block K = ∂ü/∂u of A with the smallest
+    singular values (a free direction is a double zero eigenvalue of A, one mode)."""
+    k = lin.k
+    return np.linalg.svd(lin.A[k:, :k])[2][k - count:] if count else []
+
+
+def _mode(system, t, q, lin, s, x, scale):
+    """The Mode of eigenvalue s with the independent coordinates' motion x."""
+    shape = lin.basis @ x
+    shape = shape / shape[np.argmax(np.abs(shape))]
+    return Mode(complex(s), float(abs(s) / (2 * np.pi)), _damping(s, scale), _kind(s, scale), shape,
+                _joint_shape(system, t, q, shape))
+
+
+def _damping(s, scale):
+    """−Re s/|s|; NaN for a free mode, 0 where Re s is rounding (below ε times the largest |s|)."""
+    if abs(s) <= MODE_ZERO_RTOL * scale:
+        return float("nan")
+    return 0.0 if abs(s.real) <= 8 * np.finfo(float).eps * scale else float(-s.real / abs(s))
+
+
+def _kind(s, scale):
+    if abs(s) <= MODE_ZERO_RTOL * scale:
+        return "free"
+    if abs(s.imag) > MODE_ZERO_RTOL * scale:
+        return "vibration" if s.real <= MODE_ZERO_RTOL * scale else "unstable"
+    return "overdamped" if s.real < 0 else "unstable"
+
+
+def _joint_shape(system, t, q, shape):
+    """{joint: complex array}: the change of each joint's positions along ``shape``."""
+    real = system.joint_values(t, q, shape.real)
+    imag = system.joint_values(t, q, shape.imag)
+    return {name: real[name].rate + 1j * imag[name].rate for name in real}
+
+
+def mode_motion(system, result, index, amplitude=0.05, periods=2, frames=60):
+    """A Trajectory that shows mode ``index`` of ``result`` (for the viewer: one per mode):
+    q(t) = q₀ + amplitude · Re(shape · e^{iωt}) over ``periods`` periods (1 s each for a
+    mode of frequency 0), put back on the constraints at each frame (a finite amplitude
+    leaves the tangent plane). ``amplitude`` is the largest coordinate's excursion, in its
+    units. Energies and residuals are not computed (NaN)."""
+    mode = result.modes[index]
+    omega = 2 * np.pi * (mode.frequency or 1.0)
+    t = np.linspace(0.0, periods * 2 * np.pi / omega, frames)
+    q = np.array([project_positions(system, result.t, result.q + amplitude * (mode.shape * np.exp(1j * omega * x)).real)
+                  for x in t])
+    nan = np.full(frames, np.nan)
+    return Trajectory(result.coordinates, t, q, np.gradient(q, t, axis=0), nan, nan, nan, nan)
+
+
+def format_modes(result, digits=6):
+    """The modes as a text table: one row per mode, the joints (or, in a model without
+    joint values, the coordinates) that move most, relative to the largest."""
+    lin = result.linearization
+    independent = ", ".join(lin.state_names[:lin.k]) or "none"
+    lines = [f"modes of {result.system_name} at t = {result.t:g}: {lin.k} degree(s) of freedom "
+             f"(independent coordinates: {independent})",
+             f"{'#':>3}  {'frequency [Hz]':>15}  {'damping ratio':>13}  {'kind':<10}  {'eigenvalue [rad/s]':<26}"
+             "  largest motion"]
+    for i, mode in enumerate(result.modes, 1):
+        s = mode.eigenvalue
+        lines.append(f"{i:>3}  {mode.frequency:>15.{digits}g}  {mode.damping_ratio:>13.4g}  {mode.kind:<10}  "
+                     f"{f'{s.real:.{digits}g}{s.imag:+.{digits}g}j':<26}  {_largest(result, mode)}")
+    if not result.stable:
+        lines.append("unstable: an eigenvalue has a positive real part (the equilibrium is not a rest one keeps)")
+    return "\n".join(lines)
+
+
+def _largest(result, mode):
+    """The SHOWN joint values (where the model has joints with values) or coordinates that
+    move most in ``mode``, relative to the largest."""
+    names, values = list(result.coordinates), mode.shape
+    if mode.joint_shape:
+        names = [f"{j}[{c}]" if len(v) > 1 else j for j, v in mode.joint_shape.items() for c in range(len(v))]
+        values = np.concatenate(list(mode.joint_shape.values()))
+    top = np.abs(values).max(initial=0.0)
+    if top == 0:
+        return ""
+    values = values / values[np.argmax(np.abs(values))]
+    order = np.argsort(-np.abs(values))[:SHOWN]
+    return ", ".join(f"{names[j]} {_short(values[j])}" for j in order if abs(values[j]) > 1e-6)
+
+
+def _short(z):
+    return f"{z.real:.3g}" if abs(z.imag) <= 1e-9 * max(abs(z), 1e-300) else f"{z.real:.3g}{z.imag:+.3g}j"
+
+
+def to_dict(result):
+    """The modes as JSON-ready data: per mode its eigenvalue, frequency, damping ratio,
+    kind and shapes (real parts; ``*_imag`` where a shape is complex)."""
+    lin = result.linearization
+    out = {"model": result.system_name, "t": result.t, "q": dict(zip(result.coordinates, map(float, result.q))),
+           "degrees_of_freedom": lin.k, "independent_coordinates": list(lin.state_names[:lin.k]),
+           "stable": result.stable, "modes": []}
+    for mode in result.modes:
+        entry = {"eigenvalue": [mode.eigenvalue.real, mode.eigenvalue.imag], "frequency_hz": mode.frequency,
+                 "damping_ratio": None if np.isnan(mode.damping_ratio) else mode.damping_ratio, "kind": mode.kind,
+                 "shape": {c: float(x.real) for c, x in zip(result.coordinates, mode.shape) if abs(x) > 1e-12},
+                 "joint_shape": {j: [float(x) for x in v.real] for j, v in mode.joint_shape.items()}}
+        if np.abs(mode.shape.imag).max(initial=0.0) > 1e-9:
+            entry["shape_imag"] = {c: float(x.imag) for c, x in zip(result.coordinates, mode.shape) if abs(x) > 1e-12}
+            entry["joint_shape_imag"] = {j: [float(x) for x in v.imag] for j, v in mode.joint_shape.items()}
+        out["modes"].append(entry)
+    return out

@@ -1,0 +1,275 @@
+"""Putting a state back on the constraint manifold.
+
+(2.14) enforces the constraints only at the acceleration level (2.4): an integrated
+state drifts off φ(q, t) = 0 and φ̇ = 0. These functions move it back with the least
+change (each coordinate weighed by how strongly it moves the constraints, ``_correction``):
+positions by Gauss–Newton on the position-level rows, q ← q − Φ_q⁺ φ
+(Φ_q = the rows of A of the holonomic constraints), then velocities on every
+velocity-level row (holonomic and non-holonomic, both linear in q̇),
+q̇ ← q̇ − A_v⁺ ψ. Coordinates marked fixed are not changed. Unit quaternions are
+holonomic rows of their bodies, so they are restored like any other constraint.
+
+Tolerances are relative, so a mechanism projects alike in millimetres or kilometres: a
+row's residual is judged against the size of its terms, estimated from the row of A
+(``equations.term_scales``: Σ_j |A_ij q_j| for φ_i, Σ_j |A_ij q̇_j| for ψ_i), times
+``PROJECTION_RTOL``.
+"""
+
+import functools
+
+import numpy as np
+import scipy.sparse
+import scipy.sparse.linalg
+
+from ..core.equations import term_scales
+from ..model.evaluation import DENSE_ENTRIES
+from ..core.errors import SolveError
+from ..core.tolerances import PROJECTION_RTOL
+
+MAX_ITERATIONS = 50
+
+
+def _free_columns(n, fixed):
+    free = np.ones(n, dtype=bool)
+    if fixed is not None:
+        free[np.asarray(fixed, dtype=int)] = False
+    return free
+
+
+SPARSE_ACCEPT = 1e-10  # relative residual under which the sparse least-norm step is taken
+PROJECTION_RCOND = 1e-8  # directions of J (columns equilibrated) below this × σ₁ count as dependent
+VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity step
+COLUMN_FLOOR = 1e-4  # a retried projection's smallest column scale, relative to the largest entry of its rows
+
+
+def _correction(J, r, groups, floor=0.0):
+    """The smallest Δ with J Δ = r in the metric that weighs each coordinate by how strongly
+    it moves the constraints, ‖diag(c) Δ‖ with c_j = ‖J_:j‖ (column equilibration): a
+    quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
+    moved, not turned, as one 1 m long is. Coordinates that move together (``groups``, one
+    label per column: System.coordinate_groups) share one scale, the root mean square of
+    their columns' norms: a single component's column vanishes where that component passes
+    through zero (∂(|u|² − 1)/∂u_z = 2u_z; a particle's x on a rod), and a scale of its own
+    would let the step move it by r/c_j. With G = J D (D = diag(1/c)) and independent
+    rows, Δ = D Gᵀ (G Gᵀ)⁻¹ r, G Gᵀ factored sparse (a tree of joints gives a
+    tree-structured G Gᵀ: linear time), or dense when J is small (DENSE_ENTRIES). Rows that are dependent, or dependent to within
+    ``PROJECTION_RCOND`` (a loop whose dependency moves with the configuration, off its
+    manifold: the step along the near-dependent direction would be r's drift over σ), go to
+    dense least squares that drops those directions; so does a sparse step that does not
+    meet J Δ = r to SPARSE_ACCEPT."""
+    if J.shape[0] == 0 or J.shape[1] == 0:  # no rows, or every coordinate fixed
+        return np.zeros(J.shape[1])
+    if not scipy.sparse.issparse(J):
+        return _dense_correction(J, r, groups, floor)
+    if J.shape[0] * J.shape[1] <= DENSE_ENTRIES:
+        return _dense_correction(J.toarray(), r, groups, floor)
+    columns = _grouped(np.asarray(J.multiply(J).sum(axis=0)).ravel(), groups)
+    magnitude = abs(J).tocsr()
+    widest = np.asarray(magnitude.max(axis=1).todense()).ravel()  # each row's largest entry
+    touched = magnitude.copy()
+    touched.data = np.repeat(widest, np.diff(touched.indptr))
+    columns = _floored(columns, floor * np.asarray(touched.max(axis=0).todense()).ravel())
+    D = scipy.sparse.diags(1.0 / columns)
+    G = (J @ D).tocsr()
+    size = np.linalg.norm(r) + 1e-300
+    try:
+        with np.errstate(all="ignore"):
+            z = G.T @ scipy.sparse.linalg.splu((G @ G.T).tocsc()).solve(r)
+        if _accepted(z, G, scipy.sparse.linalg.norm(G), r, size):
+            return D @ z
+    except RuntimeError:  # splu: the matrix is exactly singular
+        pass
+    return D @ np.linalg.lstsq(G.toarray(), r, rcond=PROJECTION_RCOND)[0]
+
+
+def _dense_correction(J, r, groups, floor=0.0):
+    """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
+    columns = _grouped(np.einsum("ij,ij->j", J, J), groups)
+    least = 0.0
+    if floor:
+        magnitude = np.abs(J)
+        touched = np.where(magnitude > 0, magnitude.max(axis=1, keepdims=True, initial=0.0), 0.0)
+        least = floor * touched.max(axis=0, initial=0.0)
+    d = 1.0 / _floored(columns, least)
+    G = J * d
+    size = np.linalg.norm(r) + 1e-300
+    try:
+        with np.errstate(all="ignore"):
+            z = G.T @ np.linalg.solve(G @ G.T, r)
+        if _accepted(z, G, np.linalg.norm(G), r, size):
+            return d * z
+    except np.linalg.LinAlgError:  # exactly singular
+        pass
+    return d * np.linalg.lstsq(G, r, rcond=PROJECTION_RCOND)[0]
+
+
+def _grouped(squares, groups):
+    """Column scales from the squared column norms: per group, the root mean square."""
+    labels, inverse, counts = _labelled(np.asarray(groups).tobytes(), np.asarray(groups).dtype.str)
+    return np.sqrt(np.bincount(inverse, weights=squares, minlength=labels)[inverse] / counts[inverse])
+
+
+@functools.lru_cache(maxsize=64)
+def _labelled(groups, dtype):
+    """(number of groups, each column's group index, each group's size) of the group labels
+    (as bytes: a System's labels are the same at every projection of a run)."""
+    labels, inverse, counts = np.unique(np.frombuffer(groups, dtype=dtype), return_inverse=True,
+                                        return_counts=True)
+    return labels.size, inverse, counts
+
+
+def _floored(columns, least):
+    """Column scales c_j, at least ``least`` (1 for a column that is zero)."""
+    floored = np.maximum(columns, least)
+    return np.where(floored > 0, floored, 1.0)
+
+
+def _accepted(z, G, norm_G, r, size):
+    """The step z from the normal equations: finite, not amplified beyond PROJECTION_RCOND
+    (nearly dependent rows), and meeting G z = r to SPARSE_ACCEPT."""
+    well_posed = np.linalg.norm(z) * PROJECTION_RCOND * norm_G <= size
+    return bool(np.all(np.isfinite(z)) and well_posed and np.linalg.norm(G @ z - r) <= SPARSE_ACCEPT * size)
+
+
+def project_positions(system, t, q, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
+    """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices);
+    ``arrays``: the ConstraintArrays at q (any q̇), if at hand.
+
+    Gauss–Newton in the equilibrated metric of ``_correction``; where its residual grows,
+    again from q with every column scale at least COLUMN_FLOOR × the largest entry of the
+    rows it meets. A column nearly zero only at this point (a quaternion component near 0:
+    ∂(|u|² − 1)/∂u_z = 2u_z) counts in that metric as nearly free to move: the step moves
+    it by about r/c_j, whose second-order effect (r/c_j)² exceeds r, and Newton diverges
+    even from a state on the manifold to rounding."""
+    start = np.array(q, dtype=float)
+    free = _free_columns(start.size, fixed)
+    q = _newton(system, t, start, free, tolerance, floor=0.0, arrays=arrays)
+    return q if q is not None else _newton(system, t, start, free, tolerance, floor=COLUMN_FLOOR, last=True,
+                                           arrays=arrays)
+
+
+def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
+    """Gauss–Newton steps from q (a copy is changed) until every position row is met; None
+    when the residual grows (unless ``last``: then a SolveError names the unmet rows).
+    ``arrays``: the ConstraintArrays at q, if at hand (φ and A do not depend on q̇)."""
+    q, qd = q.copy(), np.zeros_like(q)
+    previous = np.inf
+    for _ in range(MAX_ITERATIONS):
+        if arrays is None:
+            arrays = system.constraint_arrays(t, q, qd, sparse=None)
+        phi = arrays.phi
+        rows = np.isfinite(phi)
+        unmet = np.abs(phi[rows]) > tolerance * term_scales(arrays.A, q)[rows]
+        if not unmet.any():
+            return q
+        size = np.abs(phi[rows]).max()
+        if not last and size > 2 * previous:
+            return None
+        previous = size
+        q[free] -= _correction(arrays.A[rows][:, free], phi[rows], system.coordinate_groups[free], floor)
+        arrays = None
+        if not np.all(np.isfinite(q)):
+            break
+    if not last:
+        return None
+    arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    phi, A = arrays.phi, arrays.A
+    raise SolveError(_unmet(system, phi, "positions", free),
+                     constraints=[n for n, r, s in zip(system.constraint_names, phi, term_scales(A, q))
+                                  if abs(r) > tolerance * s])
+
+
+def project_velocities(system, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
+    """q̇ on the velocity-level rows (φ̇ = 0, ψ = 0), changing only free velocities;
+    ``arrays``: the ConstraintArrays at (q, q̇), if at hand."""
+    qd = np.array(qd, dtype=float)
+    free = _free_columns(qd.size, fixed)
+    if arrays is None:
+        arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    psi = arrays.psi
+    rows = np.isfinite(psi)
+    if not (np.abs(psi[rows]) > tolerance * term_scales(arrays.A, qd)[rows]).any():
+        return qd
+    A = arrays.A[rows]
+    qd[free] -= _correction(A[:, free], psi[rows], system.coordinate_groups[free])  # ψ is affine in q̇, slope A
+    _, psi = system.constraint_residuals(t, q, qd)
+    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
+    if unmet.any():
+        raise SolveError(_unmet(system, psi, "velocities", free),
+                         constraints=[n for n, u in zip(np.array(system.constraint_names)[rows], unmet) if u])
+    return qd
+
+
+# relative_drift: a row's scale is at least this share of ‖A_i‖₁ ‖x‖∞. At a singular position
+# some rows' terms vanish (the N-four-bar's horizontal velocity rows when the bars lie flat)
+# down to term_scales' default floor of 1e-3 of that, and the same absolute drift read up to a
+# thousand times larger there: simulate's spans between projections then shrank to 5e-10 s
+# and stayed there (N = 2 at dt = 0.001, its second crossing)
+DRIFT_FLOOR = 0.1
+
+
+def relative_drift(system, t, q, qd, arrays=None):
+    """The largest residual of φ or ψ relative to its row's terms (module docstring), at
+    least DRIFT_FLOOR of the row's norm times the largest coordinate (or rate): how far
+    the state lies off the manifold, alike at every scale. ``arrays``: the
+    ConstraintArrays at (q, q̇), if at hand."""
+    if arrays is None:
+        arrays = system.constraint_arrays(t, q, qd, sparse=None)
+    worst = 0.0
+    for residual, x in ((arrays.phi, q), (arrays.psi, qd)):
+        rows = np.isfinite(residual)
+        scale = term_scales(arrays.A, x, floor=DRIFT_FLOOR)[rows]
+        relative = np.abs(residual[rows]) / np.maximum(scale, np.finfo(float).tiny)
+        worst = max(worst, float(relative.max(initial=0.0)))
+    return worst
+
+
+def project(system, t, q, qd, fixed_q=None, fixed_qd=None, arrays=None):
+    """(q, q̇) on the constraint manifold: positions first, then velocities. ``arrays``:
+    the ConstraintArrays at (q, q̇), if at hand (used while q is unchanged)."""
+    moved = project_positions(system, t, q, fixed_q, arrays=arrays)
+    same = arrays is not None and np.array_equal(moved, q)
+    return moved, project_velocities(system, t, moved, qd, fixed_qd, arrays=arrays if same else None)
+
+
+def consistent_initial_state(system, t=0.0):
+    """The model's initial state made consistent with the constraints.
+
+    First every value the model sets is kept and only the others are completed (a
+    partial state). If that is impossible (a state slightly off), only the values
+    listed in ``initial_fixed`` are kept and the rest change as little as possible.
+    Returns (q, q̇, changes) with changes = {name: (given, new)} for the values that
+    moved. Raises SolveError when no consistent state keeps the fixed values."""
+    q0, qd0 = system.initial_state()
+    try:
+        q, qd = _project_keeping(system, t, q0, qd0, system.initial_given)
+    except SolveError:
+        try:
+            q, qd = _project_keeping(system, t, q0, qd0, system.initial_fixed)
+        except SolveError as err:
+            kept = ", ".join(sorted(system.initial_fixed)) or "nothing"
+            raise SolveError(f"no consistent initial state exists (keeping {kept}): {err}",
+                             constraints=err.constraints) from None
+    system.check_branches(q, t)  # a joint's rows met on a branch it does not mean: a fixed joint flipped
+    names = list(system.coordinates)
+    changes = {}
+    q_size, qd_size = np.abs(q).max(initial=0.0), np.abs(qd).max(initial=0.0)
+    for i, c in enumerate(names):
+        if abs(q[i] - q0[i]) > PROJECTION_RTOL * q_size:
+            changes[c] = (float(q0[i]), float(q[i]))
+        if abs(qd[i] - qd0[i]) > PROJECTION_RTOL * qd_size:
+            changes[c + "_dot"] = (float(qd0[i]), float(qd[i]))
+    return q, qd, changes
+
+
+def _project_keeping(system, t, q, qd, keep):
+    names = list(system.coordinates)
+    return project(system, t, q, qd, [i for i, c in enumerate(names) if c in keep],
+                   [i for i, c in enumerate(names) if c + "_dot" in keep])
+
+
+def _unmet(system, residual, level, free):
+    worst = np.nanargmax(np.abs(residual))
+    return (f"the constraints cannot be met by adjusting the {level} of "
+            f"{', '.join(c for c, f in zip(system.coordinates, free) if f) or 'no coordinate (all are fixed)'}; "
+            f"largest residual {abs(residual[worst]):.3g} in {system.constraint_names[worst]}")

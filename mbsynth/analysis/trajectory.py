@@ -1,0 +1,212 @@
+"""Trajectories and their files.
+
+A ``Trajectory`` holds one row per output time: ``t``, ``q``, ``qd``, the largest
+position and velocity constraint residuals, the total energy, and the model's declared
+``outputs`` (one column per name in ``output_names``: mbsynth.model.outputs). Files:
+
+- ``.npz``: arrays ``t``, ``q``, ``qd``, ``coordinates`` (plus ``energy``,
+  ``residual_position``, ``residual_velocity``, ``status``, ``outputs``, ``output_names``);
+- ``.csv``: a header ``t, <coordinate>..., <coordinate>_dot..., energy, <output>...`` and
+  one row per time.
+
+``TrajectoryWriter`` writes while a run goes on, so an interrupted or failed run keeps
+everything computed so far, and never leaves half a file under the final name: CSV
+rows are appended to ``FILE.partial``, cut back to its last complete row when the run
+ends and renamed to FILE only when the run completed (a CSV has no place for the
+status: an interrupted, failed or killed run leaves its rows in FILE.partial, and no
+FILE of an earlier run); NPZ is checkpointed to a temporary file that replaces FILE
+atomically (and is removed if writing it fails), with the run's status inside.
+"""
+
+import csv
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import ModelError
+from ..core.files import write_atomically
+
+FORMATS = (".npz", ".csv")
+COMPLETED = "completed"
+
+
+@dataclass
+class Trajectory:
+    coordinates: tuple
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    energy: np.ndarray
+    kinetic: np.ndarray
+    residual_position: np.ndarray
+    residual_velocity: np.ndarray
+    status: str = COMPLETED
+    stats: dict = field(default_factory=dict)
+    outputs: np.ndarray = None  # T × len(output_names): the model's declared outputs
+    output_names: tuple = ()
+
+    def __post_init__(self):
+        if self.outputs is None:
+            self.outputs = np.zeros((len(self.t), len(self.output_names)))
+
+    @property
+    def energy_drift(self):
+        """max |E(t) − E(0)| relative to max(|E(0)|, the largest kinetic energy): a
+        pendulum whose energy is zero at the start still gets a meaningful scale."""
+        E = self.energy
+        if E.size == 0 or not np.all(np.isfinite(E)):
+            return float("nan")
+        scale = max(abs(E[0]), float(np.nanmax(np.abs(self.kinetic))) if self.kinetic.size else 0.0)
+        return 0.0 if scale == 0 else float(np.abs(E - E[0]).max() / scale)
+
+    @property
+    def max_residual(self):
+        values = np.concatenate([self.residual_position, self.residual_velocity])
+        values = values[np.isfinite(values)]
+        return float(values.max()) if values.size else 0.0
+
+    def column(self, name):
+        """The history of one coordinate (``part.coord``), velocity (``part.coord_dot``) or
+        output (its column name: ``tip[x]``)."""
+        if name in self.output_names:
+            return self.outputs[:, self.output_names.index(name)]
+        if name in self.coordinates:
+            return self.q[:, self.coordinates.index(name)]
+        if name.endswith("_dot") and name[:-4] in self.coordinates:
+            return self.qd[:, self.coordinates.index(name[:-4])]
+        raise KeyError(f"no coordinate or output '{name}'; coordinates: {', '.join(self.coordinates)}"
+                       + (f"; outputs: {', '.join(self.output_names)}" if self.output_names else ""))
+
+    def save(self, path):
+        """Write the whole trajectory to ``path`` (.npz or .csv), atomically; the CSV of a
+        run that did not complete goes to ``path``.partial (see the module docstring)."""
+        with TrajectoryWriter(path, self.coordinates, self.output_names) as writer:
+            writer.append(self)
+            writer.status = self.status
+
+
+def partial_file(path):
+    """FILE.partial: where a CSV run's rows go until the run completes."""
+    path = Path(path)
+    return path.with_name(path.name + ".partial")
+
+
+def output_file(path, completed):
+    """The file that holds a run's output written to ``path``: ``path`` itself, or for a
+    CSV run that did not complete, ``partial_file(path)``."""
+    path = Path(path)
+    return path if completed or path.suffix != ".csv" else partial_file(path)
+
+
+def load_trajectory(path):
+    """Read a trajectory written by ``Trajectory.save`` or a run (.npz, .csv or the
+    .csv.partial of a run that did not complete)."""
+    path = Path(path)
+    if path.suffix == ".npz":
+        with np.load(path, allow_pickle=False) as data:
+            coordinates = tuple(str(c) for c in data["coordinates"])
+            get = {k: data[k] for k in data.files}
+        n_rows = get["t"].size
+        nan = np.full(n_rows, np.nan)
+        names = tuple(str(x) for x in get.get("output_names", ()))
+        return Trajectory(coordinates, get["t"], get["q"], get["qd"], get.get("energy", nan),
+                          get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
+                          str(get.get("status", COMPLETED)), outputs=get.get("outputs"), output_names=names)
+    if path.suffix == ".csv" or path.name.endswith(".csv.partial"):
+        with path.open(newline="") as f:
+            header = next(csv.reader(f))
+        if "energy" not in header[1:]:
+            raise ModelError(f"{path}: not a trajectory file (its header has no 'energy' column: "
+                             "t, coordinates, velocities, energy, outputs)")
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        energy = header.index("energy", 1)  # t, coordinates, velocities, energy, outputs
+        n = (energy - 1) // 2
+        nan = np.full(data.shape[0], np.nan)
+        return Trajectory(tuple(header[1:1 + n]), data[:, 0], data[:, 1:1 + n], data[:, 1 + n:1 + 2 * n],
+                          data[:, energy], nan, nan, nan, outputs=data[:, energy + 1:],
+                          output_names=tuple(header[energy + 1:]))
+    raise ModelError(f"{path}: unknown trajectory format (use {' or '.join(FORMATS)})")
+
+
+class TrajectoryWriter:
+    """Writes trajectory rows as they come (see the module docstring)."""
+
+    def __init__(self, path, coordinates, output_names=(), checkpoint_seconds=2.0):
+        self.path = Path(path)
+        if self.path.suffix not in FORMATS:
+            raise ModelError(f"{self.path}: output must end in {' or '.join(FORMATS)}")
+        if not self.path.parent.is_dir():
+            raise ModelError(f"{self.path}: the folder {self.path.parent} does not exist")
+        self.coordinates, self.output_names = tuple(coordinates), tuple(output_names)
+        self.checkpoint_seconds = checkpoint_seconds
+        self.status = "running"
+        self._chunks = []
+        self._last_checkpoint = time.monotonic()
+        if self.path.suffix == ".csv":
+            self._partial = partial_file(self.path)
+            try:
+                self._csv_file = self._partial.open("w", newline="")
+                self.path.unlink(missing_ok=True)  # an earlier run's file: not this run's output
+            except OSError as err:
+                raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
+            self._csv = csv.writer(self._csv_file)
+            self._csv.writerow(["t", *self.coordinates, *(c + "_dot" for c in self.coordinates), "energy",
+                                *self.output_names])
+            self._csv_file.flush()
+            self._complete = self._csv_file.tell()  # bytes of complete rows
+        else:
+            self._write_npz()  # an empty file at once: a path that cannot be written fails before the run
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def append(self, traj):
+        """Add the rows of a Trajectory (or a chunk of one)."""
+        if self.path.suffix == ".csv":
+            for row in zip(traj.t, traj.q, traj.qd, traj.energy, traj.outputs):
+                self._csv.writerow([repr(float(row[0])), *map(repr, map(float, row[1])),
+                                    *map(repr, map(float, row[2])), repr(float(row[3])), *map(repr, map(float, row[4]))])
+            self._csv_file.flush()
+            self._complete = self._csv_file.tell()
+        else:
+            self._chunks.append(traj)
+            if time.monotonic() - self._last_checkpoint > self.checkpoint_seconds:
+                self._write_npz()
+
+    def close(self):
+        """Finish the file: under its final name if the run completed (NPZ: whatever the
+        state of the run, which it records)."""
+        if self.path.suffix == ".csv":
+            self._csv_file.close()
+            os.truncate(self._partial, self._complete)  # drop a row cut short by a failed write
+            if self.status == COMPLETED:
+                os.replace(self._partial, self.path)
+        else:
+            self._write_npz()
+
+    def _write_npz(self):
+        self._last_checkpoint = time.monotonic()
+        chunks = self._chunks
+        n = len(self.coordinates)
+
+        def stack(name, width=None):
+            parts = [getattr(c, name) for c in chunks]
+            if not parts:
+                return np.zeros(0) if width is None else np.zeros((0, width))
+            return np.concatenate(parts)
+
+        columns = dict(t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
+                       energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
+                       residual_velocity=stack("residual_velocity"), status=np.array(self.status),
+                       outputs=stack("outputs", len(self.output_names)),
+                       output_names=np.array(self.output_names, dtype=str))
+        try:
+            write_atomically(self.path, lambda temporary: np.savez(temporary, **columns))
+        except OSError as err:
+            raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err

@@ -1,0 +1,82 @@
+"""``python -m mbsynth.compiled``: compile the fast path's kernels into the cache ahead of use.
+
+On two cores: first the kernel's largest parts for both variants of ``kernel.motion`` in
+helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
+correction) in a helper (``python -m mbsynth.compiled rigid``) while this process compiles the
+general ones; then each warm-up model here, loading what is missing from the cache (all of
+it, unless a helper failed).
+"""
+
+import sys
+import time
+
+import numpy as np
+
+from . import cache
+
+
+def warm(texts):
+    """Build each model's Engine and run every kernel entry point on it."""
+    from . import background
+    from ..io import loads
+    for text in texts:
+        system = loads(text, "warm-up")
+        engine = background.build(system)
+        q, qd = system.initial_state()
+        engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
+        correction = engine.correction()
+        if correction is not None:  # simulate's rows and corrections
+            correction(q, qd)
+
+
+def main():
+    started = time.perf_counter()
+    if sys.argv[1:] == ["rigid"]:  # the helper compiling the rigid tree's entry points
+        warm([WARM_RIGID])
+        return
+    from . import ahead, background, kernel
+    rigid = []
+    if not background.compiled():
+        ahead.start(kernel.RIGID_TREE, kernel.GENERAL)
+        ahead.finish()
+        rigid = ahead.spawn(__spec__.name, "rigid")
+    warm(WARM_MODELS)
+    ahead.wait(rigid)
+    warm([WARM_RIGID])
+    print(f"mbsynth fast path compiled into {cache.cache_dir()} in {time.perf_counter() - started:.1f} s")
+
+
+# A body on a spherical joint with a particle on a rod, without and with a loop (a second,
+# redundant hinge) and a generated force: every kernel runs, and the correction's (the
+# kernel at rest, the compiled rows) on the tree.
+WARM_TREE = """
+name: warm_up
+gravity: [0, 0, -9.81]
+subsystems:
+  link: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5]}},
+         initial: {angular_velocity: [0.1, 0.2, 0.3]}}
+  bob: {type: particle, mass: 0.5, initial: {position: [0, 0, -0.5]}}
+joints:
+  - {name: pivot, type: spherical, parent: world, child: link.top}
+  - {name: rod, type: distance, parent: link, child: bob, length: 0.5}
+"""
+# Two bodies on a revolute and a fixed joint: a rigid tree (kernel.RIGID_TREE).
+WARM_RIGID = """
+name: warm_up_rigid
+gravity: [0, 0, -9.81]
+world: {frames: {pivot: {position: [0, 0, 0], axis: [1, 0, 0]}}}
+subsystems:
+  upper: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5],
+          axis: [1, 0, 0]}, low: {position: [0, 0, -0.5]}}, initial: {angular_velocity: [0.3, 0, 0]}}
+  lower: {type: rigid_body, mass: 0.5, inertia: [0.05, 0.05, 0.01], frames: {top: {position: [0, 0, 0.3]}}}
+joints:
+  - {name: hinge, type: revolute, parent: world.pivot, child: upper.top}
+  - {name: weld, type: fixed, parent: upper.low, child: lower.top}
+"""
+WARM_MODELS = [WARM_TREE + """  - {name: again, type: spherical, parent: world, child: link.top}
+forces:
+  - {name: push, type: force, at: bob, value: ["sin(t)", 0, 0]}
+""", WARM_TREE]  # kernel.GENERAL
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,207 @@
+"""Putting a state back on the constraints with the kernel itself, in the mass metric.
+
+At q̇ = 0, with no gravity and no generated forces, the kernel's Q and b vanish (every
+b term of a kernel row is quadratic in q̇), so its q̈ for a right side shifted by −r is
+the least-M-norm Δ with A Δ = −r ((2.14) with Q = 0). One such call is a Gauss–Newton
+step of the projection in the mass metric: positions with r = φ(q) (repeated while φ is
+above CORRECTION_RTOL of the coordinates' size, at most MAX_STEPS times), then velocities with
+r = φ̇(q, q̇) = A q̇, a linear problem one step solves. From an integrator's drift of
+5e-9 one step leaves rounding (2e-15 on a UR5). After a single position step of at most
+REUSE of the coordinates' size, with φ̇ at most REUSE of the rates, the velocity step
+reuses that step's factorization: A at the uncorrected q leaves φ̇ off by about
+|Δq| |Δq̇|, REUSE² relative; each body's quaternion rate first loses its part along u
+(``_unit_rates``), so that the reusing call solves for the joint rows' right sides alone
+(kernel.motion's REUSED at rest). The kernel's own residual check is skipped
+(kernel.UNCHECKED):
+the rows after each step check it, and a velocity step that does not cut φ̇ sends the
+state to projection.py. A correction costs a kernel call with its factorization, one
+that reuses it and three passes of the rows, far less than projection.py's sparse
+factorization (benchmarks/end_to_end_results.md).
+``correct`` does it in one compiled call for each state of a block; ``Correction.block``
+splits a block among the cores (``simulate``: the output times a step passed, with its
+end), each thread with its own Work.
+
+Only for Systems all of whose rows and coordinates the kernel's tree covers (rows.py's
+``covers``; no loops, no extra coordinates); elsewhere, and at any state the kernel
+declines, the caller projects with projection.py.
+"""
+
+import threading
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from .bodies import OPTIONS
+from . import threads
+from .joints import RIGID
+from .kernel import LAYOUT, OK, REUSED, UNCHECKED, WORK, motion
+from .packing import view1
+from .rows import Rows, largest, residuals_energy
+from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL
+
+MAX_STEPS = 3  # position steps before the state goes to projection.py
+REUSE = 1e-8  # the largest position step and φ̇ (relative) for which the velocity step reuses a factorization
+SHRINK = 1e-3  # a velocity step must cut φ̇ by this much at least ...
+TINY = np.finfo(float).tiny  # the largest rate's floor
+# a thread of ``Correction.block`` takes states of this many coordinates in all at least: handing
+# work to a thread costs about what correcting states of several hundred coordinates costs
+PER_THREAD = 1500
+KINETIC, POTENTIAL, PHI_MAX, PSI_MAX, DONE = range(5)  # the columns of ``correct``'s ``found``
+
+
+class Corrected(NamedTuple):
+    """A corrected state and, there (rows.py), the kinetic and potential energy and the
+    largest |φ| and |φ̇|."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    kinetic: float
+    potential: float
+    phi_max: float
+    psi_max: float
+
+
+@njit(nogil=True, **OPTIONS)
+def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, general, work):
+    """Each state (row of Q, Q̇) corrected into Q_on, Q̇_on (module docstring), found's row
+    (KINETIC, POTENTIAL, PHI_MAX, PSI_MAX there, DONE = 1), or DONE = 0 where the kernel
+    declines it or the rows' checks fail. LI, LF, LX: the Layout packed; LF_rest: its
+    floats with no gravity (Engine.at_rest); WI, WF, WX: a Work packed; gen: zeros for
+    the generated function's outputs; general: kernel.motion's (Template.general); work:
+    a thread's arrays (``Correction._arguments``: rows.py's φ, φ̇, Rs; the right side; the
+    factored q; q̇ = 0)."""
+    phi, psi, Rs, shift, factored, rest = work
+    qdd = view1(WF, WX, WORK.qdd)
+    kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
+    quat_row = view1(LI, LX, LAYOUT.quat_row)
+    for b in range(Q.shape[0]):
+        found[b, DONE] = 0.0
+        q, qd = Q_on[b], QD_on[b]
+        for c in range(q.shape[0]):
+            q[c], qd[c] = Q[b, c], QD[b, c]
+        _, _, phi_max, _, q_max, qd_max = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs, False)
+        size, reuse, declined = max(q_max, 1.0), False, False
+        for step in range(MAX_STEPS + 1):
+            if phi_max <= CORRECTION_RTOL * size:
+                break
+            _negated(phi, shift)
+            if step == MAX_STEPS or \
+                    motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0] != OK:
+                declined = True
+                break
+            reuse = step == 0 and largest(qdd) <= REUSE * size  # the Work keeps q's factorization
+            for c in range(q.shape[0]):
+                factored[c] = q[c] if reuse else factored[c]
+                q[c] += qdd[c]
+            _unit_rates(q, qd, kind, start)
+            _, _, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        if declined:
+            continue
+        if step == 0:  # on the constraints as it came: its φ̇ not read yet
+            _, _, _, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        rates = max(qd_max, TINY)
+        _negated(psi, shift)
+        if reuse and psi_max <= REUSE * rates:
+            for i in range(kind.shape[0]):
+                if kind[i] == RIGID:
+                    shift[quat_row[i]] = 0.0  # met by _unit_rates, to rounding: the kernel redoes only the solve
+            status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED, general)[0]
+        else:
+            status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0]
+        if status != OK:
+            continue
+        before = psi_max
+        for c in range(qd.shape[0]):
+            qd[c] += qdd[c]
+        kinetic, potential, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
+        if psi_max <= max(SHRINK * before, CORRECTION_RATE_RTOL * size * rates):
+            found[b, KINETIC], found[b, POTENTIAL], found[b, PHI_MAX], found[b, PSI_MAX] = \
+                kinetic, potential, phi_max, psi_max
+            found[b, DONE] = 1.0
+
+
+@njit(**OPTIONS)
+def _unit_rates(q, qd, kind, start):
+    """Each body's quaternion rate u̇ less its part along u, (u·u̇/uᵀu) u: the velocity step's
+    own change along u (its unit-norm row uᵀΔu̇ = −uᵀu̇ moves u̇ only there, a direction
+    of no mass), made before it, so that the step's right side is the joint rows' alone
+    (kernel.motion's REUSED then redoes only the solve)."""
+    for i in range(kind.shape[0]):
+        if kind[i] == RIGID:
+            o = start[i] + 3
+            uu = q[o] * q[o] + q[o + 1] * q[o + 1] + q[o + 2] * q[o + 2] + q[o + 3] * q[o + 3]
+            f = (q[o] * qd[o] + q[o + 1] * qd[o + 1] + q[o + 2] * qd[o + 2] + q[o + 3] * qd[o + 3]) / uu
+            for a in range(4):
+                qd[o + a] -= f * q[o + a]
+
+
+@njit(**OPTIONS)
+def _negated(x, out):
+    for i in range(x.shape[0]):
+        out[i] = -x[i]
+
+
+class Correction:
+    """The kernel's projection: ``rows`` (rows.py) on an Engine's Layout, and ``at_rest``,
+    that Engine with no gravity (Engine.at_rest)."""
+
+    def __init__(self, rows, at_rest):
+        self.rows, self.at_rest = rows, at_rest
+        self.gen = np.zeros(at_rest.outputs)
+        self.arguments = [self._arguments(at_rest.work, (rows.phi, rows.psi, *rows.work))]  # one per thread
+        self.lock = threading.Lock()  # Systems that differ in parameters only share it (Engine.at)
+
+    def _arguments(self, packed_work, rows_work):
+        """``correct``'s arguments after ``found``, for one thread: its Work (packed) and the
+        rows' work arrays (φ, φ̇, Rs) its own."""
+        n = self.at_rest.n
+        work = (*rows_work, np.zeros(rows_work[0].shape), np.zeros(n), np.zeros(n))
+        return (*self.rows.packed, self.at_rest.packed[1], *packed_work, self.gen, self.at_rest.general, work)
+
+    @classmethod
+    def build(cls, engine):
+        """The Correction on ``engine``'s Layout, or None where its kernel does not cover the System."""
+        rows = Rows(engine.L, engine.packed, int(engine.L.sizes[1]))
+        return cls(rows, engine.at_rest()) if rows.covers else None
+
+    def __call__(self, q, qd):
+        """``Corrected`` (q, q̇) on the constraints (new arrays) with their rows, or None where
+        the kernel declines the state, MAX_STEPS position steps leave φ above CORRECTION_RTOL, or
+        the velocity step leaves φ̇ above SHRINK of what it was (and above rounding)."""
+        return self.block(q[None, :], qd[None, :])[0]
+
+    def block(self, Q, QD):
+        """``__call__`` of each state (row of Q, Q̇), in compiled calls on up to threads.THREADS
+        threads (states of PER_THREAD coordinates in all at least each): a list."""
+        Q, QD = np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(QD, dtype=float)
+        count = Q.shape[0]
+        Q_on, QD_on, found = np.empty(Q.shape), np.empty(QD.shape), np.empty((count, DONE + 1))
+        parts = max(1, min(threads.THREADS, count * Q.shape[1] // PER_THREAD))  # read here: a benchmark may lower it
+        bounds = [count * k // parts for k in range(parts + 1)]
+
+        def part(k):
+            a, b = bounds[k], bounds[k + 1]
+            correct(Q[a:b], QD[a:b], Q_on[a:b], QD_on[a:b], found[a:b], *self.arguments[k])
+
+        with self.lock:
+            while len(self.arguments) < parts:
+                self.arguments.append(self._arguments(self.at_rest.new_work()[0], self.rows.new_work(*self.rows.sizes)))
+            others = [threads.pool().submit(part, k) for k in range(1, parts)]
+            part(0)  # on this thread meanwhile
+            for other in others:
+                other.result()
+        return [Corrected(q, qd, *info[:DONE]) if info[DONE] else None for q, qd, info in zip(Q_on, QD_on, found)]
+
+    def residuals_energy(self, q, qd):
+        """(φ, φ̇, T, V) at (q, q̇): the System's residuals and its parts' energies."""
+        with self.lock:
+            phi, psi, kinetic, potential = self.rows(q, qd)[:4]
+            return phi.copy(), psi.copy(), kinetic, potential
+
+    def drift(self, q, qd):
+        """The largest |φ| relative to the largest coordinate (at least 1: a quaternion's
+        unit), or |φ̇| relative to the largest rate."""
+        with self.lock:
+            phi_max, psi_max, q_max, qd_max = self.rows(q, qd)[4:]
+        return max(phi_max / max(q_max, 1.0), psi_max / max(qd_max, TINY))

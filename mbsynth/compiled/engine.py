@@ -1,0 +1,177 @@
+"""The compiled path: a Template per model structure, an Engine per parameter values.
+
+``Template.build(system)`` lays the System out (layout.build) and compiles its generated
+function (codegen.py), or returns None when the kernels cover no part of it. Systems that
+differ only in parameter values (``System.with_parameters``, a Data's ``set_parameters``)
+share one Template: the parameters are arguments of the generated function, and the
+Layout's numbers (masses, inertias, frame offsets) are re-evaluated per parameter values
+(layout.with_parameters), which costs no compilation, and only where a parameter they
+depend on changed (a controller's torques do not: ``Template.number_parameters``; those
+Engines share one set of buffers, ``Engine.at``). ``Template.engine(p)`` makes the Engine
+at parameter values p: its numbers and work buffers. An Engine holds no reference to a System.
+
+``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
+send the problem to the exact treatment (kernel.py's status); ``motion_batch`` evaluates
+many states in parallel.
+"""
+
+import copy
+import threading
+
+import numpy as np
+
+from ..core.equations import Motion
+from . import ahead, codegen, kernel, layout
+from .assembly import Work, make_work
+from .correction import Correction
+from .packing import pack, views
+from .threads import THREADS, pool
+
+EMPTY = np.zeros(0)
+CHUNK = 16  # fewest rows a thread takes at a time
+
+
+class Template:
+    """What the Systems with one structure share: the Layout (with the numbers of the System
+    it was built from, at parameter values ``p``) and the compiled generated function."""
+
+    def __init__(self, system, L, exprs):
+        self.L, self.n, self.p = L, system.n, system.parameter_values
+        self.names = tuple(system.parameters)
+        self.sources = layout.sources(L, system)  # the parts and joints its numbers are read from
+        self.outputs = len(exprs)
+        self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
+                                                  system.parameter_symbols) if exprs else None
+        self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
+        self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
+        used = layout.number_parameters(L, self.sources, system.parameters)
+        # the parameters the Layout's numbers use: values that differ only in others share L as it is
+        self.number_parameters = np.array([self.names.index(n) for n in sorted(used)], dtype=np.int64)
+        self.on_layout = None  # the first Engine on L itself, whose buffers the later ones share
+        self.lock = threading.Lock()
+
+    @classmethod
+    def build(cls, system):
+        found = layout.build(system)
+        return None if found is None else cls(system, *found)
+
+    def engine(self, p):
+        """The Engine at parameter values ``p`` (an array in the model's parameter order): this
+        Template's structure and code, its own numbers where they differ from the Layout's
+        (masses, inertias, frames), else the buffers of the first Engine on the Layout (a
+        controller's torques: ``Engine.at``)."""
+        p = np.array(p, dtype=float)
+        if not np.array_equal(p[self.number_parameters], self.p[self.number_parameters]):
+            return Engine(self, layout.with_parameters(self.L, self.sources, dict(zip(self.names, p))), p)
+        with self.lock:
+            if self.on_layout is None:
+                self.on_layout = Engine(self, self.L, p)
+                return self.on_layout
+        return self.on_layout.at(p)
+
+
+class Engine:
+    """The fast path for one System at its parameter values ``p`` (Layout ``L``)."""
+
+    def __init__(self, template, L, p):
+        self.template, self.L, self.p = template, L, p
+        self.n, self.outputs, self.module = template.n, template.outputs, template.module
+        self.closes_loops, self.general = template.closes_loops, template.general
+        self.gen = np.zeros(self.outputs)
+        self.packed = pack(L)
+        self.work, self.W = self.new_work()
+        self.buffers = (*self.packed, *self.work)  # kernel.motion's last six arguments
+        self.no_freedom = np.zeros((self.n, 0))  # the nullspace of a unique motion (read-only)
+        self.no_freedom.flags.writeable = False
+        self.lock = threading.Lock()
+        self.batch_lock = threading.Lock()
+        self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
+        self.corrections = []  # the Correction, once made (a list: ``at``'s copies share it)
+
+    def at(self, p):
+        """This Engine at other parameter values that its Layout's numbers do not use (a
+        controller's torques): the same buffers and locks, so a System per control sample
+        allocates nothing."""
+        other = copy.copy(self)
+        other.p = p
+        return other
+
+    def at_rest(self):
+        """This Engine with no gravity, for calls at q̇ = 0 with no generated forces (correction.py)."""
+        return Engine(self.template, self.L._replace(node_mg=np.zeros_like(self.L.node_mg)), self.p)
+
+    def correction(self):
+        """The kernel's projection on this Engine's Layout (correction.py), or None where the
+        kernel does not cover the System."""
+        if not self.corrections:
+            self.corrections.append(Correction.build(self))
+        return self.corrections[0]
+
+    def new_work(self):
+        """(packed buffers, Work of views into them)."""
+        work = make_work(self.L)
+        packed = pack(work)
+        return packed, views(Work, work, *packed)
+
+    def warm(self, q, qd):
+        """Compile (or load from the cache) everything ``motion`` calls, at the state (q, q̇):
+        the generated function first, then, once the helpers this process started (ahead.py)
+        have put their parts of the kernel into the cache, the kernel."""
+        if self.module is not None:
+            self.module.evaluate(0.0, q, qd, self.p, self.gen)
+        ahead.finish()
+        self.motion(0.0, q, qd)
+
+    def motion(self, t, q, qd, bshift=None):
+        """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
+        bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ)."""
+        with self.lock:
+            status, residual = self._solved(t, q, qd, EMPTY if bshift is None else bshift)
+            if status != kernel.OK:
+                return None
+            return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
+
+    def derivative(self, t, y):
+        """(q̇, q̈) stacked at the state y = (q, q̇) (a contiguous float array), as an
+        integrator's stage wants it, or None for the exact path: ``motion`` without a Motion."""
+        y = np.ascontiguousarray(y, dtype=float)
+        q, qd = y[:self.n], y[self.n:]
+        with self.lock:
+            status, _ = self._solved(t, q, qd, EMPTY)
+            return np.concatenate((qd, self.W.qdd)) if status == kernel.OK else None
+
+    def _solved(self, t, q, qd, bshift):
+        """kernel.motion's (status, residual) at (t, q, q̇), its q̈ and Qc left in this
+        Engine's Work (the caller holds the lock): the generated function, then the kernel."""
+        if self.module is not None:
+            self.module.evaluate(float(t), q, qd, self.p, self.gen)
+        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, kernel.CHECKED, self.general)
+
+    def motion_batch(self, t, q, qd):
+        """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread
+        per core, each with its own Work, taking chunks of rows in turn (a thread slowed by
+        other load does fewer), the kernels running without the GIL."""
+        count = q.shape[0]
+        qdd, status = np.zeros((count, self.n)), np.zeros(count, dtype=np.int64)
+        size = max(CHUNK, -(-count // (THREADS * 8)))
+        chunks = iter(range(0, count, size))  # next() on it is atomic under the GIL
+
+        def worker(work):
+            gen = np.zeros((size, self.outputs))  # the generated outputs of one chunk, reused chunk after chunk
+            for a in chunks:
+                b = min(a + size, count)
+                if self.module is not None:
+                    self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[:b - a])
+                kernel.motion_rows(q[a:b], qd[a:b], gen[:b - a], *self.packed, *work, self.general, qdd[a:b],
+                                   status[a:b])
+
+        threads = max(1, min(THREADS, -(-count // size)))
+        with self.batch_lock:
+            while len(self.batch_works) < threads:
+                self.batch_works.append(self.new_work()[0])
+            if threads > 1:
+                list(pool().map(worker, self.batch_works[:threads]))
+            else:
+                worker(self.batch_works[0])
+        return qdd, status
+

@@ -1,0 +1,218 @@
+"""Many compiled functions evaluated together: one call per shared structure.
+
+Connectors and parts built from one template (``Connector._place``, a robot's links)
+share the raw numpy function of ``symbolic.compile_function`` and differ only in the
+coordinates they read and in their numbers. ``Batch`` stacks those arguments (one column
+per instance) and calls the shared function once, numpy broadcasting every operation,
+instead of once per instance in a Python loop. Functions that are not ``Compiled``, or
+whose raw function does not broadcast, are called one by one.
+"""
+
+import operator
+
+import numpy as np
+
+from . import structures
+from ..symbolic.derive import Compiled
+from ..core.tolerances import STACKED_CHECK_RTOL
+
+STACK_MIN = 8  # fewer instances than this are called one by one (numpy's per-call cost on small arrays)
+
+
+class Batch:
+    """``functions[i](t, q[indices[i]], qd[indices[i]], p)`` for all i at once; each
+    returns a tuple of arrays (one per *slot*: a, b, C, φ, ψ of a connector; M, Q or T, V
+    of a part). A call returns, per slot, the raveled outputs of all functions
+    concatenated in order (``slots`` of them). The layout is fixed at the first call."""
+
+    def __init__(self, functions, indices, slots):
+        self.functions, self.slots = list(functions), slots
+        self.indices = [np.asarray(i, dtype=int) for i in indices]
+        self.layout = None
+        self.kernels = "when ready"  # or "wait" / "never": decided at the first call, for good (fix_kernels)
+
+    def fix_kernels(self, wait):
+        """From now on each group's path is decided at its first call and kept: its numba
+        kernel, built then if need be (``wait``), or numpy throughout (not ``wait``) — so
+        that results do not depend on when a background compilation finishes."""
+        self.kernels = "wait" if wait else "never"
+
+    def __call__(self, t, q, qd, p):
+        t = np.float64(t)
+        if self.layout is None:
+            return self._first(t, q, qd, p)
+        total, groups, singles, slots = self.layout
+        out = np.empty(total)
+        with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
+            for group in groups:
+                out[group.dest] = group(t, q, qd, p)
+        for f, idx, dest in singles:
+            out[dest] = np.concatenate([np.ravel(x) for x in f(t, q[idx], qd[idx], p)])
+        return [out[a:b] for a, b in slots]
+
+    def _first(self, t, q, qd, p):
+        """Call each function alone, lay the outputs out, group the functions that share a
+        raw function and keep the groups whose stacked call reproduces the single calls."""
+        outputs = [[np.ravel(x) for x in f(t, q[idx], qd[idx], p)] for f, idx in zip(self.functions, self.indices)]
+        count = self.slots
+        sizes = np.array([[x.size for x in o] for o in outputs], dtype=int).reshape(len(outputs), count)
+        slot_size = sizes.sum(axis=0)
+        slot_start = np.concatenate([[0], np.cumsum(slot_size)])
+        # position of each function's outputs in the flat result: slot start + the sizes before it
+        before = np.cumsum(sizes, axis=0) - sizes
+        dests = [np.concatenate([slot_start[j] + before[i, j] + np.arange(sizes[i, j]) for j in range(count)])
+                 .astype(int) for i in range(len(outputs))]
+        expected = np.concatenate([np.zeros(0)] + [o[j] for j in range(count) for o in outputs])  # slot by slot
+        groups, singles = [], []
+        for members in _shared(self.functions, self.indices):
+            group = None
+            if isinstance(self.functions[members[0]], Compiled):
+                group = _Group([self.functions[i] for i in members], np.array([self.indices[i] for i in members]),
+                               np.array([dests[i] for i in members]).T, self.kernels)
+                if not group.reproduces(t, q, qd, p, expected):
+                    group = None
+            if group is None:
+                singles.extend((self.functions[i], self.indices[i], dests[i]) for i in members)
+            else:
+                groups.append(group)
+        self.layout = (int(slot_start[-1]), groups, singles, list(zip(slot_start[:-1], slot_start[1:])))
+        return [expected[a:b] for a, b in self.layout[3]]
+
+
+def _shared(functions, indices):
+    """The functions as lists of positions, those that can share one call together."""
+    found = {}
+    for i, (f, idx) in enumerate(zip(functions, indices)):
+        key = (id(f.raw), idx.size, _values_key(f.values), len(f.fixed)) if isinstance(f, Compiled) else ("alone", i)
+        found.setdefault(key, []).append(i)
+    return list(found.values())
+
+
+def _values_key(values):
+    if not hasattr(values, "picks"):
+        return id(values)
+    return ("gathered", len(values.fixed), tuple((k, a, i is None) for k, a, i in values.picks))
+
+
+class _Group:
+    """Functions sharing one raw function: evaluated by its numba kernel
+    (compiled/structures.py) once that is ready, else by one stacked numpy call when there are
+    at least STACK_MIN of them, else one by one. ``dest`` (outputs × members): where each
+    output of each member goes in the flat result."""
+
+    def __init__(self, functions, indices, dest, kernels="when ready"):
+        first = functions[0]
+        self.raw, self.dest = first.raw, dest
+        self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
+        self.fixed = np.ascontiguousarray(np.array([f.fixed for f in functions], dtype=float).T)
+        # constants that are numbers and arguments (symbolic.gather): stacked, and per pick k the
+        # argument a and each member's position in it (None: a scalar), put in per call
+        self.picks = None
+        self.values = first.values
+        if hasattr(first.values, "picks"):
+            self.values = np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
+            self.picks = [(k, a, None if i is None else np.array([f.values.picks[n][2] for f in functions]))
+                          for n, (k, a, i) in enumerate(first.values.picks)]
+        self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
+        self.kernel = None  # the numba kernel once it is ready and checked
+        self.refused = kernels == "never"  # numpy for good (also when the kernel disagreed with numpy)
+        self.wait = kernels == "wait"
+
+    def __call__(self, t, q, qd, p):
+        if self.picks is None:
+            values = _stacked(self.values(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
+        elif self.picks:
+            values = self._gathered(t, q, qd, p)
+        else:
+            values = self.values
+        if self.kernel is None and not self.refused:
+            self._take_kernel(t, q, qd, p, values)
+        if self.kernel is not None:
+            result = np.empty(self.dest.shape)
+            self.kernel(t, q, qd, p, self.columns, values, self.fixed, result)
+            return result
+        return self._numpy(t, q, qd, p, values)
+
+    def _gathered(self, t, q, qd, p):
+        """The stacked constants with each member's arguments put in."""
+        values, members = self.values.copy(), np.arange(self.dest.shape[1])
+        for k, a, at in self.picks:
+            given = (t, q, qd, p)[a]
+            if at is None:
+                values[k] = given
+            elif a in (1, 2):  # a coordinate or velocity slot: the member's column
+                values[k] = given[self.columns[at, members]]
+            else:
+                values[k] = given[at]
+        return values
+
+    def _take_kernel(self, t, q, qd, p, values):
+        """Use the kernel from now on if it is ready and agrees with numpy at this state."""
+        found = structures.kernel(self.raw, wait=self.wait)
+        if found is None:
+            self.refused = self.wait  # waited for, and none: numpy for good
+            return
+        result = np.empty(self.dest.shape)
+        try:
+            found(t, q, qd, p, self.columns, values, self.fixed, result)
+        except Exception:  # noqa: BLE001 - arguments the kernel was not compiled for: numpy serves
+            self.refused = True
+            return
+        if _agree(result, self._numpy(t, q, qd, p, values)):
+            self.kernel = found
+        else:
+            self.refused = True
+
+    def _numpy(self, t, q, qd, p, values):
+        members = self.dest.shape[1]
+        if members < STACK_MIN:
+            result = np.empty(self.dest.shape)
+            for m in range(members):
+                cols = self.columns[:, m]
+                result[:, m] = self.raw(t, q[cols], qd[cols], p, values[:, m], self.fixed[:, m])
+            return result
+        qs, qds = q[self.columns], qd[self.columns]
+        out = self.raw(t, qs, qds, p, values, self.fixed)
+        if self.pick is None:
+            arrays = [k for k, x in enumerate(out) if np.ndim(x) > 0]
+            others = [k for k in range(len(out)) if np.ndim(out[k]) == 0]
+            self.pick = (_getter(arrays), arrays, _getter(others), others)
+        get_arrays, arrays, get_others, others = self.pick
+        result = np.empty(self.dest.shape)
+        if arrays:
+            result[arrays] = np.array(get_arrays(out), dtype=float)
+        if others:
+            result[others] = np.array(get_others(out), dtype=float)[:, None]
+        return result
+
+    def reproduces(self, t, q, qd, p, expected):
+        try:
+            with np.errstate(all="ignore"):
+                got = self(t, q, qd, p)
+        except Exception:  # noqa: BLE001 - a raw function that does not broadcast is called singly
+            return False
+        return _agree(got, expected[self.dest])
+
+
+def _agree(got, want):
+    """Equal to STACKED_CHECK_RTOL of the largest finite value, NaN where NaN."""
+    scale = np.abs(want[np.isfinite(want)]).max(initial=0.0)
+    return got.shape == want.shape and np.allclose(got, want, rtol=STACKED_CHECK_RTOL,
+                                                   atol=STACKED_CHECK_RTOL * scale,
+                                                   equal_nan=True)
+
+
+def _getter(positions):
+    """A function picking ``positions`` of a sequence as a tuple (one C call)."""
+    if len(positions) == 1:
+        k = positions[0]
+        return lambda seq: (seq[k],)
+    return operator.itemgetter(*positions) if positions else (lambda seq: ())
+
+
+def _stacked(values, members):
+    """The values as rows of a (len(values), members) array, scalars repeated along their row."""
+    stacked = np.empty((len(values), members))
+    for row, value in zip(stacked, values):
+        row[...] = value
+    return stacked

@@ -1,0 +1,417 @@
+"""The fast path's whole evaluation, in numba: assemble, factor the tree, close the loops,
+recover q̈ and Qc, check.
+
+Extra rows (loop joints, other constraints) and extra coordinates (other parts) join the
+tree system K z = r as a bordered system. With G the extra rows on the tree unknowns,
+
+    [[M_x, A_xᵀ], [A_x, −G K⁻¹ Gᵀ]] [q̈_x; λ_x] = [F_x; b_x − G K⁻¹ r],   z = K⁻¹ (r − Gᵀ λ_x):
+
+the tree is factored once and each extra row costs one tree solve. The small symmetric
+Schur matrix is solved by its eigendecomposition, dropping eigenvalues below
+``SCHUR_ZERO_RTOL`` of the largest, or of 1 (redundant rows, as a planar loop's in 3D; the
+masses are divided by the largest and the rows have unit norm, so a row that acts has an
+eigenvalue of the order of an inverse mass, ≥ about 1/N, and rows that repeat tree rows
+give a Schur matrix of rounding noise). A dropped
+direction must leave the right side alone (else the rows contradict: INCONSISTENT) and
+must move no acceleration (else the motion is not unique: NOT_UNIQUE).
+
+Status: OK, or why the caller must hand the problem to the exact treatment — a singular
+tree block (SINGULAR), the two cases above, a residual above ``RESIDUAL_MAX`` or a
+non-finite result. ``residual`` is the relative residual of the equilibrated KKT
+equations M q̈ + Aᵀλ = Q + C, A q̈ = b (its numerator bounds that of (2.12), since
+P Aᵀ = 0 and ‖P‖ = 1).
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
+from .bodies import INLINE, OPTIONS, rate_transpose
+from .eigen import symmetric_eigen
+from .joints import RIGID
+from .layout import Layout
+from .packing import borrowed, fields, view1, view2, view3, view4
+from .tree import factor, solve
+from ..core.tolerances import KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL, SCHUR_ZERO_RTOL
+
+OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
+CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
+# checks): numpy integers, which numba types as int64 rather than as a literal per value (one compilation)
+RIGID_TREE, GENERAL = None, True  # ``motion``'s ``general``: numba prunes the branches on ``general is None``, so
+# a rigid tree's motion compiles without particle joints, extra rows and extra coordinates (Layout.general)
+RESIDUAL_MAX = 1e-9
+LAYOUT, WORK = fields(Layout), fields(Work)
+
+
+@njit(**OPTIONS)
+def _copy(a, b):
+    """b ← a (a loop: numba's slice assignment compiles slowly)."""
+    for i in range(a.shape[0]):
+        b[i] = a[i]
+
+
+@njit(**OPTIONS)
+def _scatter(x, weight, segs, seg6, y):
+    """y += weight · (extra row x on the tree unknowns). segs: (xseg_ptr, xseg_node, v, yoff)."""
+    ptr, node, v, yoff = segs
+    for seg in range(ptr[x], ptr[x + 1]):
+        i = node[seg]
+        for a in range(v[i]):
+            y[yoff[i] + a] += weight * seg6[seg, a]
+
+
+@njit(**OPTIONS)
+def _row_dot(x, segs, seg6, z):
+    """(extra row x on the tree unknowns) · z."""
+    ptr, node, v, yoff = segs
+    total = 0.0
+    for seg in range(ptr[x], ptr[x + 1]):
+        i = node[seg]
+        for a in range(v[i]):
+            total += seg6[seg, a] * z[yoff[i] + a]
+    return total
+
+
+@njit(**OPTIONS)
+def _moves(vec, nx, topology, segs, seg6, factored, y, w):
+    """The acceleration a unit Schur direction (u_x, μ) moves: (u_x, −(K⁻¹Gᵀμ) on accelerations)."""
+    y[:] = 0.0
+    for x in range(vec.shape[0] - nx):
+        _scatter(x, -vec[nx + x], segs, seg6, y)
+    solve(topology, factored, y, w, False)
+    total = 0.0
+    for x in range(nx):
+        total += vec[x] * vec[x]
+    v, yoff = segs[2], segs[3]
+    for i in range(v.shape[0]):
+        for a in range(v[i]):
+            total += w[yoff[i] + a] ** 2
+    return math.sqrt(total)
+
+
+@njit(**OPTIONS)
+def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam, multipliers):
+    """Solve the Schur system of the extra rows and coordinates into lam (extra
+    accelerations, then extra multipliers), then the tree into z (its multipliers too
+    where ``multipliers``: tree.solve). Returns a status."""
+    mx, nx = Ax.shape[0], Ax.shape[1]
+    S[:, :] = 0.0
+    for x in range(nx):
+        rhs[x] = Fx[x]
+        for c in range(nx):
+            S[x, c] = Mx[x, c]
+    for x in range(mx):
+        for c in range(nx):
+            S[c, nx + x] = Ax[x, c]
+            S[nx + x, c] = Ax[x, c]
+        rhs[nx + x] = xb[x] - _row_dot(x, segs, seg6, z0)
+    for x in range(mx):
+        y[:] = 0.0
+        _scatter(x, 1.0, segs, seg6, y)
+        solve(topology, factored, y, w, False)
+        for r in range(mx):
+            S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
+    values = np.zeros(mx + nx)
+    symmetric_eigen(S, vectors, values)
+    top = max(np.abs(values).max(), 1.0) if values.shape[0] else 1.0
+    lam[:] = 0.0
+    dropped = size = 0.0
+    for e in range(values.shape[0]):  # the right side's scale: before the tree's part cancels
+        size += rhs[e] * rhs[e]
+    for x in range(mx):
+        size += xb[x] * xb[x]
+    for e in range(values.shape[0]):
+        coef = 0.0
+        for c in range(values.shape[0]):
+            coef += vectors[c, e] * rhs[c]
+        if abs(values[e]) > SCHUR_ZERO_RTOL * top:
+            for c in range(values.shape[0]):
+                lam[c] += coef / values[e] * vectors[c, e]
+        else:
+            dropped += coef * coef
+            if _moves(vectors[:, e], nx, topology, segs, seg6, factored, y, w) > KERNEL_NULL_RTOL:
+                return NOT_UNIQUE
+    if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
+        return INCONSISTENT
+    _copy(ry, y)
+    for x in range(mx):
+        _scatter(x, -lam[nx + x], segs, seg6, y)
+    solve(topology, factored, y, z, multipliers)
+    return OK
+
+
+@njit(**OPTIONS)
+def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc):
+    """q̈ (bodies.py: ü = (u s + Eᵀa)/ν, a = Bᵀα) and Qc = M q̈ − Q from the solution."""
+    for i in range(kind.shape[0]):
+        c, o, m = start[i], yoff[i], mass[i]
+        for a in range(3):
+            qdd[c + a] = z[o + a]
+            Qc[c + a] = m * z[o + a] - Qf[c + a]
+        if kind[i] != RIGID:
+            continue
+        u, J, Bi = q[c + 3:c + 7], inertia[i], Rs[i, 3]
+        a_rates = (Bi[0, 0] * z[o + 3] + Bi[1, 0] * z[o + 4] + Bi[2, 0] * z[o + 5],
+                   Bi[0, 1] * z[o + 3] + Bi[1, 1] * z[o + 4] + Bi[2, 1] * z[o + 5],
+                   Bi[0, 2] * z[o + 3] + Bi[1, 2] * z[o + 4] + Bi[2, 2] * z[o + 5])
+        et = rate_transpose(u, a_rates)
+        f = rate_transpose(u, (J[0, 0] * a_rates[0] + J[0, 1] * a_rates[1] + J[0, 2] * a_rates[2],
+                               J[1, 0] * a_rates[0] + J[1, 1] * a_rates[1] + J[1, 2] * a_rates[2],
+                               J[2, 0] * a_rates[0] + J[2, 1] * a_rates[1] + J[2, 2] * a_rates[2]))
+        for a in range(4):
+            qdd[c + 3 + a] = (u[a] * s[i] + et[a]) / nu[i]
+            Qc[c + 3 + a] = 4 * nu[i] * f[a] - Qf[c + 3 + a]
+    nx = x_coord.shape[0]
+    for x in range(nx):
+        total = 0.0
+        for c in range(nx):
+            total += Mx[x, c] * lam[c]
+        qdd[x_coord[x]] = lam[x]
+        Qc[x_coord[x]] = mu * total - Qf[x_coord[x]]
+
+
+@njit(**OPTIONS)
+def _shifts_only(qd, bshift, kind, quat_row):
+    """Whether a state is at rest (q̇ = 0) and its shifts leave the unit-norm rows alone: then
+    every b term of the rows vanishes (each is quadratic in q̇, or a unit-norm row's
+    acceleration s, zero), and their right sides are the shifts alone."""
+    if bshift.shape[0] == 0:
+        return False
+    for c in range(qd.shape[0]):
+        if qd[c] != 0.0:
+            return False
+    for i in range(kind.shape[0]):
+        if kind[i] == RIGID and bshift[quat_row[i]] != 0.0:
+            return False
+    return True
+
+
+@njit(**OPTIONS)
+def _shifted_rows(kind, node_joint, k, rows, joint_row, bshift, rscale, rb, s):
+    """The tree rows' right sides of a state ``_shifts_only`` accepts: the shifts, equilibrated
+    as the rows were (rscale); the unit-norm rows' s zero."""
+    for i in range(kind.shape[0]):
+        if kind[i] == RIGID:
+            s[i] = 0.0
+        j = node_joint[i]
+        if j >= 0:
+            for r in range(k[i]):
+                rb[rows[i] + r] = rscale[rows[i] + r] * bshift[joint_row[j] + r]
+
+
+@njit(**OPTIONS)
+def _finite(qdd, Qc):
+    """Whether every entry of q̈ and Qc is finite."""
+    for c in range(qdd.shape[0]):
+        if not (math.isfinite(qdd[c]) and math.isfinite(Qc[c])):
+            return False
+    return True
+
+
+@njit(**INLINE)
+def _node_dynamics(i, vi, ki, yoff, rows, H, F, J, z, dyn):
+    """dyn_i ← H_i y_i + J_iᵀ λ_i − F_i (the children's rows are added later); returns its
+    contributions to (‖M‖², ‖x‖², ‖r‖²)."""
+    o, r0 = yoff[i], rows[i]
+    norm_M = norm_x = norm_r = 0.0
+    for a in range(vi):
+        t = -F[i, a]
+        for c in range(vi):
+            t += H[i, a, c] * z[o + c]
+            norm_M += H[i, a, c] ** 2
+        for r in range(ki):
+            t += J[r0 + r, a] * z[o + vi + r]
+        dyn[i, a] = t
+        norm_x += z[o + a] ** 2
+        norm_r += F[i, a] ** 2
+    return norm_M, norm_x, norm_r
+
+
+@njit(**INLINE)
+def _node_rows(i, vi, ki, vp, p, yoff, rows, J, P, rb, z, dyn):
+    """The residual of node i's parent-joint rows, their multipliers added to the parent's
+    dyn; returns (Σ residual², ‖A‖², ‖b‖²) of those rows."""
+    o, r0 = yoff[i], rows[i]
+    res = norm_A = norm_r = 0.0
+    for r in range(ki):
+        lam_r, t = z[o + vi + r], -rb[r0 + r]
+        for a in range(vi):
+            t += J[r0 + r, a] * z[o + a]
+            norm_A += J[r0 + r, a] ** 2
+        if p >= 0:
+            for a in range(vp):
+                dyn[p, a] += P[r0 + r, a] * lam_r
+                t += P[r0 + r, a] * z[yoff[p] + a]
+                norm_A += P[r0 + r, a] ** 2
+        res += t * t
+        norm_r += rb[r0 + r] ** 2
+    return res, norm_A, norm_r
+
+
+@njit(**OPTIONS)
+def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn):
+    """Relative residual of the equilibrated KKT equations at the solution (module docstring).
+    Rigid nodes on revolute or fixed joints run with constant sizes (numba unrolls them)."""
+    _, parent, v, k, yoff, rows, _ = topology
+    ptr, node = segs[0], segs[1]
+    mx, nx = Ax.shape[0], Ax.shape[1]
+    res = norm_M = norm_A = norm_x = norm_r = 0.0
+    for i in range(kind.shape[0]):
+        if v[i] == 6 and k[i] == 5:
+            m2, x2, r2 = _node_dynamics(i, 6, 5, yoff, rows, H, F, J, z, dyn)
+        elif v[i] == 6 and k[i] == 6:
+            m2, x2, r2 = _node_dynamics(i, 6, 6, yoff, rows, H, F, J, z, dyn)
+        else:
+            m2, x2, r2 = _node_dynamics(i, v[i], k[i], yoff, rows, H, F, J, z, dyn)
+        norm_M += m2
+        norm_x += x2
+        norm_r += r2
+        if kind[i] == RIGID:  # the unit-norm row, exact by construction
+            norm_x += s[i] ** 2
+            norm_r += s[i] ** 2
+            norm_A += 1.0
+    for i in range(kind.shape[0]):
+        p = parent[i]
+        vp = v[p] if p >= 0 else 0
+        if v[i] == 6 and vp == 6 and k[i] == 5:
+            t2, a2, r2 = _node_rows(i, 6, 5, 6, p, yoff, rows, J, P, rb, z, dyn)
+        elif v[i] == 6 and vp == 6 and k[i] == 6:
+            t2, a2, r2 = _node_rows(i, 6, 6, 6, p, yoff, rows, J, P, rb, z, dyn)
+        else:
+            t2, a2, r2 = _node_rows(i, v[i], k[i], vp, p, yoff, rows, J, P, rb, z, dyn)
+        res += t2
+        norm_A += a2
+        norm_r += r2
+    for x in range(mx):
+        t = _row_dot(x, segs, seg6, z) - xb[x]
+        for seg in range(ptr[x], ptr[x + 1]):
+            for a in range(6):
+                dyn[node[seg], a] += seg6[seg, a] * lam[nx + x]
+                norm_A += seg6[seg, a] ** 2
+        for c in range(nx):
+            t += Ax[x, c] * lam[c]
+            norm_A += Ax[x, c] ** 2
+        res += t * t
+        norm_r += xb[x] ** 2
+    for i in range(kind.shape[0]):
+        for a in range(v[i]):
+            res += dyn[i, a] ** 2
+    for c in range(nx):
+        t = -Fx[c]
+        for e in range(nx):
+            t += Mx[c, e] * lam[e]
+            norm_M += Mx[c, e] ** 2
+        for x in range(mx):
+            t += Ax[x, c] * lam[nx + x]
+        res += t * t
+        norm_x += lam[c] ** 2
+        norm_r += Fx[c] ** 2
+    scale = (math.sqrt(norm_M) + math.sqrt(norm_A)) * math.sqrt(norm_x) + math.sqrt(norm_r) + 1e-300
+    return math.sqrt(res) / scale
+
+
+@njit(**OPTIONS)
+def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general):
+    """(status, residual) at one state; on OK, the Work's qdd holds q̈ and its Qc M q̈ − Q.
+    gen: the generated function's outputs at (t, q, q̇) — time enters only there; bshift:
+    added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
+    Layout and the Work packed (packing.py). ``mode``: CHECKED factors the tree and checks
+    the residual; UNCHECKED skips the check (residual 0: a caller that checks the result
+    itself, correction.py); REUSED also keeps the factorization the last call on this Work
+    left, for a call with the same M and A (the same q) and another right side; when that
+    call was at the same state, at rest (q̇ = 0) with the same forces, and this one's shifts
+    leave the unit-norm rows alone (``_shifts_only``: a correction's velocity step), only
+    the right side is rebuilt and solved, not the masses and rows. ``general``:
+    RIGID_TREE for a Layout of rigid bodies on tree joints only (compiled without the rest),
+    else GENERAL."""
+    q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
+    kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
+    mass, mg, inertia = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), view3(LF, LX, LAYOUT.node_J)
+    v, k, yoff, rows = (view1(LI, LX, LAYOUT.node_v), view1(LI, LX, LAYOUT.node_k), view1(LI, LX, LAYOUT.node_yoff),
+                        view1(LI, LX, LAYOUT.node_rows))
+    parent, x_coord = view1(LI, LX, LAYOUT.node_parent), view1(LI, LX, LAYOUT.x_coord)
+    transport = view1(LI, LX, LAYOUT.node_transport)
+    topology = (view1(LI, LX, LAYOUT.order), parent, v, k, yoff, rows, transport)
+    joints = (view3(LI, LX, LAYOUT.joint_program), view1(LI, LX, LAYOUT.joint_k), view2(LI, LX, LAYOUT.joint_kinds),
+              view2(LI, LX, LAYOUT.joint_start), view3(LF, LX, LAYOUT.joint_s), view4(LF, LX, LAYOUT.joint_R),
+              view1(LF, LX, LAYOUT.joint_length), view2(LI, LX, LAYOUT.joint_node))
+    xseg_ptr, xseg_node = view1(LI, LX, LAYOUT.xseg_ptr), view1(LI, LX, LAYOUT.xseg_node)
+    segs = (xseg_ptr, xseg_node, v, yoff)
+    gen_rows = (view1(LI, LX, LAYOUT.gen_arow), view1(LI, LX, LAYOUT.gen_aseg), view1(LI, LX, LAYOUT.gen_acol),
+                view1(LI, LX, LAYOUT.gen_brow))
+    Qf, Cf, qdd, Qc = view1(WF, WX, WORK.Qf), view1(WF, WX, WORK.Cf), view1(WF, WX, WORK.qdd), view1(WF, WX, WORK.Qc)
+    H, F, dyn = view3(WF, WX, WORK.H), view2(WF, WX, WORK.F), view2(WF, WX, WORK.dyn)
+    factored = (view3(WF, WX, WORK.HA), view3(WF, WX, WORK.Sn), view3(WF, WX, WORK.Jr), view3(WF, WX, WORK.X),
+                view3(WF, WX, WORK.U), view3(WF, WX, WORK.Ninv), view2(WF, WX, WORK.c), view2(WF, WX, WORK.x0),
+                view2(WF, WX, WORK.zeta))
+    s, nu, Rs = view1(WF, WX, WORK.s), view1(WF, WX, WORK.nu), view4(WF, WX, WORK.Rs)
+    J, P, rb, rscale = view2(WF, WX, WORK.J), view2(WF, WX, WORK.P), view1(WF, WX, WORK.rb), view1(WF, WX, WORK.rscale)
+    ry, y, z, z0, w = (view1(WF, WX, WORK.ry), view1(WF, WX, WORK.y), view1(WF, WX, WORK.z), view1(WF, WX, WORK.z0),
+                       view1(WF, WX, WORK.w))
+    scratch = (view3(WF, WX, WORK.V), view3(WF, WX, WORK.R), view2(WF, WX, WORK.Jt), view2(WF, WX, WORK.A),
+               view1(WF, WX, WORK.b))
+    seg7, seg6, xb, Ax = view2(WF, WX, WORK.seg7), view2(WF, WX, WORK.seg6), view1(WF, WX, WORK.xb), view2(WF, WX, WORK.Ax)
+    Mx, Fx, lam = view2(WF, WX, WORK.Mx), view1(WF, WX, WORK.Fx), view1(WF, WX, WORK.lam)
+    node_joint, joint_row, quat_row = (view1(LI, LX, LAYOUT.node_joint), view1(LI, LX, LAYOUT.joint_row),
+                                       view1(LI, LX, LAYOUT.quat_row))
+
+    if mode == REUSED and x_coord.shape[0] + xb.shape[0] == 0 and _shifts_only(qd, bshift, kind, quat_row):
+        _shifted_rows(kind, node_joint, k, rows, joint_row, bshift, rscale, rb, s)
+        tree_rhs(v, k, yoff, rows, F, rb, ry)
+        _copy(ry, y)
+        solve(topology, factored, y, z, False)
+        _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, 1.0, qdd, Qc)
+        return (OK if _finite(qdd, Qc) else NOT_FINITE), 0.0
+    o = generated(gen, view1(LI, LX, LAYOUT.gen_q), view1(LI, LX, LAYOUT.gen_c), view1(LI, LX, LAYOUT.gen_mi),
+                  view1(LI, LX, LAYOUT.gen_mj), Qf, Cf, Mx)
+    mu = nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu,
+               view1(WF, WX, WORK.q7), Rs)
+    for x in range(x_coord.shape[0]):
+        Fx[x] = Qf[x_coord[x]] + Cf[x_coord[x]]
+        for c in range(x_coord.shape[0]):
+            mu = max(mu, abs(Mx[x, c]))
+    mu = mu if mu > 0 else 1.0
+    divide_masses(mu, H, F, Mx, Fx)
+    tree_rows(q, qd, bshift, kind, start, node_joint, view1(LI, LX, LAYOUT.node_end), parent,
+              rows, nu, s, Rs, joints, joint_row, scratch, J, P, rb, rscale, general)
+    if general is not None and xb.shape[0]:
+        extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_xrow),
+                   view2(LI, LX, LAYOUT.joint_xseg), view1(LI, LX, LAYOUT.xrow_row), xseg_ptr, xseg_node, gen_rows,
+                   scratch, seg7, seg6, xb, Ax)
+    transports(q, start, parent, node_joint, view1(LI, LX, LAYOUT.node_end), transport,
+               joints[4], Rs, factored[8])
+    tree_rhs(v, k, yoff, rows, F, rb, ry)
+
+    if mode != REUSED and factor(topology, H, J, P, factored, view2(WF, WX, WORK.G), view1(WI, WX, WORK.pivot)) >= 0:
+        return SINGULAR, 0.0
+    _copy(ry, y)
+    if general is not None and x_coord.shape[0] + xb.shape[0] > 0:
+        solve(topology, factored, y, z0, False)  # _close solves again into z
+        status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
+                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED)
+        if status != OK:
+            return status, 0.0
+    else:
+        solve(topology, factored, y, z, mode == CHECKED)
+    _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc)
+    residual = 0.0
+    if mode == CHECKED:
+        residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn)
+    if not _finite(qdd, Qc):
+        return NOT_FINITE, residual
+    if not residual <= RESIDUAL_MAX:
+        return RESIDUAL, residual
+    return OK, residual
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, qdd, status):
+    """q̈ of each state (row of q, q̇, gen) into qdd and its status into status. Releases
+    the GIL: engine.py runs blocks of rows in threads, each with its own Work."""
+    empty = np.zeros(0)
+    qdd_view = view1(WF, WX, WORK.qdd)
+    for row in range(q.shape[0]):
+        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED, general)[0]
+        _copy(qdd_view, qdd[row])

@@ -1,0 +1,51 @@
+"""Every threshold by which mbsynth decides a numerical question, in one place, each with its
+own name: what counts as zero, as consistent, as converged, as agreeing.
+
+All are relative (to the scale named beside each) and dimensionless unless said otherwise.
+The compiled kernels read theirs as compile-time constants: a change here recompiles them
+(compiled/cache.py salts its cache with this file).
+"""
+
+# ---- the equations (core/equations.py, core/solvers.py): rank and consistency of (2.14)
+RANK_RTOL = 1e-12  # singular values below RANK_RTOL · σ_max of the equilibrated matrix are zero
+CONSISTENCY_RTOL = 1e-9  # least relative size of b ∉ range(A) or of wᵀ(Q + C) that is an error
+SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
+NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
+NEAR_SINGULAR = 1e-5  # σ_i below this fraction of σ₁ (of the equilibrated A): a nearly dependent direction
+VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off makes the verdict uncertain
+# (a mass ratio of 1e-9, 1e3 times the cut-off, is a legitimate model and is not flagged)
+
+# ---- the compiled path (compiled/)
+PIVOT_RTOL = 1e-9  # tree.py: a pivot below this fraction of its scale counts as zero
+SCHUR_ZERO_RTOL = 1e-10  # kernel.py: Schur eigenvalues below this fraction of max(the largest, 1) are zero
+KERNEL_CONSISTENCY_RTOL = 1e-10  # kernel.py: largest part of the right side along dropped directions,
+# relative to b's (tighter than CONSISTENCY_RTOL: the kernel hands a doubtful state to the exact path)
+KERNEL_NULL_RTOL = 1e-8  # kernel.py: largest acceleration a dropped (unit) direction may move
+CORRECTION_RTOL = 1e-14  # correction.py: largest |φ| left, relative to the largest coordinate (at least 1): ~50 ε
+CORRECTION_RATE_RTOL = 1e-12  # correction.py: a velocity step must leave φ̇ below this, relative to the
+# largest coordinate (at least 1) times the largest rate (or cut it by SHRINK)
+STACKED_CHECK_RTOL = 1e-12  # grouped.py: a stacked call must agree with the single calls to this,
+# relative to the group's largest value (checked once, at the first state)
+
+# ---- the model (model/)
+BALANCE_ZERO_RTOL = 1e-9  # balances.py: a sampled balance below this (relative to the force scale) is zero
+DEPENDENT_RTOL = 1e-8  # reactions.py: a row takes part in a dependency when its weight in one exceeds this
+COULOMB_LOAD_RTOL = 1e-12  # friction.py: Coulomb loads N have converged when they change by less than this
+
+# ---- analysis (analysis/)
+PROJECTION_RTOL = 1e-12  # projection.py: largest residual accepted after projection, relative to the row's terms
+ON_MANIFOLD_RTOL = 1e-8  # linearization.py: largest φ, ψ residual accepted, relative to its row's terms
+CHANGE_POINT_RTOL = 1e-7  # linearization.py: a dependency's second derivative on the tangent space above
+# this (relative) marks a change point
+ACCELERATION_TOL = 1e-10  # statics.py: largest |q̈| (SI units) accepted at an equilibrium, relative to
+# (1 + the scale of K)
+ISOLATED_RTOL = 1e-9  # statics.py: a singular value of K below this times the largest: a free direction
+MODE_ZERO_RTOL = 1e-6  # modes.py: an eigenvalue below this times the largest |s| is zero (a free direction):
+# a zero stiffness computed with rounding error ε splits a double zero eigenvalue into ±√ε, so the cut is near √ε
+COMPONENT_TOL = 1e-12  # diagnose.py: a direction's component below this is left out of its description
+AXIS_TOL = 1e-9  # diagnose.py: a unit vector within this of a body's or the world's axis is that axis
+
+# ---- validation against Pinocchio (robots/)
+VALIDATION_RTOL = 1e-9  # validate.py: largest relative error that passes
+SELF_STRESS_RTOL = 1e-9  # validate.py: singular values of J below this · σ_max are self-stresses;
+# wrench directions likewise

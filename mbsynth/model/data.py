@@ -1,0 +1,328 @@
+"""A System's workspace: ``data = system.data()``, as Pinocchio's Data beside its Model.
+
+A System (system.py) is the model, a value: parts, connectors, forces, the coordinate
+layout, parameter names and default values. What a computation keeps between calls lives
+in a Data made from it:
+
+- the parameter values, an array ``p`` in the model's parameter order (a controller writes
+  them: ``set_parameters``; parameters defined by expressions of others follow);
+- the Evaluator of the connectors and parts (evaluation.py, the KKT path's arrays);
+- the compiled Engine (mbsynth.compiled) at those values, or None: the path ``motion`` takes.
+
+``system.data()`` is a run's Data: its path is fixed when it is made — the compiled
+Engine when the kernels are compiled (in this process or on disk; its Template is waited
+for), else the KKT path throughout — so a run's result never depends on when a background
+compilation finishes. The Data behind a System's own methods (``System.motion``, …) is
+made with ``fixed=False``: it takes the compiled Engine as soon as it is ready.
+
+A Data reads as its System for the model's description (coordinates, parts, names,
+``initial_state``): an algorithm written for a System takes a Data as well, and computes
+at the Data's parameter values.
+
+What Systems of one structure share (the System's ``shared``: the compiled Template, the
+Evaluators of the runs) is a cache of derived values: it changes how fast a Data is made,
+never what it computes.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..compiled import background
+from ..core import equations, solvers
+from ..core.errors import SolveError
+from . import friction, reactions
+from .evaluation import Evaluator
+from .joint_values import JointValuesBatch
+
+METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """The arrays of (2.1), (2.4) and (2.6) for the whole system at one state."""
+
+    M: np.ndarray
+    Q: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+
+
+class Shared:
+    """What the Systems of one structure (the same parts, connectors and forces; any
+    parameter values) share: the compiled Template's slot and the Evaluators made for them,
+    one per kernel setting ("wait", "never": a run's; "when ready": a System's own)."""
+
+    def __init__(self, system):
+        self.structure = _structure(system)
+        self.compiled = background.TemplateSlot()
+        self.evaluators = {}
+
+    def fits(self, system):
+        """Whether ``system`` has the structure this was made for (the same parts,
+        connectors and forces, the same parameter names)."""
+        mine, theirs = self.structure, _structure(system)
+        return mine[3] == theirs[3] and all(len(a) == len(b) and all(x is y for x, y in zip(a, b))
+                                            for a, b in zip(mine[:3], theirs[:3]))
+
+    def evaluator(self, system, kernels):
+        found = self.evaluators.get(kernels)
+        if found is None:
+            found = Evaluator(system)
+            if kernels != "when ready":
+                found.fix_kernels(kernels == "wait")
+            self.evaluators[kernels] = found
+        return found
+
+
+def _structure(system):
+    return system.parts, system.connectors, system.forces, tuple(system.parameters)
+
+
+class Data:
+    """The workspace of computations on ``system`` at parameter values ``p``."""
+
+    def __init__(self, system, fixed=True):
+        self.system, self.fixed = system, fixed
+        self.p = system.parameter_values
+        self._kernels = ("wait" if background.compiled() else "never") if fixed else "when ready"
+        self._evaluator = None  # made on first use: a compiled run may never need it
+        self._engine = None
+        self._joint_values = None  # joint_values.JointValuesBatch, made on first use
+        if fixed:
+            template = background.template(system, wait=self._kernels == "wait")
+            self._engine = None if template is None else template.engine(self.p)
+
+    def __getattr__(self, name):
+        """The System's attribute: the model's description (coordinates, parts, names, …)."""
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(self.system, name)
+
+    def __repr__(self):
+        return f"Data({self.system.name!r}, path={'compiled' if self.engine else 'KKT'})"
+
+    @property
+    def parameters(self):
+        """{name: value} at this Data's parameter values."""
+        return dict(zip(self.system.parameters, self.p.tolist()))
+
+    @property
+    def parameter_values(self):
+        return self.p
+
+    @property
+    def evaluator(self):
+        if self._evaluator is None:
+            self._evaluator = self.system.shared.evaluator(self.system, self._kernels)
+        return self._evaluator
+
+    @property
+    def engine(self):
+        """The compiled Engine that serves ``motion``, or None (the KKT path). A run's Data
+        fixed it when made; a System's own takes it once its Template is ready."""
+        if self._engine is None and not self.fixed:
+            template = background.template(self.system)
+            self._engine = None if template is None else template.engine(self.p)
+        return self._engine
+
+    def set_parameters(self, values):
+        """Write new values of some parameters ({name: value}, a controller's at a sample);
+        those defined by expressions of others follow. Raises ModelError for an unknown
+        name, a non-finite value, or a part whose M or Q the values make unusable
+        (``System.resolved_parameters``)."""
+        self.p = self.system.resolved_parameters(values, self.p)
+        if self._engine is not None:
+            self._engine = self._engine.template.engine(self.p)
+
+    def _state(self, q, qd):
+        return self.system._state(q, qd)
+
+    # ---- the arrays of (2.1), (2.4), (2.6)
+
+    def evaluate(self, t, q, qd):
+        """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
+        q, qd = self._state(q, qd)
+        evaluator = self.evaluator
+        return Assembly(*evaluator.parts(t, q, qd, self.p), *evaluator.dense_rows(t, q, qd, self.p))
+
+    def constraint_rows(self, t, q, qd):
+        """A (m × n, scipy.sparse CSR) and b at (t, q, q̇): the rows alone, without M."""
+        arrays = self.constraint_arrays(t, q, qd)
+        return arrays.A, arrays.b
+
+    def constraint_arrays(self, t, q, qd, sparse=True):
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
+        dense where that is faster (sparse=None: few rows and coordinates)."""
+        q, qd = self._state(q, qd)
+        return self.evaluator.constraints(t, q, qd, self.p, sparse)
+
+    def constraint_residuals(self, t, q, qd):
+        """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
+        q, qd = self._state(q, qd)
+        return self.evaluator.residuals(t, q, qd, self.p)
+
+    def energy(self, t, q, qd):
+        """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
+        q, qd = self._state(q, qd)
+        return self.evaluator.energies(t, q, qd, self.p)
+
+    def branch_problems(self, q=None, t=0.0):
+        return self.system.branch_problems(q, t, self.p)
+
+    def check_branches(self, q, t=0.0):
+        """Raise SolveError naming the first joint whose frames, at the state q, are in a
+        pose the joint does not mean (``System.branch_problems``)."""
+        problems = self.branch_problems(q, t)
+        if problems:
+            raise SolveError(f"model '{self.system.name}': {problems[0][1]}", constraints=[problems[0][0]])
+
+    # ---- the motion (2.14)
+
+    def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
+        """The constrained acceleration at (t, q, q̇): a ``Motion`` (``System.motion`` says
+        what each argument means); its ``lam`` is computed when first read."""
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
+        q, qd = self._state(q, qd)
+        motion = self._solved(t, q, qd, method, baumgarte, drift)
+        return motion.with_multipliers(lambda: self._multipliers(t, q, qd, motion)[0])
+
+    def _solved(self, t, q, qd, method, baumgarte, drift):
+        """The Motion of ``motion``, without its multipliers."""
+        if method == "fast":
+            engine = self.tree_engine(drift)
+            if engine is not None:
+                shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
+                found = engine.motion(t, q, qd, shift)
+                if found is not None:
+                    return found
+        return self._kkt_motion(t, q, qd, method, baumgarte, drift)
+
+    def _kkt_motion(self, t, q, qd, method, baumgarte, drift):
+        """The Motion of (2.14) (``method``: its KKT form or the literal pseudo-inverse)
+        from the assembled M, Q, A, b, C, without its multipliers."""
+        arrays = self.evaluate(t, q, qd)
+        b = arrays.b if baumgarte is None else self._stabilized(t, q, qd, arrays.b, *baumgarte)
+        off_manifold = (lambda: (self.constraint_residuals(t, q, qd)[0], q)) if drift else None
+        system = self.system
+
+        def solve(C):
+            return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=system.coordinates,
+                                   constraints=system.constraint_names, drift=off_manifold)
+        if system.coulomb:  # C depends on q̈ (friction.py)
+            return friction.coulomb_motion(system.connectors, arrays, solve, t, q, qd, self.p)
+        return solve(arrays.C)
+
+    def tree_engine(self, drift=False):
+        """The compiled Engine that serves ``motion``, or None: the KKT path, or (``drift``)
+        a state off the manifold of a model with loops (the kernel's Schur step drops
+        dependent rows by its own rule, not by the drift rule of ``equations``)."""
+        engine = self.engine
+        return None if engine is None or (drift and engine.closes_loops) else engine
+
+    def stage_motion(self, baumgarte=None, drift=False):
+        """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
+        without ``lam``: the compiled engine's own call where ``motion`` would make it anyway
+        (no Baumgarte shift), skipping the checks and bookkeeping of each call."""
+        engine = self.tree_engine(drift)
+        if engine is None or baumgarte is not None:
+            return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
+
+        def stage(t, q, qd):
+            found = engine.motion(t, q, qd)
+            return found if found is not None else self._kkt_motion(t, q, qd, "fast", None, drift)
+        return stage
+
+    def motion_batch(self, t, q_batch, qd_batch):
+        """(qdd (B × n), unique (B,)) at many states, one per row of ``q_batch`` and
+        ``qd_batch`` (t: a number or one per row): the compiled Engine's rows in threads
+        (its Template waited for: a batch is worth it), each state it hands back and every
+        state of a model it does not cover through ``motion``. A state with no motion raises
+        SolveError naming its row."""
+        system = self.system
+        # no copy of states already in float64 rows (a copy of a large batch costs page faults, serially)
+        q, qd = (np.atleast_2d(np.ascontiguousarray(x, dtype=float)) for x in (q_batch, qd_batch))
+        if q.ndim != 2 or q.shape != qd.shape or q.shape[1] != system.n:
+            raise ValueError(f"model '{system.name}' has {system.n} coordinates: q_batch and qd_batch must both "
+                             f"have shape (B, {system.n}), got {q.shape} and {qd.shape}")
+        count = q.shape[0]
+        t = np.broadcast_to(np.asarray(t, dtype=float), (count,)).copy()
+        engine = self.engine
+        if engine is None and not self.fixed:
+            template = background.template(system, wait=True)
+            engine = self._engine = None if template is None else template.engine(self.p)
+        if engine is None:
+            qdd, done = np.zeros((count, system.n)), np.zeros(count, dtype=bool)
+        else:
+            qdd, status = engine.motion_batch(t, q, qd)
+            done = status == 0
+        unique = done.copy()
+        for row in np.flatnonzero(~done):
+            try:
+                motion = self.motion(t[row], q[row], qd[row])
+            except SolveError as err:
+                raise SolveError(f"state {row} of the batch: {err}", constraints=err.constraints,
+                                 coordinates=err.coordinates) from None
+            qdd[row], unique[row] = motion.qdd, motion.unique
+        return qdd, unique
+
+    def _stabilized(self, t, q, qd, b, alpha, beta):
+        phi, psi = self.constraint_residuals(t, q, qd)
+        return b - 2 * alpha * np.nan_to_num(psi) - beta**2 * np.nan_to_num(phi)
+
+    # ---- what the motion implies: multipliers, reactions, joint values
+
+    def _multipliers(self, t, q, qd, motion, arrays=None):
+        """(λ, dependent rows) of ``motion`` at (t, q, q̇): Qc − C = Aᵀλ (reactions.py)."""
+        arrays = self.evaluate(t, q, qd) if arrays is None else arrays
+        C = arrays.C if motion.C is None else motion.C
+        return reactions.multipliers(arrays.A, arrays.M @ motion.qdd - arrays.Q - C)
+
+    def joint_values(self, t, q, qd, qdd=None):
+        """{joint name: JointValues(position, rate, acceleration)} (``System.joint_values``)."""
+        q, qd = self._state(q, qd)
+        qdd = None if qdd is None else np.asarray(qdd, dtype=float).ravel()
+        if self._joint_values is None:
+            self._joint_values = JointValuesBatch(k for k in self.system.joint_kinematics().values()
+                                                  if k.position_names)
+        return self._joint_values(t, q, qd, qdd, self.p)
+
+    def reactions(self, t, q, qd, motion=None):
+        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default this
+        Data's motion there): ``System.reactions`` says what they hold."""
+        q, qd = self._state(q, qd)
+        motion = self.motion(t, q, qd) if motion is None else motion
+        arrays = self.evaluate(t, q, qd)
+        lam, dependent = self._multipliers(t, q, qd, motion, arrays)
+        kinematics, p = self.system.joint_kinematics(), self.p
+        out, row = {}, 0
+        for con in self.system.connectors:
+            rows = slice(row, row + con.size)
+            force = torque = None
+            if con.name in kinematics:
+                k = kinematics[con.name]
+                g = self._joint_force(con, lam[rows], t, q, qd)
+                force, torque = reactions.wrench(k.frame(t, q, qd, p), con.parts[1].idle_directions(q[k.child_indices]),
+                                                 g[k.child_indices])
+            out[con.name] = reactions.Reaction(lam[rows].copy(), bool(dependent[rows].any()), force, torque)
+            row += con.size
+        return out
+
+    def _joint_force(self, joint, lam, t, q, qd):
+        """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the
+        load λ gives, Coulomb friction: friction.py) and its force elements."""
+        p = self.p
+        g = np.zeros(self.system.n)
+        a, _, c = joint.evaluate(t, q, qd, p)
+        g[joint.indices] += a.T @ lam + c
+        if joint.coulomb is not None:
+            w, direction = joint.coulomb.evaluate(t, q, qd, p)
+            g[joint.coulomb.indices] -= np.sign(w) * np.linalg.norm(lam[joint.coulomb.load_rows]) * direction
+        for element in self.system.forces:
+            if element.joint == joint.name:
+                g[element.indices] += element.evaluate(t, q, qd, p)
+        return g
+

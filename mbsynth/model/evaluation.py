@@ -1,0 +1,126 @@
+"""A System's arrays at one state, evaluated a structure at a time (grouped.Batch).
+
+An ``Evaluator(system)`` (a Data's, data.py) gives
+
+- ``constraints(t, q, qd)``: one evaluation of every connector's rows: A (sparse CSR), b,
+  C, and the residuals φ, φ̇ (NaN on rows without that level) — drift control and
+  projection (projection.py) need them together;
+- ``parts(t, q, qd)``: the block-diagonal M and the stacked Q of (2.1), force elements included;
+- ``energies(t, q, qd)``: kinetic and potential energies of the parts and force elements.
+
+The results equal those of calling each connector and part (``Connector.evaluate``,
+``residuals``, ``Part.evaluate``, ``energy``), which remain the reference.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..compiled.grouped import Batch
+from .parts.base import Part
+from ..symbolic.derive import Compiled
+
+DENSE_ENTRIES = 40000  # rows × coordinates up to which dense arrays beat scipy.sparse's overhead
+
+
+class ConstraintArrays(NamedTuple):
+    """The constraints at one state: rows A (m × n, CSR or dense) q̈ = b (2.4), the non-ideal
+    force C (2.6), position and velocity residuals φ, φ̇ per row."""
+
+    A: object  # scipy.sparse.csr_matrix or np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+    phi: np.ndarray
+    psi: np.ndarray
+
+
+class Evaluator:
+    """The layout of a System's connectors and parts for evaluation in batches."""
+
+    def __init__(self, system):
+        constraints, n = system.connectors, system.n
+        self.n = n
+        self.m = sum(c.size for c in constraints)
+        self.rows = Batch([c._rows for c in constraints], [c.indices for c in constraints], 5)
+        starts = np.cumsum([0] + [c.size for c in constraints])
+        pattern = [np.meshgrid(np.arange(s, s + c.size), c.indices, indexing="ij")
+                   for s, c in zip(starts, constraints)]
+        a_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in pattern])
+        a_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in pattern])
+        self.c_cols = np.concatenate([np.zeros(0, int)] + [c.indices for c in constraints])
+        # CSR of A: the entries sorted by (row, column) — a connector's columns are distinct,
+        # its rows its own, so no two entries share a place
+        self.a_order = np.lexsort((a_cols, a_rows))
+        self.a_indices = a_cols[self.a_order]
+        self.a_indptr = np.concatenate([[0], np.cumsum(np.bincount(a_rows, minlength=self.m))])
+        self.a_dense = (a_rows, a_cols)
+        level = [np.repeat(c._levels[k], c.size) for k in (0, 1) for c in constraints]
+        self.no_phi = ~np.concatenate([np.zeros(0, bool)] + level[:len(constraints)])
+        self.no_psi = ~np.concatenate([np.zeros(0, bool)] + level[len(constraints):])
+        stops = np.cumsum([len(s.coordinates) for s in system.parts])
+        ranges = [np.arange(stop - len(s.coordinates), stop) for s, stop in zip(system.parts, stops)]
+        grouped = [type(s).evaluate is Part.evaluate and isinstance(s._evaluate, Compiled) for s in system.parts]
+        self.blocks = Batch([s._evaluate if g else s.evaluate for s, g in zip(system.parts, grouped)], ranges, 2)
+        self.energy = Batch([s._energy if type(s).energy is Part.energy and isinstance(s._energy, Compiled)
+                             else s.energy for s in system.parts], ranges, 2)
+        forces = system.forces
+        self.forces = Batch([f._evaluate for f in forces], [f.indices for f in forces], 2)
+        self.f_cols = np.concatenate([np.zeros(0, int)] + [f.indices for f in forces])
+        block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
+        self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
+        self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
+        self.fixed = False  # every group's path decided at its first call, for good (fix_kernels)
+
+    def fix_kernels(self, wait):
+        """Fix every group's path at its first evaluation (grouped.Batch.fix_kernels); returns self."""
+        for batch in (self.rows, self.blocks, self.energy, self.forces):
+            batch.fix_kernels(wait)
+        self.fixed = True
+        return self
+
+    def constraints(self, t, q, qd, p, sparse=True):
+        """ConstraintArrays at (t, q, q̇) with parameter values p; A sparse (CSR) or dense
+        (an ndarray), or (sparse=None) dense when it has at most DENSE_ENTRIES entries."""
+        a, b, c, phi, psi = self.rows(t, q, qd, p)
+        if sparse is None:
+            sparse = self.m * self.n > DENSE_ENTRIES
+        if sparse:
+            import scipy.sparse  # loaded with the first sparse A, not with mbsynth
+
+            A = scipy.sparse.csr_matrix((a[self.a_order], self.a_indices, self.a_indptr), shape=(self.m, self.n))
+        else:
+            A = np.zeros((self.m, self.n))
+            A[self.a_dense] = a
+        return ConstraintArrays(A, b, np.bincount(self.c_cols, weights=c, minlength=self.n),
+                                *self._levels(phi, psi))
+
+    def residuals(self, t, q, qd, p):
+        """(φ, φ̇) per row at (t, q, q̇): NaN on rows without that level."""
+        return self._levels(*self.rows(t, q, qd, p)[3:])
+
+    def _levels(self, phi, psi):
+        phi, psi = phi.copy(), psi.copy()
+        phi[self.no_phi] = np.nan
+        psi[self.no_psi] = np.nan
+        return phi, psi
+
+    def dense_rows(self, t, q, qd, p):
+        """(A dense, b, C) at (t, q, q̇)."""
+        a, b, c, _, _ = self.rows(t, q, qd, p)
+        A = np.zeros((self.m, self.n))
+        A[self.a_dense] = a
+        return A, b, np.bincount(self.c_cols, weights=c, minlength=self.n)
+
+    def parts(self, t, q, qd, p):
+        """(M, Q) at (t, q, q̇): the parts' M block diagonal (dense), their Q stacked plus the
+        force elements'."""
+        blocks, Q = self.blocks(t, q, qd, p)
+        M = np.zeros((self.n, self.n))
+        M[self.m_rows, self.m_cols] = blocks
+        return M, Q + np.bincount(self.f_cols, weights=self.forces(t, q, qd, p)[0], minlength=self.n)
+
+    def energies(self, t, q, qd, p):
+        """(kinetic, potential): the parts' T and V, and the force elements' potentials, summed."""
+        T, V = self.energy(t, q, qd, p)
+        return float(T.sum()), float(V.sum() + self.forces(t, q, qd, p)[1].sum())
+

@@ -1,0 +1,318 @@
+"""Joint values: the relative coordinates of a joint's two frames, read off the parts' states.
+
+Frame A is on the parent (or the world), frame B on the child; x, y, z their axes and
+p their origins in the world, ω the parts' angular velocities. Per kind of joint:
+
+    revolute     angle θ = atan2((x_A × x_B)·z_A, x_A·x_B)       rate z_A·(ω_B − ω_A)
+    prismatic    displacement s = z_A·(p_B − p_A)                rate ṡ
+    cylindrical  angle, displacement                             angle_rate, displacement_rate
+    universal    angle1 = atan2(z_B·y_A, z_B·x_A) (about z_A),   rate1 = z_A·(ω_B − ω_A),
+                 angle2 = atan2(−z_A·y_B, z_A·x_B) (about z_B)   rate2 = z_B·(ω_B − ω_A)
+    spherical    rotation vector of R_Aᵀ R_B (rx, ry, rz)        R_Bᵀ(ω_B − ω_A) (wx, wy, wz)
+    free         p_B, quaternion of R_B (x y z qw qx qy qz)      R_Bᵀ ṗ_B, R_Bᵀ ω_B (vx vy vz wx wy wz)
+
+A joint's acceleration is the time derivative of its rates' components,
+(∂w/∂q̇) q̈ + (∂w/∂q) q̇ + ∂w/∂t, compiled with the rates. These are Pinocchio's
+conventions: a revolute joint's (q, v, v̇) are (θ, θ̇, θ̈); a free-flyer's v is the
+spatial velocity in its own axes and v̇ its derivative, Rᵀp̈ − ω × Rᵀṗ (not the classical
+acceleration); Pinocchio's quaternion is (x, y, z, w), mbsynth's (w, x, y, z). Angles
+are atan2 in (−π, π] at one state; ``unwrap`` makes them continuous along a trajectory.
+Fixed and distance joints have no values.
+
+The same compiled function gives the pose of the joint's reaction frame (the child frame
+B, or a robot's child link frame) and its Jacobian, which turn the generalized force a
+joint exerts on its child into a wrench (``System.reactions``).
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+import sympy as sp
+
+from .connectors.joints import SHARED_PARTS
+from ..symbolic.cache import placeholder, remembered
+from ..compiled.grouped import Batch
+from ..core.kinematics import matrix_quaternion
+from .parts.base import Frame
+from ..symbolic.derive import T_SYMBOL, JointValue, Slots, compile_function, jacobian, time_derivative
+
+# kind -> (position names, rate names, acceleration names, which positions are angles)
+NAMES = {
+    "revolute": (("angle",), ("rate",), ("acceleration",), (True,)),
+    "prismatic": (("displacement",), ("rate",), ("acceleration",), (False,)),
+    "cylindrical": (("angle", "displacement"), ("angle_rate", "displacement_rate"),
+                    ("angle_acceleration", "displacement_acceleration"), (True, False)),
+    "universal": (("angle1", "angle2"), ("rate1", "rate2"), ("acceleration1", "acceleration2"), (True, True)),
+    "spherical": (("rx", "ry", "rz"), ("wx", "wy", "wz"), ("wx_dot", "wy_dot", "wz_dot"), (False,) * 3),
+    "free": (("x", "y", "z", "qw", "qx", "qy", "qz"), ("vx", "vy", "vz", "wx", "wy", "wz"),
+             ("vx_dot", "vy_dot", "vz_dot", "wx_dot", "wy_dot", "wz_dot"), (False,) * 7),
+}
+MATRIX_POSITIONS = {"spherical", "free"}  # positions computed from the frames' rotations, not compiled
+
+
+class JointValues(NamedTuple):
+    """One joint's ``position``, ``rate`` and ``acceleration`` (None without q̈), arrays
+    with one entry per joint coordinate (``JointKinematics.names``)."""
+
+    position: np.ndarray
+    rate: np.ndarray
+    acceleration: np.ndarray = None
+
+
+class FramePose(NamedTuple):
+    """The reaction frame's world ``origin`` and ``rotation`` (frame → world), and
+    ``jacobian`` (6 × the child's coordinates): [ṗ; ω] = jacobian · q̇_child."""
+
+    origin: np.ndarray
+    rotation: np.ndarray
+    jacobian: np.ndarray
+
+
+class JointKinematics:
+    """The compiled joint values of one joint of ``kind`` between ``frame_a`` on ``parent``
+    (None: the world) and ``frame_b`` on ``child``, and the pose of ``report_frame`` (a
+    frame on the child with B's origin: B itself, or a robot's link frame). Joints alike
+    (kind, types of parts, frames fixed on them) share one derivation and one compiled
+    function (``_template``), their frames' values passed in, as connectors.joints does."""
+
+    def __init__(self, name, kind, parent, frame_a, child, frame_b, report_frame, system):
+        self.name, self.kind = name, kind
+        self.position_names, self.rate_names, self.acceleration_names, self.angles = NAMES.get(kind, ((), (), (), ()))
+        where = {s: i for i, s in enumerate(system.q_symbols)}
+        q = (list(parent.q) if parent is not None else []) + list(child.q)
+        qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+        self.indices = np.array([where[s] for s in q], dtype=int)
+        self.child_indices = np.array([where[s] for s in child.q], dtype=int)
+        args = (T_SYMBOL, list(q), list(qd), list(system.parameter_symbols))
+        frames = (frame_a, frame_b, report_frame)
+        if _shareable(parent, child, frames):
+            slots, exprs = _template(kind, parent, child)
+            constants = [pair for end, frame in enumerate(frames) for pair in zip(_PLACEHOLDERS[end], _entries(frame))]
+            self._evaluate = compile_function((T_SYMBOL, *slots, args[3]), exprs, constants=constants)
+        else:
+            self._evaluate = compile_function(args, _expressions(kind, parent, child, frames, q, qd))
+
+    @property
+    def names(self):
+        """The names of its coordinates (``angle``, ``displacement``, ``rx`` …)."""
+        return self.position_names
+
+    def values(self, t, q, qd, qdd, p):
+        """``JointValues`` at the model's state (q, q̇) and, when given, q̈."""
+        i = self.indices
+        scalars, rates, rate_a, rate_b, origin, _, RA, RB, _ = self._evaluate(t, q[i], qd[i], p)
+        position = _positions(self.kind, scalars.ravel(), RA, RB, origin.ravel())  # free: report frame is B
+        acceleration = None if qdd is None else rate_a @ qdd[i] - rate_b.ravel()
+        return JointValues(position, rates.ravel(), acceleration)
+
+    def frame(self, t, q, qd, p):
+        """The ``FramePose`` of the reaction frame."""
+        i = self.indices
+        *_, pR, RR, _, _, J = self._evaluate(t, q[i], qd[i], p)
+        return FramePose(pR.ravel(), RR, J)
+
+
+class JointValuesBatch:
+    """``JointKinematics.values`` of many joints at once: their compiled functions called a
+    shared structure at a time (grouped.Batch), the outputs then split per joint."""
+
+    SLOTS = 9  # the outputs of a JointKinematics' function (``_expressions``)
+
+    def __init__(self, kinematics):
+        self.kinematics = list(kinematics)
+        self.batch = Batch([k._evaluate for k in self.kinematics], [k.indices for k in self.kinematics], self.SLOTS)
+        self.shapes = None  # per joint, where each output lies in its slot (``_layout``, at the first call)
+
+    def __call__(self, t, q, qd, qdd, p):
+        """{joint name: JointValues} at (t, q, q̇) and, when given, q̈."""
+        if self.shapes is None:
+            self.shapes = self._layout(t, q, qd, p)
+        slots = self.batch(t, q, qd, p)
+        found = {}
+        for k, places in zip(self.kinematics, self.shapes):
+            scalars, rates, rate_a, rate_b, origin, _, RA, RB, _ = (slots[j][a:b].reshape(shape)
+                                                                     for j, (a, b, shape) in enumerate(places))
+            position = _positions(k.kind, scalars.ravel(), RA, RB, origin.ravel())
+            acceleration = None if qdd is None else rate_a @ qdd[k.indices] - rate_b.ravel()
+            found[k.name] = JointValues(position, rates.ravel().copy(), acceleration)
+        return found
+
+    def _layout(self, t, q, qd, p):
+        """Per joint, per output: (start, stop, shape) in the batch's slot of that output."""
+        starts, places = [0] * self.SLOTS, []
+        for k in self.kinematics:
+            outputs = k._evaluate(t, q[k.indices], qd[k.indices], p)
+            place = []
+            for j, x in enumerate(outputs):
+                place.append((starts[j], starts[j] + np.size(x), np.shape(x)))
+                starts[j] += np.size(x)
+            places.append(place)
+        return places
+
+
+def _expressions(kind, parent, child, frames, q, qd):
+    """What a JointKinematics compiles, in the parts' symbols q, q̇ (parent's then child's):
+    scalar positions, rates, ∂rate/∂q̇, the rest of d(rate)/dt (``differentiate``'s b),
+    the report frame's origin and rotation, R_A, R_B, and the report frame's Jacobian."""
+    pA, RA = _pose(parent, frames[0])
+    pB, RB = child.pose(frames[1])
+    positions, rates = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
+    rates = sp.Matrix(rates) if rates else sp.zeros(0, 1)
+    rate_a = jacobian(rates, qd)
+    rate_b = -(jacobian(rates, q) * sp.Matrix(qd)) - sp.diff(rates, T_SYMBOL) if rates else sp.zeros(0, 1)
+    pR, RR = child.pose(frames[2])
+    frame_rate = sp.Matrix.vstack(sp.Matrix([time_derivative(x, q, qd) for x in pR]), child.angular_velocity())
+    J = jacobian(frame_rate, list(child.qd))
+    return [sp.Matrix(positions) if positions else sp.zeros(0, 1), rates, rate_a, rate_b, sp.Matrix(pR),
+            sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
+
+
+# offsets (3) and rotations (3 × 3) of frames A, B and the report frame, and the slots of the
+# parts' coordinates and velocities: placeholders kept by the derivation cache
+_PLACEHOLDERS = [tuple(placeholder(f"joint_value_{e}{i}") for i in range(12)) for e in "ABR"]
+_SLOT_Q, _SLOT_QD = Slots("joint_value_q"), Slots("joint_value_qd")
+_templates = {}
+
+
+def _template(kind, parent, child):
+    """((q slots, q̇ slots), expressions) of ``_expressions`` for joints of ``kind``
+    between parts of the types of ``parent`` and ``child``, frames as placeholders;
+    derived once, and kept on disk (derivation_cache.py)."""
+    key = (kind, type(parent), len(parent.q) if parent is not None else 0, type(child), len(child.q))
+    if key not in _templates:
+        names = (kind, type(parent).__qualname__, key[2], type(child).__qualname__, key[4])
+        _templates[key] = remembered("joint-values", names, lambda: _derive_template(kind, parent, child))
+    return _templates[key]
+
+
+def _derive_template(kind, parent, child):
+    q = (list(parent.q) if parent is not None else []) + list(child.q)
+    qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+    slots = ([_SLOT_Q[i] for i in range(len(q))], [_SLOT_QD[i] for i in range(len(q))])
+    frames = [Frame("", "", sp.Matrix(x[:3]), sp.Matrix(3, 3, x[3:])) for x in _PLACEHOLDERS]
+    to_slots = dict(zip(q + qd, slots[0] + slots[1]))
+    return slots, [e.xreplace(to_slots) for e in _expressions(kind, parent, child, frames, q, qd)]
+
+
+def _shareable(parent, child, frames):
+    """Whether the joint's expressions can come from a template: parts whose poses depend on
+    their coordinates alone and frames fixed on them."""
+    coordinates = set((parent.q if parent is not None else [])) | set(child.q)
+    return (all(type(p) in SHARED_PARTS for p in (parent, child) if p is not None)
+            and not any(sp.sympify(x).free_symbols & coordinates for f in frames for x in _entries(f)))
+
+
+def _entries(frame):
+    return list(frame.position) + list(frame.rotation)
+
+
+def value_expressions(joint):
+    """{name: sympy expression} of a joint's values that are expressions of the state (the
+    names model files use as ``<joint>.<name>``): its positions except a spherical joint's
+    rotation vector, and its rates."""
+    kind = joint.joint_kind
+    if kind not in NAMES:
+        return {}
+    positions, rates, _, _ = NAMES[kind]
+    if kind in ("revolute", "prismatic", "cylindrical"):  # the joint's own (shared) expressions
+        exprs = {"revolute": [joint.angle, joint.angle_rate], "prismatic": [joint.displacement, joint.displacement_rate],
+                 "cylindrical": [joint.angle, joint.displacement, joint.angle_rate, joint.displacement_rate]}[kind]
+        return dict(zip(positions + rates, exprs))
+    parent, child = joint.parts
+    q = (list(parent.q) if parent is not None else []) + list(child.q)
+    qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+    pA, RA = _pose(parent, joint.frames[0])
+    pB, RB = child.pose(joint.frames[1])
+    scalars, rate_exprs = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
+    return dict(zip(positions[:len(scalars)] + rates, list(scalars) + list(rate_exprs)))
+
+
+def value_names(joint):
+    """The names of ``value_expressions`` (found without deriving them)."""
+    if joint.joint_kind not in NAMES:
+        return []
+    positions, rates, _, _ = NAMES[joint.joint_kind]
+    return list(positions if joint.joint_kind not in MATRIX_POSITIONS else ()) + list(rates)
+
+
+def constraint_symbols(joint):
+    """``value_expressions`` for constraints: each angle a ``symbolic.JointValue`` whose
+    derivative is its rate, so that a constraint on it (a servo row ``angle − θ(t)``) is
+    differentiated through the rate, not through the atan2 (exact on the manifold)."""
+    exprs = value_expressions(joint)
+    if not exprs:
+        return exprs
+    positions, rates, _, angles = NAMES[joint.joint_kind]
+    for position, rate, is_angle in zip(positions, rates, angles):
+        if is_angle:
+            exprs[position] = JointValue(f"{joint.name}.{position}", exprs[position], exprs[rate])
+    return exprs
+
+
+def _pose(part, frame):
+    if part is None:
+        return sp.Matrix(frame.position), sp.Matrix(frame.rotation)
+    return part.pose(frame)
+
+
+def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):
+    """(scalar position expressions, rate expressions) of a joint of ``kind``."""
+    xa, ya, za = RA[:, 0], RA[:, 1], RA[:, 2]
+    xb, yb, zb = RB[:, 0], RB[:, 1], RB[:, 2]
+    omega = child.angular_velocity() - (parent.angular_velocity() if parent is not None else sp.zeros(3, 1))
+    angle = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
+    displacement = za.dot(pB - pA)
+    if kind == "revolute":
+        return [angle], [za.dot(omega)]
+    if kind == "prismatic":
+        return [displacement], [time_derivative(displacement, q, qd)]
+    if kind == "cylindrical":
+        return [angle, displacement], [za.dot(omega), time_derivative(displacement, q, qd)]
+    if kind == "universal":
+        return [sp.atan2(zb.dot(ya), zb.dot(xa)), sp.atan2(-za.dot(yb), za.dot(xb))], [za.dot(omega), zb.dot(omega)]
+    if kind == "spherical":
+        return [], list(RB.T * omega)
+    if kind == "free":
+        velocity = sp.Matrix([time_derivative(x, q, qd) for x in pB])
+        return [], list(RB.T * velocity) + list(RB.T * child.angular_velocity())
+    return [], []
+
+
+def _positions(kind, scalars, RA, RB, origin):
+    """The position entries: compiled scalars, or from the frames' rotations."""
+    if kind == "spherical":
+        from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
+        return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
+    if kind == "free":
+        return np.concatenate([origin, matrix_quaternion(RB)])
+    return scalars
+
+
+def _orthonormal(R):
+    """The rotation nearest R (R is exact on the constraint manifold; rounding off it)."""
+    U, _, Vt = np.linalg.svd(R)
+    return U @ Vt
+
+
+def along(system, t, q, qd, qdd=None):
+    """{joint name: JointValues of arrays (one row per time)} along a trajectory (arrays t,
+    q, q̇ and optionally q̈, one row per time), with the angles made continuous (unwrapped):
+    a joint turning past π keeps counting."""
+    rows = [system.joint_values(ti, qi, qdi, None if qdd is None else qdd[i])
+            for i, (ti, qi, qdi) in enumerate(zip(t, q, qd))]
+    kinematics = system.joint_kinematics()
+    out = {}
+    for name in (rows[0] if rows else {}):
+        position, rate, acceleration = (np.array([r[name][k] for r in rows]) if qdd is not None or k < 2 else None
+                                        for k in range(3))
+        out[name] = JointValues(_unwrapped(kinematics[name], position), rate, acceleration)
+    return out
+
+
+def _unwrapped(kinematics, positions):
+    """``positions`` (T × k) of a joint with its angles made continuous."""
+    positions = np.array(positions, dtype=float)
+    for j, is_angle in enumerate(kinematics.angles):
+        if is_angle:
+            positions[:, j] = np.unwrap(positions[:, j])
+    return positions

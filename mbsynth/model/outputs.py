@@ -1,0 +1,120 @@
+"""Outputs: named quantities a model declares, evaluated along a run.
+
+    outputs:
+      elbow: arm_elbow_joint.angle          # an expression of t, parameters, coordinates,
+                                            #   velocities (part.c_dot) and joint values
+      hinge_load: {reaction: hinge.force}   # a joint's force or torque (System.reactions),
+                                            #   or a connector's multipliers
+      tip: {position: rod.tip}              # a frame's origin in the world (x, y, z)
+      tip_velocity: {velocity: rod.tip}     # its velocity in the world
+      kinetic: {energy: kinetic}            # kinetic, potential or total
+
+An output with several components gives one column each, named ``tip[x]``, ``tip[y]``,
+``tip[z]`` (``load[0]``, … for multipliers). Expressions, positions and velocities are
+compiled together into one function of the state; reactions need the motion and are
+computed from it (reactions.py).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from ..core.errors import ModelError
+from ..symbolic.derive import T_SYMBOL, compile_function, time_derivative
+
+AXES = ("x", "y", "z")
+ENERGIES = ("kinetic", "potential", "total")
+REACTION_PARTS = ("force", "torque", "multipliers")
+
+
+@dataclass(frozen=True)
+class Output:
+    """One declared output: ``kind`` (expression, reaction, position, velocity, energy),
+    the sympy ``expressions`` of its components (expression, position, velocity), and for
+    a reaction its ``connector`` and ``part`` (force, torque, multipliers), for an energy
+    which one (``part``)."""
+
+    name: str
+    kind: str
+    expressions: tuple = ()
+    connector: str = ""
+    part: str = ""
+    size: int = 1
+
+    @property
+    def columns(self):
+        if self.size == 1 and self.kind in ("expression", "energy"):
+            return [self.name]
+        labels = AXES if self.kind in ("position", "velocity") or self.part in ("force", "torque") else range(self.size)
+        return [f"{self.name}[{label}]" for label in labels]
+
+
+def expression_output(name, expr):
+    return Output(name, "expression", (sp.sympify(expr),))
+
+
+def frame_output(name, kind, part, frame, q, qd):
+    """The world position or velocity of ``frame`` on ``part`` (None: the world)."""
+    position = sp.Matrix(frame.position) if part is None else part.pose(frame)[0]
+    if kind == "velocity":
+        position = sp.Matrix([time_derivative(x, q, qd) for x in position])
+    return Output(name, kind, tuple(position), size=3)
+
+
+def reaction_output(name, connector, which):
+    """``which`` (force, torque or multipliers) of ``connector``'s reaction."""
+    if which not in REACTION_PARTS:
+        raise ModelError(f"output '{name}': a reaction is '<connector>.force', '.torque' or '.multipliers', "
+                         f"not '.{which}'")
+    if which != "multipliers" and not hasattr(connector, "joint_kind"):
+        raise ModelError(f"output '{name}': '{connector.name}' is no joint: it has multipliers, not a {which}")
+    return Output(name, "reaction", connector=connector.name, part=which,
+                  size=connector.size if which == "multipliers" else 3)
+
+
+def energy_output(name, which):
+    if which not in ENERGIES:
+        raise ModelError(f"output '{name}': energy is one of {', '.join(ENERGIES)}, not {which!r}")
+    return Output(name, "energy", part=which)
+
+
+class OutputEvaluator:
+    """The columns of a System's outputs at states of a run."""
+
+    def __init__(self, system):
+        self.system = system
+        self.outputs = tuple(system.outputs)
+        self.names = [c for o in self.outputs for c in o.columns]
+        exprs = [e for o in self.outputs for e in o.expressions]
+        args = (T_SYMBOL, list(system.q_symbols), list(system.qd_symbols), list(system.parameter_symbols))
+        self._compiled = compile_function(args, [sp.Matrix(exprs)]) if exprs else None
+        self.needs_reactions = any(o.kind == "reaction" for o in self.outputs)
+
+    def __bool__(self):
+        return bool(self.outputs)
+
+    def evaluate(self, t, q, qd, motion=None):
+        """One row: every output's columns at (t, q, q̇); ``motion`` (System.motion at that
+        state) for reactions, computed when not given."""
+        system, p = self.system, self.system.parameter_values
+        compiled = iter(self._compiled(t, q, qd, p)[0].ravel()) if self._compiled else iter(())
+        reactions = None
+        if self.needs_reactions:
+            reactions = system.reactions(t, q, qd, motion)
+        energies = None
+        row = []
+        for output in self.outputs:
+            if output.kind == "reaction":
+                row += list(getattr(reactions[output.connector], output.part))
+            elif output.kind == "energy":
+                energies = system.energy(t, q, qd) if energies is None else energies
+                kinetic, potential = energies
+                row.append({"kinetic": kinetic, "potential": potential, "total": kinetic + potential}[output.part])
+            else:
+                row += [next(compiled) for _ in output.expressions]
+        return np.array(row, dtype=float)
+
+    def table(self, t, q, qd):
+        """The rows at each time of a trajectory (arrays t, q, q̇), one per row."""
+        return np.array([self.evaluate(ti, qi, qdi) for ti, qi, qdi in zip(t, q, qd)]).reshape(len(t), len(self.names))

@@ -1,0 +1,139 @@
+"""What every part shares: its unconstrained M q̈ = Q (2.1) as sympy expressions of its
+own coordinates, compiled once; its energies; its named frames."""
+
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from ...symbolic.derive import T_SYMBOL, compile_function, placed_values
+
+LINK_FRAME = "link"  # the frame a robot link's body carries at the URDF link frame (robots/build.py)
+
+@dataclass(frozen=True)
+class Frame:
+    """A named frame on a part: ``position`` (sympy 3-vector) and ``rotation`` (3 × 3,
+    frame → part axes) relative to the part's own reference, and drawing ``geometry``."""
+
+    part: str
+    name: str
+    position: sp.Matrix
+    rotation: sp.Matrix
+    geometry: tuple = field(default=(), compare=False)
+
+    @property
+    def label(self):
+        return f"{self.part}.{self.name}"
+
+    @functools.cached_property
+    def constant_rotation(self):
+        """``rotation`` as floats where it is made of real numbers alone (a robot's frames),
+        else None (it holds parameters or coordinates): read by every run's branch check."""
+        rotation = sp.Matrix(self.rotation)
+        try:
+            return None if rotation.free_symbols else np.array(rotation, dtype=float)
+        except TypeError:  # no real number
+            return None
+
+
+class Part:
+    """A subsystem given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
+    and the model's parameter symbols ``params``.
+
+    Subclasses describe the kind of part; they provide ``pose(frame)`` (world position
+    and rotation of a frame), ``angular_velocity()`` (world) and may add constraints of
+    their own (``own_constraints``) and initial values (``initial``).
+    """
+
+    kind = "part"
+    defaults = {}  # initial coordinate values that are not zero unless the model says otherwise
+    # coordinates that move together (a point's x, y, z; a quaternion's four numbers): one
+    # scale for all of them in the projection's metric (projection.py); others stand alone
+    groups = ()
+
+    def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None,
+                 shared=None):
+        """``shared``: (q slots, q̇ slots, constants) when M, Q, T, V are a template's,
+        written in those slots and in placeholders with the values ``constants`` ((symbol,
+        value) pairs): compiled once for all parts alike, put in only when asked."""
+        self.name = name
+        self.coordinates = tuple(coordinates)
+        self.q, self.qd = list(q), list(qd)
+        self.frames = {f.name: f for f in frames}
+        self.geometry = tuple(geometry)
+        self.initial = dict(initial or {})
+        template = (_matrix(M), _matrix(Q), sp.sympify(T), sp.sympify(V))
+        q_slots, qd_slots, constants = shared or (self.q, self.qd, ())
+        self._symbolic = None if shared else template
+        self._shared = shared and (template, (q_slots, qd_slots), constants)
+        args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
+        self._evaluate = compile_function(args, template[:2], constants)
+        self._energy = compile_function(args, template[2:], constants)
+        self._reads = None  # the symbols M and Q are written in (``reads``), once asked
+
+    def _materialized(self):
+        if self._symbolic is None:
+            template, slots, constants = self._shared
+            put = placed_values(slots, range(len(self.q)), constants, self.q, self.qd)
+            self._symbolic = tuple(x.xreplace(put) for x in template)
+        return self._symbolic
+
+    M = property(lambda self: self._materialized()[0], doc="mass matrix (2.1), sympy")
+    Q = property(lambda self: self._materialized()[1], doc="force vector (2.1), sympy")
+    T = property(lambda self: self._materialized()[2], doc="kinetic energy, sympy")
+    V = property(lambda self: self._materialized()[3], doc="potential energy, sympy")
+
+    def reads(self, symbols):
+        """Whether M or Q (2.1) is written in any of ``symbols`` (parameter symbols: whether
+        new values of them can change this part; ``System.with_parameters``)."""
+        if self._reads is None:
+            if self._symbolic is None:
+                template, _, constants = self._shared
+                values = [sp.sympify(value) for _, value in constants]
+            else:
+                template, values = self._symbolic, []
+            self._reads = frozenset().union(*(x.free_symbols for x in (*template[:2], *values)))
+        return not self._reads.isdisjoint(symbols)
+
+    def evaluate(self, t, q, qd, p):
+        """(M, Q) of this part at its own coordinates q, velocities qd (2.1)."""
+        M, Q = self._evaluate(t, q, qd, p)
+        return M, Q.ravel()
+
+    def energy(self, t, q, qd, p):
+        """(kinetic, potential) energy of this part."""
+        T, V = self._energy(t, q, qd, p)
+        return float(T), float(V)
+
+    def symbolic(self):
+        """(M, Q) as sympy matrices of the model's symbols."""
+        return self.M, self.Q
+
+    def own_constraints(self, q, qd, params):
+        """Constraints the part's coordinates always obey (a quaternion's unit norm)."""
+        return []
+
+    def pose(self, frame):
+        """(position, rotation) of ``frame`` in the world, as sympy expressions."""
+        raise NotImplementedError(f"a {self.kind} part has no frames")
+
+    def angular_velocity(self):
+        """The part's angular velocity in world axes (zero for point-like parts)."""
+        return sp.zeros(3, 1)
+
+    def idle_directions(self, q):
+        """Orthonormal columns (over the part's coordinates, at its coordinates ``q``) of
+        the directions that move nothing: none for most parts."""
+        return np.zeros((len(self.coordinates), 0))
+
+
+def _matrix(x):
+    """``x`` as a sympy matrix; one already (a template shared by all parts alike) as it is."""
+    return x if isinstance(x, sp.MatrixBase) else sp.Matrix(x)
+
+
+def frame_velocity(position, q, qd):
+    """d/dt of a world position that depends on q only."""
+    return sp.Matrix(position).jacobian(sp.Matrix(q)) * sp.Matrix(qd)
+

@@ -1,0 +1,385 @@
+"""A System: the model — parts, their coordinate layout, the constraints joining them,
+the force elements, parameter names and default values.
+
+A System is a value: built once, never changed, two equal Systems behave the same.
+What a computation keeps between calls (parameter values as an array, evaluators, the
+compiled engine and the path it takes) lives in a Data made from it (``system.data()``,
+data.py). The System's own methods (``evaluate``, ``motion``, ``reactions``, …) compute at
+its parameter values through a Data it makes on first use: ``evaluate(t, q, qd)``
+assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
+``motion(t, q, qd)`` solves them with the singular-mass equation (2.14).
+"""
+
+import functools
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import sympy as sp
+
+from .connectors.joints import Joint
+from .data import Data, Shared
+from ..core.errors import ModelError
+from .joint_values import JointKinematics, value_expressions
+from .parts import LINK_FRAME, Frame
+from ..symbolic.derive import T_SYMBOL
+
+
+@dataclass(frozen=True)
+class Closure:
+    """A force balance wᵀ(Q + C) = 0 appended by ``closure: auto`` (see model/balances.py)."""
+
+    constraint: str
+    equation: str
+    direction: dict
+    state_dependent: bool
+
+
+@dataclass(frozen=True)
+class System:
+    """An assembled model. Build it with ``mbsynth.load`` or ``System.build``."""
+
+    name: str
+    parts: tuple  # the model file's ``subsystems:``
+    connectors: tuple  # the model file's ``constraints:`` and ``joints:``, and the parts' own rows
+    coordinates: tuple
+    q_symbols: tuple
+    qd_symbols: tuple
+    parameters: dict
+    initial_q: np.ndarray
+    initial_qd: np.ndarray
+    forces: tuple = ()
+    closures: tuple = ()
+    initial_given: frozenset = frozenset()
+    initial_fixed: frozenset = frozenset()
+    definitions: dict = None  # parameter name -> sympy expression of earlier parameters
+    initial_definitions: dict = None  # initial value name -> sympy expression of parameters
+    source: str = ""  # the model file's text, for workers that rebuild the System
+    source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
+    robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
+    outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
+    # what Systems of this structure share (data.Shared: the compiled Template, evaluators): a
+    # cache of derived values, handed on by ``with_parameters``, no part of the System's value
+    shared: Shared = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self):
+        if self.shared is None or not self.shared.fits(self):  # built anew, or its structure replaced
+            object.__setattr__(self, "shared", Shared(self))
+
+    @classmethod
+    def build(cls, name, parts, connectors, q_symbols, qd_symbols, parameters, initial=None, forces=(),
+              initial_fixed=()):
+        """Lay out the parts' coordinates in order, check names, set the initial state.
+
+        ``initial`` maps ``part.coordinate`` and ``part.coordinate_dot`` to values;
+        the rest start at the parts' defaults (zero, or the identity orientation).
+        ``initial_given`` records the names the model set, ``initial_fixed`` those that
+        must not change when the initial state is made consistent (projection.py).
+        """
+        coordinates = tuple(f"{s.name}.{c}" for s in parts for c in s.coordinates)
+        if len(set(coordinates)) != len(coordinates):
+            raise ModelError(f"model '{name}': duplicate coordinate names in {coordinates}")
+        names = [c.name for c in connectors]
+        duplicates = sorted({x for x in names if names.count(x) > 1})
+        if duplicates:
+            raise ModelError(f"model '{name}': duplicate constraint names {duplicates}")
+        q0 = np.array([float(s.defaults.get(c, 0.0)) for s in parts for c in s.coordinates])
+        qd0 = np.zeros(len(coordinates))
+        index = {c: i for i, c in enumerate(coordinates)}
+        for key, value in (initial or {}).items():
+            if key in index:
+                q0[index[key]] = value
+            elif key.endswith("_dot") and key[:-4] in index:
+                qd0[index[key[:-4]]] = value
+            else:
+                raise ModelError(f"model '{name}': initial value for unknown coordinate '{key}'")
+        return cls(name, tuple(parts), tuple(connectors), coordinates, tuple(q_symbols),
+                   tuple(qd_symbols), dict(parameters), q0, qd0, tuple(forces),
+                   initial_given=frozenset(initial or ()), initial_fixed=frozenset(initial_fixed))
+
+    @property
+    def subsystems(self):
+        """The parts, by the model file's name for them (``subsystems:``)."""
+        return self.parts
+
+    @property
+    def constraints(self):
+        """The connectors, by the model file's name for them (``constraints:``)."""
+        return self.connectors
+
+    @property
+    def n(self):
+        return len(self.coordinates)
+
+    @functools.cached_property
+    def coordinate_groups(self):
+        """One label per coordinate, equal for the coordinates that move together (a part's
+        ``groups``: a point's x, y, z, a quaternion's four numbers), for projection.py's metric."""
+        labels, start = [], 0
+        for part in self.parts:
+            group = {c: start + k for k, members in enumerate(part.groups) for c in members}
+            labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
+            start += len(part.groups) + len(part.coordinates)
+        return np.array(labels)
+
+    @functools.cached_property
+    def constraint_names(self):
+        """One name per row of A (a joint with k rows names them ``joint[label]``): a tuple,
+        made once (every KKT evaluation hands it on)."""
+        return tuple(row for c in self.connectors for row in c.row_names)
+
+    @property
+    def parameter_values(self):
+        return np.array(list(self.parameters.values()), dtype=float)
+
+    @property
+    def parameter_symbols(self):
+        return [sp.Symbol(p) for p in self.parameters]
+
+    def initial_state(self):
+        """(q, q̇) from the model's ``initial:`` mapping (copies)."""
+        return self.initial_q.copy(), self.initial_qd.copy()
+
+    def with_parameters(self, **values):
+        """A new System with some parameter values changed (the original is unchanged).
+
+        Parameters defined by expressions of others, and initial values written as
+        expressions of parameters, follow the new values. Closure balances appended at
+        load time are kept as derived; they stay valid while the masses that were zero
+        stay zero. The new System shares this one's compiled path (``mbsynth.compiled``:
+        parameters are arguments of its code), so a sweep compiles once."""
+        p = self.resolved_parameters(values, check_parts=False)
+        new = dict(zip(self.parameters, p.tolist()))
+        subs = {sp.Symbol(name): sp.Float(value) for name, value in new.items()}
+        q0, qd0 = self.initial_state()
+        index = {c: i for i, c in enumerate(self.coordinates)}
+        for key, expr in (self.initial_definitions or {}).items():
+            target, i = (qd0, index[key[:-4]]) if key not in index else (q0, index[key])
+            target[i] = float(expr.xreplace(subs))
+        changed = replace(self, parameters=new, initial_q=q0, initial_qd=qd0)
+        same_start = np.array_equal(q0, self.initial_q) and np.array_equal(qd0, self.initial_qd)
+        moved = {sp.Symbol(name) for name, value in new.items() if value != self.parameters[name]}
+        problems = changed.part_problems(moved if same_start else None)  # a moved start: every part
+        if problems:
+            given = values if len(values) <= 3 else f"{len(values)} new parameter values"
+            raise ModelError(f"model '{self.name}' with {given}: {problems[0][1]}")
+        return changed
+
+    def resolved_parameters(self, values, p=None, check_parts=True):
+        """The parameter values (an array in the model's order) with ``values`` ({name:
+        value}) set over ``p`` (default: the model's): parameters defined by expressions of
+        others follow. Raises ModelError for a name the model has no parameter of, a
+        non-finite value, or (``check_parts``) a part that reads a changed parameter and
+        whose M or Q is then not finite or M not positive semi-definite at the initial state."""
+        unknown = sorted(set(values) - set(self.parameters))
+        if unknown:
+            raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
+                             f"it has {sorted(self.parameters)}")
+        bad = sorted(name for name, x in values.items() if not np.isfinite(float(x)))
+        if bad:
+            raise ModelError(f"model '{self.name}': non-finite values for parameter(s) {bad}")
+        old = self.parameter_values if p is None else np.asarray(p, dtype=float)
+        new = old.copy()
+        for i, name in enumerate(self.parameters):
+            if name in values:
+                new[i] = float(values[name])
+        if self.definitions:  # parameters defined by expressions of earlier ones follow, in order
+            subs = {}
+            for i, name in enumerate(self.parameters):
+                if name in self.definitions and name not in values:
+                    new[i] = float(self.definitions[name].xreplace(subs))
+                subs[sp.Symbol(name)] = sp.Float(new[i])
+        if check_parts:
+            moved = {sp.Symbol(name) for name, a, b in zip(self.parameters, old.tolist(), new.tolist()) if a != b}
+            problems = self.part_problems(moved, new) if moved else []
+            if problems:
+                raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")
+        return new
+
+    def data(self):
+        """A new workspace for a run on this System (data.Data): its parameter values, its
+        evaluators and the compiled engine, the path fixed as it is made."""
+        return Data(self)
+
+    @functools.cached_property
+    def _data(self):
+        """The Data of this System's own methods, made on first use (data.Data, fixed=False)."""
+        return Data(self, fixed=False)
+
+    def part_problems(self, parameters=None, p=None):
+        """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
+        positive semi-definite, at the initial state — a model no equation of motion fits.
+        ``parameters``: only the parts written in these parameter symbols (those whose values
+        changed: ``with_parameters``); every part by default. ``p``: the parameter values
+        (default: the model's)."""
+        q, qd = self.initial_state()
+        p = self.parameter_values if p is None else p
+        problems, start = [], 0
+        for part in self.parts:
+            stop = start + len(part.coordinates)
+            if parameters is not None and not part.reads(parameters):
+                start = stop
+                continue
+            with np.errstate(all="ignore"):
+                M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], p)
+            if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
+                problems.append((part.name, f"subsystem '{part.name}': M or Q is not finite at the initial state"))
+            elif np.linalg.eigvalsh(M).min() < -1e-12 * max(np.abs(M).max(), 1e-300):
+                problems.append((part.name, f"subsystem '{part.name}': the mass matrix is not positive "
+                                            "semi-definite at the initial state (a negative mass or inertia, "
+                                            "or a T that is no kinetic energy)"))
+            start = stop
+        return problems
+
+    def branch_problems(self, q=None, t=0.0, p=None):
+        """[(joint name, message)] for each joint whose frames meet its rows at ``q`` (the
+        initial state by default) in a pose it does not mean: a fixed joint's frames turned
+        180° (connectors/joints.py). ``p``: the parameter values (default: the model's)."""
+        q = self.initial_q if q is None else q
+        values = dict(zip(self.q_symbols, np.asarray(q, dtype=float)))
+        values.update(zip(self.parameter_symbols, self.parameter_values if p is None else p))
+        values[T_SYMBOL] = t
+        return [(c.name, message) for c in self.connectors if (message := c.wrong_branch(values))]
+
+    def check_branches(self, q, t=0.0):
+        """Raise SolveError naming the first joint whose frames, at the state q, are in a
+        pose the joint does not mean (``branch_problems``)."""
+        self._data.check_branches(q, t)
+
+    def with_constraints(self, extra, closures=()):
+        """A new System with ``extra`` constraints appended (the original is unchanged)."""
+        return replace(self, connectors=self.connectors + tuple(extra),
+                       closures=self.closures + tuple(closures))
+
+    def _state(self, q, qd):
+        q, qd = np.asarray(q, dtype=float).ravel(), np.asarray(qd, dtype=float).ravel()
+        if q.shape != (self.n,) or qd.shape != (self.n,):
+            raise ValueError(f"model '{self.name}' has {self.n} coordinates; got q of shape "
+                             f"{q.shape} and qd of shape {qd.shape}")
+        return q, qd
+
+    def evaluate(self, t, q, qd):
+        """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
+        return self._data.evaluate(t, q, qd)
+
+    def constraint_rows(self, t, q, qd):
+        """A (m × n, scipy.sparse CSR) and b at (t, q, q̇) — the rows alone, without M:
+        what projection.py needs, in memory proportional to the rows' entries."""
+        return self._data.constraint_rows(t, q, qd)
+
+    def constraint_arrays(self, t, q, qd, sparse=True):
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
+        dense where that is faster (sparse=None: few rows and coordinates)."""
+        return self._data.constraint_arrays(t, q, qd, sparse)
+
+    def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
+        """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
+        Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
+        (2.14)). "fast" is the linear-time compiled path (``mbsynth.compiled``) once its kernels
+        are ready (they build in the background on first use; a run's Data fixes the
+        choice for the run: data.py) and where its checks pass, else the KKT path; both
+        fall back to the exact treatment when the problem is not well posed.
+        ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
+        residuals (drift control during integration; b itself when they are zero).
+        Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``
+        iterates, and Qc includes the friction.
+        ``drift=True``: the state may lie off the constraint manifold (an integrator's
+        stage): b is judged by the drift rule of ``equations`` (least squares where the
+        drift explains an inconsistency, near-singular directions the drift dominates set
+        aside) instead of raising SolveError for contradictory constraints.
+        The Motion's ``lam`` (the multipliers, reactions.py) is computed when first read."""
+        return self._data.motion(t, q, qd, method, baumgarte, drift)
+
+    @functools.cached_property
+    def coulomb(self):
+        """Whether a constraint has Coulomb friction (its C depends on q̈), found once."""
+        return any(getattr(con, "coulomb", None) for con in self.connectors)
+
+    def motion_batch(self, t, q_batch, qd_batch):
+        """q̈ at many states, one per row of ``q_batch`` and ``qd_batch`` (t: a number or one
+        per row), in parallel: (qdd (B × n), unique (B,)); ``Data.motion_batch``."""
+        return self._data.motion_batch(t, q_batch, qd_batch)
+
+    def energy(self, t, q, qd):
+        """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
+        return self._data.energy(t, q, qd)
+
+    def constraint_residuals(self, t, q, qd):
+        """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
+        return self._data.constraint_residuals(t, q, qd)
+
+    def symbolic(self):
+        """(M, Q, A, b, C) as sympy matrices in the model's symbols."""
+        blocks = [part.symbolic() for part in self.parts]
+        M = sp.diag(*[blk[0] for blk in blocks]) if blocks else sp.zeros(0, 0)
+        Q = sum((f.symbolic() for f in self.forces), sp.Matrix.vstack(*[blk[1] for blk in blocks]))
+        n = self.n
+        A = sp.Matrix.vstack(sp.zeros(0, n), *[con.a for con in self.connectors])
+        b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.connectors])
+        C = sum((con.C for con in self.connectors), sp.zeros(n, 1))
+        return M, Q, A, b, C
+
+    def joint_kinematics(self):
+        """{name: joint_values.JointKinematics} of every joint (reaction frames; fixed and
+        distance joints have no values) and of each floating robot's root link
+        (``<prefix>root_joint``, a free joint, as Pinocchio names it), compiled on first use."""
+        return self._joint_kinematics
+
+    @functools.cached_property
+    def _joint_kinematics(self):
+        found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
+                                         c.report_frame, self)
+                 for c in self.connectors if isinstance(c, Joint)}
+        parts = {p.name: p for p in self.parts}
+        for robot in self.robots:
+            if robot.floating:
+                root = parts[robot.parts[robot.description.root]]
+                frame = root.frames[LINK_FRAME]
+                world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
+                name = f"{robot.prefix}root_joint"
+                found[name] = JointKinematics(name, "free", None, world, root, frame, frame, self)
+        return found
+
+    def joint_values(self, t, q, qd, qdd=None):
+        """{joint name: JointValues(position, rate, acceleration)} of every joint that has
+        values (joint_values.py: revolute ``angle``, prismatic ``displacement``, …, a
+        floating robot's ``root_joint``), in model order; acceleration None without q̈."""
+        return self._data.joint_values(t, q, qd, qdd)
+
+    def reactions(self, t, q, qd, motion=None):
+        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default
+        ``self.motion(t, q, qd)``): the multipliers of each connector's rows, and for each
+        joint the wrench (``force``, ``torque``) the parent exerts on the child through it —
+        its rows, its friction, its actuation and spring — at the child's reaction frame
+        (the frame B of the joint; a robot's child link frame), in that frame's axes."""
+        return self._data.reactions(t, q, qd, motion)
+
+    def expression_names(self):
+        """{name: sympy expression} of what expressions about this model may use: t, the
+        parameters, coordinates ``part.c``, velocities ``part.c_dot`` and joint values
+        ``joint.angle``, ``joint.rate``, … (joint_values.value_expressions; a robot joint
+        named like a part has none)."""
+        names = {"t": T_SYMBOL, **{str(s): s for s in (*self.parameter_symbols, *self.q_symbols, *self.qd_symbols)}}
+        parts = {p.name for p in self.parts}
+        for con in self.connectors:
+            if isinstance(con, Joint) and con.name not in parts:
+                names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
+        return names
+
+    def working_forces(self):
+        """The names of what can change the total energy T + V: force elements with efforts
+        (actuation, dampers), parts with generalized forces or an explicit t, constraints
+        with a non-ideal C (friction) or an explicit t (a prescribed motion). Empty: the
+        energy is conserved, and its change along a run is drift."""
+        found = [e.name for e in self.forces if not e.conservative]
+        for part in self.parts:
+            own = part.__dict__.get("_symbolic")  # parts shared from a template hold neither
+            if any(f != 0 for f in getattr(part, "forces", ())) or (own and any(T_SYMBOL in x.free_symbols
+                                                                                  for x in own[2:])):
+                found.append(part.name)
+        for con in self.connectors:
+            own = con.__dict__.get("_symbolic")  # placed (joint) rows hold neither
+            if getattr(con, "coulomb", None) or (own and (any(x != 0 for x in own[2]) or any(
+                    T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ()))))):
+                found.append(con.name)
+        return found

@@ -1,0 +1,1 @@
+"""Many runs of one model: parameter sweeps on Dask (sweep.py)."""

@@ -1,0 +1,356 @@
+"""Parameter studies on Dask: many simulations of one model, one row of results each.
+
+Every combination of the swept parameters (or every row of a samples table) is one
+run: the model with those parameter values simulated to ``t_end``, reduced to the
+metrics asked for. Runs go to a Dask cluster — a local one that mbsynth starts
+(one single-threaded worker process per core, everything bound to 127.0.0.1) or the
+user's (``scheduler``). Each worker builds the model from its text once (file names in
+it relative to the model file's folder) and reuses it for every run it gets
+(``System.with_parameters`` only changes numbers). Results are one table row per
+run, failures included with their error; the table is written to ``out`` (.parquet or
+.csv) atomically as runs finish, and a sweep restarted with the same ``out`` skips
+the runs already in it. Runs are keyed by a hash of their parameter values, so a run
+that Dask repeats (a worker lost mid-run) still appears exactly once; every row records
+the sweep's settings (model, t_end, simulation options, metrics), and a restart with
+other settings is refused rather than mixing the two. Trajectories come back from the
+workers and are written by the client, so ``trajectories`` is a folder on this machine.
+"""
+
+import hashlib
+import itertools
+import json
+import logging
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import sympy as sp
+
+from ..core.errors import ModelError, SolveError
+from ..core.expressions import ExpressionError, parse
+from ..core.files import write_atomically
+from ..io import load, loads
+from ..analysis.simulate import simulate
+from ..symbolic.derive import T_SYMBOL
+
+log = logging.getLogger(__name__)
+
+AGGREGATES = ("final", "max", "min", "mean")
+SUMMARIES = ("energy_drift", "max_residual")
+CHECKPOINT_SECONDS = 1.0
+LOCALHOST = "127.0.0.1"  # where the local cluster listens: its scheduler, workers and dashboard
+
+
+@dataclass(frozen=True)
+class Metric:
+    """A summary of one run: ``energy_drift``, ``max_residual``, or ``AGG:expression``
+    with AGG one of final, max, min, mean over the output times and the expression of
+    coordinates (``part.coord``), velocities (``part.coord_dot``), joint values
+    (``joint.angle``, ``joint.rate``, …), parameters and t."""
+
+    spec: str
+
+    @property
+    def name(self):
+        return self.spec
+
+    def parse(self, system):
+        """Check the metric against ``system``; return (aggregate, sympy expression or None)."""
+        if self.spec in SUMMARIES:
+            return self.spec, None
+        kind, sep, text = self.spec.partition(":")
+        if not sep or kind not in AGGREGATES:
+            raise ModelError(f"metric {self.spec!r}: write {' or '.join(SUMMARIES)}, or AGG:expression "
+                             f"with AGG one of {', '.join(AGGREGATES)} (e.g. 'max:body1.x1')")
+        try:
+            return kind, parse(text, _symbols(system))
+        except ExpressionError as err:
+            raise ModelError(f"metric {self.spec!r}: {err}") from None
+
+    def evaluate(self, system, traj):
+        kind, expr = self.parse(system)
+        if expr is None:
+            return getattr(traj, kind)
+        args = [T_SYMBOL, *system.q_symbols, *system.qd_symbols, *system.parameter_symbols]
+        f = sp.lambdify(args, expr, modules="numpy")
+        params = [np.full(traj.t.size, v) for v in system.parameters.values()]
+        values = np.broadcast_to(f(traj.t, *traj.q.T, *traj.qd.T, *params), traj.t.shape)
+        return float({"final": lambda v: v[-1], "max": np.max, "min": np.min, "mean": np.mean}[kind](values))
+
+
+def _symbols(system):
+    return system.expression_names()
+
+
+def grid(ranges):
+    """All combinations of {name: (start, stop, count)} or {name: [values...]}."""
+    axes = {}
+    for name, spec in ranges.items():
+        if isinstance(spec, tuple) and len(spec) == 3:
+            start, stop, count = spec
+            if int(count) < 1:
+                raise ModelError(f"parameter {name}: COUNT must be at least 1, got {count}")
+            axes[name] = np.linspace(float(start), float(stop), int(count))
+        else:
+            axes[name] = np.asarray(spec, dtype=float).ravel()
+    return [dict(zip(axes, map(float, combo))) for combo in itertools.product(*axes.values())]
+
+
+def parse_range(text):
+    """'NAME=START:STOP:COUNT' -> (name, (start, stop, count))."""
+    name, sep, spec = text.partition("=")
+    parts = spec.split(":")
+    try:
+        if not sep or len(parts) != 3:
+            raise ValueError
+        return name.strip(), (float(parts[0]), float(parts[1]), int(parts[2]))
+    except ValueError:
+        raise ModelError(f"--param {text!r}: expected NAME=START:STOP:COUNT, e.g. k1=10:100:20") from None
+
+
+def read_samples(path):
+    """One run per row of a CSV file whose columns are parameter names."""
+    try:
+        table = pd.read_csv(path)
+    except (OSError, ValueError) as err:
+        raise ModelError(f"{path}: cannot read samples: {err}") from None
+    if table.empty:
+        raise ModelError(f"{path}: no samples")
+    bad = [c for c in table.columns if not np.issubdtype(table[c].dtype, np.number)]
+    if bad:
+        raise ModelError(f"{path}: columns {bad} are not numbers")
+    return [{k: float(v) for k, v in row.items()} for row in table.to_dict("records")]
+
+
+def run_id(values):
+    """A stable key of one run's parameter values."""
+    return _digest(json.dumps({k: repr(float(v)) for k, v in sorted(values.items())}))
+
+
+def _digest(text):
+    """16 hex digits of the SHA-1 of ``text``."""
+    return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class ModelText:
+    """What a worker needs to rebuild a System: its file's text, the name errors give,
+    and the folder its file names (meshes, URDFs) are relative to."""
+
+    source: str
+    name: str
+    folder: str
+
+    @classmethod
+    def of(cls, system):
+        return cls(system.source, system.name, system.source_folder)
+
+    def system(self):
+        """The System, built once per process."""
+        key = (self.source, self.folder)
+        if key not in _SYSTEMS:
+            _SYSTEMS[key] = loads(self.source, name=self.name, folder=self.folder or None)
+        return _SYSTEMS[key]
+
+
+_SYSTEMS = {}  # per worker process: (model text, folder) -> System
+
+
+def run_one(model, values, t_end, metrics, options, keep_trajectory=False):
+    """One simulation of ``model`` (a ModelText) with ``values``: (a result row, the
+    trajectory when ``keep_trajectory`` and the run got one, else None)."""
+    row = {"run_id": run_id(values), **values, "status": "ok", "error": ""}
+    started = time.perf_counter()
+    traj = None
+    try:
+        system = model.system().with_parameters(**values)
+        traj = simulate(system, t_end, **options)
+        for metric in metrics:
+            row[metric.name] = metric.evaluate(system, traj)
+    except Exception as err:  # noqa: BLE001  (every failure is the run's row; the sweep goes on)
+        traj = getattr(err, "trajectory", traj)  # a SimulationError's run up to the failure
+        row.update(status="failed", error=error_text(err))
+        for metric in metrics:
+            row[metric.name] = np.nan
+    row["wall_time_s"] = time.perf_counter() - started
+    row["worker_pid"] = os.getpid()
+    return row, traj if keep_trajectory else None
+
+
+def error_text(err):
+    """A failed run's error: the message of a model or solve error (they name the part and
+    time), the type and message of any other."""
+    if isinstance(err, (SolveError, ModelError, ValueError)):
+        return str(err)
+    return f"{type(err).__name__}: {err}"
+
+
+def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift", "max_residual"), out=None,
+          scheduler=None, workers=None, trajectories=None, progress=None, **options):
+    """Run every combination of ``params`` ({name: (start, stop, count) or values}) or every
+    row of ``samples`` (a CSV path or a list of dicts); return the results as a DataFrame.
+
+    model: a model path or a System loaded from a file. options: passed to ``simulate``
+    (dt, method, rtol, atol, stabilization). workers: the size of the local cluster (not
+    with ``scheduler``). trajectories: a folder here, where each run's trajectory is saved
+    as <run_id>.npz. progress: callable(done, failed, total, eta_s).
+    """
+    system = model if hasattr(model, "with_parameters") else load(model)
+    if not system.source:
+        raise ModelError(f"model '{system.name}': a sweep needs a model read from a file (mbsynth.load)")
+    if scheduler and workers is not None:
+        raise ModelError(f"workers={workers} (--workers) sizes the local cluster mbsynth starts; with the "
+                         f"scheduler {scheduler} its own workers run the sweep: give one or the other")
+    runs = _runs(system, params, samples)
+    if out is not None and Path(out).suffix not in (".parquet", ".csv"):
+        raise ModelError(f"{out}: results must be .parquet or .csv")
+    metric_list = [Metric(m) for m in metrics]
+    for metric in metric_list:
+        metric.parse(system)
+    settings = sweep_settings(system, t_end, metric_list, options)
+    done = _read_results(out, settings)
+    todo = [v for v in runs if run_id(v) not in done]
+    results = dict(done)
+    log.info("sweep of %d runs: %d already in %s, %d to go", len(runs), len(done), out, len(todo))
+    if todo:
+        if trajectories is not None:
+            Path(trajectories).mkdir(parents=True, exist_ok=True)
+        with _client(scheduler, workers) as client:
+            _execute(client, ModelText.of(system), todo, (t_end, metric_list, options, settings), trajectories,
+                     results, out, progress, len(runs))
+    table = _table(results, runs)
+    if out is not None:
+        _write_results(out, table)
+    return table
+
+
+def _runs(system, params, samples):
+    if (params is None) == (samples is None):
+        raise ModelError("give either parameter ranges or samples, not both or neither")
+    runs = grid(params) if params is not None else (
+        read_samples(samples) if isinstance(samples, (str, Path)) else [dict(s) for s in samples])
+    unknown = sorted({k for r in runs for k in r} - set(system.parameters))
+    if unknown:
+        raise ModelError(f"model '{system.name}' has no parameter(s) {unknown}; it has {sorted(system.parameters)}")
+    return runs
+
+
+class _client:
+    """A Dask client on the user's scheduler, or on a local cluster started and stopped here (its
+    worker processes, one per core, run the compiled kernels on one thread each: MBSYNTH_THREADS)."""
+
+    def __init__(self, scheduler, workers):
+        self.scheduler, self.workers = scheduler, workers
+
+    def __enter__(self):
+        from distributed import Client, LocalCluster
+
+        if self.scheduler:
+            self.cluster = None
+            self.client = Client(self.scheduler)
+        else:
+            self.cluster = LocalCluster(n_workers=self.workers or os.cpu_count(), threads_per_worker=1,
+                                        processes=True, host=LOCALHOST, dashboard_address=f"{LOCALHOST}:0",
+                                        silence_logs=logging.ERROR, env={"MBSYNTH_THREADS": "1"})
+            self.client = Client(self.cluster)
+        return self.client
+
+    def __exit__(self, *exc):
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def _execute(client, model, todo, job, trajectories, results, out, progress, total):
+    """Submit the runs ``todo`` (job: t_end, metrics, options, settings) and gather their
+    rows into ``results`` as they finish, saving trajectories and checkpoints of ``out``."""
+    from distributed import as_completed
+
+    t_end, metrics, options, settings = job
+    futures = {client.submit(run_one, model, values, t_end, metrics, options, trajectories is not None,
+                             key=f"mbsynth-run-{run_id(values)}", pure=False, retries=2): values
+               for values in todo}
+    started, last_write = time.perf_counter(), 0.0
+    finished = 0
+    for future in as_completed(futures):
+        row, traj = _outcome(future, futures.pop(future))
+        if traj is not None:
+            traj.save(Path(trajectories) / f"{row['run_id']}.npz")
+        row["settings"] = settings
+        results[row["run_id"]] = row
+        finished += 1
+        if out is not None and time.perf_counter() - last_write > CHECKPOINT_SECONDS:
+            _write_results(out, pd.DataFrame(list(results.values())))
+            last_write = time.perf_counter()
+        if progress is not None:
+            rate = finished / max(time.perf_counter() - started, 1e-9)
+            failed = sum(r["status"] != "ok" for r in results.values())
+            progress(len(results), failed, total, (total - len(results)) / rate)
+
+
+def _outcome(future, values):
+    """A finished run's (row, trajectory or None); a row of its error when the run never
+    returned (a worker lost for good, Dask's own failure)."""
+    from distributed import KilledWorker
+
+    try:
+        return future.result()
+    except KilledWorker as err:
+        error = f"worker lost: {err}"
+    except Exception as err:  # noqa: BLE001  (the run is recorded as failed, the sweep goes on)
+        error = error_text(err)
+    return {"run_id": run_id(values), **values, "status": "failed", "error": error}, None
+
+
+def sweep_settings(system, t_end, metrics, options):
+    """What the runs' results depend on besides their parameter values, as JSON text: the
+    model (its text's hash and folder), t_end, the simulation options and the metrics."""
+    return json.dumps({"model_sha1": _digest(system.source), "folder": system.source_folder, "t_end": float(t_end),
+                       "options": options, "metrics": [m.spec for m in metrics]}, sort_keys=True, default=list)
+
+
+def _table(results, runs):
+    order = [run_id(v) for v in runs]
+    return pd.DataFrame([results[k] for k in order if k in results])
+
+
+def _read_results(out, settings):
+    """The finished runs of an earlier sweep with the same ``settings`` in ``out`` (by run
+    id); a ModelError when ``out`` holds another sweep's runs."""
+    if out is None or not Path(out).exists():
+        return {}
+    table = _read_table(out)
+    if "run_id" not in table:
+        return {}
+    _check_settings(out, set(table["settings"]) if "settings" in table else {""}, settings)
+    return {row["run_id"]: row for row in table.to_dict("records") if row.get("status") == "ok"}
+
+
+def _check_settings(out, found, settings):
+    """ModelError unless every row of ``out`` was run with ``settings``, saying what differs."""
+    if found <= {settings}:
+        return
+    now = json.loads(settings)
+    other = sorted(found - {settings})[0]
+    before = json.loads(other) if other else {}  # "": a table written before settings were recorded
+    changes = [f"{key} {before.get(key, 'not recorded')!r} there, {now[key]!r} now" for key in sorted(now)
+               if before.get(key) != now[key]]
+    raise ModelError(f"{out}: holds runs of another sweep ({'; '.join(changes)}); resuming would mix them. "
+                     f"Give another --out, or remove {out} to start over")
+
+
+def _read_table(path):
+    path = Path(path)
+    try:
+        return pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path, keep_default_na=False)
+    except (OSError, ValueError) as err:
+        raise ModelError(f"{path}: cannot read the results of an earlier sweep: {err}") from None
+
+
+def _write_results(out, table):
+    path = Path(out)
+    write_atomically(path, lambda temporary: table.to_parquet(temporary, index=False) if path.suffix == ".parquet"
+                     else table.to_csv(temporary, index=False))

@@ -1,0 +1,128 @@
+"""Symbolic derivations kept on disk, so that a model built again in a fresh process
+skips sympy's differentiation and code generation (the in-process caches of symbolic.py
+and connectors/joints.py hold them only for the process).
+
+``remembered(kind, inputs, derive)`` returns ``derive()``, stored under a digest of
+``kind``, ``inputs`` (nested tuples of sympy expressions, strings and numbers), this
+package's sources, sympy's version and Python's bytecode version (compiled functions are
+kept as code): any change of the code that derives them makes a new entry. Derivations
+work in placeholder symbols (coordinate slots, frame values); those made with ``placeholder(tag)`` are plain symbols whose names no model symbol can
+have (they start with a NUL), so they are the same in every process. A Dummy is equal
+only within its process: a derivation whose inputs or result hold one is not stored
+(it is derived as before).
+
+Entries are pickles in ``<cache>/derivations/<sources digest>/`` (core/files.py's cache
+directory, its stale versions pruned alike); one that cannot be read is derived again and
+rewritten, and a cache that cannot be written only costs the derivation.
+``MBSYNTH_DERIVATION_CACHE=off`` turns the disk off (the benchmark's cold figures).
+"""
+
+import hashlib
+import os
+import pickle
+from importlib.util import MAGIC_NUMBER
+from pathlib import Path
+
+import sympy as sp
+from sympy.core.parameters import evaluate
+
+from ..core.files import cache_dir, mark_and_prune, sources_hash, write_atomically
+
+_folder = None
+
+
+def placeholder(tag):
+    """The placeholder symbol of ``tag``, the same in every process."""
+    return sp.Symbol("\0" + tag)
+
+
+class Unstable(Exception):
+    """A value that cannot be stored: an expression holding a Dummy."""
+
+
+def _stable(value):
+    """``value``, checked to hold no Dummy (nested tuples and lists of expressions and
+    matrices)."""
+    if isinstance(value, (tuple, list)):
+        for v in value:
+            _stable(v)
+    elif isinstance(value, (sp.Basic, sp.MatrixBase)) and value.has(sp.Dummy):
+        raise Unstable(value)
+    return value
+
+
+def remembered(kind, inputs, derive, *, store=_stable, load=lambda stored: stored):
+    """``derive()``, from disk when derived before from equal ``inputs`` (see the module
+    docstring). ``store``/``load`` turn the result into what is pickled and back (by
+    default: sympy expressions, as they are)."""
+    folder = _cache_folder()
+    if folder is None:
+        return derive()
+    try:
+        key = fingerprint(inputs)
+    except Unstable:
+        return derive()
+    path = folder / f"{kind}-{key}.pkl"
+    if path.exists():
+        try:
+            with evaluate(False):  # stored in canonical form: rebuilt as is, four times faster
+                stored = pickle.loads(path.read_bytes())
+            return load(stored)
+        except Exception:  # noqa: BLE001 - a damaged or foreign entry: derive it again
+            pass
+    result = derive()
+    try:
+        data = pickle.dumps(store(result), protocol=pickle.HIGHEST_PROTOCOL)
+        write_atomically(path, lambda temporary: temporary.write_bytes(data))  # a sweep's processes write alike
+    except (Unstable, OSError, pickle.PicklingError, TypeError, AttributeError):
+        pass
+    return result
+
+
+def fingerprint(value, seen=None):
+    """A digest of ``value`` (nested tuples of sympy expressions and matrices, strings,
+    numbers) that is the same in every process (Unstable for a Dummy): each expression node
+    hashed once, from its class, an atom's exact content and its arguments' digests
+    (``seen``: node -> digest)."""
+    seen = {} if seen is None else seen
+    if isinstance(value, sp.MatrixBase):
+        return fingerprint(("Matrix", value.shape, tuple(value)), seen)
+    if isinstance(value, (tuple, list)):
+        parts = [fingerprint(v, seen) for v in value]
+        return hashlib.sha1(f"{type(value).__name__}({','.join(parts)})".encode()).hexdigest()
+    if not isinstance(value, sp.Basic):
+        return hashlib.sha1(f"{type(value).__name__}:{value!r}".encode()).hexdigest()
+    node = (type(value), value)  # Float(1) and Integer(1) apart, whatever == says
+    digest = seen.get(node)
+    if digest is None:
+        if value.args:
+            content = ",".join(fingerprint(arg, seen) for arg in value.args)
+        elif isinstance(value, sp.Dummy):
+            raise Unstable(value)
+        elif isinstance(value, sp.Symbol):
+            content = f"{value.name}:{sorted(value.assumptions0.items())}"
+        elif isinstance(value, sp.Float):
+            content = repr(value._mpf_)
+        else:
+            content = repr(value)  # integers, rationals, constants (pi, nan, oo)
+        digest = seen[node] = hashlib.sha1(f"{type(value).__name__}({content})".encode()).hexdigest()
+    return digest
+
+
+def _cache_folder():
+    """``<cache>/derivations/<digest of this package's sources and sympy's version>``,
+    created; None when off or not writable."""
+    global _folder
+    if _folder is None:
+        _folder = False
+        if os.environ.get("MBSYNTH_DERIVATION_CACHE", "").lower() not in ("off", "0", "no"):
+            try:
+                salt = sp.__version__ + MAGIC_NUMBER.hex()
+                digest = sources_hash(Path(__file__).resolve().parents[1], "**/*.py", salt=salt)
+                folder = cache_dir() / "derivations" / digest
+                folder.mkdir(parents=True, exist_ok=True)
+                mark_and_prune(folder)  # and the entries of older sources removed
+                _folder = folder
+            except OSError:
+                pass
+    return _folder or None

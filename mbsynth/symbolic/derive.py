@@ -1,0 +1,463 @@
+"""Symbolic derivations done once per model, and their compilation to numpy.
+
+- ``lagrange(T, V, F, q, qd, t)``: the unconstrained equation ``M q̈ = Q`` (2.1)
+  of a part given by its kinetic energy T, potential energy V and generalized
+  forces F, from Lagrange's equations.
+- ``differentiate(phi, q, qd, t)``: a constraint ``phi = 0`` differentiated to
+  the row ``A q̈ = b`` (2.4), once if phi contains velocities, twice if not.
+- ``generalized_force(V, efforts, q, qd)``: Q of a potential and (effort, rate) pairs.
+- ``compile_function(args, exprs)``: one fast numpy function for many expressions.
+
+Both the derivations and the compiled functions are shared between expressions of the
+same *structure* (``canonical``): a robot's fifty revolute joints differ only in the
+names of their coordinates and the numbers of their frames, so their rows are
+differentiated and compiled a handful of times, not fifty.
+"""
+
+import functools
+import hashlib
+import importlib
+import inspect
+import linecache
+import marshal
+import types
+
+import numpy as np
+import sympy as sp
+
+from .cache import Unstable, fingerprint, placeholder, remembered
+
+T_SYMBOL = sp.Symbol("t")
+_LARGEST = sp.Float(np.finfo(float).max)
+# pi and e as numpy floats, so that all arithmetic of a compiled expression is numpy's:
+# Python floats raise on overflow and division by zero ((2*pi + 1e308)**251, 1/(1 - t) at
+# t = 1) where numpy's give inf, which the checks of M, Q, A, b then report
+_FLOAT64 = {"pi": np.float64(np.pi), "e": np.float64(np.e)}
+SIMPLIFY_MAX_OPS = 60  # sympy.simplify takes seconds beyond this, growing fast (nested sin, exp)
+
+
+def lagrange(T, V, F, q, qd, t=T_SYMBOL):
+    """M and Q of (2.1) from Lagrange's equations d/dt ∂T/∂q̇ − ∂T/∂q + ∂V/∂q = F.
+
+    Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
+    M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
+    Each entry is simplified when it is small (``tidy``). Kept on disk (derivation_cache.py).
+    """
+    def derive():
+        qs, qds = sp.Matrix(q), sp.Matrix(qd)
+        p = sp.Matrix([T]).jacobian(qds).T  # generalized momenta ∂T/∂q̇
+        M = p.jacobian(qds)
+        Q = (sp.Matrix(F) + sp.Matrix([T - V]).jacobian(qs).T
+             - p.jacobian(qs) * qds - p.diff(t))
+        return M.applyfunc(tidy), Q.applyfunc(tidy)
+
+    inputs = (sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F), tuple(q), tuple(qd), t)
+    return remembered("lagrange", inputs, derive)
+
+
+def tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
+    """sympy.simplify for expressions small enough to be worth it (it is slow on big ones)."""
+    return sp.simplify(expr) if sp.count_ops(expr) <= max_ops else expr
+
+
+def jacobian(exprs, symbols):
+    """∂exprs/∂symbols (a len(exprs) × len(symbols) matrix), differentiating each
+    expression only by the symbols it contains: a model has hundreds of coordinates and
+    a joint's rows involve fourteen."""
+    exprs, symbols = [sp.sympify(e) for e in exprs], list(symbols)
+    out = sp.zeros(len(exprs), len(symbols))
+    for i, e in enumerate(exprs):
+        free = e.free_symbols
+        for j, s in enumerate(symbols):
+            if s in free:
+                out[i, j] = e.diff(s)
+    return out
+
+
+class JointValue(sp.Dummy):
+    """A joint's angle (``hinge.angle``) in a constraint: a symbol standing for ``value``,
+    an expression of the coordinates (an atan2 of the parts' axes), whose time derivative
+    is ``rate`` (the joint's rate, linear in q̇). Constraints on it are differentiated by
+    the chain rule through the rate — cheap — instead of through the atan2 twice, which
+    is exact on the constraint manifold, where d(value)/dt = rate (joint_values.py); the
+    value is put in afterwards (``expand_joint_values``)."""
+
+    def __new__(cls, name, value, rate):
+        symbol = super().__new__(cls, name)
+        symbol.value, symbol.rate = sp.sympify(value), sp.sympify(rate)
+        return symbol
+
+
+def joint_values_in(expr):
+    """The JointValue symbols of ``expr``."""
+    return [s for s in sp.sympify(expr).free_symbols if isinstance(s, JointValue)]
+
+
+def expand_joint_values(expr):
+    """``expr`` with its JointValue symbols replaced by their values."""
+    found = joint_values_in(expr)
+    return sp.sympify(expr).xreplace({s: s.value for s in found}) if found else expr
+
+
+def time_derivative(expr, q, qd, t=T_SYMBOL):
+    """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t, and the
+    chain rule Σ (∂e/∂s) ṡ through the JointValue symbols s it holds."""
+    chain = sum((sp.diff(expr, s) * s.rate for s in joint_values_in(expr)), sp.S.Zero)
+    return (jacobian([expr], q) * sp.Matrix(qd))[0] + sp.diff(expr, t) + chain
+
+
+def generalized_force(V, efforts, q, qd):
+    """Q = −∂V/∂q + Σ effort ∂rate/∂q̇ (virtual power; each rate linear in q̇), a column over
+    q; kept on disk (derivation_cache.py)."""
+    efforts = tuple((sp.sympify(effort), sp.sympify(rate)) for effort, rate in efforts)
+
+    def derive():
+        Q = -jacobian([V], q).T
+        for effort, rate in efforts:
+            Q += effort * jacobian([rate], qd).T
+        return Q
+
+    return remembered("generalized-force", (sp.sympify(V), efforts, tuple(q), tuple(qd)), derive)
+
+
+class Slots:
+    """Positional placeholder symbols ``<prefix><i>``, named so that they clash with no
+    model's names and stay the same across processes (derivation_cache.placeholder)."""
+
+    def __init__(self, prefix):
+        self.prefix, self.items = prefix, []
+
+    def __getitem__(self, i):
+        while len(self.items) <= i:
+            self.items.append(placeholder(f"{self.prefix}{len(self.items)}"))
+        return self.items[i]
+
+
+_ARGUMENT, _RATE, _NUMBER = Slots("a"), Slots("r"), Slots("k")
+
+
+def _numbers(expr, found):
+    """The non-integer numbers of ``expr`` into the dict ``found``, in preorder, numeric
+    exponents left alone (x**2, sqrt)."""
+    if expr.is_Number:
+        if expr.is_Float or (expr.is_Rational and not expr.is_Integer):  # not nan, oo
+            found.setdefault(expr, None)
+        return
+    args = expr.args[:1] if expr.is_Pow and expr.exp.is_Number else expr.args
+    for arg in args:
+        _numbers(arg, found)
+
+
+def canonical(exprs, symbols):
+    """(placeholder forms of ``exprs``, the numbers they stand for): ``symbols`` become
+    positional placeholders and each distinct non-integer number a placeholder ``k_i``.
+    Two expressions with equal placeholder forms have the same structure, whatever the
+    names of their symbols and the values of their numbers."""
+    found = {}
+    for e in exprs:
+        _numbers(e, found)
+    forward = {s: _ARGUMENT[i] for i, s in enumerate(symbols)}
+    forward.update({x: _NUMBER[i] for i, x in enumerate(found)})
+    return tuple(e.xreplace(forward) for e in exprs), tuple(found)
+
+
+def differentiated(exprs, q, qd, t=T_SYMBOL):
+    """(A rows (sparse, len(exprs) × len(q)), b, velocity-level forms) of the
+    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure."""
+    exprs = [sp.sympify(e) for e in exprs]
+    if any(joint_values_in(e) for e in exprs):  # the chain rule through joint rates (JointValue)
+        rows = [differentiate(e, q, qd, t) for e in exprs]
+        entries = {(r, j): expand_joint_values(x) for r, row in enumerate(rows) for j, x in enumerate(row[0]) if x != 0}
+        return (sp.SparseMatrix(len(exprs), len(q), entries), [expand_joint_values(row[1]) for row in rows],
+                [expand_joint_values(row[2]) for row in rows])
+    where = positions(q, qd)
+    involved = sorted({where[s] for e in exprs for s in e.free_symbols if s in where})
+    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved])
+    a, b, psi = _differentiated(forms, len(involved), t)
+    back = {_ARGUMENT[j]: q[i] for j, i in enumerate(involved)}
+    back.update({_ARGUMENT[len(involved) + j]: qd[i] for j, i in enumerate(involved)})
+    back.update({_NUMBER[j]: x for j, x in enumerate(numbers)})
+    entries = {}
+    for r, row in enumerate(a):
+        for j, entry in enumerate(row):
+            if entry != 0:
+                entries[r, involved[j]] = entry.xreplace(back)
+    return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
+            [x.xreplace(back) for x in psi])
+
+
+def placed_values(slots, coordinates, constants, q, qd):
+    """{placeholder: what it stands for}: the constants, and the model's coordinate and
+    velocity symbols at ``coordinates`` for the slots (q slots, q̇ slots)."""
+    put = dict(constants)
+    put.update({s: q[c] for s, c in zip(slots[0], coordinates)})
+    put.update({s: qd[c] for s, c in zip(slots[1], coordinates)})
+    return put
+
+
+_last_positions = ((), (), {})
+
+
+def positions(q, qd):
+    """{symbol: index} of the coordinates q and velocities q̇, kept for the last pair
+    asked (every constraint of a model asks for the same two)."""
+    global _last_positions
+    q, qd = tuple(q), tuple(qd)
+    if _last_positions[:2] != (q, qd):  # tuples of the same symbols compare by identity first: fast
+        where = {s: i for i, s in enumerate(q)}
+        where.update({s: i for i, s in enumerate(qd)})
+        _last_positions = (q, qd, where)
+    return _last_positions[2]
+
+
+@functools.lru_cache(maxsize=4096)
+def _differentiated(forms, count, t):
+    """``differentiate`` of each placeholder form in the coordinates a_0 … a_{count−1}
+    and velocities a_count …: (rows of a over the involved coordinates, b, ψ)."""
+    def derive():
+        q = [_ARGUMENT[i] for i in range(count)]
+        qd = [_ARGUMENT[count + i] for i in range(count)]
+        rows = [differentiate(e, q, qd, t) for e in forms]
+        return tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows), tuple(r[2] for r in rows)
+
+    return remembered("differentiated", (forms, count, t), derive)
+
+
+def differentiate(phi, q, qd, t=T_SYMBOL):
+    """Row (a, b, phidot) of A q̈ = b (2.4) for the constraint phi(q, q̇, t) = 0.
+
+    A position-level phi(q, t) is differentiated twice (phidot = d phi/dt); a
+    velocity-level phi(q, q̇, t) once (phidot is phi itself). With ψ the
+    velocity-level form, ψ̇ = (∂ψ/∂q̇) q̈ + (∂ψ/∂q) q̇ + ∂ψ/∂t = 0, so
+    a = ∂ψ/∂q̇ and b = −(∂ψ/∂q) q̇ − ∂ψ/∂t (plus the chain rule through JointValue
+    symbols, whose rates are exact on the manifold).
+    """
+    velocity_level = bool(set(qd) & phi.free_symbols)
+    psi = phi if velocity_level else time_derivative(phi, q, qd, t)
+    a = jacobian([psi], qd)
+    chain = sum((sp.diff(psi, s) * s.rate for s in joint_values_in(psi)), sp.S.Zero)  # JointValue symbols
+    b = -(jacobian([psi], q) * sp.Matrix(qd))[0] - sp.diff(psi, t) - chain
+    return a, b, psi
+
+
+def symbols_in(exprs):
+    """The symbols in ``exprs``, as ``free_symbols`` gives them for expressions without
+    bound variables (derivatives, which share subexpressions): each object visited once,
+    where free_symbols walks a shared subexpression at every use (25× slower on joints)."""
+    seen, found, stack = set(), set(), [sp.sympify(e) for e in exprs]
+    while stack:
+        expr = stack.pop()
+        if id(expr) not in seen:
+            seen.add(id(expr))
+            if expr.is_Symbol:
+                found.add(expr)
+            else:
+                stack.extend(expr.args)
+    return found
+
+
+def compile_function(args, exprs, constants=(), dtype=float):
+    """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
+    ``exprs`` (scalars, vectors or matrices), with common subexpressions shared.
+    ``dtype=complex`` keeps complex arguments complex (complex-step derivatives,
+    linearization.py); the constants must then be numbers.
+
+    ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
+    values (numbers or expressions of ``args``) are put in at each evaluation, so that
+    expressions shared by many instances (connectors.joints) are compiled once."""
+    shapes = [e.shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
+    flat = [x if isinstance(x, sp.Basic) else sp.sympify(x)
+            for e in exprs for x in (e.flat() if isinstance(e, sp.MatrixBase) else [e])]
+    if not flat:
+        def empty(*_):
+            return tuple(np.zeros(s) for s in shapes)
+        return empty
+    frozen = _frozen(args)
+    raw, numbers = _compiled(frozen, tuple(flat), tuple(c[0] for c in constants))
+    fixed = np.array([_as_double(x) for x in numbers], dtype=float)
+    return Compiled(raw, _values(frozen, tuple(sp.sympify(c[1]) for c in constants)), fixed, shapes, dtype)
+
+
+class Compiled:
+    """The function ``compile_function`` returns: ``raw`` (shared by every function of the
+    same structure, ``canonical``) applied to the arguments, the values of the constants
+    (``values``: a function of the arguments) and this instance's numbers ``fixed``.
+    grouped.py calls ``raw`` once for many instances, on stacked arguments."""
+
+    def __init__(self, raw, values, fixed, shapes, dtype=float):
+        self.raw, self.values, self.fixed, self.shapes, self.dtype = raw, values, fixed, shapes, dtype
+        self.splits = np.cumsum([int(np.prod(s)) for s in shapes])[:-1]
+
+    def __call__(self, *given):
+        given = [np.float64(v) if isinstance(v, (int, float)) else v for v in given]
+        with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
+            out = np.asarray(self.raw(*given, self.values(*given), self.fixed), dtype=self.dtype)
+        return tuple(part.reshape(shape) for part, shape in zip(np.split(out, self.splits), self.shapes))
+
+
+@functools.lru_cache(maxsize=4096)
+def _compiled(args, flat, placeholders):
+    """(numpy function of (args, placeholder values, numbers), the numbers): the
+    expressions in ``canonical`` form, compiled once per structure. Both the canonical
+    form's digest and numbers and the compiled source are kept on disk
+    (derivation_cache.py): a model built again in a fresh process skips ``canonical``."""
+    symbols = _flat(args) + list(placeholders)
+    slots = _placed(args + (placeholders,), iter(_ARGUMENT[i] for i in range(len(symbols))))
+    derived = []
+
+    def derive():
+        derived.append(canonical(flat, symbols))
+        forms, numbers = derived[0]
+        try:
+            return fingerprint((slots, len(numbers), forms)), numbers
+        except Unstable:  # a Dummy in the forms: a structure of this process alone
+            return None, numbers
+
+    digest, numbers = remembered("canonical", (args, flat, placeholders), derive, store=_stable_record)
+
+    def structure():
+        """(argument slots, canonical forms): what compiled/structures.py compiles with numba."""
+        forms = (derived[0] if derived else canonical(flat, symbols))[0]
+        return slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms
+
+    return _lambdified(digest, structure), numbers
+
+
+_by_structure = {}  # structure digest -> its numpy function, one per structure in this process
+
+
+def _lambdified(digest, structure):
+    """The numpy function of the structure ``digest`` (``structure()``: its argument slots
+    and forms), made once per structure: joints alike, and models loaded again (a sweep's
+    workers, a file checked then simulated) reuse it."""
+    raw = _by_structure.get(digest)
+    if raw is None:
+        def derive():
+            args, forms = structure()
+            return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"],
+                               cse=True, dummify=True)
+
+        if digest is None:
+            raw = derive()
+        else:
+            raw = _by_structure[digest] = remembered("lambdified", digest, derive, store=_function_source,
+                                                     load=_function_from_source)
+        raw.structure = structure  # for compiled/structures.py, which compiles it with numba
+    return raw
+
+
+def _stable_record(record):
+    if record[0] is None:
+        raise Unstable(record)
+    return record
+
+
+@functools.lru_cache(maxsize=4096)
+def _values(args, values):
+    """A function of ``args`` giving the array of ``values``: gathered from numbers and picks
+    (k, argument a, position i or None) of the arguments where that is all they are, else
+    lambdified."""
+    where = {s: (a, None) for a, s in enumerate(args) if isinstance(s, sp.Symbol)}
+    where.update({s: (a, i) for a, group in enumerate(args) if isinstance(group, tuple) for i, s in enumerate(group)})
+    if all(v.is_Number or v in where for v in values):  # numbers, and arguments (a joint's effort τ)
+        fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
+        picks = tuple((k, *where[v]) for k, v in enumerate(values) if not v.is_Number)
+
+        def gathered(*given):
+            if not picks:
+                return fixed
+            out = fixed.astype(np.result_type(fixed, *(np.asarray(given[a]) for _, a, _ in picks)))
+            for k, a, i in picks:
+                out[k] = given[a] if i is None else given[a][i]
+            return out
+        gathered.fixed, gathered.picks = fixed, picks  # grouped.py stacks these instead of calling
+        return gathered
+    raw = remembered("values", (args, values),
+                     lambda: sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"],
+                                         dummify=True),
+                     store=_function_source, load=_function_from_source)
+    return lambda *given: np.asarray(raw(*given), dtype=float)
+
+
+def _function_source(raw):
+    """(source, its compiled code marshalled, [(name, module, attribute)] for each global
+    name it reads: the attribute of that module ("" the module itself), or with module
+    None the value itself)
+    of a lambdified function, for the derivation cache. Reading it back then needs
+    neither a compile nor lambdify's namespace (``from numpy import *``)."""
+    source = inspect.getsource(raw)
+    code = compile(source, _source_file(source), "exec")
+    names = [(name, *_origin(name, raw.__globals__[name])) for name in sorted(_global_names(code))
+             if name in raw.__globals__]
+    return source, marshal.dumps(code), names
+
+
+def _function_from_source(stored):
+    source, code, names = stored
+    namespace = {name: value if module is None else _attribute(module, value) for name, module, value in names}
+    code = marshal.loads(code)
+    linecache.cache[code.co_filename] = (len(source), None, source.splitlines(True), code.co_filename)  # tracebacks
+    exec(code, namespace)  # noqa: S102 - code sympy generated, from our cache
+    return namespace["_lambdifygenerated"]
+
+
+def _attribute(module, attribute):
+    """``module``'s ``attribute``, or the module itself for ""."""
+    module = importlib.import_module(module)
+    return getattr(module, attribute) if attribute else module
+
+
+def _source_file(source):
+    """The file name a generated source's tracebacks show (linecache holds its lines)."""
+    return f"<lambdified-{hashlib.sha1(source.encode()).hexdigest()[:12]}>"
+
+
+def _global_names(code):
+    """The names ``code`` and the code nested in it look up (globals among them)."""
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _global_names(const)
+    return names
+
+
+def _origin(name, value):
+    """(module, attribute) that ``value``, a lambdified function's global ``name``, is read
+    back from, or (None, value) for a number; Unstable for anything else."""
+    if isinstance(value, types.ModuleType):
+        return value.__name__, ""
+    if isinstance(value, (int, float, complex, np.number)):
+        return None, value
+    module = getattr(value, "__module__", None)
+    for attribute in (getattr(value, "__name__", None), name):
+        if module and attribute and getattr(importlib.import_module(module), attribute, None) is value:
+            return module, attribute
+    raise Unstable(name)
+
+
+def _frozen(args):
+    """``args`` with its lists made tuples (hashable), nested."""
+    return tuple(_frozen(a) if isinstance(a, (list, tuple)) else a for a in args)
+
+
+def _flat(args):
+    """The symbols of nested argument lists, in order."""
+    return [s for a in args for s in (_flat(a) if isinstance(a, (list, tuple)) else [a])]
+
+
+def _placed(args, slots):
+    """``args`` (nested lists) with each symbol replaced by the next of ``slots``; tuples."""
+    return tuple(_placed(a, slots) if isinstance(a, (list, tuple)) else next(slots) for a in args)
+
+
+def _as_double(x):
+    """A number as a double; ±inf beyond the double range (as float arithmetic gives)."""
+    return float(x) if abs(x) <= _LARGEST else float(sp.sign(x)) * np.inf
+
+
+def beyond_double_as_inf(expr):
+    """``expr`` with exact numbers beyond the double range (a mass of 1e308 times g = 1e308)
+    replaced by ±inf, as float arithmetic would give, instead of an OverflowError when
+    evaluated; the non-finite result is then reported by the checks of M, Q, A, b."""
+    huge = {x: sp.sign(x) * sp.oo for x in sp.sympify(expr).atoms(sp.Rational) if abs(x) > _LARGEST}
+    return sp.sympify(expr).xreplace(huge) if huge else expr

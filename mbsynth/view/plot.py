@@ -1,0 +1,72 @@
+"""Plots of a trajectory: the joint coordinates (or the model's outputs, or named
+columns), kinetic and potential energy, and the constraint residuals."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+import numpy as np  # noqa: E402
+
+MAX_LINES = 12
+
+
+def plot_trajectory(traj, path, title=None, system=None, names=None):
+    """Write a three-panel figure of ``traj`` to ``path`` (PNG, PDF or SVG).
+
+    Top panel: the columns ``names`` (coordinates ``part.c``, velocities ``part.c_dot``,
+    outputs); else the model's declared outputs; else, for a ``system`` with joints, the
+    joint coordinates (angles unwrapped); else its first coordinates. Middle: kinetic and
+    potential energy, and their sum's change labelled "energy drift" only where nothing in
+    the model does work (``System.working_forces``). Bottom: the constraint residuals."""
+    fig, (ax_q, ax_e, ax_r) = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+    series, label = _series(traj, system, names)
+    for name, values in series[:MAX_LINES]:
+        ax_q.plot(traj.t, values, label=name)
+    ax_q.set_ylabel(label)
+    ax_q.legend(fontsize="small", ncol=3, loc="upper right")
+    if len(series) > MAX_LINES:
+        ax_q.set_title(f"first {MAX_LINES} of {len(series)} {label}", fontsize="small")
+    _energy(ax_e, traj, system)
+    for values, name in ((traj.residual_position, "position |φ|"), (traj.residual_velocity, "velocity |φ̇|")):
+        ax_r.semilogy(traj.t, np.maximum(values, 1e-18), label=name)
+    ax_r.set_ylabel("max constraint residual")
+    ax_r.set_xlabel("t [s]")
+    ax_r.legend(fontsize="small")
+    fig.suptitle(title or "trajectory")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _series(traj, system, names):
+    """([(label, values)], what they are) for the top panel."""
+    outputs = dict(zip(getattr(traj, "output_names", ()), np.asarray(getattr(traj, "outputs", np.zeros((0, 0)))).T))
+    if names:
+        return [(n, outputs[n] if n in outputs else traj.column(n)) for n in names], "values"
+    if outputs:
+        return list(outputs.items()), "outputs"
+    if system is not None and system.joint_kinematics():
+        from ..model.joint_values import along
+        joints = along(system, traj.t, traj.q, traj.qd)
+        kinematics = system.joint_kinematics()
+        found = [(f"{joint}.{name}", values.position[:, i]) for joint, values in joints.items()
+                 for i, name in enumerate(kinematics[joint].position_names)]
+        if found:
+            return found, "joint coordinates"
+    return [(name, traj.q[:, i]) for i, name in enumerate(traj.coordinates)], "coordinates"
+
+
+def _energy(axes, traj, system):
+    """Kinetic and potential energy; their sum's change, named drift only when no force works."""
+    potential = traj.energy - traj.kinetic
+    axes.plot(traj.t, traj.kinetic, label="kinetic T")
+    axes.plot(traj.t, potential, label="potential V")
+    working = system.working_forces() if system is not None else None
+    change = traj.energy - traj.energy[0]
+    if working == []:
+        axes.plot(traj.t, change, label="energy drift (T + V)(t) − (T + V)(0)")
+    else:
+        doing = f" (work of {', '.join(working[:3])}{', ...' if len(working) > 3 else ''})" if working else ""
+        axes.plot(traj.t, change, label=f"(T + V)(t) − (T + V)(0){doing}")
+    axes.set_ylabel("energy [J]")
+    axes.legend(fontsize="small")

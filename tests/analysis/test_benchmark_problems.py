@@ -1,0 +1,229 @@
+"""The field's benchmark problems (issue 18) run to the end and meet independent references.
+
+IFToMM/LIM A01 (simple pendulum), A02 (N-four-bar through its singular positions), A03 /
+the IVP test set's `andrews`, A04 (Bricard's over-constrained loop), Bennett's and
+Sarrus' over-constrained linkages and a 1 km pendulum in SI units. The references are in
+benchmarks/iftomm_reference.py and use no mbsynth: Jacobi's elliptic functions for the
+pendulum, the N-four-bar's exact one-degree-of-freedom equation integrated by scipy at
+1e-13, the test set's published angles at 0.03 s, energy conservation, and the joints'
+gaps computed from the bodies' coordinates with quaternions written out there.
+
+They fail on a solver that stops at, or mis-steps through, a configuration where the
+dependent rows change (Bricard, the N-four-bar) or that judges consistency with an
+absolute tolerance (the 1 km pendulum), as mbsynth did before issue 18. Output intervals
+are coarse to keep each run short (drift control projects between them as needed);
+accuracy is `simulate`'s default (DOP853, rtol = atol = 1e-10).
+"""
+
+import functools
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbsynth as mb
+from mbsynth.analysis.diagnose import diagnose
+
+ROOT = Path(__file__).resolve().parents[2]
+MECHANISMS = ROOT / "models" / "mechanisms"
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import iftomm_reference as ref  # noqa: E402
+
+load = functools.cache(lambda name: mb.load(MECHANISMS / name))
+
+
+def b0(traj):
+    """The top B0 of the first vertical bar (frame `top` at (0, L/2) of v0, L = 1)."""
+    theta = traj.column("v0.theta")
+    return traj.column("v0.x") - 0.5 * np.sin(theta), traj.column("v0.y") + 0.5 * np.cos(theta)
+
+
+def energy_change(traj):
+    """max |E(t) − E(0)| relative to max(|E(0)|, the largest kinetic energy)."""
+    assert np.all(np.isfinite(traj.energy))
+    return traj.energy_drift
+
+
+# --- the models are what they claim ------------------------------------------------------
+
+
+@pytest.mark.parametrize("name, n, dependent", [
+    ("simple_pendulum.yaml", 2, 0),
+    ("pendulum_1km.yaml", 2, 0),
+    ("andrews.yaml", 7, 0),
+    ("n_four_bar.yaml", 15, 0),
+    ("bricard.yaml", 35, 1),     # Grübler 0, mobility 1: one dependent joint row
+    ("bennett.yaml", 21, 3),     # Grübler -2, mobility 1
+    ("sarrus.yaml", 35, 1),      # Grübler 0, mobility 1
+])
+def test_model_verdicts(name, n, dependent):
+    d = diagnose(load(name))
+    assert d.unique and d.n == n and d.rank_Mhat == n
+    assert d.m - d.rank_A == dependent
+
+
+def test_degrees_of_freedom():
+    """One degree of freedom each: n minus the rank of A."""
+    for name in ("simple_pendulum.yaml", "andrews.yaml", "n_four_bar.yaml", "bricard.yaml", "bennett.yaml",
+                 "sarrus.yaml"):
+        d = diagnose(load(name))
+        assert d.n - d.rank_A == 1, name
+
+
+def test_n_four_bar_generator_matches_the_file():
+    assert (MECHANISMS / "n_four_bar.yaml").read_text() == ref.n_four_bar_yaml(2)
+    system = mb.loads(ref.n_four_bar_yaml(40), name="n_four_bar_40")
+    assert len(system.coordinates) == 3 * 81
+    q, qd = system.initial_state()
+    phi, psi = system.constraint_residuals(0.0, q, qd)
+    assert np.abs(phi).max() < 1e-14 and np.abs(psi).max() < 1e-14   # consistent as written
+
+
+def test_bricard_initial_loop_is_closed():
+    system = load("bricard.yaml")
+    q, _ = system.initial_state()
+    gap, axis = ref.loop_gaps(system.coordinates, q, ref.BRICARD_JOINTS)
+    assert gap < 1e-15 and axis < 1e-15
+
+
+# --- the references are right --------------------------------------------------------------
+
+
+def test_pendulum_reference_small_amplitude_and_energy():
+    L, g = 2.0, 9.81
+    assert ref.pendulum_period(L, g, 1e-4) == pytest.approx(2 * math.pi * math.sqrt(L / g), rel=1e-8)
+    t = np.linspace(0, 5, 201)
+    x, y = ref.pendulum_exact(t, L, g, 1.0)
+    assert np.allclose(x**2 + y**2, L**2, rtol=1e-14)
+    # energy from finite differences of the closed form
+    h = 1e-6
+    xp, yp = ref.pendulum_exact(t + h, L, g, 1.0)
+    xm, ym = ref.pendulum_exact(t - h, L, g, 1.0)
+    v2 = ((xp - xm) ** 2 + (yp - ym) ** 2) / (2 * h) ** 2
+    E = 0.5 * v2 + g * y
+    assert np.abs(E - E[0]).max() < 1e-6 * g * L
+
+
+def test_n_four_bar_reference_conserves_energy_and_crosses_singularities():
+    J, K = ref.n_four_bar_constants(2)
+    assert (J, K) == pytest.approx((3.0, 9.81 * 3.5))
+    times = ref.n_four_bar_singular_times(2, 20.0)
+    assert times[0] == pytest.approx(0.714, abs=1e-3) and len(times) == 20
+    t = np.linspace(0, 20, 2001)
+    x, y = ref.n_four_bar_reference(t, 2)
+    assert np.allclose(x**2 + y**2, 1.0, atol=1e-12)
+
+
+# --- the runs ------------------------------------------------------------------------------
+
+
+def test_simple_pendulum_a01_against_exact_motion():
+    traj = mb.simulate(load("simple_pendulum.yaml"), 10.0, dt=0.1)
+    assert traj.status == "completed"
+    x, y = ref.pendulum_exact(traj.t, 1.0, 9.81, math.pi / 2)
+    assert np.max(np.hypot(traj.column("bob.x") - x, traj.column("bob.y") - y)) < 1e-6
+    assert energy_change(traj) < 1e-8
+
+
+def assert_follows_the_one_dof_reference(traj, N):
+    """B0 within the benchmark's 1e-3 m of the exact motion; energy kept to 1e-6."""
+    assert traj.status == "completed"
+    bx, by = b0(traj)
+    xr, yr = ref.n_four_bar_reference(traj.t, N)
+    assert np.max(np.hypot(bx - xr, by - yr)) < 1e-3
+    assert energy_change(traj) < 1e-6
+
+
+def test_n_four_bar_2_follows_the_one_dof_reference_for_20_s():
+    """B0 within 1e-3 m of the exact motion over 20 s: 20 passes through the horizontal
+    (singular) positions, each of which must be crossed, not bounced off."""
+    assert_follows_the_one_dof_reference(mb.simulate(load("n_four_bar.yaml"), 20.0), 2)
+
+
+def test_n_four_bar_40_follows_the_one_dof_reference():
+    """N = 40 (243 coordinates) through its first singular position (t = 0.72 s). Only
+    0.8 s of the benchmark's 20 here (the planar bodies go through the KKT path);
+    benchmarks/iftomm.py runs the 20 s."""
+    system = mb.loads(ref.n_four_bar_yaml(40), name="n_four_bar_40")
+    assert_follows_the_one_dof_reference(mb.simulate(system, 0.8, dt=0.4), 40)
+
+
+def test_andrews_against_the_ivp_test_set():
+    traj = mb.simulate(load("andrews.yaml"), 0.03, dt=0.003)
+    assert traj.status == "completed" and traj.t[-1] == pytest.approx(0.03, abs=1e-15)
+    angles = np.array([traj.column(f"sq.{c}")[-1] for c in ref.ANDREWS_COORDINATES])
+    np.testing.assert_allclose(angles, ref.ANDREWS_T003, rtol=1e-7, atol=1e-8)
+    # energy balance: the motor's torque mom does work mom (beta - beta0)
+    beta = traj.column("sq.beta")
+    E = traj.energy - ref.ANDREWS_MOM * (beta - beta[0])
+    assert np.abs(E - E[0]).max() < 1e-7 * np.abs(traj.kinetic).max()
+
+
+def test_bricard_10_s_conserves_energy_and_keeps_the_loop_closed():
+    system = load("bricard.yaml")
+    traj = mb.simulate(system, 10.0, dt=0.5)
+    assert traj.status == "completed"
+    assert energy_change(traj) < 1e-8
+    gaps = [ref.loop_gaps(system.coordinates, q, ref.BRICARD_JOINTS) for q in traj.q]
+    assert max(g[0] for g in gaps) < 1e-10 and max(g[1] for g in gaps) < 1e-10
+    assert traj.max_residual < 1e-10
+
+
+def test_bennett_conserves_energy_and_keeps_the_loop_closed():
+    system = load("bennett.yaml")
+    traj = mb.simulate(system, 3.0, dt=0.25)
+    assert traj.status == "completed"
+    assert energy_change(traj) < 1e-8
+    a, b = 0.5, 0.5 * math.sin(math.pi / 3) / math.sin(math.pi / 6)
+    sa, ca, sb, cb = math.sin(math.pi / 6), math.cos(math.pi / 6), math.sin(math.pi / 3), math.cos(math.pi / 3)
+    z = (0, 0, 1)
+    joints = [((None, (0, 0, 0), z), ("link1", (-a / 2, 0, 0), (0, sa, ca))),
+              (("link1", (a / 2, 0, 0), z), ("link2", (-b / 2, 0, 0), (0, sb, cb))),
+              (("link2", (b / 2, 0, 0), z), ("link3", (-a / 2, 0, 0), (0, sa, ca))),
+              ((None, (-b, 0, 0), (0, sb, cb)), ("link3", (a / 2, 0, 0), z))]
+    gaps = [ref.loop_gaps(system.coordinates, q, joints) for q in traj.q]
+    assert gaps[0][0] < 1e-14
+    assert max(g[0] for g in gaps) < 1e-10 and max(g[1] for g in gaps) < 1e-10
+    moved = np.abs(traj.q[-1] - traj.q[0]).max()
+    assert moved > 0.1   # it does move
+
+
+def test_sarrus_plate_translates_and_energy_is_conserved():
+    traj = mb.simulate(load("sarrus.yaml"), 2.0, dt=0.25)
+    assert traj.status == "completed"
+    assert energy_change(traj) < 1e-8
+    assert np.abs(traj.column("top.x")).max() < 1e-10 and np.abs(traj.column("top.y")).max() < 1e-10
+    for c in ("qx", "qy", "qz"):
+        assert np.abs(traj.column(f"top.{c}")).max() < 1e-10
+    z = traj.column("top.z")
+    assert 0.05 < z.min() < 0.55 and z.max() == pytest.approx(0.6, abs=1e-9)
+
+
+def test_pendulum_1km_runs_120_s_with_the_rod_held():
+    """SI units at the kilometre scale: the rod constraint x² + y² − L² (its terms of size
+    L² = 1e6 m²) held to 1e-10 L² for two periods, the bob on the exact motion."""
+    L = 1000.0
+    traj = mb.simulate(load("pendulum_1km.yaml"), 120.0, dt=2.0)
+    assert traj.status == "completed" and traj.t[-1] == pytest.approx(120.0)
+    x, y = traj.column("bob.x"), traj.column("bob.y")
+    assert np.abs(x**2 + y**2 - L**2).max() <= 1e-10 * L**2
+    xr, yr = ref.pendulum_exact(traj.t, L, 9.81, 0.3)
+    assert np.max(np.hypot(x - xr, y - yr)) < 1e-6 * L
+    assert energy_change(traj) < 1e-8
+
+
+def test_benchmark_script_quick_writes_its_table(tmp_path):
+    """benchmarks/iftomm.py --quick on three problems: a table row each, a failure
+    reported in its row rather than raised."""
+    import iftomm
+    out = tmp_path / "results.md"
+    results = iftomm.main(["--quick", "--only", "pendulum,andrews,pendulum_1km", "--out", str(out)])
+    text = out.read_text()
+    assert [r.problem.name for r in results] == ["pendulum", "andrews", "pendulum_1km"]
+    for r in results:
+        assert r.problem.title in text
+    pendulum, andrews = results[0], results[1]
+    assert pendulum.status == "completed" and pendulum.error < 1e-6
+    assert andrews.status == "completed" and andrews.error < 1e-6

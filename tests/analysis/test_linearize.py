@@ -1,0 +1,289 @@
+"""Equilibrium, linearization and modes (statics.py, linearization.py, modal.py) against
+independent numbers: closed forms of the paper's example 3, a double pendulum, a
+parallelogram four-bar and a pendulum in Cartesian coordinates, and Pinocchio's
+analytical derivatives of robots (validate_modes.py)."""
+
+import json
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import mbsynth as mb
+from mbsynth.analysis.modes import format_modes, mode_motion, to_dict
+from mbsynth.robots.validate_modes import eigenvalue_error, validate_modes
+
+REL = 1e-9
+
+
+def omegas(result):
+    """The angular natural frequencies of the vibration modes."""
+    return np.sort([2 * np.pi * m.frequency for m in result.modes if m.kind == "vibration"])
+
+
+# -- the paper's example 3 with a massless node --------------------------------------------
+
+def test_example3_massless_node_single_mode():
+    """m1 = 0: the node between k1 and k2 balances (5.40); m2 on the springs in series,
+    ω² = k1 k2 / ((k1 + k2) m2); equilibrium at the springs' rest lengths."""
+    system = mb.load("models/paper/example3_m1_zero_auto.yaml")
+    p = system.parameters
+    result = mb.modes(system, equilibrium=True)
+    expected = np.sqrt(p["k1"] * p["k2"] / ((p["k1"] + p["k2"]) * p["m2"]))
+    assert result.linearization.k == 1
+    assert omegas(result) == pytest.approx([expected], rel=REL)
+    assert result.modes[0].damping_ratio == pytest.approx(0.0, abs=1e-12)
+    q = dict(zip(system.coordinates, result.q))
+    assert q["body1.x1"] == pytest.approx(p["l10"], rel=REL)
+    assert q["body2.q2"] == pytest.approx(p["l20"], rel=REL)
+    assert q["body2.q1"] == pytest.approx(p["l10"] + p["d"], rel=REL)
+    shape = dict(zip(system.coordinates, result.modes[0].shape.real))  # the node moves k2/(k1+k2) of m2
+    assert shape["body1.x1"] / (shape["body2.q1"] + shape["body2.q2"]) == pytest.approx(
+        p["k2"] / (p["k1"] + p["k2"]), rel=REL)
+
+
+def test_example3_massless_spring_end():
+    """m2 = 0: the free spring k2 is slack (5.49) and m1 swings on k1 alone: ω² = k1/m1."""
+    system = mb.load("models/paper/example3_m2_zero_auto.yaml")
+    result = mb.modes(system, equilibrium=True)
+    assert omegas(result) == pytest.approx([np.sqrt(system.parameters["k1"] / system.parameters["m1"])], rel=REL)
+
+
+def test_massless_node_without_its_balance_is_refused():
+    """Without closure the massless node is indeterminate: a verdict, no spectrum."""
+    with open("models/paper/example3_m1_zero_auto.yaml") as f:
+        text = f.read().replace("closure: auto", "")
+    system = mb.loads(text)
+    q = np.array([1.0, 1.2, 0.8])
+    with pytest.raises(mb.SolveError, match="not unique|no motion|balance"):
+        mb.linearize(system, 0.0, q, np.zeros(3))
+
+
+def test_massless_link_with_free_spin_is_refused():
+    """A massless rigid link between spherical joints spins freely about its axis."""
+    system = mb.load("models/mechanisms/massless_link.yaml")
+    q, qd = system.initial_state()
+    with pytest.raises(mb.SolveError, match="not unique"):
+        mb.linearize(system, 0.0, q, np.zeros_like(qd))
+
+
+# -- a double pendulum of particles on massless rods ------------------------------------------
+
+DOUBLE = (Path(__file__).resolve().parents[2] / "models" / "mechanisms" / "double_pendulum_rods.yaml").read_text()
+
+
+def test_double_pendulum_on_distance_joints():
+    """Equal masses and lengths: ω² = (2 ∓ √2) g/l, each in two planes of swing."""
+    system = mb.loads(DOUBLE)
+    p = system.parameters
+    result = mb.modes(system, equilibrium=True)
+    q = dict(zip(system.coordinates, result.q))
+    assert q["p2.z"] == pytest.approx(-2 * p["l"], rel=REL)  # hanging straight down
+    slow, fast = np.sqrt((2 - np.sqrt(2)) * p["g"] / p["l"]), np.sqrt((2 + np.sqrt(2)) * p["g"] / p["l"])
+    assert result.linearization.k == 4
+    assert omegas(result) == pytest.approx([slow, slow, fast, fast], rel=REL)
+    assert result.stable
+
+
+DAMPED = """
+name: damped_bob
+parameters: {m: 1.2, k: 80.0, l0: 0.5, c: 1.5, g: 9.81}
+gravity: [0, 0, -g]
+world: {frames: {anchor: {position: [0, 0, 0]}}}
+subsystems:
+  bob: {type: particle, mass: m, initial: {position: [0.05, 0.02, -0.6]}}
+forces:
+  - {name: spring, type: spring, between: [world.anchor, bob], stiffness: k, rest_length: l0, damping: c}
+"""
+
+
+def test_damped_spring_pendulum():
+    """A bob on a spring-damper: bouncing at ω² = k/m with ζ = c/(2√(km)); swinging, as a
+    pendulum of the stretched length l0 + mg/k, undamped (the damper acts along the spring,
+    whose length a small swing does not change)."""
+    system = mb.loads(DAMPED)
+    p = system.parameters
+    result = mb.modes(system, equilibrium=True)
+    swing = np.sqrt(p["g"] / (p["l0"] + p["m"] * p["g"] / p["k"]))
+    assert [m.kind for m in result.modes] == ["vibration"] * 3
+    assert 2 * np.pi * result.frequencies == pytest.approx([swing, swing, np.sqrt(p["k"] / p["m"])], rel=REL)
+    assert result.damping_ratios == pytest.approx([0, 0, p["c"] / (2 * np.sqrt(p["k"] * p["m"]))], rel=REL, abs=1e-12)
+    assert result.stable
+
+
+# -- a four-bar: a parallelogram, its coupler translating -----------------------------------
+
+def parallelogram(crank_angle):
+    """A parallelogram four-bar in the x-y plane, gravity along −y: cranks of length a at
+    O = (0, 0) and D = (d, 0) at ``crank_angle`` from hanging straight down, the coupler
+    (length d) joining their ends."""
+    return f"""
+name: parallelogram
+parameters: {{a: 0.4, d: 1.1, m1: 0.5, m2: 1.2, m3: 0.9, I2: 0.15, g: 9.81, th: {crank_angle!r}}}
+gravity: [0, -g, 0]
+world: {{frames: {{O: {{position: [0, 0, 0]}}, D: {{position: [d, 0, 0]}}}}}}
+subsystems:
+  crank:
+    type: planar_body
+    mass: m1
+    inertia: m1*a**2/12
+    frames: {{O: {{position: [-a/2, 0, 0]}}, B: {{position: [a/2, 0, 0]}}}}
+    initial: {{position: [a/2*sin(th), -a/2*cos(th)], theta: th - pi/2}}
+  coupler:
+    type: planar_body
+    mass: m2
+    inertia: I2
+    frames: {{B: {{position: [-d/2, 0, 0]}}, C: {{position: [d/2, 0, 0]}}}}
+    initial: {{position: [d/2 + a*sin(th), -a*cos(th)], theta: 0}}
+  rocker:
+    type: planar_body
+    mass: m3
+    inertia: m3*a**2/12
+    frames: {{D: {{position: [-a/2, 0, 0]}}, C: {{position: [a/2, 0, 0]}}}}
+    initial: {{position: [d + a/2*sin(th), -a/2*cos(th)], theta: th - pi/2}}
+joints:
+  - {{name: ground_O, type: revolute, parent: world.O, child: crank.O}}
+  - {{name: crank_coupler, type: revolute, parent: crank.B, child: coupler.B}}
+  - {{name: coupler_rocker, type: revolute, parent: coupler.C, child: rocker.C}}
+  - {{name: ground_D, type: revolute, parent: world.D, child: rocker.D}}
+"""
+
+
+def test_four_bar_single_mode():
+    """The cranks swing together and the coupler translates: with θ the cranks' angle,
+    T = ½ (m1 a²/3 + m3 a²/3 + m2 a²) θ̇², V = −(m1/2 + m3/2 + m2) g a cos θ, so
+    ω² = (m1/2 + m3/2 + m2) g a / (m1 a²/3 + m3 a²/3 + m2 a²)."""
+    system = mb.loads(parallelogram(0.3))
+    p = system.parameters
+    a, g, m1, m2, m3 = p["a"], p["g"], p["m1"], p["m2"], p["m3"]
+    result = mb.modes(system, equilibrium=True)
+    expected = np.sqrt((m1 / 2 + m3 / 2 + m2) * g * a / (m1 * a**2 / 3 + m3 * a**2 / 3 + m2 * a**2))
+    assert result.linearization.k == 1
+    assert omegas(result) == pytest.approx([expected], rel=REL)
+    joints = result.modes[0].joint_shape  # both cranks turn alike, the coupler does not turn
+    assert joints["ground_O"][0] == pytest.approx(joints["ground_D"][0], rel=REL)
+    assert abs(joints["ground_O"][0]) > 0
+    assert joints["crank_coupler"][0] == pytest.approx(-joints["ground_O"][0], rel=REL)
+
+
+def test_mode_motion_stays_on_the_constraints():
+    """The animation of the four-bar's mode: every frame on the loop's constraints, the
+    crank swinging by about the amplitude, back where it started after whole periods."""
+    system = mb.loads(parallelogram(0.3))
+    result = mb.modes(system, equilibrium=True)
+    motion = mode_motion(system, result, 0, amplitude=0.01, periods=1, frames=21)
+    for q in motion.q:
+        assert np.abs(system.constraint_residuals(0.0, q, 0 * q)[0]).max() < 1e-10
+    swing = np.ptp(motion.column(result.linearization.state_names[0]))
+    assert swing == pytest.approx(0.02, rel=1e-2)
+    assert motion.q[-1] == pytest.approx(motion.q[0], abs=1e-10)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-7])
+def test_four_bar_at_and_near_its_change_point(offset):
+    """All four links in line (cranks horizontal): the loop's rows are dependent there
+    (a change point): a verdict, not a spectrum with a spurious degree of freedom."""
+    system = mb.loads(parallelogram(np.pi / 2 + offset))
+    q, qd = system.initial_state()
+    with pytest.raises(mb.SolveError, match="singular position"):
+        mb.linearize(system, 0.0, q, qd)
+
+
+# -- a pendulum in Cartesian coordinates, linearized while it moves --------------------------
+
+CARTESIAN = """
+name: cartesian_pendulum
+parameters: {m: 0.8, l: 1.3, g: 9.81}
+subsystems:
+  bob:
+    type: lagrangian
+    coordinates: [x, z]
+    T: 0.5*m*(x_dot**2 + z_dot**2)
+    V: m*g*z
+constraints:
+  - {name: rod, holonomic: bob.x**2 + bob.z**2 - l**2}
+"""
+
+
+def test_linearization_while_moving_matches_the_reduced_equation():
+    """With u = x independent, z = −√(l² − u²) and the pendulum's equation give
+    ü = −g (u/l)√(1 − u²/l²) − u u̇²/(l² − u²); its exact derivatives (sympy, here) are
+    the second row of A at a moving state."""
+    system = mb.loads(CARTESIAN)
+    p = system.parameters
+    l, g = p["l"], p["g"]
+    theta, rate = 0.4, 1.7
+    q = np.array([l * np.sin(theta), -l * np.cos(theta)])
+    qd = np.array([l * np.cos(theta), l * np.sin(theta)]) * rate
+    lin = mb.linearize(system, 0.0, q, qd)
+    assert lin.state_names == ("bob.x", "bob.x_dot")
+    u, v = sp.symbols("u v")
+    udd = -g * (u / l) * sp.sqrt(1 - u**2 / l**2) - u * v**2 / (l**2 - u**2)
+    at = {u: q[0], v: qd[0]}
+    expected = [float(sp.diff(udd, u).subs(at)), float(sp.diff(udd, v).subs(at))]
+    assert lin.A[0] == pytest.approx([0.0, 1.0], abs=1e-12)
+    assert lin.A[1] == pytest.approx(expected, rel=1e-9)
+    assert lin.qdd[0] == pytest.approx(float(udd.subs(at)), rel=1e-9)
+
+
+def test_state_off_the_constraints_is_refused():
+    system = mb.loads(CARTESIAN)
+    with pytest.raises(mb.SolveError, match="off the constraints"):
+        mb.linearize(system, 0.0, np.array([0.5, -1.0]), np.zeros(2))
+
+
+# -- equilibrium verdicts --------------------------------------------------------------------
+
+FREE = """
+name: drifting
+parameters: {m: 1.0, g: 0.0}
+gravity: [0, 0, -g]
+subsystems:
+  p: {type: particle, mass: m}
+"""
+
+
+def test_equilibrium_not_isolated_names_the_free_directions():
+    with pytest.raises(mb.SolveError, match="not isolated") as err:
+        mb.equilibrium(mb.loads(FREE))
+    assert set(err.value.coordinates) == {"p.x", "p.y", "p.z"}
+
+
+def test_no_equilibrium_found():
+    with pytest.raises(mb.SolveError, match="no static equilibrium"):
+        mb.equilibrium(mb.loads(FREE.replace("g: 0.0", "g: 9.81")), max_iterations=5)
+
+
+def test_modes_refuse_a_configuration_that_does_not_rest():
+    system = mb.load("models/paper/example3_m1_zero_auto.yaml")
+    with pytest.raises(mb.SolveError, match="does not rest"):
+        mb.modes(system)  # the initial state is stretched
+
+
+def test_table_and_json():
+    result = mb.modes(mb.load("models/paper/example3_m1_zero_auto.yaml"), equilibrium=True)
+    text = format_modes(result)
+    assert "0.68916" in text and "body2.q2" in text
+    data = json.loads(json.dumps(to_dict(result)))
+    assert data["degrees_of_freedom"] == 1
+    assert data["modes"][0]["frequency_hz"] == pytest.approx(result.modes[0].frequency)
+
+
+def test_eigenvalue_error_matches_spectra():
+    assert eigenvalue_error([3j, -3j, 2.0], [2.0, -3j, 3j]) == 0.0
+    assert eigenvalue_error([1j, -1j], [1j, -1j, 0]) == float("inf")
+    assert eigenvalue_error([3j, -3j], [3.3j, -3j]) == pytest.approx((3.3**2 - 9) / 3.3**2)
+    assert eigenvalue_error([1e-7, -1e-7], [0, 0]) == pytest.approx(1e-14)  # a split double zero
+
+
+# -- robots against Pinocchio ----------------------------------------------------------------
+
+@pytest.mark.parametrize("robot", ["double_pendulum", "ur5"])
+def test_robot_held_by_gravity_torques_matches_pinocchio(robot):
+    """Eigenvalues equal those of [[0, I], [∂v̇/∂q, ∂v̇/∂v]] from computeABADerivatives, and
+    B equals M⁻¹ mapped to the model's coordinates (validate_modes.py)."""
+    result = validate_modes(mb.from_robot(robot, floating=False), samples=2, seed=3)
+    assert result.eigenvalue_error < 1e-6
+    assert result.input_error < 1e-6

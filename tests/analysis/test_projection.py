@@ -1,0 +1,155 @@
+"""projection._correction: the least-norm step of a sparse J, checked against dense least
+squares (numpy's SVD-based lstsq, an independent computation)."""
+
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse
+
+from mbsynth.analysis.projection import _correction
+
+RNG = np.random.default_rng(3)
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def tree_rows(count, width=5):
+    """Rows like a chain's joints: each block of ``width`` rows touches two neighbouring bodies."""
+    J = scipy.sparse.lil_matrix((width * count, 7 * count))
+    for i in range(count):
+        J[width * i:width * (i + 1), 7 * i:7 * (i + 1)] = RNG.normal(size=(width, 7))
+        if i:
+            J[width * i:width * (i + 1), 7 * (i - 1):7 * i] = RNG.normal(size=(width, 7))
+    return J.tocsr()
+
+
+def weighted_least_norm(J, r):
+    """numpy's minimum of ‖diag(c) Δ‖ subject to J Δ = r, c_j = ‖J_:j‖ (the metric of
+    projection._correction): Δ = D (J D)⁺ r with D = diag(1/c)."""
+    J = J.toarray()
+    D = 1.0 / np.linalg.norm(J, axis=0)
+    return D * np.linalg.lstsq(J * D, r, rcond=1e-12)[0]
+
+
+def test_independent_rows_give_the_least_norm_step():
+    J = tree_rows(40)
+    J = (J @ scipy.sparse.diags(RNG.uniform(1e-3, 1e3, size=J.shape[1]))).tocsr()  # coordinates in mixed units
+    r = RNG.normal(size=J.shape[0])
+    step = _correction(J, r, np.arange(J.shape[1]))
+    expected = weighted_least_norm(J, r)
+    assert np.linalg.norm(step - expected) < 1e-10 * np.linalg.norm(expected)
+
+
+def test_the_step_does_not_depend_on_the_coordinates_units():
+    """Rescaling a coordinate (metres to millimetres, a quaternion beside lengths of a
+    kilometre) rescales its share of the step and nothing else: the same physical move."""
+    J = tree_rows(10)
+    r = RNG.normal(size=J.shape[0])
+    units = RNG.uniform(1e-3, 1e3, size=J.shape[1])
+    scaled = _correction((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r,
+                         np.arange(J.shape[1]))  # coordinate j counted in 1/units_j
+    np.testing.assert_allclose(scaled / units, _correction(J, r, np.arange(J.shape[1])), rtol=1e-9, atol=1e-12)
+
+
+def test_dependent_rows_still_give_the_least_norm_step():
+    J = tree_rows(10)
+    J = scipy.sparse.vstack([J, J[3] + 2 * J[17]]).tocsr()  # a redundant row, as a planar loop in 3D has
+    r = J @ RNG.normal(size=J.shape[1])  # consistent right side
+    step = _correction(J, r, np.arange(J.shape[1]))
+    expected = weighted_least_norm(J, r)
+    assert np.linalg.norm(step - expected) < 1e-9 * np.linalg.norm(expected)
+    assert np.linalg.norm(J @ step - r) < 1e-9 * np.linalg.norm(r)
+
+
+def test_a_small_system_takes_the_dense_route_to_the_same_step():
+    """Below DENSE_ENTRIES the step is solved densely: still the weighted least-norm step."""
+    from mbsynth.analysis.projection import DENSE_ENTRIES
+    J = tree_rows(4)
+    assert J.shape[0] * J.shape[1] <= DENSE_ENTRIES
+    r = RNG.normal(size=J.shape[0])
+    expected = weighted_least_norm(J, r)
+    assert np.linalg.norm(_correction(J, r, np.arange(J.shape[1])) - expected) < 1e-10 * np.linalg.norm(expected)
+
+
+def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
+    """A free body whose quaternion is u = (1 + 5e-12, 0, 0, 1e-14): the unit-norm row's
+    column for u_z is 2u_z = 2e-14, so in the equilibrated metric u_z looks free to move
+    and the least-norm step moves it by about r/(4 u_z) — Newton then diverges. The
+    projection must land on |u| = 1 by the obvious small move (u_w by about −5e-12)."""
+    import mbsynth as mb
+    from mbsynth.analysis.projection import project_positions
+
+    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+                      "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
+    q = system.initial_state()[0]
+    u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
+    q[u] = [1 + 5e-12, 0.0, 0.0, 1e-14]
+    projected = project_positions(system, 0.0, q)
+    assert abs(np.linalg.norm(projected[u]) - 1) < 2e-16
+    assert np.abs(projected - q).max() < 1e-11
+
+
+def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near_zero():
+    """The velocity row u·u̇ = 0 of a body with u = (0.6, 0.8, 0, 1e-8) and ψ = 1e-9: a scale
+    of u_z's column alone (2u_z) would take the correction almost entirely on u̇_z, about
+    ψ/(3 u_z) = 0.03 rad/s, a kick to the spin. The quaternion's four columns share one
+    scale (System.coordinate_groups), so u̇ moves along u by ψ/|u|² and no more."""
+    import mbsynth as mb
+    from mbsynth.analysis.projection import project_velocities
+
+    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+                      "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
+    q, qd = system.initial_state()
+    u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
+    q[u] = [0.6, 0.8, 0.0, 1e-8]
+    rate = np.array([-0.8, 0.6, 0.3, 0.2])  # ω of about 2 rad/s
+    qd[u] = rate - (q[u] @ rate) * q[u] + 1e-9 * q[u]  # u·u̇ = 1e-9
+    projected = project_velocities(system, 0.0, q, qd)
+    assert abs(q[u] @ projected[u]) < 1e-15
+    assert np.abs(projected - qd).max() < 1.5e-9
+
+
+def test_a_pendulum_bob_near_the_vertical_is_moved_along_its_rod():
+    """A01's bob (an energy-defined part, T = ½ m (ẋ² + ẏ²)) near the bottom, x = −0.0127,
+    its rod 1e-9 too long: x and y have equal M_ii, hence the same units, and share one
+    scale (subsystems.lagrangian.same_units), so the least change moves the bob along the
+    rod, Δ ∥ (x, y). With a scale per coordinate the step went on x almost alone, by
+    φ/(2 ∂φ/∂x) ≈ 20 φ, and its velocity projection changed the energy by 4e-7 of mg L."""
+    import mbsynth as mb
+    from mbsynth.analysis.projection import project
+
+    system = mb.load(ROOT / "models" / "mechanisms" / "simple_pendulum.yaml")
+    q = np.array([-0.0126790881960727, -0.9999196171187412]) * (1 + 5e-10)
+    qd = np.array([-4.428912801894245, 0.05615909025580679])
+    projected, _ = project(system, 0.0, q, qd)
+    step = projected - q
+    assert abs(np.hypot(*projected) - 1.0) < 1e-15
+    assert abs(step[0] * q[1] - step[1] * q[0]) < 1e-6 * np.linalg.norm(step) * np.linalg.norm(q)
+
+
+def test_coordinates_of_equal_mass_entries_share_a_scale_and_others_do_not():
+    """same_units: x, y under ½ m (ẋ² + ẏ²) together; r, θ under ½ m (ṙ² + r² θ̇²) apart."""
+    import mbsynth as mb
+
+    cartesian = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x, y], "
+                         "T: 0.5*(x_dot**2 + y_dot**2)}\n")
+    polar = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [r, th], "
+                     "T: 0.5*(r_dot**2 + r**2*th_dot**2)}\n")
+    assert len(set(cartesian.coordinate_groups)) == 1
+    assert len(set(polar.coordinate_groups)) == 2
+
+
+def test_term_scales_of_a_sparse_matrix_equal_the_sum_of_its_terms():
+    """term_scales from a CSR matrix's arrays (rows without entries included) equals
+    Σ_j |A_ij x_j| + floor Σ_j |A_ij| max|x| summed entry by entry."""
+    from mbsynth.core.equations import term_scales
+
+    A = scipy.sparse.random(40, 60, density=0.1, random_state=5, format="lil")
+    A[7, :] = 0.0
+    A = A.tocsr()
+    A.data -= 0.5
+    x = RNG.normal(size=60)
+    dense = A.toarray()
+    expected = [sum(abs(a * b) for a, b in zip(row, x)) + 1e-3 * sum(abs(row)) * max(abs(x)) for row in dense]
+    np.testing.assert_allclose(term_scales(A, x), expected, rtol=1e-14)
+    np.testing.assert_allclose(term_scales(dense, x), expected, rtol=1e-14)
+    assert term_scales(A, x)[7] == 0.0

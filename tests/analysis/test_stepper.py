@@ -1,0 +1,65 @@
+"""The run loop's hold on scipy's integrators (mbsynth.analysis.stepper) against scipy's own
+public results: the interpolant read as one product equals ``dense_output()``, and an
+explicit pair moved and resumed steps exactly as a new one that scipy starts there."""
+
+import numpy as np
+import pytest
+import scipy.integrate
+
+from mbsynth.analysis import stepper
+
+
+def damped(t, y):
+    return np.array([y[1], -np.sin(y[0]) - 0.1 * y[1], np.cos(3 * t) * y[0]])
+
+
+@pytest.mark.parametrize("method", ["DOP853", "RK45"])
+def test_rows_read_the_integrators_own_interpolant(method):
+    """The states within a step (DOP853's interpolant as one matrix product) equal scipy's
+    dense output of that step, at its ends too."""
+    solver = getattr(scipy.integrate, method)(damped, 0.0, np.array([1.0, 0.3, 0.2]), 10.0, rtol=1e-10, atol=1e-10)
+    for _ in range(5):
+        solver.step()
+    times = np.linspace(solver.t_old, solver.t, 17)
+    rows = np.full((times.size, 3), np.nan)
+    stepper.interpolate(solver, list(times), rows)
+    assert np.abs(rows - solver.dense_output()(times).T).max() <= 4 * np.finfo(float).eps
+    assert np.abs(rows[-1] - solver.y).max() <= 4 * np.finfo(float).eps
+
+
+@pytest.mark.implementation
+@pytest.mark.parametrize("method", stepper.RESUMABLE)
+def test_a_moved_and_resumed_pair_steps_as_a_new_one(method):
+    """Run to a bound, move the state (as a projection does), resume towards a farther bound
+    with a proposed step: every later step equals, bit for bit, that of a new solver scipy
+    starts at the moved state with that first step."""
+    solver = method(damped, 0.0, np.array([1.0, 0.3, 0.2]), 2.0, rtol=1e-9, atol=1e-9)
+    while solver.status == "running":
+        solver.step()
+    assert solver.status == "finished" and solver.t == 2.0
+    y = solver.y + np.array([1e-6, -2e-6, 0.0])
+    stepper.move(solver, y, damped(solver.t, y))
+    stepper.resume(solver, 5.0, first_step=0.05)
+    fresh = method(damped, 2.0, y, 5.0, rtol=1e-9, atol=1e-9, first_step=0.05)
+    while fresh.status == "running":
+        solver.step()
+        fresh.step()
+        assert solver.t == fresh.t and np.array_equal(solver.y, fresh.y)
+    assert solver.status == "finished" and solver.t == 5.0
+
+
+@pytest.mark.implementation
+def test_a_rewound_step_is_taken_again_shorter():
+    """``rewind`` puts the solver back where ``saved`` found it, its steps capped: the step
+    taken again is the capped one, from the same state."""
+    solver = scipy.integrate.DOP853(damped, 0.0, np.array([1.0, 0.3, 0.2]), 10.0, rtol=1e-9, atol=1e-9)
+    solver.step()
+    state = stepper.saved(solver)
+    solver.step()
+    taken = solver.t - state[0]
+    stepper.rewind(solver, state, taken / 4)
+    solver.step()
+    assert solver.t == pytest.approx(state[0] + taken / 4, rel=1e-15)
+    fresh = scipy.integrate.DOP853(damped, state[0], state[1], 10.0, rtol=1e-9, atol=1e-9, first_step=taken / 4)
+    fresh.step()
+    assert np.array_equal(solver.y, fresh.y)
