@@ -4,7 +4,7 @@ constant torques (the cost of sampling alone: the same motion, 200 restarts).
 
 The controller writes its torques into the run's Data at each sample (``Data.set_parameters``:
 no System is built during the run); the integrator restarts at each sample, where the
-torques jump. Both runs are timed in the same process, alternating, best of ``--repeats``;
+torques jump. The runs are timed in the same process, alternating, best of ``--repeats``;
 the ratio is what sampled control costs on top of the dynamics.
 
     .venv/bin/python benchmarks/controlled_run.py [--repeats 5] [--t-end 2]
@@ -73,7 +73,7 @@ def main():
     lines = [f"# Sampled control on the UR5 ({args.t_end:g} s)", "",
              f"`benchmarks/controlled_run.py --repeats {args.repeats} --t-end {args.t_end:g}` on "
              f"{platform.node()} ({platform.machine()}, {platform.python_version()}), {date.today()}: "
-             "best of the repeats, the two runs alternating in one process.", "",
+             "best of the repeats, the runs alternating in one process.", "",
              "| run | seconds | evaluations | steps | ratio |", "|---|---:|---:|---:|---:|"]
     for name, (seconds, trajectory) in best.items():
         lines.append(f"| {name} | {seconds:.4f} | {trajectory.stats['evaluations']} | {trajectory.stats['steps']} "
