@@ -51,10 +51,10 @@ import scipy.integrate
 
 from .control import SampledControl
 from ..core.errors import SimulationError, SolveError
-from ..model.outputs import OutputEvaluator
 from . import stepper
 from .projection import consistent_initial_state, project, relative_drift
-from .trajectory import COMPLETED, Trajectory, TrajectoryWriter
+from .recording import Recorder
+from .trajectory import COMPLETED
 
 log = logging.getLogger(__name__)
 
@@ -119,14 +119,14 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     control = None if controller is None else SampledControl(controller, control_dt or times[1] - times[0])
     samples = set() if control is None else set(control.times(t0, t_end))
     outputs = set(times)
-    writer = TrajectoryWriter(out, system.coordinates, run.outputs.names) if out is not None else None
+    recorder = Recorder(data, out)
     started = time.perf_counter()
     status = "stopped"
     try:
         if control is not None:
             control.apply(data, t0, q, qd)
             run.restart()
-        run.record(t0, q, qd, writer)
+        recorder.record(t0, q, qd, run.correction, run.compiled_energy)
         run.t_now = t0
         stops = sorted(samples | {times[-1]})  # where a continuous integrator stops: the forces jump, or the run ends
         run.times = sorted(outputs | samples)
@@ -137,24 +137,30 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
                 run.restart()
             if t_next in outputs:
                 at_hand = () if t_next in samples else (run.arrays, run.corrected)  # a sample's parameters are new
-                run.record(t_next, q, qd, writer, *at_hand)
+                recorder.record(t_next, q, qd, run.correction, run.compiled_energy, *at_hand)
                 if progress is not None:
                     progress(t_next)
         status = COMPLETED
     except SolveError as err:
         status = f"failed at t = {run.t_failed:.9g}: {err}"
         raise SimulationError(f"run stopped at t = {run.t_failed:.9g} (last good state saved at "
-                              f"t = {run.t[-1]:.9g}): {err}", time=run.t_failed, trajectory=run.trajectory(status),
+                              f"t = {recorder.t[-1]:.9g}): {err}", time=run.t_failed,
+                              trajectory=_trajectory(recorder, run, status),
                               constraints=err.constraints, coordinates=err.coordinates) from None
     except KeyboardInterrupt:
-        status = f"interrupted at t = {run.t[-1]:.9g}"
+        status = f"interrupted at t = {recorder.t[-1]:.9g}"
         raise
     finally:
-        if writer is not None:
-            writer.status = status
-            writer.close()
-    traj = run.trajectory(status)
+        recorder.close(status)
+    traj = _trajectory(recorder, run, status)
     traj.stats.update(wall_time=time.perf_counter() - started, initial_changes=changes)
+    return traj
+
+
+def _trajectory(recorder, run, status):
+    """The rows recorded, with the run's counts."""
+    traj = recorder.trajectory(status)
+    traj.stats.update(run.stats())
     return traj
 
 
@@ -178,19 +184,16 @@ def _output_times(t0, t_end, dt):
 
 
 class _Run:
-    """The state of one integration: settings, output rows and counters. ``system`` is the
-    run's Data (data.py), which reads as its System."""
+    """One integration: its settings, the integrator and its drift control, and its counts
+    (the rows are the Recorder's, recording.py). ``system`` is the run's Data (data.py),
+    which reads as its System."""
 
     def __init__(self, data, method, rtol, atol, stabilization, baumgarte):
         self.system, self.method, self.rtol, self.atol = data, method, rtol, atol
-        self.outputs = OutputEvaluator(data)
         self.stabilization = stabilization
         self.baumgarte = baumgarte if stabilization == "baumgarte" else None
         self.restart()
         self.n = data.n
-        self.rows = {k: [] for k in ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity",
-                                     "outputs")}
-        self.columns = tuple(self.rows.values())  # in that order (``record``)
         self.steps = self.evaluations = 0
         self.solver = None  # the integrator, kept from span to span (``_resumed``, ``_reach``)
         self.times = []  # the times ``advance`` is called for, in order (outputs and control samples)
@@ -210,10 +213,6 @@ class _Run:
         self.span_rtol = rtol  # the rtol the span under way is integrated at
         self.crawl_calls = CRAWL_CALLS  # the evaluations it may take near a singular position (_Crawl)
         self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
-
-    @property
-    def t(self):
-        return self.rows["t"]
 
     def restart(self):
         """Go on from the Data's parameter values (new at a control sample: the forces jump,
@@ -470,40 +469,13 @@ class _Run:
         raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
                          f"{', '.join(culprits[:6])}", coordinates=culprits)
 
-    def record(self, t, q, qd, writer, arrays=None, corrected=None):
-        """A row at (t, q, q̇); ``arrays``: its ConstraintArrays, ``corrected``: its
-        correction.Corrected, if at hand. The residuals and energies are the compiled ones
-        where the kernel covers them (compiled/rows.py)."""
-        if corrected is None:
-            if self.correction is not None:
-                phi, psi, kinetic, potential = self.correction.residuals_energy(q, qd)
-            else:
-                phi, psi = self.system.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
-            residuals = _max_abs(phi), _max_abs(psi)
-        else:
-            kinetic, potential, *residuals = corrected[2:]
-        if not self.compiled_energy:
-            kinetic, potential = self.system.energy(t, q, qd)
-        values = (t, np.array(q), np.array(qd), kinetic + potential, kinetic, *residuals,
-                  self.outputs.evaluate(t, q, qd) if self.outputs else _NO_OUTPUTS)
-        for column, value in zip(self.columns, values):
-            column.append(value)
-        if writer is not None:
-            writer.append(_chunk(self.system.coordinates, dict(zip(self.rows, values)), self.outputs.names))
-
-    def trajectory(self, status):
-        r = self.rows
-        traj = Trajectory(tuple(self.system.coordinates), np.array(r["t"]), np.array(r["q"]).reshape(-1, self.n),
-                          np.array(r["qd"]).reshape(-1, self.n), np.array(r["energy"]), np.array(r["kinetic"]),
-                          np.array(r["residual_position"]), np.array(r["residual_velocity"]), status,
-                          outputs=np.array(r["outputs"], dtype=float).reshape(len(r["t"]), len(self.outputs.names)),
-                          output_names=tuple(self.outputs.names))
-        traj.stats.update(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique,
-                          singular_positions=self.singular_positions, relaxed_spans=self.relaxed_spans)
+    def stats(self):
+        """The run's counts for ``Trajectory.stats``."""
         if self.non_unique:
             log.warning("the motion was not unique somewhere on this run; the free directions got zero "
                         "acceleration (η = 0 in (2.14))")
-        return traj
+        return dict(steps=self.steps, evaluations=self.evaluations, non_unique=self.non_unique,
+                    singular_positions=self.singular_positions, relaxed_spans=self.relaxed_spans)
 
 
 def _looser(rtol, atol):
@@ -515,22 +487,3 @@ def _looser(rtol, atol):
 
 class _Crawl(Exception):
     """A span's stages near a singular position take too many evaluations (CRAWL_CALLS)."""
-
-
-_NO_OUTPUTS = np.zeros(0)  # a row's outputs where the model declares none (read-only)
-_NO_OUTPUTS.flags.writeable = False
-
-
-def _max_abs(values):
-    largest = np.abs(values).max(initial=0.0)
-    if np.isfinite(largest):
-        return float(largest)
-    finite = values[np.isfinite(values)]
-    return float(np.abs(finite).max()) if finite.size else 0.0
-
-
-def _chunk(coordinates, row, output_names):
-    return Trajectory(tuple(coordinates), np.array([row["t"]]), row["q"][None, :], row["qd"][None, :],
-                      np.array([row["energy"]]), np.array([row["kinetic"]]), np.array([row["residual_position"]]),
-                      np.array([row["residual_velocity"]]), outputs=row["outputs"][None, :],
-                      output_names=tuple(output_names))
