@@ -118,3 +118,15 @@ def test_built_site_loads_mathjax_locally():
     assert (SITE / "_static" / "mathjax" / "tex-chtml.js").is_file()
     fonts = SITE / "_static" / "mathjax" / "output" / "chtml" / "fonts" / "woff-v2"
     assert any(fonts.glob("*.woff"))  # the fonts MathJax's CommonHTML output loads beside it
+
+
+def test_the_guides_layout_names_every_module():
+    """The guide's "Layout" section is the tree: every module of the package is named there
+    (a package's __init__ by its folder)."""
+    guide = (DOCS / "guide.md").read_text()
+    layout = guide[guide.index("## Layout"):]
+    package = DOCS.parent / "mbsynth"
+    unnamed = [str(path.relative_to(package)) for path in sorted(package.rglob("*.py"))
+               if (path.parent.name + "/" if path.name == "__init__.py" else path.name) not in layout]
+    assert unnamed == []
+
