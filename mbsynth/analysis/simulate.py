@@ -10,7 +10,7 @@ Continuously, where the compiled kernel can put a state back on the constraints 
 DOP853): the steps are chosen by the error control alone, up to the next control sample
 or the end; each accepted step is corrected and the integrator goes on from there, given
 the corrected state's derivative, its steps capped (``max_step``) to keep the drift
-between corrections below DRIFT_TARGET; each output row is read from the step's dense
+between corrections below DRIFT_TARGET (drift.py); each output row is read from the step's dense
 output (the interpolant ``solve_ivp`` gives at ``t_eval``) and corrected (a copy: the
 integrator goes on from its own state), the rows a step passed in one block with its
 end (correction.Correction.block, on all cores).
@@ -52,6 +52,7 @@ import scipy.integrate
 from .control import SampledControl
 from ..core.errors import SimulationError, SolveError
 from . import stepper
+from .drift import next_cap
 from .projection import consistent_initial_state, project, relative_drift
 from .recording import Recorder
 from .trajectory import COMPLETED
@@ -66,9 +67,6 @@ MAX_STATE = 1e12  # a coordinate or velocity beyond this counts as an exploding 
 # scipy would crawl on for minutes at that step size before it gives up by itself
 COLLAPSE_CALLS = 1000
 COLLAPSE_SPAN = 1e-8
-DRIFT_TARGET = 1e-9  # largest relative drift off the manifold between two projections
-DRIFT_REDO = 1e3  # a span that drifted more than this × DRIFT_TARGET is integrated again, shorter
-MIN_SPAN = 1e-6  # of the output interval: the shortest span that is redone
 # near a singular position the stages' accelerations carry noise of about |q̇| ψ / σ² (ψ the
 # velocity drift, σ the smallest singular value of A), which a tight tolerance chases with
 # ever smaller steps: a span whose stages came near one (Motion.singular) and then took
@@ -206,7 +204,7 @@ class _Run:
         self.t_now = None  # the time the state has reached (outputs and control samples alike)
         self.non_unique = False
         self.calls, self.t_mark, self.span = 0, 0.0, 0.0
-        self.drift_span = None  # the span between projections, when shorter than the output interval
+        self.drift_span = np.inf  # the cap on a span between projections (drift.next_cap; np.inf: none)
         self.singular = []  # (t, rows) of the stages near a singular position (Motion.singular)
         self.singular_positions = []  # per output interval with such stages: {t_from, t_to, rows}
         self.singular_call = None  # the span's evaluation count at its first stage near a singular position
@@ -308,15 +306,13 @@ class _Run:
             self.next_step = solver.h_abs
         self._check(solver.t, solver.y)
         q, qd = solver.y[:self.n], solver.y[self.n:]
-        drift = self.correction.drift(q, qd)
-        if drift > DRIFT_REDO * DRIFT_TARGET and taken > MIN_SPAN * self.span:
-            stepper.rewind(solver, start, taken / 4)
+        redo, cap = next_cap(self.correction.drift(q, qd), taken, solver.max_step, solver.t_bound - solver.t,
+                             self.span)
+        if redo:
+            stepper.rewind(solver, start, cap)
             self.steps -= 1
             return
-        if drift > DRIFT_TARGET:
-            stepper.cap(solver, taken / 2)
-        elif drift < DRIFT_TARGET / 100 and np.isfinite(solver.max_step):
-            stepper.cap(solver, np.inf if 2 * solver.max_step >= solver.t_bound - solver.t else 2 * solver.max_step)
+        stepper.cap(solver, cap)
         times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
         states = np.empty((len(times) + 1, solver.y.size))
         if times:
@@ -345,17 +341,16 @@ class _Run:
         t = self.t_now
         interval = t_next - t
         while t < t_next:
-            t_to = t_next if self.drift_span is None or t + 1.5 * self.drift_span >= t_next else t + self.drift_span
+            t_to = t_next if t + 1.5 * self.drift_span >= t_next else t + self.drift_span
             q_to, qd_to = self._integrate(t, t_to, q, qd, loosen)
             arrays = None
             if self.stabilization == "projection":
                 self.t_failed = t_to
                 arrays = self.system.constraint_arrays(t_to, q_to, qd_to, sparse=None)
                 drift = relative_drift(self.system, t_to, q_to, qd_to, arrays)
-                if drift > DRIFT_REDO * DRIFT_TARGET and t_to - t > MIN_SPAN * interval:
-                    self.drift_span = (t_to - t) / 4
+                redo, self.drift_span = next_cap(drift, t_to - t, self.drift_span, interval, interval)
+                if redo:
                     continue
-                self._adapt_span(drift, t_to - t, interval)
                 q_on, qd_on = project(self.system, t_to, q_to, qd_to, arrays=arrays)
                 if not (np.array_equal(q_on, q_to) and np.array_equal(qd_on, qd_to)):
                     q_to, qd_to, arrays = q_on, qd_on, None
@@ -373,12 +368,6 @@ class _Run:
         self.arrays = arrays  # the ConstraintArrays at the state reached, if at hand (for ``record``)
         self.corrected = corrected  # its Corrected, if at hand (for ``record``)
         return q, qd
-
-    def _adapt_span(self, drift, span, interval):
-        if drift > DRIFT_TARGET:
-            self.drift_span = span / 2
-        elif drift < DRIFT_TARGET / 100 and self.drift_span is not None:
-            self.drift_span = None if 2 * self.drift_span >= interval else 2 * self.drift_span
 
     def _integrate(self, t, t_next, q, qd, loosen=False):
         """The integrator from (t, q, q̇) to t_next; the state at t_next, checked. A span that

@@ -1,0 +1,31 @@
+"""The run loop's drift control: how long a span of integration may be before the state is
+put back on the constraints (corrected by the kernel after each step of a continuous run,
+projected between the output times of a cut one).
+
+The accelerations (2.14) satisfy the constraints at the acceleration level only, so positions
+and velocities drift off them by the integration error. The stages of a span are only as good
+as that drift (their motion is the drift rule's least-squares one where it explains an
+inconsistency), so a span is kept short enough that the relative drift (projection.py's
+``relative_drift``, or the kernel's) stays below DRIFT_TARGET.
+"""
+
+import numpy as np
+
+DRIFT_TARGET = 1e-9  # largest relative drift off the manifold between two corrections or projections
+DRIFT_REDO = 1e3  # a span that drifted more than this × DRIFT_TARGET is integrated again, shorter
+MIN_SPAN = 1e-6  # of the output interval: the shortest span that is integrated again
+
+
+def next_cap(drift, taken, cap, room, interval):
+    """(redo, cap): after a span of length ``taken`` drifted by ``drift``, whether to integrate
+    it again (at a quarter of its length: it drifted more than DRIFT_REDO × DRIFT_TARGET and
+    is longer than MIN_SPAN of the ``interval``), and the cap on the spans that follow —
+    halved after a drift above DRIFT_TARGET, doubled after one below a hundredth of it, lifted
+    (np.inf) once twice the cap reaches ``room``, else ``cap`` as it was (np.inf: none)."""
+    if drift > DRIFT_REDO * DRIFT_TARGET and taken > MIN_SPAN * interval:
+        return True, taken / 4
+    if drift > DRIFT_TARGET:
+        return False, taken / 2
+    if drift < DRIFT_TARGET / 100 and np.isfinite(cap):
+        return False, np.inf if 2 * cap >= room else 2 * cap
+    return False, cap
