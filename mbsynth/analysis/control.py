@@ -35,14 +35,7 @@ class SampledControl:
         if not isinstance(values, dict):
             raise ModelError(f"controller at t = {t:.6g}: expected a dict {{parameter: value}}, got "
                              f"{type(values).__name__}")
-        unknown = sorted(set(values) - set(data.system.parameters))
-        if unknown:
-            raise ModelError(f"controller at t = {t:.6g} set unknown parameter(s) {unknown}; the model has "
-                             f"{sorted(data.system.parameters)}")
-        bad = [name for name, x in values.items() if not np.isfinite(float(x))]
-        if bad:
-            raise ModelError(f"controller at t = {t:.6g} gave non-finite values for {bad}")
-        try:
+        try:  # unknown names, non-finite values, a part they make unusable (System.resolved_parameters)
             data.set_parameters(values)
         except ModelError as err:
             raise ModelError(f"controller at t = {t:.6g}: {err}") from None

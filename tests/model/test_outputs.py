@@ -109,5 +109,7 @@ def test_sampled_controller_holds_the_static_balance():
     (theta,), (rate,), _ = system.joint_values(trajectory.t[-1], trajectory.q[-1], trajectory.qd[-1])["hinge"]
     balance = brentq(lambda x: 50.0 * (x - 0.5) + 9.81 * 0.5 * np.sin(x), 0.0, 1.0)
     assert theta == pytest.approx(balance, abs=1e-6) and abs(rate) < 1e-5
-    with pytest.raises(mb.ModelError, match=r"unknown parameter\(s\) \['torque'\]"):
+    with pytest.raises(mb.ModelError, match=r"controller at t = 0: model '.*' has no parameter\(s\) \['torque'\]"):
         mb.simulate(system, 0.1, controller=lambda t, v: {"torque": 1.0})
+    with pytest.raises(mb.ModelError, match=r"controller at t = 0: .*non-finite values for parameter\(s\) \['tau'\]"):
+        mb.simulate(system, 0.1, controller=lambda t, v: {"tau": float("nan")})
