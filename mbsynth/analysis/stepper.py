@@ -38,8 +38,14 @@ def rewind(solver, state, max_step):
 
 
 def move(solver, y, f):
-    """The solver's state moved to y (onto the constraints), f its derivative there."""
+    """The solver's state moved to y (onto the constraints), f its derivative there (None:
+    not known yet, to be given by a ``move`` before the solver steps again)."""
     solver.y, solver.f = y, f
+
+
+def stands_at(solver, y):
+    """Whether the solver's state is y, its derivative there known."""
+    return solver.f is not None and np.array_equal(solver.y, y)
 
 
 def resume(solver, t_bound, first_step=None):

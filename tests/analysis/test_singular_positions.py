@@ -12,7 +12,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import mbsynth as mb
-from mbsynth.analysis.simulate import RELAXED_RTOL
+from mbsynth.analysis.cut import RELAXED_RTOL
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))

@@ -1,0 +1,115 @@
+"""The continuous strategy of the run loop: where the compiled kernel puts a state back on
+the constraints itself (compiled/correction.py: a tree of kernel joints and bodies, no
+loops), with ``stabilization="projection"`` and an explicit Runge–Kutta pair (RK23, RK45,
+DOP853).
+
+The steps are chosen by the error control alone, up to the next control sample or the end;
+each accepted step is corrected and the integrator goes on from there, given the corrected
+state's derivative, its steps capped (``max_step``) to keep the drift between corrections
+below DRIFT_TARGET (drift.py). Each output row is read from the step's dense output (the
+interpolant ``solve_ivp`` gives at ``t_eval``) and corrected (a copy: the integrator goes
+on from its own state), the rows a step passed in one block with its end
+(correction.Correction.block, on all cores). An output interval in which the integrator
+crawls near a singular position, or fails, is integrated again, cut (cut.py), from the last
+output: a failure is then reported in the interval it happens in, the rows before it kept.
+"""
+
+import bisect
+
+import numpy as np
+
+from . import stepper
+from ..core.errors import SolveError
+from .cut import RELAXED_MAX, CutIntegration
+from .derivative import MAX_STATE, Crawl
+from .drift import next_cap
+from .projection import project
+
+
+class ContinuousIntegration(CutIntegration):
+    """Integration by the error control alone, each step corrected (integration.py); an
+    interval it cannot do is done cut (CutIntegration.advance)."""
+
+    @staticmethod
+    def fits(data, method, stabilization):
+        """Whether a run on ``data`` (its Data) with the OdeSolver class ``method`` and
+        ``stabilization`` can be integrated continuously."""
+        engine = data.tree_engine(True)
+        return engine is not None and engine.correction() is not None \
+            and issubclass(method, stepper.RESUMABLE) and stabilization == "projection"
+
+    def __init__(self, *args):
+        self.passed = {}  # the states at the times the last step passed ({t: (y, Corrected, bounded)})
+        super().__init__(*args)
+
+    def advance(self, t_next, q, qd, t_stop):
+        try:
+            y, corrected, bounded = self._reach(t_next, q, qd, t_stop)
+        except (Crawl, SolveError) as stop:
+            self.solver = None  # stopped within a step
+            q, qd = super().advance(t_next, q, qd, loosen=isinstance(stop, Crawl))
+            self.solver = None  # the continuous integrator starts afresh from t_next
+            return q, qd
+        if not bounded:
+            self.f.check(t_next, y)
+        q, qd = self._on_constraints(t_next, y, corrected)
+        return self.arrived(t_next, q, qd, None, corrected)
+
+    def _reach(self, t_next, q, qd, t_stop):
+        """The state at t_next, its correction and whether it is finite and within MAX_STATE:
+        the integrator's steps taken until one reaches or passes t_next. At the start, after a
+        control sample or a cut interval it goes on from (q, q̇) at ``t_now`` towards t_stop
+        (Integration.resumed)."""
+        self.f.begin(self.t_now, t_next, may_crawl=self.rtol < RELAXED_MAX)
+        solver = self.solver
+        if solver is None or self.forces_jumped:
+            solver = self.resumed(self.t_now, np.concatenate([q, qd]), t_stop, self.rtol, self.atol)
+            self.passed = {}
+        while solver.t < t_next:
+            self._step(solver, t_next)
+        return self.passed[t_next]
+
+    def _step(self, solver, t_next):
+        """One accepted step, its state then corrected, and with it, in one block
+        (correction.Correction.block), the states at the times from t_next to where it
+        reached, read from its interpolant: ``passed`` keeps (state, Corrected or None,
+        whether the state is within MAX_STATE) per time. The step is capped (``max_step``) to
+        keep the drift between corrections below DRIFT_TARGET: halved after a larger drift,
+        doubled after one below a hundredth of it; a step that drifted more than
+        DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length. A step that
+        reaches the bound (a control sample or the end) leaves f at the corrected state to
+        be computed when the integrator goes on (Integration.resumed)."""
+        start = stepper.saved(solver)
+        message = solver.step()
+        if solver.status == "failed":
+            raise self.failed_step(solver, message)
+        self.steps += 1
+        taken = solver.t - start[0]
+        if solver.t != solver.t_bound or self.next_step is None:  # a step cut at the bound proposes less
+            self.next_step = solver.h_abs
+        self.f.check(solver.t, solver.y)
+        q, qd = solver.y[:self.n], solver.y[self.n:]
+        redo, cap = next_cap(self.correction.drift(q, qd), taken, solver.max_step, solver.t_bound - solver.t,
+                             self.f.span)
+        if redo:
+            stepper.rewind(solver, start, cap)
+            self.steps -= 1
+            return
+        stepper.cap(solver, cap)
+        times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
+        states = np.empty((len(times) + 1, solver.y.size))
+        if times:
+            stepper.interpolate(solver, times, states[:-1])
+        states[-1] = solver.y
+        corrected = self.correction.block(states[:, :self.n], states[:, self.n:])
+        bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
+        self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
+        q_on, qd_on = self._on_constraints(solver.t, solver.y, corrected[-1])
+        if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
+            y = np.concatenate([q_on, qd_on])
+            stepper.move(solver, y, None if solver.status == "finished" else self.f(solver.t, y))
+
+    def _on_constraints(self, t, y, corrected):
+        """(q, q̇) of the state y on the constraints: ``corrected``'s where the kernel's
+        correction put it there (correction.Corrected), else projected (projection.py)."""
+        return project(self.data, t, y[:self.n], y[self.n:]) if corrected is None else corrected[:2]

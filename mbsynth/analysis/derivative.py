@@ -1,0 +1,118 @@
+"""The run loop's right-hand side: y' = (q̇, q̈) at the integrator's stages, q̈ from (2.14)
+(the compiled engine's where it covers the state, else the Data's stage motion), and what
+the stages tell about the run.
+
+The stages lie off the constraint manifold by the integration error, so their motion follows
+the drift rule of ``equations`` (least squares where the drift explains an inconsistency of
+b, nearly dependent directions near a singular position set aside). Counted here, per
+interval of integration (``begin``):
+
+- a step-size collapse: COLLAPSE_CALLS evaluations that advance t by less than COLLAPSE_SPAN
+  of the interval (or than 1e4 ε |t|, steps near the resolution of t) raise SolveError
+  naming the fastest changing coordinates (scipy would crawl on for minutes first);
+- a crawl near a singular position: near one the stages' accelerations carry noise of about
+  |q̇| ψ / σ² (ψ the velocity drift the projection leaves, σ the smallest singular value of
+  A), which a tight tolerance chases with ever smaller steps; more than CRAWL_CALLS
+  evaluations (RELAXED_CRAWL_CALLS in an interval already relaxed) after the interval's
+  first stage near one (``Motion.singular``) raise Crawl, for the cut integrator to
+  integrate the interval again more loosely (cut.py);
+- the stages near a singular position, per interval (``note_singular``), and whether the
+  motion was not unique at any stage.
+"""
+
+import logging
+
+import numpy as np
+
+from ..core.errors import SolveError
+
+log = logging.getLogger(__name__)
+
+MAX_STATE = 1e12  # a coordinate or velocity beyond this counts as an exploding state
+COLLAPSE_CALLS = 1000  # ~80 steps of an explicit pair
+COLLAPSE_SPAN = 1e-8
+CRAWL_CALLS = 240
+RELAXED_CRAWL_CALLS = 1000
+
+
+class Crawl(Exception):
+    """An interval's stages near a singular position take too many evaluations (CRAWL_CALLS)."""
+
+
+class StateDerivative:
+    """f(t, y) of the run on ``data`` (its Data), y = (q, q̇), with ``baumgarte`` (α, β) or None."""
+
+    def __init__(self, data, baumgarte):
+        self.data, self.n, self.baumgarte = data, data.n, baumgarte
+        self.evaluations = 0
+        self.t_failed = float("nan")  # where the run was when it failed: its last stage or state looked at
+        self.non_unique = False
+        self.singular = []  # (t, rows) of the interval's stages near a singular position
+        self.singular_positions = []  # per interval with such stages: {t_from, t_to, rows}
+        self.use(None)
+        self.begin(0.0, 0.0)
+
+    def use(self, engine):
+        """Its motion from the Data's parameter values as they are now (new at a control
+        sample), ``engine`` the compiled Engine serving the stages (data.tree_engine) or None."""
+        self.stage_motion = self.data.stage_motion(self.baumgarte, drift=True)
+        # the compiled engine's (q̇, q̈) where stage_motion would call it anyway: no Motion per stage
+        self.fast = None if engine is None or self.baumgarte is not None else engine.derivative
+
+    def begin(self, t, t_next, relaxed=False, may_crawl=True):
+        """Count the evaluations from here: an interval from t to t_next; ``relaxed``: it is
+        integrated more loosely already (it may crawl longer); ``may_crawl``: False where it
+        cannot be relaxed further (no Crawl raised)."""
+        self.calls, self.t_mark, self.span = 0, t, t_next - t
+        self.singular_call = None  # the interval's evaluation count at its first stage near a singular position
+        self.crawl_calls = (RELAXED_CRAWL_CALLS if relaxed else CRAWL_CALLS) if may_crawl else np.inf
+
+    def __call__(self, t, y):
+        self.t_failed = t
+        self.calls += 1
+        self.evaluations += 1
+        if self.calls % COLLAPSE_CALLS == 0:
+            if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
+                raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
+            self.t_mark = t
+        found = None if self.fast is None else self.fast(t, y)  # unique, far from singular
+        if found is None:
+            q, qd = y[:self.n], y[self.n:]
+            motion = self.stage_motion(t, q, qd)
+            self.non_unique |= not motion.unique
+            if motion.singular:
+                self.singular.append((t, motion.singular))
+                self.singular_call = self.calls if self.singular_call is None else self.singular_call
+        if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
+            raise Crawl
+        return found if found is not None else np.concatenate([qd, motion.qdd])
+
+    def note_singular(self):
+        """One entry of ``singular_positions`` for the stages of the interval just done."""
+        if self.singular:
+            times = [t for t, _ in self.singular]
+            rows = sorted({r for _, names in self.singular for r in names})
+            self.singular_positions.append(dict(t_from=min(times), t_to=max(times), rows=rows))
+            log.info("singular position near t = %.6g (nearly dependent rows %s)", min(times), ", ".join(rows))
+            self.singular = []
+
+    def collapse(self, t, y, why):
+        """The SolveError of a step-size collapse at (t, y), naming the coordinates of the
+        largest accelerations (within a factor 10 of the largest): what the steps chase."""
+        self.t_failed = t
+        data = self.data
+        qdd = np.abs(data.motion(t, y[:self.n], y[self.n:], baumgarte=self.baumgarte, drift=True).qdd)
+        fastest = [(c, a) for c, a in zip(data.coordinates, qdd) if a >= qdd.max() / 10]
+        return SolveError(f"step-size collapse, the integrator gave up ({why}); fastest changing: "
+                          f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}",
+                          coordinates=[c for c, _ in fastest])
+
+    def check(self, t, y):
+        """Raise SolveError naming the coordinates where y is not finite or beyond MAX_STATE."""
+        if np.abs(y).max(initial=0.0) <= MAX_STATE:  # false where any is NaN
+            return
+        self.t_failed = t
+        names = [*self.data.coordinates, *(c + "_dot" for c in self.data.coordinates)]
+        culprits = [names[i] for i in np.flatnonzero(~np.isfinite(y) | (np.abs(y) > MAX_STATE))]
+        raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
+                         f"{', '.join(culprits[:6])}", coordinates=culprits)

@@ -1,0 +1,106 @@
+"""The run loop's integration stage: one interface, two strategies behind it.
+
+An Integration takes a run's state from the time it reached (``t_now``) to the next output
+time or control sample (``advance``), stepping one of scipy's OdeSolvers (stepper.py) on the
+right-hand side of derivative.py. With ``stabilization="projection"`` the state it hands
+back lies on the constraints (projected, projection.py, or corrected by the compiled kernel,
+compiled/correction.py) and has been judged strictly there: a real contradiction raises
+SolveError. ``restart`` follows a jump of the forces (new parameter values in the Data, at a
+control sample): the integrator's f is computed afresh there.
+
+- ContinuousIntegration (continuous.py): where the kernel corrects states itself (a tree of
+  kernel joints and bodies) and the integrator is an explicit pair, the steps are chosen by
+  the error control alone, up to the next control sample or the end, each corrected.
+- CutIntegration (cut.py): otherwise, each interval integrated on its own, the last step
+  cut short at its end, the state projected there and between as the drift asks.
+
+``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share how an integrator goes
+on from a state: the same explicit pair where it can (stepper.RESUMABLE), else a new one.
+"""
+
+import logging
+
+from . import stepper
+from .derivative import StateDerivative
+
+log = logging.getLogger(__name__)
+
+
+class Integration:
+    """What both strategies hold: the settings, the right-hand side ``f`` with its counts,
+    the integrator kept from interval to interval, and the state reached."""
+
+    def __init__(self, data, method, rtol, atol, stabilization, baumgarte, times):
+        self.data, self.method, self.rtol, self.atol = data, method, rtol, atol
+        self.stabilization, self.times, self.n = stabilization, list(times), data.n
+        self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None)
+        self.steps = 0
+        self.solver = None  # the integrator, kept from interval to interval (``resumed``)
+        self.solver_tolerances = None  # its (rtol, atol)
+        self.next_step = None  # the step it proposed after its last step not cut short at an interval's end
+        self.t_now = None  # the time the state has reached (outputs and control samples alike)
+        self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
+        self.corrected = None  # the kernel's correction.Corrected there, if at hand
+        self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
+        self.restart()
+
+    @property
+    def t_failed(self):
+        """Where the run was when it failed."""
+        return self.f.t_failed
+
+    def restart(self):
+        """Go on from the Data's parameter values (new at a control sample: the forces
+        jump, so the integrator's f is computed afresh): its stages' motion and its compiled
+        correction, where the kernel covers the model."""
+        self.forces_jumped = True
+        engine = self.data.tree_engine(True)
+        self.f.use(engine)
+        self.correction = None if engine is None else engine.correction()
+        self.compiled_energy = self.correction is not None and all(f.V == 0 for f in self.data.forces)
+
+    def advance(self, t_next, q, qd, t_stop):
+        """The state (q, q̇) at t_next from (q, q̇) at ``t_now``; t_stop: the next control
+        sample or the end, where a continuous integrator must stop."""
+        raise NotImplementedError
+
+    def resumed(self, t, y, t_bound, rtol, atol):
+        """The integrator at (t, y), bound for t_bound, its first step the one it last
+        proposed: the same explicit pair where it stands at t with these tolerances
+        (stepper.RESUMABLE), moved to y — given f there — where a projection moved the state
+        or the forces jumped; else a new one, as ``solve_ivp`` would start it."""
+        first = None if self.next_step is None else min(self.next_step, t_bound - t)
+        solver = self.solver
+        if isinstance(solver, stepper.RESUMABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
+            if self.forces_jumped or not stepper.stands_at(solver, y):
+                stepper.move(solver, y, self.f(t, y))
+            stepper.resume(solver, t_bound, first)
+        else:
+            solver = self.solver = self.method(self.f, t, y, t_bound, rtol=rtol, atol=atol, first_step=first)
+            self.solver_tolerances = (rtol, atol)
+        self.forces_jumped = False
+        return solver
+
+    def arrived(self, t_next, q, qd, arrays=None, corrected=None):
+        """The state reached at t_next (``arrays``: its ConstraintArrays, if at hand), judged
+        strictly there with projection, unless the kernel ``corrected`` it (its checks passed
+        there already; correction.Corrected, with the rows there)."""
+        self.f.note_singular()
+        if self.stabilization == "projection" and corrected is None:
+            self.f.t_failed = t_next
+            self.data.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
+        self.t_now, self.arrays, self.corrected = t_next, arrays, corrected
+        return q, qd
+
+    def failed_step(self, solver, message):
+        """The SolveError of the integrator's own failure (its step size too small)."""
+        return self.f.collapse(solver.t, solver.y, (message or "the integrator failed").rstrip("."))
+
+    def stats(self):
+        """The run's counts for ``Trajectory.stats``."""
+        f = self.f
+        if f.non_unique:
+            log.warning("the motion was not unique somewhere on this run; the free directions got zero "
+                        "acceleration (η = 0 in (2.14))")
+        return dict(steps=self.steps, evaluations=f.evaluations, non_unique=f.non_unique,
+                    singular_positions=f.singular_positions, relaxed_spans=self.relaxed_spans)
