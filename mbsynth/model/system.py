@@ -131,9 +131,10 @@ class System:
     def parameter_values(self):
         return np.array(list(self.parameters.values()), dtype=float)
 
-    @property
+    @functools.cached_property
     def parameter_symbols(self):
-        return [sp.Symbol(p) for p in self.parameters]
+        """The parameters' sympy symbols, in the model's order."""
+        return tuple(sp.Symbol(p) for p in self.parameters)
 
     def initial_state(self):
         """(q, q̇) from the model's ``initial:`` mapping (copies)."""
@@ -189,7 +190,7 @@ class System:
                     new[i] = float(self.definitions[name].xreplace(subs))
                 subs[sp.Symbol(name)] = sp.Float(new[i])
         if check_parts:
-            moved = {sp.Symbol(name) for name, a, b in zip(self.parameters, old.tolist(), new.tolist()) if a != b}
+            moved = {self.parameter_symbols[i] for i in np.flatnonzero(old != new)}
             problems = self.part_problems(moved, new) if moved else []
             if problems:
                 raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")

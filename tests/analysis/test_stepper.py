@@ -38,7 +38,10 @@ def test_a_moved_and_resumed_pair_steps_as_a_new_one(method):
         solver.step()
     assert solver.status == "finished" and solver.t == 2.0
     y = solver.y + np.array([1e-6, -2e-6, 0.0])
+    stepper.move(solver, y, None)  # moved, its derivative not known yet
+    assert not stepper.stands_at(solver, y)
     stepper.move(solver, y, damped(solver.t, y))
+    assert stepper.stands_at(solver, y) and not stepper.stands_at(solver, y + 1e-9)
     stepper.resume(solver, 5.0, first_step=0.05)
     fresh = method(damped, 2.0, y, 5.0, rtol=1e-9, atol=1e-9, first_step=0.05)
     while fresh.status == "running":
