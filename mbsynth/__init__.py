@@ -13,7 +13,7 @@ pinocchio and numba load when their feature is used.
 import importlib
 
 from .core.equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
-from .core.errors import ModelError, SimulationError, SolveError
+from .core.errors import ControlError, ModelError, NoEquilibrium, SimulationError, SolveError
 
 __version__ = "0.1.0"
 
@@ -30,7 +30,7 @@ _SUBMODULES = {"viewer": "view.viewer"}
 
 __all__ = [
     "Motion", "RankReport", "constrained_acceleration", "rank_report", "udwadia_kalaba",
-    "ModelError", "SolveError", "SimulationError", *_LAZY, *_SUBMODULES,
+    "ModelError", "SolveError", "SimulationError", "ControlError", "NoEquilibrium", *_LAZY, *_SUBMODULES,
 ]
 
 

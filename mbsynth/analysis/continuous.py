@@ -14,8 +14,6 @@ crawls near a singular position, or fails, is integrated again, cut (cut.py), fr
 output: a failure is then reported in the interval it happens in, the rows before it kept.
 """
 
-import bisect
-
 import numpy as np
 
 from . import stepper
@@ -96,7 +94,7 @@ class ContinuousIntegration(CutIntegration):
             self.steps -= 1
             return
         stepper.cap(solver, cap)
-        times = self.times[bisect.bisect_left(self.times, t_next):bisect.bisect_left(self.times, solver.t)]
+        times = self.schedule.between(t_next, solver.t)
         states = np.empty((len(times) + 1, solver.y.size))
         if times:
             stepper.interpolate(solver, times, states[:-1])

@@ -7,12 +7,11 @@ and returns new values for some of the model's parameters — a robot's ``tau_<j
 an actuation's amplitude. It is called at t0 and every ``control_dt`` after, and its values
 are held until the next call (zero-order hold, as a digital controller does); they are
 written into the run's Data (``Data.set_parameters``: no System is built during a run),
-and the integrator restarts at each sample, where the forces jump.
+and the integrator restarts at each sample, where the forces jump. A law that fails stops
+the run with a ControlError that holds the rows recorded before (``trajectory``).
 """
 
-import numpy as np
-
-from ..core.errors import ModelError
+from ..core.errors import ControlError, ModelError
 
 
 class SampledControl:
@@ -25,17 +24,19 @@ class SampledControl:
             raise ValueError(f"control_dt must be positive, got {control_dt}")
         self.law, self.dt = law, float(control_dt)
 
-    def times(self, t0, t_end):
-        """The sample times in [t0, t_end)."""
-        return t0 + self.dt * np.arange(int(np.ceil((t_end - t0) / self.dt - 1e-9)))
-
     def apply(self, data, t, q, qd):
-        """Write the law's parameter values at the sample (t, q, q̇) into ``data``."""
-        values = self.law(t, data.joint_values(t, q, qd))
+        """Write the law's parameter values at the sample (t, q, q̇) into ``data``. Raises
+        ControlError where the law raises (the cause chained) or returns what the model
+        cannot take: not a dict, an unknown name, a value that is no finite real number, a
+        value that makes a part unusable (System.resolved_parameters)."""
+        try:
+            values = self.law(t, data.joint_values(t, q, qd))
+        except Exception as err:
+            raise ControlError(f"controller at t = {t:.6g} raised {type(err).__name__}: {err}", time=t) from err
         if not isinstance(values, dict):
-            raise ModelError(f"controller at t = {t:.6g}: expected a dict {{parameter: value}}, got "
-                             f"{type(values).__name__}")
-        try:  # unknown names, non-finite values, a part they make unusable (System.resolved_parameters)
+            raise ControlError(f"controller at t = {t:.6g}: expected a dict {{parameter: value}}, got "
+                               f"{type(values).__name__}", time=t)
+        try:
             data.set_parameters(values)
         except ModelError as err:
-            raise ModelError(f"controller at t = {t:.6g}: {err}") from None
+            raise ControlError(f"controller at t = {t:.6g}: {err}", time=t) from None

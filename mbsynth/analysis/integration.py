@@ -30,9 +30,9 @@ class Integration:
     """What both strategies hold: the settings, the right-hand side ``f`` with its counts,
     the integrator kept from interval to interval, and the state reached."""
 
-    def __init__(self, data, method, rtol, atol, stabilization, baumgarte, times):
+    def __init__(self, data, method, rtol, atol, stabilization, baumgarte, schedule):
         self.data, self.method, self.rtol, self.atol = data, method, rtol, atol
-        self.stabilization, self.times, self.n = stabilization, list(times), data.n
+        self.stabilization, self.schedule, self.n = stabilization, schedule, data.n
         self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None)
         self.steps = 0
         self.solver = None  # the integrator, kept from interval to interval (``resumed``)

@@ -3,31 +3,42 @@ total energy, its largest constraint residuals and the model's declared outputs 
 the Trajectory and, when a file is asked for, written as the run goes
 (trajectory.TrajectoryWriter)."""
 
+import os
+
 import numpy as np
 
+from ..core.errors import ModelError
 from ..model.outputs import OutputEvaluator
 from .trajectory import Trajectory, TrajectoryWriter
 
-COLUMNS = ("t", "q", "qd", "energy", "kinetic", "residual_position", "residual_velocity", "outputs")
-_NO_OUTPUTS = np.zeros(0)  # a row's outputs where the model declares none (read-only)
-_NO_OUTPUTS.flags.writeable = False
+MEMORY_SHARE = 0.8  # of the memory available when a run starts: the most its rows may take
 
 
 class Recorder:
-    """The rows of a run on ``data`` (a run's Data), written to ``out`` (.npz or .csv) too
-    when given."""
+    """The ``rows`` rows of a run on ``data`` (a run's Data), held in arrays made at the
+    start (the memory they take is known then: ``row_bytes``), written to ``out`` (.npz or
+    .csv) too when given, from ``open`` on."""
 
-    def __init__(self, data, out=None):
-        self.data = data
+    def __init__(self, data, rows, out=None):
+        self.data, self.out = data, out
         self.outputs = OutputEvaluator(data)
-        self.rows = {k: [] for k in COLUMNS}
-        self.columns = tuple(self.rows.values())  # in COLUMNS' order (``record``)
-        self.writer = None if out is None else TrajectoryWriter(out, data.coordinates, self.outputs.names)
+        n, m = len(data.coordinates), len(self.outputs.names)
+        _check_fits(rows, row_bytes(n, m), out)
+        self.count = 0
+        self.columns = dict(t=np.empty(rows), q=np.empty((rows, n)), qd=np.empty((rows, n)), energy=np.empty(rows),
+                            kinetic=np.empty(rows), residual_position=np.empty(rows),
+                            residual_velocity=np.empty(rows), outputs=np.empty((rows, m)))
+        self.writer = None
+
+    def open(self):
+        """Start the file, if one was asked for (a path that cannot be written fails here)."""
+        if self.out is not None:
+            self.writer = TrajectoryWriter(self.out, self.data.coordinates, self.outputs.names, rows=self.trajectory)
 
     @property
     def t(self):
         """The times recorded so far."""
-        return self.rows["t"]
+        return self.columns["t"][:self.count]
 
     def record(self, t, q, qd, correction=None, compiled_energy=False, arrays=None, corrected=None):
         """A row at (t, q, q̇). Its residuals and energies are the compiled ones where the
@@ -46,12 +57,15 @@ class Recorder:
             kinetic, potential, *residuals = corrected[2:]
         if not compiled_energy:
             kinetic, potential = data.energy(t, q, qd)
-        values = (t, np.array(q), np.array(qd), kinetic + potential, kinetic, *residuals,
-                  self.outputs.evaluate(t, q, qd) if self.outputs else _NO_OUTPUTS)
-        for column, value in zip(self.columns, values):
-            column.append(value)
+        values = dict(t=t, q=q, qd=qd, energy=kinetic + potential, kinetic=kinetic, residual_position=residuals[0],
+                      residual_velocity=residuals[1])
+        if self.outputs:
+            values["outputs"] = self.outputs.evaluate(t, q, qd)
+        for name, value in values.items():
+            self.columns[name][self.count] = value
+        self.count += 1
         if self.writer is not None:
-            self.writer.append(_chunk(data.coordinates, dict(zip(COLUMNS, values)), self.outputs.names))
+            self.writer.append(self.trajectory("running", rows=slice(self.count - 1, self.count)))
 
     def close(self, status):
         """Finish the file, if any, with the run's ``status``."""
@@ -59,14 +73,56 @@ class Recorder:
             self.writer.status = status
             self.writer.close()
 
-    def trajectory(self, status):
-        """The rows so far as a Trajectory with ``status``."""
-        r, n = self.rows, len(self.data.coordinates)
-        return Trajectory(tuple(self.data.coordinates), np.array(r["t"]), np.array(r["q"]).reshape(-1, n),
-                          np.array(r["qd"]).reshape(-1, n), np.array(r["energy"]), np.array(r["kinetic"]),
-                          np.array(r["residual_position"]), np.array(r["residual_velocity"]), status,
-                          outputs=np.array(r["outputs"], dtype=float).reshape(len(r["t"]), len(self.outputs.names)),
+    def trajectory(self, status, rows=None):
+        """The rows so far (``rows``: a slice of them) as a Trajectory with ``status``; its
+        arrays are views of the recorder's."""
+        rows = slice(0, self.count) if rows is None else rows
+        c = {name: column[rows] for name, column in self.columns.items()}
+        return Trajectory(tuple(self.data.coordinates), c["t"], c["q"], c["qd"], c["energy"], c["kinetic"],
+                          c["residual_position"], c["residual_velocity"], status, outputs=c["outputs"],
                           output_names=tuple(self.outputs.names))
+
+
+def row_bytes(n, m):
+    """The bytes of one row of a run with n coordinates and m outputs (its output time
+    included)."""
+    return 8 * (2 * n + m + 6)
+
+
+def _check_fits(rows, size, out):
+    """Raise ModelError when ``rows`` rows of ``size`` bytes would take more than
+    MEMORY_SHARE of the memory available now: refused before the run starts, not lost to
+    a MemoryError in the middle of it."""
+    available = available_memory()
+    need = rows * size
+    if available is not None and need > MEMORY_SHARE * available:
+        raise ModelError(f"{rows:,} output rows would take {_bytes(need)}, more than this machine has free "
+                         f"({_bytes(available)}): ask for fewer rows (a larger dt or a shorter run)"
+                         + (f"; nothing was written to {out}" if out is not None else ""))
+
+
+def available_memory():
+    """The bytes of memory available to a new allocation (MemAvailable of /proc/meminfo;
+    the free physical pages elsewhere), or None where neither is known."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _bytes(count):
+    """``count`` bytes in words: 7.3 GB, 512 MB, ..."""
+    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if count >= size:
+            return f"{count / size:.3g} {unit}"
+    return f"{count} bytes"
 
 
 def _max_abs(values):
@@ -77,9 +133,3 @@ def _max_abs(values):
     finite = values[np.isfinite(values)]
     return float(np.abs(finite).max()) if finite.size else 0.0
 
-
-def _chunk(coordinates, row, output_names):
-    return Trajectory(tuple(coordinates), np.array([row["t"]]), row["q"][None, :], row["qd"][None, :],
-                      np.array([row["energy"]]), np.array([row["kinetic"]]), np.array([row["residual_position"]]),
-                      np.array([row["residual_velocity"]]), outputs=row["outputs"][None, :],
-                      output_names=tuple(output_names))

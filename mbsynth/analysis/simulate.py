@@ -22,20 +22,21 @@ There a tolerance tighter than the stages' noise makes the integrator crawl: suc
 integrated again more loosely (cut.py) and listed in ``stats["relaxed_spans"]``.
 """
 
-import bisect
 import logging
+import math
 import time
 
 import numpy as np
 import scipy.integrate
 
 from .control import SampledControl
-from ..core.errors import SimulationError, SolveError
+from ..core.errors import ControlError, SimulationError, SolveError
 from . import stepper
 from .continuous import ContinuousIntegration
 from .cut import CutIntegration
 from .projection import consistent_initial_state
 from .recording import Recorder
+from .schedule import Schedule
 from .trajectory import COMPLETED
 
 log = logging.getLogger(__name__)
@@ -64,8 +65,8 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     if stabilization not in STABILIZATIONS:
         raise ValueError(f"stabilization must be one of {STABILIZATIONS}, got {stabilization!r}")
     method = _integrator(method)
-    if not t_end > t0:
-        raise ValueError(f"t_end ({t_end}) must be after t0 ({t0})")
+    if not (np.isfinite(t0) and np.isfinite(t_end) and t_end > t0):
+        raise ValueError(f"t_end ({t_end}) must be after t0 ({t0}), both finite")
     data = system.data()  # the run's workspace: one motion path (compiled or KKT) for the whole run
     if q0 is None and qd0 is None:
         q, qd, changes = consistent_initial_state(data, t0)
@@ -76,14 +77,14 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         q = start_q if q0 is None else np.asarray(q0, dtype=float)
         qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
         changes = {}
+    recorder = Recorder(data, _output_count(t0, t_end, dt), out)  # refused here if the rows cannot fit in memory
     times = _output_times(t0, t_end, dt)
-    control = None if controller is None else SampledControl(controller, control_dt or times[1] - times[0])
-    samples = set() if control is None else set(control.times(t0, t_end))
-    outputs = set(times)
-    stops = sorted(samples | {times[-1]})  # where a continuous integrator stops: the forces jump, or the run ends
+    control = None if controller is None else \
+        SampledControl(controller, times[1] - times[0] if control_dt is None else control_dt)
+    schedule = Schedule(times, None if control is None else control.dt)
     strategy = ContinuousIntegration if ContinuousIntegration.fits(data, method, stabilization) else CutIntegration
-    run = strategy(data, method, rtol, atol, stabilization, baumgarte, sorted(outputs | samples))
-    recorder = Recorder(data, out)
+    run = strategy(data, method, rtol, atol, stabilization, baumgarte, schedule)
+    recorder.open()
     started = time.perf_counter()
     status = "stopped"
     try:
@@ -92,13 +93,18 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
             run.restart()
         recorder.record(t0, q, qd, run.correction, run.compiled_energy)
         run.t_now = t0
-        for t_next in run.times[1:]:
-            q, qd = run.advance(t_next, q, qd, stops[bisect.bisect_left(stops, t_next)])
-            if t_next in samples:
-                control.apply(data, t_next, q, qd)
+        for t_next, is_output, is_sample in schedule:
+            q, qd = run.advance(t_next, q, qd, schedule.next_stop(t_next))
+            if is_sample:
+                try:
+                    control.apply(data, t_next, q, qd)
+                except ControlError:
+                    if is_output:  # the state reached is good: its row, with the values held until now
+                        recorder.record(t_next, q, qd, run.correction, run.compiled_energy, run.arrays, run.corrected)
+                    raise
                 run.restart()
-            if t_next in outputs:
-                at_hand = () if t_next in samples else (run.arrays, run.corrected)  # a sample's parameters are new
+            if is_output:
+                at_hand = () if is_sample else (run.arrays, run.corrected)  # a sample's parameters are new
                 recorder.record(t_next, q, qd, run.correction, run.compiled_energy, *at_hand)
                 if progress is not None:
                     progress(t_next)
@@ -109,6 +115,10 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
                               f"t = {recorder.t[-1]:.9g}): {err}", time=run.t_failed,
                               trajectory=_trajectory(recorder, run, status),
                               constraints=err.constraints, coordinates=err.coordinates) from None
+    except ControlError as err:
+        status = f"failed at t = {err.time:.9g}: {err}"
+        err.trajectory = _trajectory(recorder, run, status)
+        raise
     except KeyboardInterrupt:
         status = f"interrupted at t = {recorder.t[-1]:.9g}"
         raise
@@ -136,10 +146,20 @@ def _integrator(method):
     return stepper.METHODS[method]
 
 
-def _output_times(t0, t_end, dt):
+def _output_count(t0, t_end, dt):
+    """The number of output times from t0 to t_end every dt (``_output_times``), counted
+    without making them."""
     if dt is None:
-        return np.linspace(t0, t_end, DEFAULT_OUTPUTS + 1)
+        return DEFAULT_OUTPUTS + 1
     if not dt > 0:
         raise ValueError(f"dt must be positive, got {dt}")
+    count = math.ceil((t_end - t0) / dt)  # np.arange's length
+    return count + 1 if t_end - (t0 + (count - 1) * dt) > 1e-12 * dt else count
+
+
+def _output_times(t0, t_end, dt):
+    """Every dt from t0, and t_end (a last interval shorter than 1e-12 dt merged into the one before)."""
+    if dt is None:
+        return np.linspace(t0, t_end, DEFAULT_OUTPUTS + 1)
     times = np.arange(t0, t_end, dt)
     return np.append(times, t_end) if t_end - times[-1] > 1e-12 * dt else np.append(times[:-1], t_end)

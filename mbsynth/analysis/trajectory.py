@@ -134,7 +134,9 @@ def load_trajectory(path):
 class TrajectoryWriter:
     """Writes trajectory rows as they come (see the module docstring)."""
 
-    def __init__(self, path, coordinates, output_names=(), checkpoint_seconds=2.0):
+    def __init__(self, path, coordinates, output_names=(), checkpoint_seconds=2.0, rows=None):
+        """``rows``: where the NPZ checkpoints read every row so far (a callable(status) ->
+        Trajectory, a run's recorder) instead of keeping the appended rows themselves."""
         self.path = Path(path)
         if self.path.suffix not in FORMATS:
             raise ModelError(f"{self.path}: output must end in {' or '.join(FORMATS)}")
@@ -143,8 +145,9 @@ class TrajectoryWriter:
         self.coordinates, self.output_names = tuple(coordinates), tuple(output_names)
         self.checkpoint_seconds = checkpoint_seconds
         self.status = "running"
+        self._rows = rows
         self._chunks = []
-        self._last_checkpoint = time.monotonic()
+        self._last_checkpoint, self._period = time.monotonic(), checkpoint_seconds
         if self.path.suffix == ".csv":
             self._partial = partial_file(self.path)
             try:
@@ -175,8 +178,9 @@ class TrajectoryWriter:
             self._csv_file.flush()
             self._complete = self._csv_file.tell()
         else:
-            self._chunks.append(traj)
-            if time.monotonic() - self._last_checkpoint > self.checkpoint_seconds:
+            if self._rows is None:
+                self._chunks.append(traj)
+            if time.monotonic() - self._last_checkpoint > self._period:
                 self._write_npz()
 
     def close(self):
@@ -191,15 +195,19 @@ class TrajectoryWriter:
             self._write_npz()
 
     def _write_npz(self):
-        self._last_checkpoint = time.monotonic()
-        chunks = self._chunks
+        """The file with every row so far; the next checkpoint ``checkpoint_seconds`` later,
+        or ten times as long as this one took to write (a long run's file grows: its
+        checkpoints take at most a tenth of the run); ``checkpoint_seconds=0``: at every
+        append."""
+        started = time.monotonic()
+        chunks = self._chunks if self._rows is None else [self._rows(self.status)]
         n = len(self.coordinates)
 
         def stack(name, width=None):
             parts = [getattr(c, name) for c in chunks]
             if not parts:
                 return np.zeros(0) if width is None else np.zeros((0, width))
-            return np.concatenate(parts)
+            return parts[0] if len(parts) == 1 else np.concatenate(parts)  # one: the rows themselves, no copy
 
         columns = dict(t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
                        energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
@@ -210,3 +218,7 @@ class TrajectoryWriter:
             write_atomically(self.path, lambda temporary: np.savez(temporary, **columns))
         except OSError as err:
             raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
+        finally:
+            self._last_checkpoint = time.monotonic()
+            self._period = self.checkpoint_seconds and max(self.checkpoint_seconds,
+                                                           10 * (self._last_checkpoint - started))

@@ -1,4 +1,4 @@
-"""The two kinds of error a user of mbsynth can cause."""
+"""The kinds of error a user of mbsynth can cause, and the verdicts that are no fault."""
 
 
 class ModelError(ValueError):
@@ -21,6 +21,13 @@ class SolveError(ArithmeticError):
         self.coordinates = tuple(coordinates)
 
 
+class NoEquilibrium(SolveError):
+    """A verdict, not a fault: the model has no rest where one is asked for — no static
+    equilibrium found from the given configuration, one that is not isolated
+    (analysis/statics.py), or a state given to ``modes`` that is not at rest. The command
+    line exits 1 for it."""
+
+
 class SimulationError(SolveError):
     """A run that had to stop (no motion at a state, a NaN/inf or exploding state, a
     step-size collapse). ``time`` is where it stopped and ``trajectory`` holds every
@@ -29,5 +36,16 @@ class SimulationError(SolveError):
 
     def __init__(self, message, *, time, trajectory, constraints=(), coordinates=()):
         super().__init__(message, constraints=constraints, coordinates=coordinates)
+        self.time = time
+        self.trajectory = trajectory
+
+
+class ControlError(ModelError):
+    """A run's controller failed at a sample: it raised (the cause is chained) or gave a
+    value the model cannot take. ``time`` is the sample's time and ``trajectory`` holds
+    every output row computed before (saved when an output file was asked for)."""
+
+    def __init__(self, message, *, time, trajectory=None):
+        super().__init__(message)
         self.time = time
         self.trajectory = trajectory

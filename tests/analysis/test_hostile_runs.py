@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -165,3 +166,21 @@ def test_a_killed_run_never_leaves_half_a_file_under_the_final_name(tmp_path, su
         saved = Trajectory(("p.x",), data[:, 0], data[:, 1:2], data[:, 2:3], data[:, 3], *[data[:, 3]] * 3)
     assert saved.t.size > 1
     np.testing.assert_allclose(saved.q[:, 0], np.cos(saved.t), atol=1e-8)
+
+
+def test_output_that_cannot_fit_in_memory_is_refused_before_the_run(tmp_path):
+    """10¹² + 1 rows of a 1-coordinate model, 8 bytes × (2·1 + 6) each (t, q, q̇, energies,
+    residuals and the output time): 64 TB, refused before anything is written."""
+    system = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0.5*x**2}\n")
+    out = tmp_path / "big.npz"
+    with pytest.raises(mb.ModelError, match=r"1,000,000,000,001 output rows would take 64 TB") as caught:
+        simulate(system, 1e6, dt=1e-6, out=out)
+    assert f"nothing was written to {out}" in str(caught.value) and list(tmp_path.iterdir()) == []
+
+
+def test_the_command_line_refuses_output_that_cannot_fit_with_exit_2(tmp_path):
+    out = tmp_path / "big.npz"
+    done = subprocess.run([sys.executable, "-m", "mbsynth", "simulate", "models/mechanisms/simple_pendulum.yaml",
+                           "--t-end", "1e6", "--dt", "1e-6", "--out", str(out)], capture_output=True, text=True,
+                          timeout=300, cwd=Path(__file__).parents[2])
+    assert done.returncode == 2 and "output rows would take" in done.stderr and not out.exists()
