@@ -10,7 +10,7 @@ import argparse
 import re
 from pathlib import Path
 
-from mbsynth.cli.parsers import parser
+from mbsynth.cli.parsers import EXIT_CODES, VERDICTS, parser
 from mbsynth.io.schema import SECTIONS
 
 _CODE = re.compile(r"(``.*?``|`[^`]*`)")
@@ -83,14 +83,25 @@ def cli_page():
     top = parser()
     lines = ["# Command line", "",
              "Generated from the argparse parsers of `mbsynth.cli.parsers`. Every command has `--help`; "
-             "`--json` prints one JSON object on stdout. Exit status 2 means a model error.", "",
-             "```text", top.format_usage().strip(), "```", ""]
+             "`--json` prints one JSON object on stdout (on an error `{\"error\": ...}`, else one line "
+             "`error: ...` on stderr).", "",
+             "```text", top.format_usage().strip(), "```", "",
+             "(cli-exit-status)=", "## Exit status", "",
+             "Every command exits with one of these (`mbsynth.cli.parsers.EXIT_CODES`; each command's "
+             "`--help` ends with its own line of it):", "",
+             "| status | meaning |", "|---|---|"]
+    lines += [f"| {code} | {_escape(meaning, cell=True)} |" for code, meaning in EXIT_CODES.items()]
+    lines += ["", "What a verdict (exit 1) is, command by command:", "",
+              "| command | exit 1 |", "|---|---|"]
+    lines += [f"| `{name}` | {_escape(verdict or 'never: it has no verdict', cell=True)} |"
+              for name, verdict in VERDICTS.items()]
+    lines.append("")
     for name, sub, help_ in _subcommands(top):
         lines += [f"(cli-{name})=", f"## `mbsynth {name}`", "", _escape(help_[:1].upper() + help_[1:]) + ".", "",
                   "```text", sub.format_usage().strip(), "```", "", _escape(sub.description or ""), ""]
         lines += [_argument(sub, a) for a in sub._actions
                   if a.help != argparse.SUPPRESS and not isinstance(a, argparse._HelpAction)]
-        lines.append("")
+        lines += ["", _escape(sub.epilog or ""), ""]
     return "\n".join(lines)
 
 

@@ -10,13 +10,52 @@ from pathlib import Path
 from ..core.errors import ModelError
 
 
+# The exit status of every command (main maps what a command raises onto it): the one table
+# the CLI reference, ``mbsynth --help`` and each command's --help print (exit_status).
+OK, VERDICT, BAD_INPUT, BUG, INTERRUPTED, CLOSED_OUTPUT = 0, 1, 2, 3, 130, 141
+EXIT_CODES = {
+    OK: "success",
+    VERDICT: "a verdict (the command ran, and its answer needs attention)",
+    BAD_INPUT: "bad input: a usage error, a bad flag value, a file that cannot be read or written, a model "
+               "error (the message names the file and line, part, parameter or value at fault)",
+    BUG: "an internal error, a bug in mbsynth (please report it; --debug shows where)",
+    INTERRUPTED: "interrupted (Ctrl-C); the message says where the output so far is, or that none was written",
+    CLOSED_OUTPUT: "the reader of the printed output closed it early (as in '| head'; 128 + SIGPIPE, as for "
+                   "any Unix command): nothing more is printed",
+}
+VERDICTS = {  # what exit 1 means for each command (none: the command has no verdict)
+    "check": "a force balance is missing (the motion is not unique beyond free directions), or no motion "
+             "exists at the initial state",
+    "simulate": "the run had to stop (its output up to there is kept)",
+    "sweep": "a run failed (its row holds the error)",
+    "view": "the simulation had to stop (the motion up to there is drawn)",
+    "validate": "a relative error exceeds --tolerance, or no comparison is possible",
+    "modes": "no rest state (the state is not at rest, q̈ ≠ 0 at q̇ = 0; with --equilibrium: no static "
+             "equilibrium is found)",
+    "robots": None,
+}
+
+
+def exit_status(command=None):
+    """The exit-status table as one paragraph: for ``command``, its verdict (exit 1) spelled out."""
+    rows = []
+    for code, meaning in EXIT_CODES.items():
+        if code == VERDICT and command is not None:
+            if VERDICTS[command] is None:
+                continue
+            meaning = f"{meaning}: {VERDICTS[command]}"
+        rows.append(f"{code} {meaning}")
+    return "Exit status: " + "; ".join(rows) + "."
+
+
 def parser():
     """The full ``mbsynth`` ArgumentParser; ``args.command`` names the command module."""
-    top = ArgumentParser(prog="mbsynth", description="The ``mbsynth`` command.")
+    top = ArgumentParser(prog="mbsynth", description="The ``mbsynth`` command.", epilog=exit_status())
     top.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     commands = top.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for add in (_check, _simulate, _sweep, _view, _validate, _modes, _robots):
         command = add(commands)
+        command.epilog = exit_status(command.prog.rsplit(" ", 1)[1])
         command.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     return top
 
@@ -26,8 +65,7 @@ def _check(commands):
         "check", help="is the motion of a model unique? (Result 3 at the initial state)",
         description="Report the ranks of M, A and [M; A] at the model's initial state, whether the "
                     "motion is unique, each indeterminate direction and the force balance that "
-                    "would close it. Exit 0 when the motion is determined or only free directions "
-                    "remain, 1 when a balance is missing or no motion exists, 2 on a model error. "
+                    "would close it (the motion is determined where only free directions remain). "
                     "A model with joints gets its accelerations as joint accelerations (a revolute "
                     "joint's angle, a prismatic joint's displacement, ...: the time derivatives of "
                     "the joints' rates) and the joints each indeterminate direction moves.")
@@ -52,8 +90,8 @@ def _simulate(commands):
     sim.add_argument("--plot", help="figure (.png, .pdf, .svg) of the joint coordinates (or the model's outputs, "
                                     "or --plot-vars), kinetic and potential energy, and the constraint residuals")
     sim.add_argument("--plot-vars", nargs="+", metavar="NAME",
-                     help="what the figure's top panel draws: coordinates (part.c), velocities (part.c_dot), "
-                          "outputs")
+                     help="what the figure's top panel draws (with --plot): coordinates (part.c), velocities "
+                          "(part.c_dot), outputs; a name the model lacks is refused before the run")
     sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
     sim.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
     sim.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance (default 1e-10)")
@@ -114,8 +152,7 @@ def _validate(commands):
                     "components of its wrench that are unique). "
                     "ROBOT_OR_MODEL is a robot name (see 'mbsynth robots'), "
                     "a URDF file, or a model file (.yaml) of rigid bodies and robots, compared with its "
-                    "equivalent Pinocchio model. Exit 0 when every relative error is within the tolerance, "
-                    "1 when one is not (or no comparison is possible), 2 on a model error.")
+                    "equivalent Pinocchio model.")
     val.add_argument("target", metavar="ROBOT_OR_MODEL", help="robot name, URDF file or model file")
     val.add_argument("--samples", type=int, default=20, help="random states per base (default 20)")
     val.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -131,8 +168,7 @@ def _modes(commands):
                     "equilibrium nearest it) in independent coordinates of its constraints' tangent "
                     "space, massless parts closed by their balances, and print one row per mode: "
                     "frequency, damping ratio, kind (vibration, overdamped, unstable, free) and the "
-                    "joints (or coordinates) that move most. Exit 0, 1 when the state is no rest state "
-                    "or the linearization is refused (the reason is printed), 2 on a model error.")
+                    "joints (or coordinates) that move most.")
     modes.add_argument("model", help="model file (YAML)")
     modes.add_argument("--equilibrium", action="store_true",
                        help="first find the static equilibrium near the initial state (Newton)")

@@ -20,7 +20,12 @@ def run(args):
                 outputs=(("--out", (".npz", ".csv")), ("--plot", PLOT_FORMATS)))
     if args.method not in INTEGRATORS:
         raise ModelError(f"--method {args.method}: not one of {', '.join(INTEGRATORS)}")
+    if args.plot_vars and not args.plot:
+        raise ModelError(f"--plot-vars {' '.join(args.plot_vars)}: chooses what the figure draws; "
+                         "give the figure's file with --plot FILE.png too")
     system = load(args.model)
+    if args.plot_vars:
+        check_plot_vars(system, args.plot_vars)
     bar = ProgressBar(args.t_end) if on_terminal(args) else None
     started = time.perf_counter()
     try:
@@ -55,6 +60,19 @@ def run(args):
     if error and not args.json:
         print(f"error: {error}", file=sys.stderr)
     return 0 if error is None else 1
+
+
+def check_plot_vars(system, names):
+    """ModelError naming each of ``names`` that is no coordinate (part.c), velocity
+    (part.c_dot) or output column of ``system``, and those it has."""
+    coordinates = system.coordinates
+    outputs = [column for output in system.outputs for column in output.columns]
+    known = {*coordinates, *(f"{c}_dot" for c in coordinates), *outputs}
+    unknown = [name for name in names if name not in known]
+    if unknown:
+        raise ModelError(f"--plot-vars {' '.join(unknown)}: model '{system.name}' has no such coordinate, velocity "
+                         f"or output; its coordinates: {', '.join(coordinates)} (velocities: each with _dot)"
+                         + (f"; its outputs: {', '.join(outputs)}" if outputs else "; it declares no outputs"))
 
 
 def format_summary(s):

@@ -230,3 +230,30 @@ def test_the_installed_command_prints_one_line_without_traceback(files):
                             capture_output=True, text=True, check=False)
     assert result.returncode == 2 and result.stdout == ""
     assert result.stderr.count("\n") == 1 and result.stderr.startswith("error: --t-end")
+
+
+def test_an_unknown_plot_var_is_refused_before_the_run(capsys, tmp_path, monkeypatch):
+    """The user's `--plot-vars bob.q` (the pendulum's coordinates are bob.x, bob.y): exit 2
+    with the names it has, and no run (simulate is never called)."""
+    monkeypatch.setattr(simulate_command, "simulate", lambda *args, **kwargs: pytest.fail("the run started"))
+    pendulum = ROOT / "models" / "mechanisms" / "simple_pendulum.yaml"
+    code, out, err = run(capsys, f"simulate {pendulum} --t-end 1 --plot {tmp_path}/p.png --plot-vars bob.x bob.q")
+    assert code == 2 and err == ("error: --plot-vars bob.q: model 'simple_pendulum' has no such coordinate, "
+                                 "velocity or output; its coordinates: bob.x, bob.y (velocities: each with _dot); "
+                                 "it declares no outputs\n")
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_plot_vars_without_plot_is_refused(capsys, monkeypatch):
+    monkeypatch.setattr(simulate_command, "simulate", lambda *args, **kwargs: pytest.fail("the run started"))
+    code, out, err = run(capsys, f"simulate {MODEL} --t-end 1 --plot-vars body1.x1 --json")
+    assert code == 2 and "give the figure's file with --plot FILE.png too" in json.loads(out)["error"]
+
+
+def test_plot_vars_draws_coordinates_velocities_and_outputs(capsys, tmp_path):
+    """Each kind of name --plot-vars takes is drawn (the figure is written, exit 0)."""
+    model = tmp_path / "outputs.yaml"
+    model.write_text(Path(MODEL).read_text() + "outputs:\n  stretch: body2.q2 - body2.q1\n")
+    code, _, err = run(capsys, f"simulate {model} --t-end 0.1 --plot {tmp_path}/p.png "
+                               "--plot-vars body1.x1 body1.x1_dot stretch")
+    assert code == 0 and (tmp_path / "p.png").stat().st_size > 0, err
