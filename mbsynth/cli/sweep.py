@@ -5,14 +5,14 @@ import json
 import sys
 import time
 
-from ..studies.sweep import parse_range, sweep
+from ..studies.sweep import parse_ranges, sweep
 from .parsers import check_flags
 from .report import on_terminal
 
 
 def run(args):
     check_flags(args, positive=("--t-end", "--dt", "--workers"), outputs=(("--out", (".parquet", ".csv")),))
-    params = dict(parse_range(p) for p in args.param) if args.param else None
+    params = parse_ranges(args.param) if args.param else None
     metrics = args.metric or ["energy_drift", "max_residual"]
     options = {} if args.dt is None else {"dt": args.dt}
     bar = _progress if on_terminal(args) else None

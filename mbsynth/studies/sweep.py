@@ -8,11 +8,14 @@ user's (``scheduler``). Each worker builds the model from its text once (file na
 it relative to the model file's folder) and reuses it for every run it gets
 (``System.with_parameters`` only changes numbers). Results are one table row per
 run, failures included with their error; the table is written to ``out`` (.parquet or
-.csv) atomically as runs finish, and a sweep restarted with the same ``out`` skips
-the runs already in it. Runs are keyed by a hash of their parameter values, so a run
-that Dask repeats (a worker lost mid-run) still appears exactly once; every row records
-the sweep's settings (model, t_end, simulation options, metrics), and a restart with
-other settings is refused rather than mixing the two. Trajectories come back from the
+.csv) atomically as runs finish and, with every row gathered, when the sweep stops for
+any reason (an interruption, a failure), and a sweep restarted with the same ``out``
+skips the runs that finished in it (failed ones run again). Runs are keyed by a hash
+of their parameter values, so a run that Dask repeats (a worker lost mid-run) still
+appears exactly once; every row records the sweep's settings (model, t_end, simulation
+options, metrics, the swept parameters and their grid), and a restart with other
+settings is refused, naming what changed, rather than mixing the two or dropping rows
+(a file that is no sweep's table is refused too). Trajectories come back from the
 workers and are written by the client, so ``trajectories`` is a folder on this machine.
 """
 
@@ -97,6 +100,19 @@ def grid(ranges):
         else:
             axes[name] = np.asarray(spec, dtype=float).ravel()
     return [dict(zip(axes, map(float, combo))) for combo in itertools.product(*axes.values())]
+
+
+def parse_ranges(texts):
+    """['NAME=START:STOP:COUNT', ...] (the --param flags) -> {name: (start, stop, count)};
+    a name given twice is refused."""
+    ranges = {}
+    for text in texts:
+        name, spec = parse_range(text)
+        if name in ranges:
+            raise ModelError(f"--param {name} is given twice ({name}={_axis_text(ranges[name])} and {text!r}): "
+                             "give each parameter once")
+        ranges[name] = spec
+    return ranges
 
 
 def parse_range(text):
@@ -210,21 +226,21 @@ def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift
     metric_list = [Metric(m) for m in metrics]
     for metric in metric_list:
         metric.parse(system)
-    settings = sweep_settings(system, t_end, metric_list, options)
-    done = _read_results(out, settings)
-    todo = [v for v in runs if run_id(v) not in done]
-    results = dict(done)
-    log.info("sweep of %d runs: %d already in %s, %d to go", len(runs), len(done), out, len(todo))
-    if todo:
-        if trajectories is not None:
-            Path(trajectories).mkdir(parents=True, exist_ok=True)
-        with _client(scheduler, workers) as client:
-            _execute(client, ModelText.of(system), todo, (t_end, metric_list, options, settings), trajectories,
-                     results, out, progress, len(runs))
-    table = _table(results, runs)
-    if out is not None:
-        _write_results(out, table)
-    return table
+    settings = sweep_settings(system, t_end, metric_list, options, params, runs)
+    results = _read_results(out, settings)  # failed ones are run again, and kept until then
+    todo = [v for v in runs if results.get(run_id(v), {}).get("status") != "ok"]
+    log.info("sweep of %d runs: %d already in %s, %d to go", len(runs), len(runs) - len(todo), out, len(todo))
+    try:
+        if todo:
+            if trajectories is not None:
+                Path(trajectories).mkdir(parents=True, exist_ok=True)
+            with _client(scheduler, workers) as client:
+                _execute(client, ModelText.of(system), todo, (t_end, metric_list, options, settings), trajectories,
+                         results, out, progress, len(runs))
+    finally:  # also on an interruption or a failure: every row gathered is kept
+        if out is not None and results:
+            _write_results(out, _table(results, runs))
+    return _table(results, runs)
 
 
 def _runs(system, params, samples):
@@ -305,11 +321,32 @@ def _outcome(future, values):
     return {"run_id": run_id(values), **values, "status": "failed", "error": error}, None
 
 
-def sweep_settings(system, t_end, metrics, options):
-    """What the runs' results depend on besides their parameter values, as JSON text: the
-    model (its text's hash and folder), t_end, the simulation options and the metrics."""
+def sweep_settings(system, t_end, metrics, options, params, runs):
+    """What a sweep's table holds, as JSON text recorded in every row: the model (its text's
+    hash and folder), t_end, the simulation options, the metrics, the swept parameters'
+    names and their grid (``grid_text``). A sweep resumed into the table must have the same."""
     return json.dumps({"model_sha1": _digest(system.source), "folder": system.source_folder, "t_end": float(t_end),
-                       "options": options, "metrics": [m.spec for m in metrics]}, sort_keys=True, default=list)
+                       "options": options, "metrics": [m.spec for m in metrics],
+                       "parameters": sorted({name for values in runs for name in values}),
+                       "grid": grid_text(params, runs)}, sort_keys=True, default=list)
+
+
+def grid_text(params, runs):
+    """The runs of a sweep in a few words: 'NAME=START:STOP:COUNT ...' (a list of values:
+    'NAME=v1,v2,...', or its length and digest when long) by name, or for samples their
+    count and a digest of their values in order."""
+    if params is None:
+        return f"{len(runs)} samples (sha1 {_digest(json.dumps([run_id(v) for v in runs]))})"
+    return " ".join(f"{name}={_axis_text(spec)}" for name, spec in sorted(params.items()))
+
+
+def _axis_text(spec):
+    """One swept parameter's values as given: 'START:STOP:COUNT' or a list of values."""
+    if isinstance(spec, tuple) and len(spec) == 3:
+        start, stop, count = spec
+        return f"{float(start)!r}:{float(stop)!r}:{int(count)}"
+    values = [repr(float(v)) for v in np.asarray(spec, dtype=float).ravel()]
+    return ",".join(values) if len(values) <= 8 else f"{len(values)} values (sha1 {_digest(','.join(values))})"
 
 
 def _table(results, runs):
@@ -318,15 +355,16 @@ def _table(results, runs):
 
 
 def _read_results(out, settings):
-    """The finished runs of an earlier sweep with the same ``settings`` in ``out`` (by run
-    id); a ModelError when ``out`` holds another sweep's runs."""
+    """The rows of an earlier sweep with the same ``settings`` in ``out`` (by run id); a
+    ModelError when ``out`` holds another sweep's runs, or is no sweep's table."""
     if out is None or not Path(out).exists():
         return {}
     table = _read_table(out)
-    if "run_id" not in table:
-        return {}
+    if not {"run_id", "status"} <= set(table.columns):
+        raise ModelError(f"{out}: exists and is not the table of a sweep (it has no run_id and status "
+                         f"columns); give another --out, or remove {out}")
     _check_settings(out, set(table["settings"]) if "settings" in table else {""}, settings)
-    return {row["run_id"]: row for row in table.to_dict("records") if row.get("status") == "ok"}
+    return {row["run_id"]: row for row in table.to_dict("records")}
 
 
 def _check_settings(out, found, settings):
@@ -345,9 +383,12 @@ def _check_settings(out, found, settings):
 def _read_table(path):
     path = Path(path)
     try:
-        return pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path, keep_default_na=False)
+        table = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
     except (OSError, ValueError) as err:
         raise ModelError(f"{path}: cannot read the results of an earlier sweep: {err}") from None
+    if "error" in table:
+        table["error"] = table["error"].astype(object).fillna("")  # an ok run's empty error (a CSV's empty cell)
+    return table
 
 
 def _write_results(out, table):

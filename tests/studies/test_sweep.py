@@ -248,3 +248,108 @@ def test_a_bad_thread_count_is_refused_by_name():
     done = subprocess.run([sys.executable, "-c", "import mbsynth.compiled.threads"], capture_output=True, text=True,
                           env={**os.environ, "MBSYNTH_THREADS": "two"})
     assert done.returncode != 0 and "MBSYNTH_THREADS must be a positive whole number, got 'two'" in done.stderr
+
+
+def test_resuming_with_another_swept_parameter_is_refused_naming_it(cluster, tmp_path, capsys, monkeypatch):
+    """The user's two commands: a sweep of k1 into x.parquet, then one of k2 into the same
+    file. The second is refused (exit 2) naming the parameters and the grid, before any
+    run, and the k1 rows stay."""
+    monkeypatch.chdir(tmp_path)
+    first = ["sweep", str(MODEL), "--param", "k1=40:160:3", "--t-end", "0.5", "--dt", "0.01", "--out", "x.parquet"]
+    assert main([*first, "--scheduler", cluster.scheduler_address]) == 0
+    capsys.readouterr()
+    code = main([*first[:3], "k2=40:160:2", *first[4:], "--workers", "1"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "parameters ['k1'] there, ['k2'] now" in err and "grid 'k1=40.0:160.0:3' there, 'k2=40.0:160.0:2' now" in err
+    assert list(pd.read_parquet("x.parquet")["k1"]) == [40.0, 100.0, 160.0]
+    with pytest.raises(mb.ModelError, match=r"grid 'k1=40.0:160.0:3' there, 'k1=40.0:160.0:4' now"):  # a finer grid
+        sweep(MODEL, {"k1": (40, 160, 4)}, 0.5, out="x.parquet", dt=0.01)
+    samples = tmp_path / "samples.csv"
+    samples.write_text("k1\n40\n100\n160\n")  # the same runs, given as samples: another grid all the same
+    with pytest.raises(mb.ModelError, match=r"grid 'k1=40.0:160.0:3' there, '3 samples \(sha1 [0-9a-f]+\)' now"):
+        sweep(MODEL, samples=samples, t_end=0.5, out="x.parquet", dt=0.01)
+
+
+def test_an_out_file_that_is_no_sweeps_table_is_refused_and_kept(tmp_path):
+    out = tmp_path / "mine.csv"
+    out.write_text("a,b\n1,2\n")
+    with pytest.raises(mb.ModelError, match="is not the table of a sweep"):
+        sweep(MODEL, {"k1": [40.0]}, 0.5, out=out, **FAST)
+    assert out.read_text() == "a,b\n1,2\n"
+
+
+def test_a_parameter_given_twice_is_refused(capsys, tmp_path):
+    code = main(["sweep", str(MODEL), "--param", "k1=40:160:3", "--param", "k1=10:20:2", "--t-end", "0.5",
+                 "--out", str(tmp_path / "o.csv"), "--json"])
+    assert code == 2
+    assert json.loads(capsys.readouterr().out)["error"] == (
+        "--param k1 is given twice (k1=40.0:160.0:3 and 'k1=10:20:2'): give each parameter once")
+
+
+class InterruptedClient:
+    """A cluster that is interrupted (Ctrl-C) while it starts."""
+
+    def __init__(self, *args):
+        pass
+
+    def __enter__(self):
+        raise KeyboardInterrupt
+
+    def __exit__(self, *exc):
+        pass
+
+
+def test_ctrl_c_before_the_first_run_says_nothing_was_written(tmp_path, capsys, monkeypatch):
+    """Interrupted while the cluster starts: exit 130, no file, and the message says so."""
+    monkeypatch.setattr(importlib.import_module("mbsynth.studies.sweep"), "_client", InterruptedClient)
+    out = tmp_path / "y.parquet"
+    code = main(["sweep", str(MODEL), "--param", "k1=40:160:3", "--t-end", "0.5", "--out", str(out)])
+    assert code == 130 and capsys.readouterr().err == f"error: interrupted; nothing was written to {out}\n"
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("stop", [KeyboardInterrupt, RuntimeError])
+def test_a_sweep_stopped_midway_keeps_every_row_gathered(cluster, tmp_path, capsys, monkeypatch, stop):
+    """Ctrl-C (exit 130) or a failure (a bug: exit 3) after the second run: both rows are in
+    the table (the checkpoint every second would have kept at most the first), and
+    resuming runs only the rest."""
+    module = importlib.import_module("mbsynth.studies.sweep")
+    monkeypatch.setattr(module, "CHECKPOINT_SECONDS", 1e9)
+    out = tmp_path / "y.csv"
+    line = ["sweep", str(MODEL), "--param", "k1=40:160:4", "--t-end", "0.2", "--dt", "0.05", "--out", str(out),
+            "--scheduler", cluster.scheduler_address]
+    real = module._execute
+
+    def stopping(client, model, todo, job, trajectories, results, out_, progress, total):
+        def after_two(done, failed, total_, eta):
+            if done == 2:
+                raise stop("stopped")
+        return real(client, model, todo, job, trajectories, results, out_, after_two, total)
+
+    monkeypatch.setattr(module, "_execute", stopping)
+    code = main(line)
+    err = capsys.readouterr().err
+    assert code == (130 if stop is KeyboardInterrupt else 3), err
+    if stop is KeyboardInterrupt:
+        assert err == f"error: interrupted; the output so far is in {out}\n"
+    kept = pd.read_csv(out)
+    assert len(kept) == 2 and (kept["status"] == "ok").all()
+    monkeypatch.setattr(module, "_execute", real)
+    assert main(line) == 0
+    resumed = pd.read_csv(out).set_index("run_id")
+    assert len(resumed) == 4  # the two kept rows as they were (not run again), two new ones
+    assert list(resumed.loc[kept["run_id"], "wall_time_s"]) == list(kept["wall_time_s"])
+
+
+def test_failed_rows_are_kept_until_run_again(cluster, tmp_path, monkeypatch):
+    """A resumed sweep runs its failed runs again; interrupted before they finish, the table
+    still holds their rows with the error."""
+    out = tmp_path / "runs.csv"
+    sweep(MODEL, {"m1": [1.0, -1.0]}, 0.2, out=out, scheduler=cluster.scheduler_address, **FAST)
+
+    monkeypatch.setattr(importlib.import_module("mbsynth.studies.sweep"), "_client", InterruptedClient)
+    with pytest.raises(KeyboardInterrupt):
+        sweep(MODEL, {"m1": [1.0, -1.0]}, 0.2, out=out, scheduler=cluster.scheduler_address, **FAST)
+    kept = pd.read_csv(out)
+    assert list(kept["status"]) == ["ok", "failed"] and "not positive semi-definite" in kept["error"].iloc[1]
