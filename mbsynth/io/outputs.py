@@ -1,7 +1,7 @@
 """Reading a model's ``outputs:`` mapping (the kinds are described in mbsynth.model.outputs)."""
 
 from ..core.errors import ModelError
-from ..model.outputs import energy_output, expression_output, frame_output, reaction_output
+from ..model.outputs import BUILT_IN_COLUMNS, energy_output, expression_output, frame_output, reaction_output
 from .joints import frame_reference
 from .schema import SECTIONS
 
@@ -19,6 +19,9 @@ def read_outputs(builder, constraints):
     for name, spec in node.items():
         path = ("outputs", name)
         builder.identifier(name, path, "output name")
+        if name in BUILT_IN_COLUMNS:
+            builder.fail(path, f"output name '{name}' is a column every trajectory has ({', '.join(BUILT_IN_COLUMNS)}, "
+                               "the coordinates and velocities); choose another")
         if not isinstance(spec, dict):
             outputs.append(expression_output(name, builder.expression(spec, path, builder.global_symbols)))
             continue

@@ -12,9 +12,11 @@
 An output with several components gives one column each, named ``tip[x]``, ``tip[y]``,
 ``tip[z]`` (``load[0]``, … for multipliers). Expressions, positions and velocities are
 compiled together into one function of the state; reactions need the motion and are
-computed from it (reactions.py).
+computed from it (reactions.py). An output that evaluates to inf or NaN is written as it
+is, with a warning (logged once per output and run) naming it and the first such time.
 """
 
+import logging
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,8 +26,11 @@ from ..core.errors import ModelError
 from ..symbolic.derive import T_SYMBOL, compile_function, time_derivative
 
 AXES = ("x", "y", "z")
+BUILT_IN_COLUMNS = ("t", "energy")  # a trajectory file's columns besides the coordinates and velocities
 ENERGIES = ("kinetic", "potential", "total")
 REACTION_PARTS = ("force", "torque", "multipliers")
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -90,6 +95,7 @@ class OutputEvaluator:
         args = (T_SYMBOL, list(system.q_symbols), list(system.qd_symbols), list(system.parameter_symbols))
         self._compiled = compile_function(args, [sp.Matrix(exprs)]) if exprs else None
         self.needs_reactions = any(o.kind == "reaction" for o in self.outputs)
+        self._not_finite = set()  # the outputs already warned of
 
     def __bool__(self):
         return bool(self.outputs)
@@ -113,7 +119,23 @@ class OutputEvaluator:
                 row.append({"kinetic": kinetic, "potential": potential, "total": kinetic + potential}[output.part])
             else:
                 row += [next(compiled) for _ in output.expressions]
-        return np.array(row, dtype=float)
+        row = np.array(row, dtype=float)
+        if not np.isfinite(row).all():
+            self._warn_not_finite(t, row)
+        return row
+
+    def _warn_not_finite(self, t, row):
+        """Log each output with an inf or NaN column in ``row`` at t, the first time only."""
+        start = 0
+        for output in self.outputs:
+            values = row[start:start + len(output.columns)]
+            start += len(output.columns)
+            if output.name not in self._not_finite and not np.isfinite(values).all():
+                self._not_finite.add(output.name)
+                shown = values[0] if output.columns == [output.name] else ", ".join(
+                    f"{c} = {v}" for c, v in zip(output.columns, values))
+                log.warning("output '%s' is not finite at t = %.6g: %s (written as it is; not repeated for this "
+                            "output)", output.name, t, shown)
 
     def table(self, t, q, qd):
         """The rows at each time of a trajectory (arrays t, q, q̇), one per row."""

@@ -113,3 +113,34 @@ def test_sampled_controller_holds_the_static_balance():
         mb.simulate(system, 0.1, controller=lambda t, v: {"torque": 1.0})
     with pytest.raises(mb.ModelError, match=r"controller at t = 0: .*non-finite values for parameter\(s\) \['tau'\]"):
         mb.simulate(system, 0.1, controller=lambda t, v: {"tau": float("nan")})
+
+
+@pytest.mark.parametrize("name", ["energy", "t"])
+def test_an_output_named_like_a_built_in_column_is_refused_at_its_line(tmp_path, name):
+    """A trajectory file has the columns t, the coordinates, their _dot, energy, then the
+    outputs: an output named ``energy`` would write a second ``energy`` column (pandas
+    reads it as ``energy.1``), so it is refused at load, with its file and line."""
+    text = Path("models/joints/driven_pendulum.yaml").read_text() + f"outputs:\n  angle: hinge.angle\n  {name}: 1\n"
+    model = tmp_path / "clash.yaml"
+    model.write_text(text)
+    with pytest.raises(mb.ModelError) as err:
+        mb.load(model)
+    line = text.splitlines().index(f"  {name}: 1") + 1
+    assert str(err.value).startswith(f"{model}:{line}: at outputs.{name}: output name '{name}'"), str(err.value)
+
+
+def test_an_output_that_is_not_finite_is_written_with_one_warning(tmp_path, caplog):
+    """``1/hinge.angle`` at the hinge's start (angle 0) is inf: written as it is, and said
+    once (the output and the time), not once per row."""
+    text = Path("models/joints/pd_pendulum.yaml").read_text() + (
+        "outputs:\n  inverse: 1/hinge.angle\n  twice: 2*hinge.angle\n")
+    text = text.replace("target: 0.5}", "target: 0.5, rest: 0.0}").replace("kp*(hinge.angle - target)",
+                                                                           "kp*(hinge.angle - target)*(1 - rest)")
+    system = mb.loads(text)
+    out = tmp_path / "run.csv"
+    with caplog.at_level("WARNING", logger="mbsynth.model.outputs"):
+        mb.simulate(system.with_parameters(rest=1.0), 0.2, dt=0.05, out=out)  # no torque: it hangs at angle 0
+    warned = [r.getMessage() for r in caplog.records if r.name == "mbsynth.model.outputs"]
+    assert len(warned) == 1 and warned[0].startswith("output 'inverse' is not finite at t = 0: inf"), warned
+    saved = mb.load_trajectory(out)
+    assert np.isinf(saved.column("inverse")).all() and np.all(saved.column("twice") == 0)  # every row inf, one word
