@@ -24,9 +24,10 @@ import scipy.sparse.linalg
 from ..core.equations import term_scales
 from ..model.evaluation import DENSE_ENTRIES
 from ..core.errors import SolveError
-from ..core.tolerances import PROJECTION_RTOL
+from ..core.tolerances import NEAR_SINGULAR, PROJECTION_RTOL
 
 MAX_ITERATIONS = 50
+DIVERGED = 1e6  # a last pass stops where its largest residual exceeds this times its smallest so far
 
 
 def _free_columns(n, fixed):
@@ -150,10 +151,11 @@ def project_positions(system, t, q, fixed=None, tolerance=PROJECTION_RTOL, array
 
 def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
     """Gauss–Newton steps from q (a copy is changed) until every position row is met; None
-    when the residual grows (unless ``last``: then a SolveError names the unmet rows).
-    ``arrays``: the ConstraintArrays at q, if at hand (φ and A do not depend on q̇)."""
-    q, qd = q.copy(), np.zeros_like(q)
-    previous = np.inf
+    when the residual grows (unless ``last``: then a SolveError names the rows unmet,
+    ``_unmet_positions``). ``arrays``: the ConstraintArrays at q, if at hand (φ and A do
+    not depend on q̇)."""
+    start, q, qd = q, q.copy(), np.zeros_like(q)
+    previous, best = np.inf, (np.inf, q.copy())
     for _ in range(MAX_ITERATIONS):
         if arrays is None:
             arrays = system.constraint_arrays(t, q, qd, sparse=None)
@@ -165,6 +167,10 @@ def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
         size = np.abs(phi[rows]).max()
         if not last and size > 2 * previous:
             return None
+        if size < best[0]:
+            best = (size, q.copy())
+        elif size > DIVERGED * best[0]:  # the last pass gives up once it runs away from its best
+            break
         previous = size
         q[free] -= _correction(arrays.A[rows][:, free], phi[rows], system.coordinate_groups[free], floor)
         arrays = None
@@ -172,11 +178,7 @@ def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
             break
     if not last:
         return None
-    arrays = system.constraint_arrays(t, q, qd, sparse=None)
-    phi, A = arrays.phi, arrays.A
-    raise SolveError(_unmet(system, phi, "positions", free),
-                     constraints=[n for n, r, s in zip(system.constraint_names, phi, term_scales(A, q))
-                                  if abs(r) > tolerance * s])
+    raise _unmet_positions(system, t, start, best[1], free, tolerance)
 
 
 def project_velocities(system, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
@@ -270,6 +272,114 @@ def _project_keeping(system, t, q, qd, keep):
 
 def _unmet(system, residual, level, free):
     worst = np.nanargmax(np.abs(residual))
-    return (f"the constraints cannot be met by adjusting the {level} of "
-            f"{', '.join(c for c, f in zip(system.coordinates, free) if f) or 'no coordinate (all are fixed)'}; "
+    return (f"the constraints cannot be met by adjusting the {level} of {_listed(system, free)}; "
             f"largest residual {abs(residual[worst]):.3g} in {system.constraint_names[worst]}")
+
+
+LISTED = 8  # coordinates named in an error before "… (n in all)"
+
+
+def _listed(system, free):
+    """The free coordinates, the first LISTED of them named."""
+    names = [c for c, f in zip(system.coordinates, free) if f]
+    if not names:
+        return "no coordinate (all are fixed)"
+    return ", ".join(names) if len(names) <= LISTED else f"{', '.join(names[:LISTED])}, … ({len(names)} in all)"
+
+
+def _unmet_positions(system, t, start, best, free, tolerance):
+    """The SolveError of a projection that could not meet the position rows: the rows
+    unmet at ``start``, largest residual relative to its row's terms first (a row no
+    configuration meets, such as a servo beyond a joint's range, is one of them; the rows
+    Newton's steps break on their way are not), and the largest residual at ``best``,
+    the iterate that came closest. Where the residual at ``best`` lies along a dependency
+    of the rows (dependent at this configuration only: a singular position, where no
+    first-order change moves it), that dependency's rows are named instead."""
+    unmet = _unmet_rows(system, t, start, tolerance)
+    arrays = system.constraint_arrays(t, best, np.zeros_like(best), sparse=None)
+    phi = np.where(np.isfinite(arrays.phi), arrays.phi, 0.0)
+    worst = int(np.argmax(np.abs(phi)))
+    closest = f"{abs(phi[worst]):.3g} in {system.constraint_names[worst]}"
+    listed = ", ".join(f"{name} ({residual:.3g})" for name, residual in unmet[:LISTED])
+    if len(unmet) > LISTED:
+        listed += f", … ({len(unmet)} rows in all)"
+    dependency = _dependency(system, t, best, arrays.A, phi, free)
+    if dependency is None:
+        return SolveError(f"the constraints cannot be met by adjusting the positions of {_listed(system, free)}: "
+                          f"unmet {listed}; Newton's steps left at best a residual of {closest}",
+                          constraints=[name for name, _ in unmet])
+    rows, distance = dependency
+    if distance is None:
+        return SolveError(f"the constraints cannot be met by adjusting the positions of {_listed(system, free)}: "
+                          f"unmet {listed}; the residual left ({closest}) is the least the rows {_names(rows)} "
+                          "reach near here (no change of the positions lowers it, to first or second order)",
+                          constraints=rows)
+    return SolveError(f"the constraints cannot be met near this configuration: rows {_names(rows)} are dependent "
+                      "here (a singular position: a loop stretched straight, or joint axes in line) and the "
+                      f"residual ({closest}) lies along their dependency; a consistent configuration lies about "
+                      f"{distance:.2g} away, which no first-order step reaches: start the model away from the "
+                      "singular position", constraints=rows)
+
+
+def _unmet_rows(system, t, q, tolerance):
+    """[(row name, |φ|)] of the position rows unmet at q, largest relative residual first."""
+    arrays = system.constraint_arrays(t, q, np.zeros_like(q), sparse=None)
+    phi = np.where(np.isfinite(arrays.phi), arrays.phi, 0.0)
+    scales = term_scales(arrays.A, q)
+    order = np.argsort(-np.abs(phi) / np.maximum(scales, np.finfo(float).tiny))
+    return [(system.constraint_names[i], float(abs(phi[i]))) for i in order if abs(phi[i]) > tolerance * scales[i]]
+
+
+def _names(rows):
+    """Row names, the first LISTED of them."""
+    return ", ".join(rows) if len(rows) <= LISTED else f"{', '.join(rows[:LISTED])}, … ({len(rows)} in all)"
+
+
+DIAGNOSED_ENTRIES = 4_000_000  # a dense SVD of the rows is taken for a diagnosis up to this size
+
+
+def _dependency(system, t, q, A, phi, free):
+    """None where φ lies mostly in the range of A's free columns (rows scaled to unit norm);
+    else (the rows of the dependency wᵀA = 0 along which it lies — singular values below
+    NEAR_SINGULAR of the largest —, the distance to a configuration that meets it or None).
+    wᵀφ(q + δ) = wᵀφ + ½ δᵀ C δ for δ in null(A) (C: the second derivative of wᵀφ there,
+    central differences of A): met at |δ| = √(2|wᵀφ|/|λ|) along an eigenvector of C whose
+    eigenvalue λ has the sign opposite to wᵀφ, and nowhere near q if none has."""
+    J = A.toarray() if scipy.sparse.issparse(A) else np.asarray(A)
+    J = J[:, free]
+    if J.size > DIAGNOSED_ENTRIES:
+        return None
+    norms = np.linalg.norm(J, axis=1)
+    norms[norms == 0] = 1.0
+    U, s, Vt = np.linalg.svd(J / norms[:, None])
+    rank = int(np.sum(s > NEAR_SINGULAR * s[0])) if s.size else 0
+    r = phi / norms
+    along = U[:, rank:].T @ r
+    if not along.size or np.linalg.norm(along) < 0.5 * np.linalg.norm(r):
+        return None
+    w = U[:, rank:] @ along / np.linalg.norm(along)  # the dependency that carries φ
+    weights = np.abs(w)
+    rows = [n for n, x in zip(system.constraint_names, weights) if x > DEPENDENCY_SHARE * weights.max()]
+    N = Vt[rank:].T  # the free coordinates' directions the rows do not move (to first order)
+    if not N.shape[1] or N.shape[1] > DIAGNOSED_DIRECTIONS:
+        return rows, None
+    h = CURVATURE_STEP * max(np.abs(q).max(), 1.0)
+    slopes = []
+    for n in N.T:
+        step = np.zeros_like(q)
+        step[free] = h * n
+        ends = [system.constraint_arrays(t, q + sign * step, np.zeros_like(q), sparse=False).A[:, free]
+                for sign in (1, -1)]
+        slopes.append(((w / norms) @ (ends[0] - ends[1])) / (2 * h))
+    C = np.array(slopes) @ N
+    values = np.linalg.eigvalsh((C + C.T) / 2)
+    residual = w @ r
+    opposite = values[values * residual < 0]
+    if not opposite.size:
+        return rows, None
+    return rows, float(np.sqrt(2 * abs(residual) / np.abs(opposite).max()))
+
+
+DIAGNOSED_DIRECTIONS = 60  # the curvature is taken along at most this many free directions
+CURVATURE_STEP = 1e-5  # central differences of A, relative to the largest coordinate (at least 1)
+DEPENDENCY_SHARE = 0.1  # a row is named in a dependency where its weight exceeds this share of the largest

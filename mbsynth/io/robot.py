@@ -5,6 +5,7 @@
       robot: ur5                 # an example-robot-data name, or a URDF file (relative to the model file)
       floating: false            # default false: the root link welded to the world at ``base``
       base: {position: [0, 0, 0.5], rpy: [0, 0, 0]}   # optional; the initial pose when floating
+      initial: {elbow_joint: 0.5}   # optional: initial joint positions (URDF names), 0 where not given
 
 The entry named ``arm`` gives one rigid body per link, named ``arm_<link>`` (frames: ``link``
 at the URDF link frame, one per joint named after it), one joint per URDF joint,
@@ -51,11 +52,16 @@ class RobotEntry:
         return self.robot.parameters
 
     def parts(self, builder):
-        """The robot's bodies, at ``base`` (read now: it may use the model's parameters)."""
+        """The robot's bodies, at ``base`` with its joints at ``initial`` (read now: they may
+        use the model's parameters)."""
         node = builder.section(self.spec.get("base"), self.path + ("base",), "pose")
         position = builder.numbers(node.get("position", [0, 0, 0]), self.path + ("base", "position"), 3)
         rotation = read_rotation(builder, node, self.path + ("base",))
-        self.robot = replace(self.robot, base=(np.array(position), rotation))
+        where = self.path + ("initial",)
+        movable = {j.name for j in self.robot.description.joints if j.kind != "fixed"}
+        given = builder.mapping(self.spec.get("initial"), where, movable)
+        positions = {joint: builder.value(builder.constant(text, where + (joint,))) for joint, text in given.items()}
+        self.robot = replace(self.robot, base=(np.array(position), rotation), positions=positions)
         return self.robot.bodies(builder.gravity, builder.param_symbols.values())
 
     def connect(self, builder):

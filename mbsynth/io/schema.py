@@ -173,7 +173,10 @@ SECTIONS = {section.name: section for section in (
              Key("floating", "boolean", "a free-floating base instead of one welded to the world", "true",
                  default="false"),
              Key("base", "mapping (section *pose*)", "pose of the root link (the initial pose when floating)",
-                 "{position: [0, 0, 0.5]}", default="the world's origin"), _DESCRIPTION)),
+                 "{position: [0, 0, 0.5]}", default="the world's origin"),
+             Key("initial", "mapping URDF joint name → " + _EXPR, "initial position of each movable joint "
+                 "[rad or m]: the links start where the URDF's kinematics puts them", "{elbow_joint: 0.5}",
+                 default="0 for every joint"), _DESCRIPTION)),
     Section("initial_rigid_body", "``initial:`` of a rigid_body",
             "Velocities are in world axes.",
             (Key("position", "list of 3 " + _EXPRS, "position of the centre of mass", "[0, 0, 1]",

@@ -22,7 +22,7 @@ import glob
 import os
 import re
 import sys
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import sympy as sp
@@ -125,7 +125,8 @@ class Robot:
     """A robot decomposed into parts: ``parts`` maps each URDF link to its part's name,
     ``joints`` each URDF joint to its connector's name, ``torques`` each movable joint to
     its torque parameter. ``base`` is the root link's world (position, rotation) when
-    fixed, its initial pose when ``floating``."""
+    fixed, its initial pose when ``floating``; ``positions`` the initial joint positions
+    ({URDF joint name: value}, 0 where not given)."""
 
     description: object
     prefix: str
@@ -135,6 +136,7 @@ class Robot:
     joints: dict
     torques: dict
     base_joint: str
+    positions: dict = field(default_factory=dict)
 
     @classmethod
     def plan(cls, description, prefix="", floating=False, base=None):
@@ -153,14 +155,14 @@ class Robot:
         return {name: 0.0 for name in self.torques.values()}
 
     def bodies(self, gravity, params):
-        """One RigidBody per link, at the pose of the robot with all joints at zero."""
+        """One RigidBody per link, at the pose of the robot with its joints at ``positions``."""
         frames = {link: [Frame(self.parts[link], LINK_FRAME, exact(-lk.com), sp.eye(3))]
                   for link, lk in self.description.links.items()}
         for joint in self.description.joints:
             on_parent, on_child = self.joint_frames(joint)
             frames[joint.parent].append(on_parent)
             frames[joint.child].append(on_child)
-        poses = self.description.zero_poses(self.base)
+        poses = self.description.poses(self.base, self.positions)
         bodies = []
         for link, lk in self.description.links.items():
             name = self.parts[link]

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import ModelError
-from ..core.kinematics import rpy_matrix
+from ..core.kinematics import quaternion_matrix, rpy_matrix
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed")
 
@@ -63,14 +63,24 @@ class Description:
         """The joints that hang links from ``link``."""
         return [j for j in self.joints if j.parent == link]
 
-    def zero_poses(self, base=None):
-        """World (position, rotation) of every link's frame with all joints at zero and
-        the root link's frame at ``base`` (the world origin by default)."""
+    def poses(self, base=None, positions=None):
+        """World (position, rotation) of every link's frame with the root link's frame at
+        ``base`` (the world origin by default) and each joint at its value in ``positions``
+        ({joint name: angle [rad] or displacement [m]}, 0 where not given): the child link's
+        frame is the joint's origin turned about (revolute, continuous) or moved along
+        (prismatic) the joint's axis, as URDF defines it."""
         position, rotation = (np.zeros(3), np.eye(3)) if base is None else base
+        positions = positions or {}
         poses = {self.root: (np.asarray(position, float), np.asarray(rotation, float))}
         for joint in self.tree_order():
             p, R = poses[joint.parent]
-            poses[joint.child] = (p + R @ joint.position, R @ joint.rotation)
+            p, R = p + R @ joint.position, R @ joint.rotation
+            x = float(positions.get(joint.name, 0.0))
+            if joint.kind == "prismatic":
+                p = p + R @ joint.axis * x
+            elif joint.kind != "fixed":
+                R = R @ quaternion_matrix([np.cos(x / 2), *(np.sin(x / 2) * joint.axis)])
+            poses[joint.child] = (p, R)
         return poses
 
     def tree_order(self):

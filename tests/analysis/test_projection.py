@@ -1,12 +1,17 @@
 """projection._correction: the least-norm step of a sparse J, checked against dense least
-squares (numpy's SVD-based lstsq, an independent computation)."""
+squares (numpy's SVD-based lstsq, an independent computation); a projection that fails
+names the rows at fault (a servo no configuration meets, a loop at a singular position)."""
 
+import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 import scipy.sparse
 
-from mbsynth.analysis.projection import _correction
+import mbsynth as mb
+from mbsynth.analysis.projection import _correction, consistent_initial_state
+from mbsynth.cli import main
 
 RNG = np.random.default_rng(3)
 ROOT = Path(__file__).resolve().parents[2]
@@ -153,3 +158,79 @@ def test_term_scales_of_a_sparse_matrix_equal_the_sum_of_its_terms():
     np.testing.assert_allclose(term_scales(A, x), expected, rtol=1e-14)
     np.testing.assert_allclose(term_scales(dense, x), expected, rtol=1e-14)
     assert term_scales(A, x)[7] == 0.0
+
+
+# -- a projection that fails names the rows at fault ------------------------------------------
+
+TWO_ARMS_AT_ZERO = """
+name: two_arms_at_zero
+parameters: {m: 1.5, L: 0.6, r: 0.02, g: 9.81}
+gravity: [0, 0, -g]
+subsystems:
+  left: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}
+  right: {type: robot, robot: ur5, base: {position: [1.6345, 0.3829 + L, 1], rpy: [0, 0, pi]}}
+  bar:
+    type: rigid_body
+    mass: m
+    inertia: [m*L**2/12, m*L**2/12, m*r**2/2]
+    frames:
+      left: {position: [0, 0, -L/2]}
+      right: {position: [0, 0, L/2], rpy: [0, pi, 0]}
+    initial: {position: [0.81725, 0.19145 + L/2, 0.994509], rpy: [pi/2, 0, pi]}
+joints:
+  - {name: left_grip, type: fixed, parent: left_tool0, child: bar.left}
+  - {name: right_grip, type: fixed, parent: right_tool0, child: bar.right}
+"""
+
+
+def test_a_loop_at_a_singular_position_is_named_with_the_distance_to_a_closed_one():
+    """Two UR5 arms at their zero pose welded to one bar: wrist 1 and wrist 3 turn about one
+    axis and the elbows are stretched, so no joint turns the bar about its own axis; the
+    URDF's π/2 to 11 digits (1.57079632679, 4.9e-12 short) leaves the loop 9.8e-12 rad
+    apart along that axis. First-order steps cannot move that residual; one of second order
+    meets it: |δ| = √(2 |wᵀφ| / |λ|), micro-radians away."""
+    system = mb.loads(TWO_ARMS_AT_ZERO)
+    with pytest.raises(mb.SolveError, match=r"dependent here \(a singular position.*lies about (\S+) away") as err:
+        consistent_initial_state(system)
+    distance = float(re.search(r"lies about (\S+) away", str(err.value)).group(1))
+    assert 1e-7 < distance < 1e-4  # √(1e-11): far beyond rounding, far below a visible change
+    assert {"left_grip[ry]", "right_grip[ry]", "left_wrist_3_joint[axis_y]"} <= set(err.value.constraints)
+
+
+def test_the_bundled_two_arms_model_closes_its_loop_within_the_urdf_digits():
+    """Posed away from that singular position (elbows bent, wrist 2 turned), the same loop
+    closes: only the URDF's 11-digit angles move, by less than 1e-11."""
+    q, qd, changes = consistent_initial_state(mb.load(ROOT / "models" / "robots" / "two_arms_bar.yaml"))
+    assert changes and max(abs(a - b) for a, b in changes.values()) < 1e-11
+
+
+def test_a_servo_beyond_the_joints_range_is_named(tmp_path, capsys):
+    """``mbsynth simulate`` of a UR5 whose elbow must be at 4 rad (its angle lies in (−π, π]):
+    exit 2 naming the servo, unmet from the start, not the joint rows Newton's steps break."""
+    path = tmp_path / "servo.yaml"
+    path.write_text("name: ur5_servo\nparameters: {g: 9.81}\ngravity: [0, 0, -g]\n"
+                    "subsystems:\n  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}\n"
+                    "constraints:\n  - {name: elbow_servo, holonomic: arm_elbow_joint.angle - 4}\n")
+    assert main(["simulate", str(path), "--t-end", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert "unmet elbow_servo (4);" in err and "(77 in all)" in err and "at best a residual of" in err
+
+
+def test_a_row_out_of_reach_says_it_is_at_its_least():
+    """A pendulum of length 2 whose bob is held at x = 3: x² + y² − 4 ≥ 5, met nowhere;
+    at y = 0 no change of y lowers it, to first or second order."""
+    system = mb.loads(PENDULUM + "initial: {bob.x: 3.0}\ninitial_fixed: [bob.x]\n")
+    with pytest.raises(mb.SolveError, match=r"unmet rod \(5\); the residual left \(5 in rod\) is the least the rows "
+                                            r"rod reach near here") as err:
+        consistent_initial_state(system)
+    assert err.value.constraints == ("rod",)
+
+
+PENDULUM = """\
+name: pendulum
+parameters: {m: 1.0, L: 2.0, g: 9.81}
+subsystems:
+  bob: {type: lagrangian, coordinates: [x, y], T: 0.5*m*(x_dot**2 + y_dot**2), V: m*g*y}
+constraints:
+  - {name: rod, holonomic: bob.x**2 + bob.y**2 - L**2}
+"""

@@ -162,7 +162,7 @@ def arm_with_loop(tmp_path):
     """A model file: the SO-100 arm (type: robot) holds a bar in its gripper link, the
     bar's tip pinned to the world where it is at the zero pose, and a payload hangs from
     the bar by a spring."""
-    p, R = describe("so100").zero_poses()["gripper"]
+    p, R = describe("so100").poses()["gripper"]
     u = matrix_quaternion(R)
     tip, centre = p + R @ [0, 0, 0.3], p + R @ [0, 0, 0.15]
     path = tmp_path / "arm.yaml"
@@ -301,3 +301,32 @@ def test_an_inertia_of_rounding_noise_is_zero_not_refused(tmp_path):
     path = tmp_path / "noise.urdf"
     tree.write(path)
     assert mb.from_robot(path).n == 21  # three links, seven coordinates each
+
+
+def test_robot_entry_initial_joint_positions_place_the_links_as_pinocchio(tmp_path):
+    """``initial: {joint: value}`` under a robot entry: every link's frame where Pinocchio's
+    forward kinematics puts it at those joint positions, the base moved and turned as
+    ``base`` says; a joint the URDF has not (or a fixed one) is refused, the movable ones listed."""
+    angles = {"shoulder_pan_joint": 0.3, "shoulder_lift_joint": -0.4, "elbow_joint": 0.8, "wrist_2_joint": 0.5}
+    path = tmp_path / "arm.yaml"
+    path.write_text("subsystems:\n  arm: {type: robot, robot: ur5, base: {position: [0.1, 0, 1], rpy: [0, 0, 0.2]}, "
+                    f"initial: {json.dumps(angles)}}}\n")
+    system = mb.load(path)
+    model = pin.buildModelFromUrdf(describe("ur5").path)
+    data = model.createData()
+    q = np.array([angles.get(model.names[j], 0.0) for j in range(1, model.njoints)])
+    pin.framesForwardKinematics(model, data, q)
+    base = pin.SE3(pin.rpy.rpyToMatrix(0, 0, 0.2), np.array([0.1, 0, 1]))
+    index = {c: i for i, c in enumerate(system.coordinates)}
+    for link, values in system.robots[0].parts.items():
+        frame = base * data.oMf[model.getFrameId(link, pin.BODY)]
+        com = describe("ur5").links[link].com
+        at = [index[f"{values}.{c}"] for c in ("x", "y", "z", "qw", "qx", "qy", "qz")]
+        np.testing.assert_allclose(system.initial_q[at[:3]], frame.translation + frame.rotation @ com, atol=1e-12)
+        u = system.initial_q[at[3:]]
+        np.testing.assert_allclose(np.abs(matrix_quaternion(frame.rotation) @ u), 1.0, atol=1e-12)
+    path.write_text("subsystems:\n  arm: {type: robot, robot: ur5, initial: {elbo_joint: 0.5}}\n")
+    with pytest.raises(mb.ModelError, match=r"arm\.yaml:2: at subsystems\.arm\.initial\.elbo_joint: unknown key "
+                                            r"'elbo_joint' \(did you mean 'elbow_joint'\?\); allowed: elbow_joint, "
+                                            r"shoulder_lift_joint, shoulder_pan_joint, wrist_1_joint"):
+        mb.load(path)
