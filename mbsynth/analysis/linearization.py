@@ -43,14 +43,18 @@ with redundant rows or singular M; least squares picks one dλ. Rows that are re
 all along the manifold change the right side only by terms in range(Aᵀ) along tangent
 directions, so the choice of λ does not matter there.
 
-Refused, with a SolveError naming the rows or coordinates: states off the manifold,
-non-unique motion, non-holonomic and acceleration-level rows (they restrict velocities or
-accelerations only, not the state's manifold), Coulomb friction (not differentiable), a
-configuration near a singular position (Φ_q nearly rank deficient: a loop near a change
-point) or at one (rows dependent here whose dependency does not persist along the
-tangent directions, detected by the rows' second derivatives).
+Refused, with a SolveError naming the rows or coordinates: NaN or infinite input, states
+off the manifold, rows that depend on time (a servo's prescribed motion) at a state that
+moves (q̇ ≠ 0, or ∂φ/∂t ≠ 0: the motion about it is a time-varying system, its
+eigenvalues at one instant no measure of stability), non-unique motion, non-holonomic
+and acceleration-level rows (they restrict velocities or accelerations only, not the
+state's manifold), Coulomb friction (not differentiable), a configuration near a singular
+position (Φ_q nearly rank deficient: a loop near a change point) or at one (rows
+dependent here whose dependency does not persist along the tangent directions, detected
+by the rows' second derivatives).
 """
 
+import functools
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -107,7 +111,7 @@ def linearize(system, t, q, qd, inputs=None):
     ``inputs``: parameter names B is taken for (they must enter only the forces Q + C);
     by default the robots' joint torques ``tau_*`` and the parameters named ``tau_*`` or
     ``u_*``. Raises SolveError where no linearization on the manifold exists."""
-    q, qd = system._state(q, qd)
+    q, qd = finite_state(system, q, qd)
     inputs = default_inputs(system) if inputs is None else tuple(inputs)
     _refuse_unsupported(system, t, q, qd)
     motion = system.motion(t, q, qd)
@@ -150,6 +154,44 @@ def default_inputs(system):
     return tuple(p for p in system.parameters if p in torques or p.startswith(("tau_", "u_")))
 
 
+def finite_state(system, q, qd):
+    """(q, q̇) as flat arrays of the model's size; SolveError naming the coordinates where
+    either is NaN or infinite."""
+    q, qd = system._state(q, qd)
+    bad = [f"{label} contains {kind} at {', '.join(system.coordinates[i] for i in np.flatnonzero(test(x)))}"
+           for label, x in (("q", q), ("qd", qd)) for kind, test in (("NaN", np.isnan), ("inf", np.isinf))
+           if test(x).any()]
+    if bad:
+        raise SolveError(f"model '{system.name}': {'; '.join(bad)}",
+                         coordinates=[c for c, x, y in zip(system.coordinates, q, qd) if not np.isfinite(x + y)])
+    return q, qd
+
+
+def time_rows(system):
+    """The names of the rows whose constraint holds t explicitly (a servo's θ(t)): their
+    manifold moves with time."""
+    return _time_rows(system.connectors)
+
+
+@functools.lru_cache(maxsize=_CACHE_SIZE)
+def _time_rows(connectors):
+    found = []
+    for con in connectors:
+        own = con.phi if con.phi is not None else con.psi if con.psi is not None else con.b
+        found += [name for name, x in zip(con.row_names, own) if x.has(T_SYMBOL)]
+    return tuple(found)
+
+
+def prescribed_motion(system, t, q, qd):
+    """The rows that depend on time (``time_rows``) where the state (t, q, q̇) moves: all of
+    them where q̇ ≠ 0, else those whose ∂φ/∂t (their ψ at q̇ = 0) is not zero; [] elsewhere."""
+    rows = time_rows(system)
+    if not rows or np.any(qd):
+        return list(rows)
+    _, rate = system.constraint_residuals(t, q, np.zeros_like(q))
+    return [name for name, x in zip(system.constraint_names, rate) if name in rows and abs(x) > ON_MANIFOLD_RTOL]
+
+
 def _refuse_unsupported(system, t, q, qd):
     """SolveError for what the linearization does not cover (module docstring)."""
     friction = [c.name for c in system.connectors if getattr(c, "coulomb", None)]
@@ -163,6 +205,14 @@ def _refuse_unsupported(system, t, q, qd):
                          "(non-holonomic or acceleration-level): the linearization covers holonomic rows "
                          "(write a massless part's balance as a holonomic row, or use closure: auto)",
                          constraints=velocity_only)
+    moving = prescribed_motion(system, t, q, qd)
+    if moving:
+        why = "q̇ ≠ 0" if np.any(qd) else f"∂φ/∂t ≠ 0 at t = {t:g}"
+        raise SolveError(f"model '{system.name}': rows {moving} depend on time (a prescribed "
+                         f"motion) and the state moves ({why}): the motion about it is a time-varying system, "
+                         "whose eigenvalues at one instant say nothing of its stability; linearize where the rows "
+                         "hold still (q̇ = 0 and ∂φ/∂t = 0), or with the prescribed motion held at a constant",
+                         constraints=moving)
     drift = relative_drift(system, t, q, qd)
     if drift > ON_MANIFOLD_RTOL:
         worst = system.constraint_names[int(np.nanargmax(np.abs(np.concatenate([phi, psi]))) % len(phi))]

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from ..core.errors import SolveError
-from .linearization import linearize
+from ..core.errors import NoEquilibrium
+from .linearization import finite_state, linearize, prescribed_motion
 from .projection import project_positions
 from .statics import equilibrium as find_equilibrium
 from .trajectory import Trajectory
@@ -70,15 +70,21 @@ class Modes:
 def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL):
     """The ``Modes`` of ``system`` at rest at ``q`` (default: the initial positions); with
     ``equilibrium=True`` at the static equilibrium found from there (statics.py). Raises
-    SolveError when the model does not rest at q (q̈ ≠ 0 at q̇ = 0)."""
+    NoEquilibrium when the model does not rest at q (q̈ ≠ 0 at q̇ = 0) or none is found,
+    SolveError where the linearization is refused (linearization.py)."""
     q = system.initial_state()[0] if q is None else np.array(q, dtype=float)
     if equilibrium:
         q = find_equilibrium(system, q, t)
-    lin = linearize(system, t, q, np.zeros(system.n))
+    q, zero = finite_state(system, q, np.zeros(system.n))
+    moving = prescribed_motion(system, t, q, zero)
+    if moving:
+        raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration: rows {moving} prescribe a "
+                            f"motion at t = {t:g} (∂φ/∂t ≠ 0); modes are taken at rest", constraints=moving)
+    lin = linearize(system, t, q, zero)
     k = lin.k
     worst = int(np.argmax(np.abs(lin.qdd))) if lin.qdd.size else 0
     if lin.qdd.size and abs(lin.qdd[worst]) > tolerance * (1 + np.abs(lin.A[k:, :k]).max(initial=0.0)):
-        raise SolveError(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
+        raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
                          f"along {system.coordinates[worst]}): modes are taken at an equilibrium "
                          "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
     values, vectors = scipy.linalg.eig(lin.A) if k else (np.zeros(0, complex), np.zeros((0, 0), complex))

@@ -13,6 +13,7 @@ import sympy as sp
 
 import mbsynth as mb
 from mbsynth.analysis.modes import format_modes, mode_motion, to_dict
+from mbsynth.cli import main
 from mbsynth.robots.validate_modes import eigenvalue_error, validate_modes
 
 REL = 1e-9
@@ -246,44 +247,149 @@ subsystems:
 
 
 def test_equilibrium_not_isolated_names_the_free_directions():
-    with pytest.raises(mb.SolveError, match="not isolated") as err:
+    with pytest.raises(mb.NoEquilibrium, match="not isolated") as err:
         mb.equilibrium(mb.loads(FREE))
     assert set(err.value.coordinates) == {"p.x", "p.y", "p.z"}
 
 
 def test_no_equilibrium_found():
-    with pytest.raises(mb.SolveError, match="no static equilibrium"):
+    """A particle under gravity falls for ever: a verdict (NoEquilibrium, exit 1), naming
+    the coordinate it keeps accelerating along at g."""
+    with pytest.raises(mb.NoEquilibrium, match=r"no static equilibrium found .*after 5 steps .*largest q̈ -9\.81 "
+                                               r"along p\.z") as err:
         mb.equilibrium(mb.loads(FREE.replace("g: 0.0", "g: 9.81")), max_iterations=5)
+    assert err.value.coordinates == ("p.z",)
 
 
-def test_modes_refuse_a_configuration_that_does_not_rest():
-    system = mb.load("models/paper/example3_m1_zero_auto.yaml")
-    with pytest.raises(mb.SolveError, match="does not rest"):
-        mb.modes(system)  # the initial state is stretched
+# -- the rest nearest the start: closed forms, energy, Pinocchio ------------------------------
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
-def test_table_and_json():
-    result = mb.modes(mb.load("models/paper/example3_m1_zero_auto.yaml"), equilibrium=True)
-    text = format_modes(result)
-    assert "0.68916" in text and "body2.q2" in text
-    data = json.loads(json.dumps(to_dict(result)))
-    assert data["degrees_of_freedom"] == 1
-    assert data["modes"][0]["frequency_hz"] == pytest.approx(result.modes[0].frequency)
+def hanging_potential(p):
+    """V of the double pendulum hanging straight down (its minimum): links of mass m1, m2
+    and length L1, L2, centres at mid-length, from the pivot."""
+    return -p["g"] * (p["m1"] * p["L1"] / 2 + p["m2"] * (p["L1"] + p["L2"] / 2))
 
 
-def test_eigenvalue_error_matches_spectra():
-    assert eigenvalue_error([3j, -3j, 2.0], [2.0, -3j, 3j]) == 0.0
-    assert eigenvalue_error([1j, -1j], [1j, -1j, 0]) == float("inf")
-    assert eigenvalue_error([3j, -3j], [3.3j, -3j]) == pytest.approx((3.3**2 - 9) / 3.3**2)
-    assert eigenvalue_error([1e-7, -1e-7], [0, 0]) == pytest.approx(1e-14)  # a split double zero
+@pytest.mark.parametrize("start", [(0.6, -0.9), (np.pi - 0.3, 0.2), (-2.5, 1.0)])
+def test_equilibrium_goes_down_to_the_hanging_double_pendulum(start):
+    """From (0.6, −0.9) rad (the model's start; a Newton iteration on q̈ = 0 alone went up
+    to the upright (π, −2π)), from near upright and from the other side: the hanging rest,
+    (0, 0) mod 2π, where V is its minimum."""
+    system = mb.load(MODELS / "rigid" / "double_pendulum_angles.yaml")
+    q = mb.equilibrium(system, np.array(start))
+    wrapped = (q + np.pi) % (2 * np.pi) - np.pi
+    assert wrapped == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert system.energy(0.0, q, np.zeros(2))[1] == pytest.approx(hanging_potential(system.parameters), rel=1e-12)
 
 
-# -- robots against Pinocchio ----------------------------------------------------------------
+def test_equilibrium_at_a_rest_keeps_it_unstable_or_not():
+    """Started exactly upright, the pendulum rests already: that rest is the answer, and
+    its modes say it is unstable."""
+    system = mb.load(MODELS / "rigid" / "double_pendulum_angles.yaml")
+    q = mb.equilibrium(system, np.array([np.pi, 0.0]))
+    assert q == pytest.approx([np.pi, 0.0], abs=1e-12)
+    assert not mb.modes(system, q).stable
 
-@pytest.mark.parametrize("robot", ["double_pendulum", "ur5"])
-def test_robot_held_by_gravity_torques_matches_pinocchio(robot):
-    """Eigenvalues equal those of [[0, I], [∂v̇/∂q, ∂v̇/∂v]] from computeABADerivatives, and
-    B equals M⁻¹ mapped to the model's coordinates (validate_modes.py)."""
-    result = validate_modes(mb.from_robot(robot, floating=False), samples=2, seed=3)
-    assert result.eigenvalue_error < 1e-6
-    assert result.input_error < 1e-6
+
+def test_modes_equilibrium_command_of_the_double_pendulum(capsys):
+    """The user's ``mbsynth modes models/rigid/double_pendulum_angles.yaml --equilibrium``:
+    the hanging rest, stable, two vibration modes."""
+    assert main(["modes", str(MODELS / "rigid" / "double_pendulum_angles.yaml"), "--equilibrium", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert list(result["q"].values()) == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert result["stable"] and [m["kind"] for m in result["modes"]] == ["vibration", "vibration"]
+
+
+def test_equilibrium_of_the_spatial_double_pendulum_in_body_coordinates():
+    """double_pendulum_3d.yaml (14 body coordinates; Newton's steps on q̈ = 0 stalled after
+    50): both links hang below the pivot at (0, 0, 2), V at its minimum."""
+    system = mb.load(MODELS / "rigid" / "double_pendulum_3d.yaml")
+    p = system.parameters
+    q = dict(zip(system.coordinates, mb.equilibrium(system)))
+    centres = [[q[f"{link}.{c}"] for c in "xyz"] for link in ("link1", "link2")]
+    assert centres == [pytest.approx([0, 0, 2 - p["L1"] / 2], abs=1e-9),
+                       pytest.approx([0, 0, 2 - p["L1"] - p["L2"] / 2], abs=1e-9)]
+    V = system.energy(0.0, np.array(list(q.values())), np.zeros(system.n))[1]
+    assert V == pytest.approx(hanging_potential(p) + 2 * p["g"] * (p["m1"] + p["m2"]), rel=1e-12)
+
+
+UR5_HELD = """
+name: ur5_hanging
+parameters: {g: 9.81}
+gravity: [0, 0, -g]
+subsystems:
+  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]},
+        initial: {shoulder_lift_joint: -0.5, elbow_joint: 0.7, wrist_2_joint: 0.4}}
+constraints:   # the joints about vertical axes at the rest, held (free there: no isolated rest)
+  - {name: pan, holonomic: arm_shoulder_pan_joint.angle}
+  - {name: wrist, holonomic: arm_wrist_2_joint.angle - 0.4}
+  - {name: twist, holonomic: arm_wrist_3_joint.angle}
+"""
+
+
+def test_ur5_comes_to_rest_where_pinocchio_gravity_torques_vanish():
+    """A UR5 released at a bent pose, zero torques, its vertical-axis joints held: the rest
+    found is where Pinocchio's generalized gravity (rnea at q̇ = q̈ = 0) is zero at every
+    joint left free, a stable one (all modes vibrate), lower in V than the start."""
+    pin = pytest.importorskip("pinocchio")
+    from mbsynth.robots.build import describe
+    system = mb.loads(UR5_HELD)
+    q = mb.equilibrium(system)
+    values = system.joint_values(0.0, q, np.zeros(system.n))
+    model = pin.buildModelFromUrdf(describe("ur5").path)
+    model.gravity.linear = np.array([0.0, 0.0, -9.81])
+    angles = np.array([float(np.atleast_1d(values[f"arm_{model.names[j]}"].position)[0])
+                       for j in range(1, model.njoints)])
+    tau = pin.computeGeneralizedGravity(model, model.createData(), angles)
+    start = pin.computeGeneralizedGravity(model, model.createData(), np.array([0, -0.5, 0.7, 0, 0.4, 0]))
+    free = [list(model.names)[1:].index(j) for j in ("shoulder_lift_joint", "elbow_joint", "wrist_1_joint")]
+    assert np.abs(tau[free]).max() < 1e-9 * np.abs(start).max()
+    assert mb.modes(system, q).stable and {m.kind for m in mb.modes(system, q).modes} == {"vibration"}
+    assert system.energy(0.0, q, np.zeros(system.n))[1] < system.energy(0.0, system.initial_q, np.zeros(system.n))[1]
+
+
+# -- refusals: NaN input, time-dependent rows at a moving state -------------------------------
+
+def test_nan_or_inf_input_is_named():
+    """NaN in q was reported as "rows ['rod'] restrict velocities … (non-holonomic …)"."""
+    system = mb.loads(CARTESIAN)
+    with pytest.raises(mb.SolveError, match=r"q contains NaN at bob\.x$") as err:
+        mb.linearize(system, 0.0, np.array([np.nan, -1.0]), np.zeros(2))
+    assert err.value.coordinates == ("bob.x",)
+    with pytest.raises(mb.SolveError, match=r"qd contains inf at bob\.z$"):
+        mb.linearize(system, 0.0, np.array([0.0, -1.0]), np.array([0.0, np.inf]))
+    with pytest.raises(mb.SolveError, match=r"q contains NaN at bob\.x, bob\.z$"):
+        mb.equilibrium(system, np.array([np.nan, np.nan]))
+    with pytest.raises(mb.SolveError, match=r"q contains NaN at bob\.z$"):
+        mb.modes(system, np.array([0.0, np.nan]))
+
+
+def test_servo_rows_at_a_moving_state_are_refused():
+    """The cart-pole whose cart follows x(t) = 0.2 sin 3t, after 0.2 s: its motion about
+    that state is a time-varying system — linearize refuses it naming the servo (it gave
+    0.00087 ± 5.42j silently), modes at that configuration says it does not rest there (it
+    said "relative residual 2.2e+307")."""
+    system = mb.load(MODELS / "joints" / "cart_pole_servo.yaml")
+    run = mb.simulate(system, 0.2)
+    q, qd = run.q[-1], run.qd[-1]
+    with pytest.raises(mb.SolveError, match=r"rows \['servo'\] depend on time .*state moves \(q̇ ≠ 0\)") as err:
+        mb.linearize(system, 0.2, q, qd)
+    assert err.value.constraints == ("servo",)
+    with pytest.raises(mb.NoEquilibrium, match=r"rows \['servo'\] prescribe a motion at t = 0\.2"):
+        mb.modes(system, q, t=0.2)
+    with pytest.raises(mb.NoEquilibrium, match=r"rows \['servo'\] prescribe a motion"):
+        mb.equilibrium(system, q, t=0.2)
+
+
+def test_servo_held_still_linearizes():
+    """Where the servo holds still (x = 0.2 sin² 3t at t = 0: ẋ = 0, the pole hanging at
+    rest), the rows do not move the state and the linearization answers: the pole on a cart
+    whose motion is prescribed, ∂θ̈/∂θ = −m g l / (I + m l²) at θ = 0."""
+    text = (MODELS / "joints" / "cart_pole_servo.yaml").read_text().replace("0.2*sin(3*t)", "0.2*sin(3*t)**2")
+    system = mb.loads(text)
+    p = system.parameters
+    lin = mb.linearize(system, 0.0, system.initial_q, np.zeros(system.n))
+    omega = np.sqrt(p["m"] * p["g"] * p["l"] / (p["I"] + p["m"] * p["l"] ** 2))
+    assert np.sort(np.abs(lin.eigenvalues.imag)) == pytest.approx([omega, omega], rel=1e-9)

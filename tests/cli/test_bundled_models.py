@@ -1,0 +1,90 @@
+"""Every model file in models/ runs: ``mbsynth check`` exits 0, a short ``mbsynth simulate``
+exits 0, and ``mbsynth modes`` gives the modes where the model rests (with
+``--equilibrium`` where it has an isolated equilibrium) or the verdict or refusal its
+model calls for, by the exit-status table (1 a verdict, 2 a refusal), naming the reason.
+Nothing is written to stderr but the one error line (no numpy warnings)."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from mbsynth.cli import main
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
+
+# what `mbsynth modes` answers, per model: "rests" (exit 0 at the initial state),
+# "equilibrium" (exit 0 with --equilibrium), or (flags, exit status, a phrase of the message)
+NOT_ISOLATED = "the equilibrium is not isolated"
+NOT_UNIQUE = "the motion is not unique"
+VELOCITY_ROWS = "restrict velocities or accelerations only"
+MODES = {
+    "forces/spring_part_chain.yaml": "equilibrium",
+    "forces/spring_pendulum.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the rod spins freely about itself
+    "joints/cart_pole_servo.yaml": ([], 1, "rows ['servo'] prescribe a motion at t = 0"),
+    "joints/driven_pendulum.yaml": "equilibrium",
+    "joints/pd_pendulum.yaml": "equilibrium",
+    "joints/slider_friction.yaml": ([], 2, "Coulomb friction at ['slide'] is not differentiable"),
+    "mechanisms/andrews.yaml": "equilibrium",
+    "mechanisms/bennett.yaml": "equilibrium",
+    "mechanisms/bricard.yaml": "equilibrium",
+    "mechanisms/double_pendulum_rods.yaml": "equilibrium",
+    "mechanisms/four_bar.yaml": "equilibrium",
+    "mechanisms/four_bar_3d.yaml": "equilibrium",
+    "mechanisms/massless_link.yaml": ([], 2, NOT_UNIQUE),  # the massless link's free spin
+    "mechanisms/massless_rod.yaml": ([], 2, NOT_UNIQUE),
+    "mechanisms/n_four_bar.yaml": "rests",
+    "mechanisms/pendulum_1km.yaml": "equilibrium",
+    "mechanisms/sarrus.yaml": "equilibrium",
+    "mechanisms/simple_pendulum.yaml": "equilibrium",
+    "mechanisms/slider_crank.yaml": "equilibrium",
+    "paper/example1_wheel.yaml": (["--equilibrium"], 1, "no static equilibrium found"),  # it rolls down for ever
+    "paper/example2_massless_particle.yaml": ([], 2, NOT_UNIQUE),
+    "paper/example3_m1_zero.yaml": "equilibrium",
+    "paper/example3_m1_zero_auto.yaml": "equilibrium",
+    "paper/example3_m2_zero.yaml": ([], 2, VELOCITY_ROWS),  # its balance is an acceleration-level row
+    "paper/example3_m2_zero_auto.yaml": "equilibrium",
+    "paper/example3_two_masses.yaml": "equilibrium",
+    "rigid/double_pendulum_3d.yaml": "equilibrium",
+    "rigid/double_pendulum_angles.yaml": "equilibrium",
+    "rigid/double_pendulum_spatial.yaml": "rests",
+    "rigid/double_pendulum_spatial_angles.yaml": "rests",
+    "rigid/free_body.yaml": (["--equilibrium"], 1, "no static equilibrium found"),  # it falls for ever
+    "rigid/tennis_racket.yaml": "rests",
+    "robots/two_arms_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the wrists turn the hanging bar
+    "robots/ur5_holding_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),
+    "robots/ur5_payload.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the vertical shoulder axis
+    "rolling/knife_edge.yaml": ([], 2, VELOCITY_ROWS),
+    "rolling/rolling_disk.yaml": ([], 2, VELOCITY_ROWS),
+}
+
+
+def test_every_model_file_is_listed():
+    assert sorted(str(p.relative_to(MODELS)) for p in MODELS.rglob("*.yaml")) == sorted(MODES)
+
+
+def run(capsys, *args):
+    code = main([*args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("name", sorted(MODES))
+def test_model_checks_simulates_and_gives_its_modes(capsys, name):
+    path = str(MODELS / name)
+    code, out, err = run(capsys, "check", path, "--json")
+    assert code == 0 and json.loads(out)["error"] is None, err
+    code, out, err = run(capsys, "simulate", path, "--t-end", "0.01", "--dt", "0.005", "--json")
+    assert code == 0 and err == "", err
+    assert json.loads(out)["status"] == "completed"
+    expected = MODES[name]
+    if expected in ("rests", "equilibrium"):
+        code, out, err = run(capsys, "modes", path, "--json", *(["--equilibrium"] if expected == "equilibrium" else []))
+        assert code == 0 and err == "", err
+        result = json.loads(out)
+        assert result["modes"] and len(result["modes"]) >= result["degrees_of_freedom"] / 2
+    else:
+        flags, status, phrase = expected
+        code, out, err = run(capsys, "modes", path, *flags)
+        assert code == status and out == ""
+        assert err.count("\n") == 1 and phrase in err, err  # one line: no warnings before it
