@@ -3,7 +3,8 @@
 parts' and joints' attributes (layout.py) and imports nothing of model/.
 
     layout.py      a System as index and number arrays (tree of bodies, loops, the rest)
-    codegen.py     one compiled function for every expression the kernels do not cover
+    codegen.py     one compiled function for every expression the kernels do not cover (and
+                   the printing and loading of generated modules, structures.py's too)
     bodies.py      rigid-body blocks and the change of variables to (r̈, α)
     rate_rows.py   rows of joints between rigid bodies, directly in (r̈, α)
     joints.py      joint rows of A and b over q̈, differentiated by hand (particles, loops)

@@ -10,6 +10,8 @@ The module has
     evaluate_rows(t, q, qd, p, out)        the same per row of q, qd (t per row), without the GIL
 
 Models that differ only in parameter values share the module: parameters are inputs.
+``assignments`` (the printed body) and ``load`` (the module from the cache) serve
+structures.py's kernels too.
 """
 
 import hashlib
@@ -47,18 +49,25 @@ _lock = threading.Lock()
 def source(exprs, q, qd, p):
     """The module's text for ``exprs`` in the symbols q, q̇ (per coordinate), p and t
     (printed as the argument ``t``)."""
-    names = {}
-    for prefix, symbols in (("q", q), ("qd", qd), ("p", p)):
-        for i, s in enumerate(symbols):
-            names[s] = (sp.Symbol(f"_{prefix}{i}"), f"{prefix}[{i}]")
-    renamed = [sp.sympify(e).xreplace({s: v[0] for s, v in names.items()}) for e in exprs]
+    reads = {s: f"{prefix}[{i}]" for prefix, symbols in (("q", q), ("qd", qd), ("p", p))
+             for i, s in enumerate(symbols)}
+    return HEADER.format(count=len(exprs)) + (assignments(exprs, reads, "out[{}]", "    ") or "    pass") + "\n" + ROWS
+
+
+def assignments(exprs, reads, target, indent):
+    """Python lines (each after ``indent``) that compute ``exprs``: each symbol of ``reads``
+    ({symbol: the expression it is read from}) the expressions use read once into a local,
+    their common subexpressions (sympy ``cse``) computed once, then ``target.format(k) =``
+    the k-th expression. Symbols not in ``reads`` are printed by their names."""
+    local = {s: sp.Symbol(f"_a{i}") for i, s in enumerate(reads)}
+    renamed = [sp.sympify(e).xreplace(local) for e in exprs]
     used = set().union(*(e.free_symbols for e in renamed)) if renamed else set()
     steps, results = sp.cse(renamed, symbols=sp.numbered_symbols("_x"), order="none")
     printer = PythonCodePrinter({"standard": "python3"})
-    lines = [f"    {symbol} = {where}" for symbol, where in names.values() if symbol in used]
-    lines += [f"    {s} = {printer.doprint(e)}" for s, e in steps]
-    lines += [f"    out[{k}] = {printer.doprint(e)}" for k, e in enumerate(results)]
-    return HEADER.format(count=len(exprs)) + "\n".join(lines or ["    pass"]) + "\n" + ROWS
+    lines = [f"{local[s]} = {where}" for s, where in reads.items() if local[s] in used]
+    lines += [f"{s} = {printer.doprint(e)}" for s, e in steps]
+    lines += [f"{target.format(k)} = {printer.doprint(e)}" for k, e in enumerate(results)]
+    return "\n".join(indent + line for line in lines)
 
 
 def compile_expressions(exprs, q, qd, p):

@@ -19,12 +19,9 @@ None and grouped.py uses numpy.
 import logging
 import threading
 
-import sympy as sp
-from sympy.printing.pycode import PythonCodePrinter
-
 from ..symbolic.derive import beyond_double_as_inf
 from .background import mode
-from .codegen import load
+from .codegen import assignments, load
 from .worker import Worker
 
 log = logging.getLogger(__name__)
@@ -48,7 +45,7 @@ UNSET = "unset"  # a raw function's ``kernel`` before its build was asked for
 
 def kernel(raw, wait=False):
     """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
-    symbolic._lambdify), or None: not ready yet, MBSYNTH_FAST=off, or not compilable.
+    symbolic.derive._lambdified), or None: not ready yet, MBSYNTH_FAST=off, or not compilable.
     ``wait``: build it now if it is not ready (as MBSYNTH_FAST=wait does). The kernel is
     kept on ``raw`` itself (its attribute ``kernel``: None while building or failed)."""
     found = getattr(raw, "kernel", UNSET)
@@ -83,25 +80,15 @@ def _build(raw):
 _worker = Worker("mbsynth-structures", _build)
 
 
-
-
 def source(args, forms):
     """The module text of ``evaluate`` for ``forms`` in the slots ``args`` = (t, q slots,
     q̇ slots, parameter slots, constant slots, number slots)."""
     t, q, qd, p, constants, numbers = args
-    names = {t: "t"}
-    names.update({s: f"q[columns[{j}, m]]" for j, s in enumerate(q)})
-    names.update({s: f"qd[columns[{j}, m]]" for j, s in enumerate(qd)})
-    names.update({s: f"p[{j}]" for j, s in enumerate(p)})
-    names.update({s: f"values[{j}, m]" for j, s in enumerate(constants)})
-    names.update({s: f"fixed[{j}, m]" for j, s in enumerate(numbers)})
-    local = {s: sp.Symbol(f"_a{i}") for i, s in enumerate(names)}
-    renamed = [beyond_double_as_inf(e).xreplace(local) for e in forms]
-    used = set().union(*(e.free_symbols for e in renamed)) if renamed else set()
-    steps, results = sp.cse(renamed, symbols=sp.numbered_symbols("_x"), order="none")
-    used |= set().union(*(e.free_symbols for _, e in steps)) if steps else set()
-    printer = PythonCodePrinter({"standard": "python3"})
-    lines = [f"        {local[s]} = {where}" for s, where in names.items() if local[s] in used]
-    lines += [f"        {s} = {printer.doprint(e)}" for s, e in steps]
-    lines += [f"        out[{k}, m] = {printer.doprint(e)}" for k, e in enumerate(results)]
-    return HEADER.format(count=len(forms)) + "\n".join(lines) + "\n"
+    reads = {t: "t"}
+    reads.update({s: f"q[columns[{j}, m]]" for j, s in enumerate(q)})
+    reads.update({s: f"qd[columns[{j}, m]]" for j, s in enumerate(qd)})
+    reads.update({s: f"p[{j}]" for j, s in enumerate(p)})
+    reads.update({s: f"values[{j}, m]" for j, s in enumerate(constants)})
+    reads.update({s: f"fixed[{j}, m]" for j, s in enumerate(numbers)})
+    body = assignments([beyond_double_as_inf(e) for e in forms], reads, "out[{}, m]", "        ")
+    return HEADER.format(count=len(forms)) + body + "\n"

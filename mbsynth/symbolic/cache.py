@@ -1,15 +1,16 @@
 """Symbolic derivations kept on disk, so that a model built again in a fresh process
-skips sympy's differentiation and code generation (the in-process caches of symbolic.py
-and connectors/joints.py hold them only for the process).
+skips sympy's differentiation and code generation (the in-process caches of derive.py and
+model/joint_templates.py hold them only for the process).
 
 ``remembered(kind, inputs, derive)`` returns ``derive()``, stored under a digest of
 ``kind``, ``inputs`` (nested tuples of sympy expressions, strings and numbers), this
 package's sources, sympy's version and Python's bytecode version (compiled functions are
-kept as code): any change of the code that derives them makes a new entry. Derivations
-work in placeholder symbols (coordinate slots, frame values); those made with ``placeholder(tag)`` are plain symbols whose names no model symbol can
-have (they start with a NUL), so they are the same in every process. A Dummy is equal
-only within its process: a derivation whose inputs or result hold one is not stored
-(it is derived as before).
+kept as code: ``remembered_function``): any change of the code that derives them makes a
+new entry. Derivations work in placeholder symbols (coordinate slots, frame values); those
+made with ``placeholder(tag)`` are plain symbols whose names no model symbol can have (they
+start with a NUL), so they are the same in every process. A Dummy is equal only within its
+process: a derivation whose inputs or result hold one is not stored (it is derived each
+time).
 
 Entries are pickles in ``<cache>/derivations/<sources digest>/`` (core/files.py's cache
 directory, its stale versions pruned alike); one that cannot be read is derived again and
@@ -18,11 +19,17 @@ rewritten, and a cache that cannot be written only costs the derivation.
 """
 
 import hashlib
+import importlib
+import inspect
+import linecache
+import marshal
 import os
 import pickle
+import types
 from importlib.util import MAGIC_NUMBER
 from pathlib import Path
 
+import numpy as np
 import sympy as sp
 from sympy.core.parameters import evaluate
 
@@ -77,6 +84,68 @@ def remembered(kind, inputs, derive, *, store=_stable, load=lambda stored: store
     except (Unstable, OSError, pickle.PicklingError, TypeError, AttributeError):
         pass
     return result
+
+
+def remembered_function(kind, inputs, derive):
+    """``remembered`` for a function sympy's lambdify makes (``derive()``): kept as its code
+    (marshalled) and where its global names come from (modules' attributes, numbers), so that
+    reading it back needs neither a compile nor lambdify's namespace (``from numpy import *``).
+    A function reading any other global is derived each time (Unstable)."""
+    return remembered(kind, inputs, derive, store=_function_source, load=_function_from_source)
+
+
+def _function_source(raw):
+    """(source, its compiled code marshalled, [(name, module, attribute)] for each global
+    name it reads: the attribute of that module ("" the module itself), or with module
+    None the value itself) of a lambdified function."""
+    source = inspect.getsource(raw)
+    code = compile(source, _source_file(source), "exec")
+    names = [(name, *_origin(name, raw.__globals__[name])) for name in sorted(_global_names(code))
+             if name in raw.__globals__]
+    return source, marshal.dumps(code), names
+
+
+def _function_from_source(stored):
+    source, code, names = stored
+    namespace = {name: value if module is None else _attribute(module, value) for name, module, value in names}
+    code = marshal.loads(code)
+    linecache.cache[code.co_filename] = (len(source), None, source.splitlines(True), code.co_filename)  # tracebacks
+    exec(code, namespace)  # noqa: S102 - code sympy generated, from our cache
+    return namespace["_lambdifygenerated"]
+
+
+def _attribute(module, attribute):
+    """``module``'s ``attribute``, or the module itself for ""."""
+    module = importlib.import_module(module)
+    return getattr(module, attribute) if attribute else module
+
+
+def _source_file(source):
+    """The file name a generated source's tracebacks show (linecache holds its lines)."""
+    return f"<lambdified-{hashlib.sha1(source.encode()).hexdigest()[:12]}>"
+
+
+def _global_names(code):
+    """The names ``code`` and the code nested in it look up (globals among them)."""
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _global_names(const)
+    return names
+
+
+def _origin(name, value):
+    """(module, attribute) that ``value``, a lambdified function's global ``name``, is read
+    back from, or (None, value) for a number; Unstable for anything else."""
+    if isinstance(value, types.ModuleType):
+        return value.__name__, ""
+    if isinstance(value, (int, float, complex, np.number)):
+        return None, value
+    module = getattr(value, "__module__", None)
+    for attribute in (getattr(value, "__name__", None), name):
+        if module and attribute and getattr(importlib.import_module(module), attribute, None) is value:
+            return module, attribute
+    raise Unstable(name)
 
 
 def fingerprint(value, seen=None):

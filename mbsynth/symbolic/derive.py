@@ -15,17 +15,11 @@ differentiated and compiled a handful of times, not fifty.
 """
 
 import functools
-import hashlib
-import importlib
-import inspect
-import linecache
-import marshal
-import types
 
 import numpy as np
 import sympy as sp
 
-from .cache import Unstable, fingerprint, placeholder, remembered
+from .cache import Unstable, fingerprint, placeholder, remembered, remembered_function
 
 T_SYMBOL = sp.Symbol("t")
 _LARGEST = sp.Float(np.finfo(float).max)
@@ -41,7 +35,7 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
 
     Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
     M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
-    Each entry is simplified when it is small (``tidy``). Kept on disk (derivation_cache.py).
+    Each entry is simplified when it is small (``tidy``). Kept on disk (cache.py).
     """
     def derive():
         qs, qds = sp.Matrix(q), sp.Matrix(qd)
@@ -108,7 +102,7 @@ def time_derivative(expr, q, qd, t=T_SYMBOL):
 
 def generalized_force(V, efforts, q, qd):
     """Q = −∂V/∂q + Σ effort ∂rate/∂q̇ (virtual power; each rate linear in q̇), a column over
-    q; kept on disk (derivation_cache.py)."""
+    q; kept on disk (cache.py)."""
     efforts = tuple((sp.sympify(effort), sp.sympify(rate)) for effort, rate in efforts)
 
     def derive():
@@ -122,7 +116,7 @@ def generalized_force(V, efforts, q, qd):
 
 class Slots:
     """Positional placeholder symbols ``<prefix><i>``, named so that they clash with no
-    model's names and stay the same across processes (derivation_cache.placeholder)."""
+    model's names and stay the same across processes (cache.placeholder)."""
 
     def __init__(self, prefix):
         self.prefix, self.items = prefix, []
@@ -300,7 +294,7 @@ def _compiled(args, flat, placeholders):
     """(numpy function of (args, placeholder values, numbers), the numbers): the
     expressions in ``canonical`` form, compiled once per structure. Both the canonical
     form's digest and numbers and the compiled source are kept on disk
-    (derivation_cache.py): a model built again in a fresh process skips ``canonical``."""
+    (cache.py): a model built again in a fresh process skips ``canonical``."""
     symbols = _flat(args) + list(placeholders)
     slots = _placed(args + (placeholders,), iter(_ARGUMENT[i] for i in range(len(symbols))))
     derived = []
@@ -340,8 +334,7 @@ def _lambdified(digest, structure):
         if digest is None:
             raw = derive()
         else:
-            raw = _by_structure[digest] = remembered("lambdified", digest, derive, store=_function_source,
-                                                     load=_function_from_source)
+            raw = _by_structure[digest] = remembered_function("lambdified", digest, derive)
         raw.structure = structure  # for compiled/structures.py, which compiles it with numba
     return raw
 
@@ -372,67 +365,10 @@ def _values(args, values):
             return out
         gathered.fixed, gathered.picks = fixed, picks  # grouped.py stacks these instead of calling
         return gathered
-    raw = remembered("values", (args, values),
-                     lambda: sp.lambdify(args, [beyond_double_as_inf(v) for v in values], modules=[_FLOAT64, "numpy"],
-                                         dummify=True),
-                     store=_function_source, load=_function_from_source)
+    raw = remembered_function("values", (args, values),
+                              lambda: sp.lambdify(args, [beyond_double_as_inf(v) for v in values],
+                                                  modules=[_FLOAT64, "numpy"], dummify=True))
     return lambda *given: np.asarray(raw(*given), dtype=float)
-
-
-def _function_source(raw):
-    """(source, its compiled code marshalled, [(name, module, attribute)] for each global
-    name it reads: the attribute of that module ("" the module itself), or with module
-    None the value itself)
-    of a lambdified function, for the derivation cache. Reading it back then needs
-    neither a compile nor lambdify's namespace (``from numpy import *``)."""
-    source = inspect.getsource(raw)
-    code = compile(source, _source_file(source), "exec")
-    names = [(name, *_origin(name, raw.__globals__[name])) for name in sorted(_global_names(code))
-             if name in raw.__globals__]
-    return source, marshal.dumps(code), names
-
-
-def _function_from_source(stored):
-    source, code, names = stored
-    namespace = {name: value if module is None else _attribute(module, value) for name, module, value in names}
-    code = marshal.loads(code)
-    linecache.cache[code.co_filename] = (len(source), None, source.splitlines(True), code.co_filename)  # tracebacks
-    exec(code, namespace)  # noqa: S102 - code sympy generated, from our cache
-    return namespace["_lambdifygenerated"]
-
-
-def _attribute(module, attribute):
-    """``module``'s ``attribute``, or the module itself for ""."""
-    module = importlib.import_module(module)
-    return getattr(module, attribute) if attribute else module
-
-
-def _source_file(source):
-    """The file name a generated source's tracebacks show (linecache holds its lines)."""
-    return f"<lambdified-{hashlib.sha1(source.encode()).hexdigest()[:12]}>"
-
-
-def _global_names(code):
-    """The names ``code`` and the code nested in it look up (globals among them)."""
-    names = set(code.co_names)
-    for const in code.co_consts:
-        if isinstance(const, types.CodeType):
-            names |= _global_names(const)
-    return names
-
-
-def _origin(name, value):
-    """(module, attribute) that ``value``, a lambdified function's global ``name``, is read
-    back from, or (None, value) for a number; Unstable for anything else."""
-    if isinstance(value, types.ModuleType):
-        return value.__name__, ""
-    if isinstance(value, (int, float, complex, np.number)):
-        return None, value
-    module = getattr(value, "__module__", None)
-    for attribute in (getattr(value, "__name__", None), name):
-        if module and attribute and getattr(importlib.import_module(module), attribute, None) is value:
-            return module, attribute
-    raise Unstable(name)
 
 
 def _frozen(args):

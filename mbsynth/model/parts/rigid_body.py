@@ -70,7 +70,7 @@ def _template():
 @functools.lru_cache(maxsize=1)
 def _unit_norm_rows():
     """((a over the slots, b, φ, φ̇), slots) of φ = (uᵀu − 1)/2 in four quaternion slots
-    (symbolic.differentiate), derived once and kept on disk (derivation_cache.py)."""
+    (symbolic.differentiate), derived once and kept on disk (symbolic/cache.py)."""
     return remembered("unit-norm", (), _derive_unit_norm)
 
 
