@@ -19,7 +19,8 @@ import numpy as np
 from numba import njit
 
 from .bodies import INLINE, OPTIONS, body_force, rate, reduce_row, rotation, rotation_rate
-from .joints import MAX_ROWS, PARTICLE, RIGID, joint_rows, vector_work
+from ..core.joint_kinds import MAX_ROWS
+from .joints import PARTICLE, RIGID, joint_rows, vector_work
 from .rate_rows import equilibrated_rows
 from .tree import GENERAL, RIGID_INVARIANT
 

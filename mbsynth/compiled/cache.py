@@ -15,13 +15,14 @@ from pathlib import Path
 from ..core.files import cache_dir, mark_and_prune, sources_hash
 
 HERE = Path(__file__).resolve().parent  # the compiled path's sources: the kernels and all they call
-TOLERANCES = HERE.parent / "core" / "tolerances.py"  # constants the kernels compile in
+# constants the kernels compile in: the tolerances and the joint kinds' row programs
+CONSTANTS = (HERE.parent / "core" / "tolerances.py", HERE.parent / "core" / "joint_kinds.py")
 
 
 def digest():
     """The digest that names this version of the compiled code: the sources beside this file
-    and the tolerances the kernels read."""
-    return sources_hash(HERE, salt=TOLERANCES.read_text())
+    and the constants the kernels read."""
+    return sources_hash(HERE, salt="".join(path.read_text() for path in CONSTANTS))
 
 def configure():
     """Point numba's cache at ``<cache>/numba/<digest()>`` unless NUMBA_CACHE_DIR is set

@@ -17,30 +17,18 @@ A row's A and b then follow from φ̈ = a q̈ − b:
     dot         φ = v·w            a = wᵀJ_v + vᵀJ_w,       b = −(w·β_v + v·β_w + 2 v̇·ẇ)
     distance    φ = (d·d − L²)/2L  a = dᵀJ_d / L,           b = −(ḋ·ḋ + d·β_d)/L
 
-``PROGRAMS`` lists each kind's rows in the order and with the signs of
-``connectors.joints.joint_equations``; the tests compare with the sympy rows.
+A joint's program is its kind's rows (core/joint_kinds.py: operation, vector, vector or
+component), the rows ``connectors.joints.joint_equations`` reads too; the tests compare the
+two for every kind.
 """
 
 import numpy as np
 from numba import njit
 
+from ..core.joint_kinds import COMPONENT, D, DOT, XA, XB, ZA, ZB
 from .bodies import OPTIONS, rotation, rotation_jacobian
 
-WORLD, RIGID, PARTICLE = 0, 1, 2  # what a joint's end sits on
-COMPONENT, DOT, DISTANCE = 0, 1, 2
-D, XA, YA, ZA, XB, YB, ZB = range(7)  # the vectors of a joint (and 7, 8: the two origins)
-
-PROGRAMS = {
-    "spherical": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2)],
-    "revolute": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2), (DOT, ZB, XA), (DOT, ZB, YA)],
-    "universal": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2), (DOT, ZA, ZB)],
-    "cylindrical": [(DOT, ZB, XA), (DOT, ZB, YA), (DOT, D, XA), (DOT, D, YA)],
-    "prismatic": [(DOT, XA, YB), (DOT, YA, ZB), (DOT, ZA, XB), (DOT, D, XA), (DOT, D, YA)],
-    "fixed": [(COMPONENT, D, 0), (COMPONENT, D, 1), (COMPONENT, D, 2), (DOT, XA, YB), (DOT, YA, ZB),
-              (DOT, ZA, XB)],
-    "distance": [(DISTANCE, D, D)],
-}
-MAX_ROWS = 6
+WORLD, RIGID, PARTICLE = 0, 1, 2  # what a joint's end sits on; vectors 7, 8: the two origins
 VALUE, VELOCITY, BIAS, JAC = 0, 1, 2, 3  # columns of a vector's record: 3 values each, then 14 Jacobian columns
 
 

@@ -2,7 +2,7 @@
 
 Kernel nodes are the rigid bodies (with their own ``<body>.unit_quaternion`` row) and the
 particles (their ``kind``); kernel joints are the holonomic joints (a ``joint_kind`` the
-kernel has a program for) whose ends are nodes or the world and
+that has rows, core/joint_kinds.py) whose ends are nodes or the world and
 whose frames are constant. A breadth-first search from the world (then from each body no
 joint path reaches) picks each node's parent joint: those joints form the tree
 (tree.py); the other kernel joints close loops, and their rows join the *extra rows*.
@@ -27,7 +27,8 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from .joints import COMPONENT, MAX_ROWS, PARTICLE, PROGRAMS, RIGID, WORLD
+from ..core.joint_kinds import COMPONENT, JOINT_KINDS, KINDS, MAX_ROWS
+from .joints import PARTICLE, RIGID, WORLD
 from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
 
 # the parts' ``kind`` of the kernel's nodes: the model is read through its parts' and joints'
@@ -63,7 +64,7 @@ class Layout(NamedTuple):
     joint_s: np.ndarray      # (K, 2, 3) frame offset in its part (world position for a world end)
     joint_R: np.ndarray      # (K, 2, 3, 3) frame rotation in its part
     joint_length: np.ndarray  # (K,) a distance joint's L (1 otherwise)
-    joint_program: np.ndarray  # (K, 6, 3) row program (joints.PROGRAMS)
+    joint_program: np.ndarray  # (K, 6, 3) row program (core/joint_kinds.py: a kind's program)
     joint_k: np.ndarray      # (K,)
     joint_row: np.ndarray    # (K,) the System's row of the joint's first row
     joint_xrow: np.ndarray   # (K,) first extra row of a loop joint, −1 for a tree joint
@@ -143,7 +144,7 @@ def build(system):
 
 
 def _kernel_joint(con, node_of, number):
-    if getattr(con, "joint_kind", None) not in PROGRAMS:
+    if getattr(con, "joint_kind", None) not in JOINT_KINDS:
         return False
     if any(part is not None and part.name not in node_of for part in con.parts):
         return False
@@ -319,7 +320,7 @@ class _Builder:
         p = self.parent[i]
         if j < 0 or not rigid[i] or (p >= 0 and not rigid[p]):
             return GENERAL
-        operations = {op for op, *_ in PROGRAMS[self.joints[j][0].joint_kind]}
+        operations = {op for op, *_ in KINDS[self.joints[j][0].joint_kind].program}
         if COMPONENT in operations:
             return RIGID_COMPONENTS
         return GENERAL if p < 0 else RIGID_INVARIANT
@@ -335,7 +336,7 @@ class _Builder:
                 kinds.append(RIGID if _kind(part) == RIGID_BODY else PARTICLE)
                 starts.append(self.nodes[i][1])
         program = np.zeros((MAX_ROWS, 3), dtype=np.int64)
-        program[:con.size] = PROGRAMS[con.joint_kind]
+        program[:con.size] = KINDS[con.joint_kind].program
         return kinds, starts, program
 
     def _generated(self, xrow_row, segs):

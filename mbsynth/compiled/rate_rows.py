@@ -7,7 +7,7 @@ R = R(u), Ṙ = d/dt R(u) and Rb = 2R(u̇) + (2s/ν) R, so that e = R c has
     ė = Ṙ c,      ë = α × e + Rb c.
 
 A frame origin p = r + R s has p̈ = r̈ + α × ρ + Rb s (ρ = R s). With the rows of
-joints.PROGRAMS, each row's coefficients on (r̈_A, α_A, r̈_B, α_B) follow from
+a kind's program (core/joint_kinds.py), each row's coefficients on (r̈_A, α_A, r̈_B, α_B) follow from
 (α × x)·w = α·(x × w):
 
     component k of d    e_k on r̈_B, ρ_B × e_k on α_B; the negatives on end A
@@ -26,8 +26,9 @@ import math
 
 from numba import njit
 
+from ..core.joint_kinds import COMPONENT, D, DOT
 from .bodies import INLINE, cross3, dot3, times3
-from .joints import COMPONENT, D, DOT, WORLD
+from .joints import WORLD
 
 ZERO = (0.0, 0.0, 0.0)
 

@@ -12,10 +12,11 @@ and velocities: R(u) and Ṙ(u, u̇) once per body, then a frame's vector R c mo
 import numpy as np
 from numba import njit
 
+from ..core.joint_kinds import COMPONENT, D, DOT
 from .bodies import OPTIONS, INLINE, dot3, rotation, rotation_rate, times3
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
-from .joints import COMPONENT, D, DOT, PARTICLE, RIGID, WORLD
+from .joints import PARTICLE, RIGID, WORLD
 
 LAYOUT = fields(Layout)
 

@@ -13,7 +13,7 @@ springs become force elements (mbsynth.model.joint_forces), friction the joint's
 
 import sympy as sp
 
-from ..model.friction import KINDS as FRICTION_KINDS
+from ..core.joint_kinds import FRICTION_KINDS
 from ..model.friction import Friction
 from ..model.joint_forces import MOTIONS, actuation, joint_motion, joint_spring
 from .parts import read_nonnegative

@@ -4,7 +4,8 @@ A joint's ``actuation``, ``spring`` and ``friction`` keys are read by ``joint_fo
 
 import sympy as sp
 
-from ..model.connectors.joints import JOINT_KINDS, Joint
+from ..core.joint_kinds import JOINT_KINDS
+from ..model.connectors.joints import Joint
 from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from .joint_forces import read_friction, read_joint_forces

@@ -11,7 +11,7 @@ their section's text and checked by the loader against those names.
 
 from dataclasses import dataclass
 
-from ..model.connectors.joints import JOINT_KINDS
+from ..core.joint_kinds import JOINT_KINDS
 
 
 @dataclass(frozen=True)

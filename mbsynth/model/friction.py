@@ -35,12 +35,11 @@ import sympy as sp
 
 from ..core.equations import equilibrate_rows
 from ..core.errors import SolveError
+from ..core.joint_kinds import FRICTION_KINDS, KINDS
 from ..symbolic.derive import T_SYMBOL, compile_function
 from ..core.tolerances import COULOMB_LOAD_RTOL, RANK_RTOL
 
 MAX_ITERATIONS = 50
-# the joint kinds that take friction: (the rate friction opposes, the rows that carry its load)
-KINDS = {"revolute": ("angle_rate", ("x", "y", "z")), "prismatic": ("displacement_rate", ("slide_x", "slide_y"))}
 
 
 @dataclass(frozen=True)
@@ -63,10 +62,11 @@ class Friction:
 
 
 def rate(joint):
-    """The rate w friction opposes at ``joint`` (revolute: angle_rate; prismatic: displacement_rate)."""
-    if joint.joint_kind not in KINDS:
-        raise ValueError(f"only {' and '.join(KINDS)} joints take friction, not a {joint.joint_kind} joint")
-    return getattr(joint, KINDS[joint.joint_kind][0])
+    """The rate w friction opposes at ``joint`` (its kind's ``friction.rate``, core/joint_kinds.py:
+    revolute: angle_rate; prismatic: displacement_rate)."""
+    if joint.joint_kind not in FRICTION_KINDS:
+        raise ValueError(f"only {' and '.join(FRICTION_KINDS)} joints take friction, not a {joint.joint_kind} joint")
+    return getattr(joint, KINDS[joint.joint_kind].friction.rate)
 
 
 class CoulombFriction:
@@ -81,7 +81,7 @@ class CoulombFriction:
         local_q, local_qd = [q[i] for i in self.indices], [qd[i] for i in self.indices]
         direction = scale * sp.Matrix([w]).jacobian(sp.Matrix(local_qd)).T
         self._evaluate = compile_function((T_SYMBOL, local_q, local_qd, list(params)), [w, direction])
-        labels = [f"{joint.name}[{label}]" for label in KINDS[joint.joint_kind][1]]
+        labels = [f"{joint.name}[{label}]" for label in KINDS[joint.joint_kind].friction.load_rows]
         self.load_rows = np.array([joint.row_names.index(x) for x in labels if x in joint.row_names], dtype=int)
 
     def evaluate(self, t, q, qd, p):

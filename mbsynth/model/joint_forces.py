@@ -13,6 +13,7 @@ a turn from θ = 0 (its potential jumps where θ wraps).
 
 import sympy as sp
 
+from ..core.joint_kinds import KINDS
 from .forces import ForceElement
 
 # the joint's (position, rate) attribute for each kind of motion
@@ -20,8 +21,9 @@ MOTIONS = {"torque": ("angle", "angle_rate"), "force": ("displacement", "displac
 
 
 def joint_motion(joint):
-    """What acts along the joint's one motion: "torque" (revolute), "force" (prismatic), else None."""
-    return {"revolute": "torque", "prismatic": "force"}.get(joint.joint_kind)
+    """What acts along the joint's one motion: "torque" (revolute), "force" (prismatic), else None
+    (its kind's ``effort``, core/joint_kinds.py)."""
+    return KINDS[joint.joint_kind].effort
 
 
 def actuation(name, joint, efforts, q, qd, params):

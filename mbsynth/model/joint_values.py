@@ -17,7 +17,8 @@ conventions: a revolute joint's (q, v, v̇) are (θ, θ̇, θ̈); a free-flyer's
 spatial velocity in its own axes and v̇ its derivative, Rᵀp̈ − ω × Rᵀṗ (not the classical
 acceleration); Pinocchio's quaternion is (x, y, z, w), mbsynth's (w, x, y, z). Angles
 are atan2 in (−π, π] at one state; ``unwrap`` makes them continuous along a trajectory.
-Fixed and distance joints have no values.
+Fixed and distance joints have no values. The names per kind are those of its record in
+core/joint_kinds.py.
 
 The same compiled function gives the pose of the joint's reaction frame (the child frame
 B, or a robot's child link frame) and its Jacobian, which turn the generalized force a
@@ -29,25 +30,11 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from .connectors.joints import SHARED_PARTS
-from ..symbolic.cache import placeholder, remembered
 from ..compiled.grouped import Batch
+from ..core.joint_kinds import KINDS
 from ..core.kinematics import matrix_quaternion
-from .parts.base import Frame
-from ..symbolic.derive import T_SYMBOL, JointValue, Slots, compile_function, jacobian, time_derivative
-
-# kind -> (position names, rate names, acceleration names, which positions are angles)
-NAMES = {
-    "revolute": (("angle",), ("rate",), ("acceleration",), (True,)),
-    "prismatic": (("displacement",), ("rate",), ("acceleration",), (False,)),
-    "cylindrical": (("angle", "displacement"), ("angle_rate", "displacement_rate"),
-                    ("angle_acceleration", "displacement_acceleration"), (True, False)),
-    "universal": (("angle1", "angle2"), ("rate1", "rate2"), ("acceleration1", "acceleration2"), (True, True)),
-    "spherical": (("rx", "ry", "rz"), ("wx", "wy", "wz"), ("wx_dot", "wy_dot", "wz_dot"), (False,) * 3),
-    "free": (("x", "y", "z", "qw", "qx", "qy", "qz"), ("vx", "vy", "vz", "wx", "wy", "wz"),
-             ("vx_dot", "vy_dot", "vz_dot", "wx_dot", "wy_dot", "wz_dot"), (False,) * 7),
-}
-MATRIX_POSITIONS = {"spherical", "free"}  # positions computed from the frames' rotations, not compiled
+from .joint_templates import Templates, joint_coordinates, pose, shared
+from ..symbolic.derive import T_SYMBOL, JointValue, compile_function, jacobian, time_derivative
 
 
 class JointValues(NamedTuple):
@@ -73,21 +60,24 @@ class JointKinematics:
     (None: the world) and ``frame_b`` on ``child``, and the pose of ``report_frame`` (a
     frame on the child with B's origin: B itself, or a robot's link frame). Joints alike
     (kind, types of parts, frames fixed on them) share one derivation and one compiled
-    function (``_template``), their frames' values passed in, as connectors.joints does."""
+    function (``TEMPLATES``, joint_templates.py), their frames' values passed in, as
+    connectors.joints does."""
 
     def __init__(self, name, kind, parent, frame_a, child, frame_b, report_frame, system):
         self.name, self.kind = name, kind
-        self.position_names, self.rate_names, self.acceleration_names, self.angles = NAMES.get(kind, ((), (), (), ()))
+        record = KINDS[kind]
+        self.position_names, self.rate_names = record.positions, record.rates
+        self.acceleration_names, self.angles = record.accelerations, record.angles
         where = {s: i for i, s in enumerate(system.q_symbols)}
-        q = (list(parent.q) if parent is not None else []) + list(child.q)
-        qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
+        q, qd = joint_coordinates(parent, child)
         self.indices = np.array([where[s] for s in q], dtype=int)
         self.child_indices = np.array([where[s] for s in child.q], dtype=int)
         args = (T_SYMBOL, list(q), list(qd), list(system.parameter_symbols))
         frames = (frame_a, frame_b, report_frame)
-        if _shareable(parent, child, frames):
-            slots, exprs = _template(kind, parent, child)
-            constants = [pair for end, frame in enumerate(frames) for pair in zip(_PLACEHOLDERS[end], _entries(frame))]
+        constants = TEMPLATES.constants(frames, set(q))
+        if shared(parent, child) and constants is not None:
+            slots, exprs = TEMPLATES(kind, parent, child)
+            constants = list(constants.items())
             self._evaluate = compile_function((T_SYMBOL, *slots, args[3]), exprs, constants=constants)
         else:
             self._evaluate = compile_function(args, _expressions(kind, parent, child, frames, q, qd))
@@ -154,7 +144,7 @@ def _expressions(kind, parent, child, frames, q, qd):
     """What a JointKinematics compiles, in the parts' symbols q, q̇ (parent's then child's):
     scalar positions, rates, ∂rate/∂q̇, the rest of d(rate)/dt (``differentiate``'s b),
     the report frame's origin and rotation, R_A, R_B, and the report frame's Jacobian."""
-    pA, RA = _pose(parent, frames[0])
+    pA, RA = pose(parent, frames[0])
     pB, RB = child.pose(frames[1])
     positions, rates = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
     rates = sp.Matrix(rates) if rates else sp.zeros(0, 1)
@@ -167,72 +157,37 @@ def _expressions(kind, parent, child, frames, q, qd):
             sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
 
 
-# offsets (3) and rotations (3 × 3) of frames A, B and the report frame, and the slots of the
-# parts' coordinates and velocities: placeholders kept by the derivation cache
-_PLACEHOLDERS = [tuple(placeholder(f"joint_value_{e}{i}") for i in range(12)) for e in "ABR"]
-_SLOT_Q, _SLOT_QD = Slots("joint_value_q"), Slots("joint_value_qd")
-_templates = {}
+def _derive_template(kind, parent, child, at):
+    """((q slots, q̇ slots), ``_expressions`` in them and ``at``'s placeholder frames)."""
+    return at.slots, [e.xreplace(at.to_slots) for e in _expressions(kind, parent, child, at.frames, at.q, at.qd)]
 
 
-def _template(kind, parent, child):
-    """((q slots, q̇ slots), expressions) of ``_expressions`` for joints of ``kind``
-    between parts of the types of ``parent`` and ``child``, frames as placeholders;
-    derived once, and kept on disk (derivation_cache.py)."""
-    key = (kind, type(parent), len(parent.q) if parent is not None else 0, type(child), len(child.q))
-    if key not in _templates:
-        names = (kind, type(parent).__qualname__, key[2], type(child).__qualname__, key[4])
-        _templates[key] = remembered("joint-values", names, lambda: _derive_template(kind, parent, child))
-    return _templates[key]
-
-
-def _derive_template(kind, parent, child):
-    q = (list(parent.q) if parent is not None else []) + list(child.q)
-    qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
-    slots = ([_SLOT_Q[i] for i in range(len(q))], [_SLOT_QD[i] for i in range(len(q))])
-    frames = [Frame("", "", sp.Matrix(x[:3]), sp.Matrix(3, 3, x[3:])) for x in _PLACEHOLDERS]
-    to_slots = dict(zip(q + qd, slots[0] + slots[1]))
-    return slots, [e.xreplace(to_slots) for e in _expressions(kind, parent, child, frames, q, qd)]
-
-
-def _shareable(parent, child, frames):
-    """Whether the joint's expressions can come from a template: parts whose poses depend on
-    their coordinates alone and frames fixed on them."""
-    coordinates = set((parent.q if parent is not None else [])) | set(child.q)
-    return (all(type(p) in SHARED_PARTS for p in (parent, child) if p is not None)
-            and not any(sp.sympify(x).free_symbols & coordinates for f in frames for x in _entries(f)))
-
-
-def _entries(frame):
-    return list(frame.position) + list(frame.rotation)
+# what JointKinematics compiles, in placeholder form, per kind and types of parts
+TEMPLATES = Templates("joint_value", "ABR", _derive_template)
 
 
 def value_expressions(joint):
     """{name: sympy expression} of a joint's values that are expressions of the state (the
     names model files use as ``<joint>.<name>``): its positions except a spherical joint's
     rotation vector, and its rates."""
-    kind = joint.joint_kind
-    if kind not in NAMES:
+    kind = KINDS[joint.joint_kind]
+    if not kind.rates:
         return {}
-    positions, rates, _, _ = NAMES[kind]
-    if kind in ("revolute", "prismatic", "cylindrical"):  # the joint's own (shared) expressions
-        exprs = {"revolute": [joint.angle, joint.angle_rate], "prismatic": [joint.displacement, joint.displacement_rate],
-                 "cylindrical": [joint.angle, joint.displacement, joint.angle_rate, joint.displacement_rate]}[kind]
-        return dict(zip(positions + rates, exprs))
+    if kind.motions:  # its values are the joint's own (shared) free motions: angle and/or displacement
+        exprs = [getattr(joint, m) for m in kind.motions] + [getattr(joint, f"{m}_rate") for m in kind.motions]
+        return dict(zip(kind.positions + kind.rates, exprs))
     parent, child = joint.parts
-    q = (list(parent.q) if parent is not None else []) + list(child.q)
-    qd = (list(parent.qd) if parent is not None else []) + list(child.qd)
-    pA, RA = _pose(parent, joint.frames[0])
+    q, qd = joint_coordinates(parent, child)
+    pA, RA = pose(parent, joint.frames[0])
     pB, RB = child.pose(joint.frames[1])
-    scalars, rate_exprs = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
-    return dict(zip(positions[:len(scalars)] + rates, list(scalars) + list(rate_exprs)))
+    scalars, rate_exprs = _relative(kind.name, parent, child, pA, RA, pB, RB, q, qd)
+    return dict(zip(kind.positions[:len(scalars)] + kind.rates, list(scalars) + list(rate_exprs)))
 
 
 def value_names(joint):
     """The names of ``value_expressions`` (found without deriving them)."""
-    if joint.joint_kind not in NAMES:
-        return []
-    positions, rates, _, _ = NAMES[joint.joint_kind]
-    return list(positions if joint.joint_kind not in MATRIX_POSITIONS else ()) + list(rates)
+    kind = KINDS[joint.joint_kind]
+    return list(kind.positions if not kind.matrix_positions else ()) + list(kind.rates)
 
 
 def constraint_symbols(joint):
@@ -242,17 +197,11 @@ def constraint_symbols(joint):
     exprs = value_expressions(joint)
     if not exprs:
         return exprs
-    positions, rates, _, angles = NAMES[joint.joint_kind]
-    for position, rate, is_angle in zip(positions, rates, angles):
+    kind = KINDS[joint.joint_kind]
+    for position, rate, is_angle in zip(kind.positions, kind.rates, kind.angles):
         if is_angle:
             exprs[position] = JointValue(f"{joint.name}.{position}", exprs[position], exprs[rate])
     return exprs
-
-
-def _pose(part, frame):
-    if part is None:
-        return sp.Matrix(frame.position), sp.Matrix(frame.rotation)
-    return part.pose(frame)
 
 
 def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):

@@ -30,14 +30,14 @@ import sympy as sp
 from .. import compiled
 from ..model.connectors.joints import Joint
 from ..core.errors import ModelError
-from ..model.joint_forces import actuation
+from ..core.joint_kinds import URDF_KINDS
+from ..model.joint_forces import actuation, joint_motion
 from ..core.kinematics import axis_matrix, matrix_quaternion
 from ..model.parts import LINK_FRAME, Frame, RigidBody
 from ..model.system import System
 from .urdf import read_urdf
 
 GRAVITY = (0.0, 0.0, -9.81)
-JOINT_KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
 # example-robot-data's own short names (those of its Python loaders), by file
 ALIASES = {
     "ur3": "ur_description/urdf/ur3_robot.urdf", "ur5": "ur_description/urdf/ur5_robot.urdf",
@@ -192,13 +192,12 @@ class Robot:
         for joint in self.description.joints:
             on_parent, on_child = self.joint_frames(joint)
             child = parts[on_child.part]
-            connector = Joint(self.joints[joint.name], JOINT_KINDS[joint.kind], parts[on_parent.part], on_parent,
+            connector = Joint(self.joints[joint.name], URDF_KINDS[joint.kind], parts[on_parent.part], on_parent,
                               child, on_child, q, qd, params, report_frame=child.frames[LINK_FRAME])
             joints.append(connector)
             if joint.name in self.torques:
-                effort = {"revolute": "torque", "prismatic": "force"}[connector.joint_kind]
                 elements.append(actuation(f"{connector.name}.actuation", connector,
-                                          {effort: sp.Symbol(self.torques[joint.name])}, q, qd, params))
+                                          {joint_motion(connector): sp.Symbol(self.torques[joint.name])}, q, qd, params))
         return joints, elements
 
     def weld(self, parts, q, qd, params):

@@ -15,9 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import ModelError
+from ..core.joint_kinds import URDF_KINDS
 from ..core.kinematics import quaternion_matrix, rpy_matrix
-
-KINDS = ("revolute", "continuous", "prismatic", "fixed")
 
 
 @dataclass(frozen=True)
@@ -247,8 +246,8 @@ def _joint(element, path, links):
     name = _name(element, path)
     where = f"{path}: joint '{name}'"
     kind = element.get("type")
-    if kind not in KINDS:
-        raise ModelError(f"{where} is of type {kind!r}; supported: {', '.join(KINDS)}")
+    if kind not in URDF_KINDS:
+        raise ModelError(f"{where} is of type {kind!r}; supported: {', '.join(URDF_KINDS)}")
     parent, child = (_attribute(_child(element, end, where), "link", where) for end in ("parent", "child"))
     for link in (parent, child):
         if link not in links:

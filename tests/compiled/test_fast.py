@@ -19,6 +19,7 @@ import pytest
 import mbsynth as mb
 from mbsynth.model.connectors.joints import Joint
 from mbsynth.core.equations import constrained_acceleration, equilibrate_rows
+from mbsynth.core.joint_kinds import JOINT_KINDS
 from mbsynth.core.tolerances import RANK_RTOL
 from mbsynth.core.errors import SolveError
 from mbsynth.compiled import engine_for
@@ -38,8 +39,9 @@ from literal import literal_2_14
 MODELS = sorted((Path(__file__).resolve().parents[2] / "models").glob("**/*.yaml"))
 TREE = "tree (Baraff)"
 
-# Every joint kind once, between bodies, a particle and the world, with frames turned and
-# offset (rpy, axis), and a loop: a distance rod from the last body back to the world.
+# Every joint kind (core/joint_kinds.py) once, between bodies, a particle and the world, with
+# frames turned and offset (rpy, axis), and a loop: a revolute joint from the last body back to
+# the world.
 ALL_JOINTS = """
 name: all_joints
 parameters: {m: 1.3, L: 0.4}
@@ -98,12 +100,13 @@ def all_joints():
 
 
 def test_joint_rows_equal_the_sympy_rows(all_joints):
-    """joints.joint_rows (differentiated by hand) against Joint.evaluate (sympy), every kind,
-    at random states with quaternions of any length (the forms are homogeneous)."""
+    """joints.joint_rows (differentiated by hand) against Joint.evaluate (sympy), every kind
+    of the table, at random states with quaternions of any length (the forms are homogeneous)."""
     system = all_joints
     L, _ = build_layout(system)
     kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
     assert len(L.joint_k) == len(kernel_joints) == 8
+    assert sorted({c.joint_kind for c in kernel_joints}) == sorted(JOINT_KINDS)  # a new kind joins ALL_JOINTS
     V, R, Jt = vector_work()
     A, b = np.zeros((6, 14)), np.zeros(6)
     rng = np.random.default_rng(3)

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.model.connectors.joints import _numeric, _pose, _rotation_at
+from mbsynth.model.connectors.joints import _numeric, _rotation_at
+from mbsynth.model.joint_templates import pose
 from mbsynth.core.kinematics import matrix_quaternion, rpy_matrix
 from mbsynth.analysis.projection import consistent_initial_state, project_positions
 from mbsynth.symbolic.derive import T_SYMBOL
@@ -118,7 +119,7 @@ def test_frame_rotations_of_the_branch_check_equal_the_poses_sympy_gives(model):
     compared = 0
     for joint in system.connectors:
         for part, frame in zip(getattr(joint, "parts", ()), getattr(joint, "frames", ())):
-            expected = _numeric(_pose(part, frame)[1], values)
+            expected = _numeric(pose(part, frame)[1], values)
             np.testing.assert_allclose(_rotation_at(part, frame, values), expected, atol=1e-14)
             compared += 1
     assert compared >= 2

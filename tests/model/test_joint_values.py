@@ -11,6 +11,7 @@ from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 import mbsynth as mb
+from mbsynth.core.joint_kinds import JOINT_KINDS, KINDS
 from mbsynth.model.connectors.base import Connector
 from mbsynth.analysis.projection import project_velocities
 from mbsynth.model.joint_values import constraint_symbols
@@ -188,16 +189,38 @@ joints:
 """
 
 
-def test_joint_rates_are_derivatives_of_positions():
+def value_chain():
+    """A hanging chain with one joint of every kind that has values (core/joint_kinds.py),
+    each between frames that meet its rows at the start (aligned; a universal joint's child
+    frame turned a quarter about x), tilted by gravity and set spinning."""
+    kinds = [k for k in JOINT_KINDS if KINDS[k].rates]
+    bodies = "\n".join(f"  b{i}: {{type: rigid_body, mass: {1 - 0.1 * i:.1f}, inertia: [0.02, 0.03, 0.04], "
+                       f"frames: {{top: {{position: [0, 0, 0.2]}}, bottom: {{position: [0, 0, -0.2]}}, "
+                       f"cross: {{position: [0, 0, 0.2], rpy: [1.5707963267948966, 0, 0]}}}}, "
+                       f"initial: {{position: [0, 0, {-0.2 - 0.4 * i:.1f}], angular_velocity: [0.3, -0.2, 0.5]}}}}"
+                       for i in range(len(kinds)))
+    joints = "\n".join(f"  - {{name: j_{kind}, type: {kind}, parent: {'world' if i == 0 else f'b{i - 1}.bottom'}, "
+                       f"child: b{i}.{'cross' if kind == 'universal' else 'top'}}}" for i, kind in enumerate(kinds))
+    return mb.loads(f"name: value_chain\ngravity: [1.5, -0.8, -9.81]\nsubsystems:\n{bodies}\njoints:\n{joints}\n")
+
+
+@pytest.mark.parametrize("model, sizes", [
+    (SPATIAL_CHAIN, {"cross": 2, "ball": 3, "sleeve": 2}),
+    (None, {f"j_{k}": len(KINDS[k].positions) for k in JOINT_KINDS if KINDS[k].rates})])
+def test_joint_rates_are_derivatives_of_positions(model, sizes):
     """Along the motion, each joint's rate is the time derivative of its position (the
     relative angular velocity R_relᵀ Ṙ_rel for a spherical joint), and its acceleration
-    the derivative of its rate: central differences on the motion's Taylor path."""
-    system = mb.loads(SPATIAL_CHAIN)
+    the derivative of its rate: central differences on the motion's Taylor path. On a
+    spatial chain, and on a chain of every kind of the table that has values (``None``:
+    ``value_chain``; a floating robot's free joint: against Pinocchio above)."""
+    system = mb.loads(model) if model else value_chain()
     trajectory = mb.simulate(system, 0.3, dt=0.3)
     t, q, qd = trajectory.t[-1], trajectory.q[-1], trajectory.qd[-1]
     qdd = system.motion(t, q, qd).qdd
     values = system.joint_values(t, q, qd, qdd)
-    assert {k: v.position.size for k, v in values.items()} == {"cross": 2, "ball": 3, "sleeve": 2}
+    assert {k: v.position.size for k, v in values.items()} == sizes
+    kinds = {c.name: c.joint_kind for c in system.connectors if hasattr(c, "joint_kind")}
+    assert all(np.abs(v.rate).max() > 1e-3 for v in values.values())  # every joint moves
 
     def at(h):
         return system.joint_values(t + h, q + h * qd + h**2 / 2 * qdd, qd + h * qdd)
@@ -207,7 +230,7 @@ def test_joint_rates_are_derivatives_of_positions():
     for name, value in values.items():
         rate = (after[name].rate - before[name].rate) / (2 * h)
         assert np.allclose(rate, value.acceleration, rtol=0, atol=1e-4 * (1 + np.abs(value.acceleration).max()))
-        if name == "ball":
+        if kinds[name] == "spherical":
             R = [Rotation.from_rotvec(x[name].position).as_matrix() for x in (after, before)]
             R0 = Rotation.from_rotvec(value.position).as_matrix()
             W = R0.T @ (R[0] - R[1]) / (2 * h)

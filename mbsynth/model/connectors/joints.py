@@ -17,11 +17,11 @@ of A, or 120° about a diagonal (x → y → z), and the axis rows z_B ⟂ x_A, 
 z_B = −z_A: poses the joint does not mean. ``Joint.wrong_branch`` tells them from the
 meant one (frames turned less than 90° apart). Rows of A and b follow by differentiating φ
 twice (symbolic.differentiate), exactly — once per kind of joint and types of parts
-(``_template``): φ is derived with the frames' offsets and rotations as placeholder
-symbols (``_PLACEHOLDERS``) and the parts' coordinates as slots, compiled once, and each
-joint passes its frames' values and coordinates (Connector._place); its sympy rows are
-built only when asked. Joints on parts whose frames move with their coordinates, or with
-friction, are derived directly.
+(``TEMPLATES``, joint_templates.py): φ is derived with the frames' offsets and rotations as
+placeholder symbols and the parts' coordinates as slots, compiled once, and each joint
+passes its frames' values and coordinates (Connector._place); its sympy rows are built only
+when asked. Joints on parts whose frames move with their coordinates, or with friction, are
+derived directly. The rows of each kind are those of its record in core/joint_kinds.py.
 """
 
 import functools
@@ -31,66 +31,31 @@ import numpy as np
 import sympy as sp
 
 from .base import Connector
+from ...core.joint_kinds import ALIGNED_AXIS, COMPONENT, DOT, JOINT_KINDS, KINDS, ORIENTATION_LOCK
 from ...core.kinematics import quaternion_rotation
-from ..parts import Frame, Particle, PlanarBody, RigidBody
-from ...symbolic.cache import placeholder, remembered
-from ...symbolic.derive import (Slots, compile_function, differentiate, differentiated, jacobian, placed_values,
-    positions, time_derivative)
-
-ROTATING = {"revolute", "cylindrical"}
-SLIDING = {"prismatic", "cylindrical"}
-LOCKED = {"fixed", "prismatic"}  # kinds with the orientation lock
-
-
-def _axes(R):
-    return R[:, 0], R[:, 1], R[:, 2]
-
-
-def _orientation_lock(RA, RB):
-    xa, ya, za = _axes(RA)
-    xb, yb, zb = _axes(RB)
-    return [xa.dot(yb), ya.dot(zb), za.dot(xb)], ["rx", "ry", "rz"]
-
-
-def _aligned_axis(RA, RB):
-    xa, ya, _ = _axes(RA)
-    zb = RB[:, 2]
-    return [zb.dot(xa), zb.dot(ya)], ["axis_x", "axis_y"]
-
-
-def _on_axis(pA, RA, pB):
-    xa, ya, _ = _axes(RA)
-    d = pB - pA
-    return [d.dot(xa), d.dot(ya)], ["slide_x", "slide_y"]
-
-
-def _coincident(pA, pB):
-    return list(pB - pA), ["x", "y", "z"]
+from ..joint_templates import SHARED_PARTS, Templates, joint_coordinates, pose, shared
+from ..parts import Particle, PlanarBody
+from ...symbolic.cache import placeholder
+from ...symbolic.derive import (compile_function, differentiate, differentiated, jacobian, placed_values, positions,
+    time_derivative)
 
 
 def joint_equations(kind, pA, RA, pB, RB, length=None):
-    """(φ rows, row labels) of a joint of ``kind`` between poses (pA, RA) and (pB, RB)."""
-    if kind == "spherical":
-        parts = [_coincident(pA, pB)]
-    elif kind == "revolute":
-        parts = [_coincident(pA, pB), _aligned_axis(RA, RB)]
-    elif kind == "universal":
-        parts = [_coincident(pA, pB), ([RA[:, 2].dot(RB[:, 2])], ["cross"])]
-    elif kind == "cylindrical":
-        parts = [_aligned_axis(RA, RB), _on_axis(pA, RA, pB)]
-    elif kind == "prismatic":
-        parts = [_orientation_lock(RA, RB), _on_axis(pA, RA, pB)]
-    elif kind == "fixed":
-        parts = [_coincident(pA, pB), _orientation_lock(RA, RB)]
-    elif kind == "distance":
-        d = pB - pA
-        parts = [([(d.dot(d) - length**2) / (2 * length)], ["length"])]
-    else:
+    """(φ rows, row labels) of a joint of ``kind`` between poses (pA, RA) and (pB, RB): the
+    rows of its record in core/joint_kinds.py, on d = pB − pA and the axes of RA and RB."""
+    if kind not in JOINT_KINDS:
         raise ValueError(f"unknown joint kind {kind!r}; known: {', '.join(JOINT_KINDS)}")
-    return [e for p in parts for e in p[0]], [label for p in parts for label in p[1]]
-
-
-JOINT_KINDS = ("fixed", "revolute", "prismatic", "cylindrical", "spherical", "universal", "distance")
+    d = pB - pA
+    vectors = (d, RA[:, 0], RA[:, 1], RA[:, 2], RB[:, 0], RB[:, 1], RB[:, 2])
+    phis = []
+    for _, operation, first, second in KINDS[kind].rows:
+        if operation == COMPONENT:
+            phis.append(vectors[first][second])
+        elif operation == DOT:
+            phis.append(vectors[first].dot(vectors[second]))
+        else:
+            phis.append((d.dot(d) - length**2) / (2 * length))
+    return phis, list(KINDS[kind].labels)
 
 
 class Joint(Connector):
@@ -110,13 +75,12 @@ class Joint(Connector):
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         self.report_frame = frame_b if report_frame is None else report_frame
         self.length = length  # a distance joint's L (sympy), None for the other kinds
-        where = positions(q, qd)
-        values = _frame_values(frame_a, 0, where), _frame_values(frame_b, 1, where)
-        if friction is None and all(values) and all(type(p) in SHARED_PARTS for p in (parent, child) if p):
-            self._place_shared(name, kind, parent, child, values[0] | values[1], q, qd, params, length)
+        values = TEMPLATES.constants((frame_a, frame_b), positions(q, qd))
+        if friction is None and values is not None and shared(parent, child):
+            self._place_shared(name, kind, parent, child, values, q, qd, params, length)
             return
-        pA, RA = _pose(parent, frame_a)
-        pB, RB = _pose(child, frame_b)
+        pA, RA = pose(parent, frame_a)
+        pB, RB = pose(child, frame_b)
         phis, labels = joint_equations(kind, pA, RA, pB, RB, length)
         kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
         phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
@@ -127,16 +91,16 @@ class Joint(Connector):
         self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
 
     def _place_shared(self, name, kind, parent, child, values, q, qd, params, length):
-        """The rows from the template of joints alike (``_template``), the frames' values
+        """The rows from the template of joints alike (``TEMPLATES``), the frames' values
         and the coordinates of the two parts put in."""
-        template = _template(kind, parent, child, length is not None)
+        template = _Template._make(TEMPLATES(kind, parent, child, length is not None))
         constants = dict(values)
         if length is not None:
             constants[_LENGTH] = sp.sympify(length)
         kept = _kept_rows(template, constants)
         rows = tuple(tuple(x[i] for i in kept) for x in (template.a, template.b, template.phis, template.psi))
         where = positions(q, qd)
-        coordinates = [where[s] for s in (parent.q if parent else []) + child.q]
+        coordinates = [where[s] for s in joint_coordinates(parent, child)[0]]
         self._motions, self._template = template.motions, template
         self._motion_put = (template.slots, coordinates, constants, q, qd)
         self.coulomb = None
@@ -163,12 +127,13 @@ class Joint(Connector):
         parameters and time), meet the joint's orientation rows in a pose it does not
         mean — turned 90° or more from aligned (orientation lock), or z_B against z_A
         (axis rows) — else None."""
-        if self.joint_kind not in LOCKED | ROTATING:
+        kind = KINDS[self.joint_kind]
+        if not (kind.holds(ORIENTATION_LOCK) or kind.holds(ALIGNED_AXIS)):
             return None
         RA, RB = (_rotation_at(part, frame, values) for part, frame in zip(self.parts, self.frames))
         if RA is None or RB is None:
             return None
-        if self.joint_kind in LOCKED:
+        if kind.holds(ORIENTATION_LOCK):
             return _turned(self, RA.T @ RB)
         with np.errstate(all="ignore"):
             return _reversed(self, RA[:, 2] @ RB[:, 2] / np.linalg.norm(RB[:, 2]) / np.linalg.norm(RA[:, 2]))
@@ -179,7 +144,6 @@ class Joint(Connector):
     displacement_rate = property(lambda self: self._motion(3), doc="its rate, else None")
 
 
-SHARED_PARTS = (RigidBody, Particle, PlanarBody)  # poses that depend on their coordinates alone
 _LENGTH = placeholder("joint_length")
 
 
@@ -198,7 +162,7 @@ def _rotation_at(part, frame, values):
     R_z(θ) R_frame, R_frame — since substituting into the pose's sympy matrices took 1.6 s
     per check on talos; other parts by substitution."""
     if part is not None and not isinstance(part, SHARED_PARTS):
-        return _numeric(_pose(part, frame)[1], values)
+        return _numeric(pose(part, frame)[1], values)
     own = frame.constant_rotation
     own = _numeric(frame.rotation, values) if own is None else own
     if own is None or part is None or isinstance(part, Particle):
@@ -248,14 +212,14 @@ def _named(parts):
 
 def _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd):
     """(angle, angle rate, displacement, displacement rate) of a joint, None where it has none."""
-    xa, _, za = _axes(RA)
+    xa, za = RA[:, 0], RA[:, 2]
     motions = [None] * 4
-    if kind in ROTATING:
+    if KINDS[kind].turns:
         xb = RB[:, 0]
         omega_a = parent.angular_velocity() if parent else sp.zeros(3, 1)
         motions[0] = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
         motions[1] = za.dot(child.angular_velocity() - omega_a)
-    if kind in SLIDING:
+    if KINDS[kind].slides:
         motions[2] = za.dot(pB - pA)
         motions[3] = time_derivative(motions[2], q, qd)
     return motions
@@ -283,7 +247,7 @@ def _phi_function(phis, slots, symbols):
 
 
 class _Template(NamedTuple):
-    """A joint's rows in placeholder symbols: frames (``_PLACEHOLDERS``), the distance
+    """A joint's rows in placeholder symbols: frames (``TEMPLATES.frames``), the distance
     (``_LENGTH``) and the two parts' coordinates (``slots``: parent's then child's)."""
 
     slots: tuple
@@ -299,27 +263,11 @@ class _Template(NamedTuple):
 _MOTION_NAMES = ("angle", "angle_rate", "displacement", "displacement_rate")
 
 
-_templates = {}
-
-
-def _template(kind, parent, child, has_length):
-    """The template of joints of ``kind`` between parts of the types of ``parent`` and
-    ``child``, derived (once, and kept on disk: derivation_cache.py) from these two."""
-    key = (kind, type(parent), len(parent.q) if parent else 0, type(child), len(child.q), has_length)
-    if key not in _templates:
-        names = (kind, type(parent).__qualname__, key[2], type(child).__qualname__, key[4], has_length)
-        _templates[key] = _Template(*remembered("joint-template", names,
-                                                lambda: _derive_template(kind, parent, child, has_length)))
-    return _templates[key]
-
-
-def _derive_template(kind, parent, child, has_length):
-    q = (list(parent.q) if parent else []) + list(child.q)
-    qd = (list(parent.qd) if parent else []) + list(child.qd)
-    slots = (tuple(_SLOT_Q[i] for i in range(len(q))), tuple(_SLOT_QD[i] for i in range(len(q))))
-    to_slots = dict(zip(q + qd, slots[0] + slots[1]))
-    pA, RA = _pose(parent, _placeholder_frame(0))
-    pB, RB = _pose(child, _placeholder_frame(1))
+def _derive_template(kind, parent, child, at, has_length):
+    """A ``_Template``'s fields, in ``at``'s slots and placeholder frames."""
+    slots, to_slots = at.slots, at.to_slots
+    pA, RA = pose(parent, at.frames[0])
+    pB, RB = pose(child, at.frames[1])
     pA, RA, pB, RB = (x.xreplace(to_slots) for x in (pA, RA, pB, RB))
     phis, labels = joint_equations(kind, pA, RA, pB, RB, _LENGTH if has_length else None)
     phis = [sp.sympify(phi) for phi in phis]
@@ -331,29 +279,5 @@ def _derive_template(kind, parent, child, has_length):
             tuple(r[2] for r in rows), motions, gradients)
 
 
-# the slots of the two parts' coordinates and velocities, and the offset (3) and rotation
-# (3 × 3) of frames A and B in their parts: placeholders kept by the derivation cache
-_SLOT_Q, _SLOT_QD = Slots("joint_q"), Slots("joint_qd")
-_PLACEHOLDERS = [(sp.Matrix([placeholder(f"joint_s{e}{i}") for i in range(3)]),
-                  sp.Matrix(3, 3, [placeholder(f"joint_R{e}{i}") for i in range(9)])) for e in "AB"]
-
-
-def _placeholder_frame(end):
-    """A frame with placeholder symbols for its offset and rotation."""
-    return Frame("", "", *_PLACEHOLDERS[end])
-
-
-def _frame_values(frame, end, coordinates):
-    """{placeholder: value} of ``frame`` as end A (0) or B (1); empty when the frame
-    moves on its part (its values depend on ``coordinates``)."""
-    s, R = _PLACEHOLDERS[end]
-    entries = list(frame.position) + list(frame.rotation)
-    if any(x in coordinates for e in entries for x in sp.sympify(e).free_symbols):
-        return {}
-    return dict(zip(list(s) + list(R), entries))
-
-
-def _pose(part, frame):
-    if part is None:
-        return sp.Matrix(frame.position), sp.Matrix(frame.rotation)
-    return part.pose(frame)
+# joints' rows in placeholder form, per kind, types of parts and whether it has a length
+TEMPLATES = Templates("joint", "AB", _derive_template)
