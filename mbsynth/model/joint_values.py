@@ -119,22 +119,26 @@ class JointValuesBatch:
             self.shapes = self._layout(t, q, qd, p)
         slots = self.batch(t, q, qd, p)
         found = {}
-        for k, places in zip(self.kinematics, self.shapes):
-            scalars, rates, rate_a, rate_b, origin, _, RA, RB, _ = (slots[j][a:b].reshape(shape)
-                                                                     for j, (a, b, shape) in enumerate(places))
-            position = _positions(k.kind, scalars.ravel(), RA, RB, origin.ravel())
-            acceleration = None if qdd is None else rate_a @ qdd[k.indices] - rate_b.ravel()
-            found[k.name] = JointValues(position, rates.ravel().copy(), acceleration)
+        for k, places in zip(self.kinematics, self.shapes):  # only the outputs the values read
+            scalars, rates, rate_a, rate_b, origin, _, RA, RB, _ = places
+            if KINDS[k.kind].matrix_positions:
+                position = _positions(k.kind, None, slots[6][RA[0]].reshape(RA[1]), slots[7][RB[0]].reshape(RB[1]),
+                                      slots[4][origin[0]])
+            else:
+                position = slots[0][scalars[0]].copy()
+            acceleration = None if qdd is None else \
+                slots[2][rate_a[0]].reshape(rate_a[1]) @ qdd[k.indices] - slots[3][rate_b[0]]
+            found[k.name] = JointValues(position, slots[1][rates[0]].copy(), acceleration)
         return found
 
     def _layout(self, t, q, qd, p):
-        """Per joint, per output: (start, stop, shape) in the batch's slot of that output."""
+        """Per joint, per output: (slice, shape) in the batch's slot of that output."""
         starts, places = [0] * self.SLOTS, []
         for k in self.kinematics:
             outputs = k._evaluate(t, q[k.indices], qd[k.indices], p)
             place = []
             for j, x in enumerate(outputs):
-                place.append((starts[j], starts[j] + np.size(x), np.shape(x)))
+                place.append((slice(starts[j], starts[j] + np.size(x)), np.shape(x)))
                 starts[j] += np.size(x)
             places.append(place)
         return places
