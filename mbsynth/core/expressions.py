@@ -171,6 +171,10 @@ class _Translator:
             return CONSTANTS[name]
         close = [s for s in self.symbols if s.split(".")[-1] == name.split(".")[-1]]
         hint = f" (did you mean {', '.join(sorted(close))}?)" if close else ""
+        owner = name.rpartition(".")[0]
+        members = sorted(s.rpartition(".")[2] for s in self.symbols if owner and s.rpartition(".")[0] == owner)
+        if members:  # a part's or joint's name with a key it has not: say which it has
+            hint += f" ('{owner}' has {', '.join(members)})"
         self.fail(node, f"unknown name '{name}'{hint}")
 
     def visit_Call(self, node):

@@ -207,8 +207,12 @@ class _Builder:
 
     def read_subsystems(self):
         node = self.root["subsystems"]
-        if not isinstance(node, LineDict) or not node:
-            self.fail(("subsystems",), "expected a mapping of named parts, e.g. 'wheel: {type: lagrangian, ...}'")
+        if node is not None and not isinstance(node, LineDict):
+            self.fail(("subsystems",), f"expected a mapping of named parts, e.g. 'wheel: {{type: lagrangian, ...}}', "
+                                       f"got {_kind(node)}")
+        if not node:
+            self.fail(("subsystems",), "the mapping is empty: a model needs at least one part, e.g. "
+                                       "'wheel: {type: lagrangian, ...}'")
         parts = []
         for name, spec in node.items():
             path = ("subsystems", name)
@@ -330,6 +334,11 @@ class _Builder:
                 self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
                           f"joint '{joint.name}' has the name of part '{joint.name}': joints and parts share one "
                           f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
+            if joint.name in self.parameters or joint.name == "world":
+                entry = self.entry_named(joint.name)
+                clash = "the world (its frames are 'world.<frame>')" if joint.name == "world" else "a parameter"
+                self.fail(entry + ("name",) if entry else ("subsystems",),
+                          f"joint '{joint.name}' has the name of {clash}: rename the joint")
             values = functools.cache(functools.partial(value_expressions, joint))
             symbols = functools.cache(functools.partial(constraint_symbols, joint))
             for key in value_names(joint):  # derived when an expression uses them (sympy: tenths of a second)

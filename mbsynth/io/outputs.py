@@ -1,5 +1,7 @@
 """Reading a model's ``outputs:`` mapping (the kinds are described in mbsynth.model.outputs)."""
 
+import functools
+
 from ..core.errors import ModelError
 from ..model.outputs import BUILT_IN_COLUMNS, energy_output, expression_output, frame_output, reaction_output
 from .joints import frame_reference
@@ -30,18 +32,19 @@ def read_outputs(builder, constraints):
             builder.fail(path, f"give exactly one of {', '.join(KINDS)} (or an expression)")
         (kind, value), = spec.items()
         kpath = path + (kind,)
-        try:
-            if kind == "reaction":
-                connector, _, which = str(value).rpartition(".")
-                if connector not in by_name:
-                    builder.fail(kpath, f"unknown joint or constraint '{connector}' in '{value}' (write "
-                                        f"'<joint>.force', '.torque' or '.multipliers'); known: {', '.join(by_name)}")
-                outputs.append(reaction_output(name, by_name[connector], which))
-            elif kind == "energy":
-                outputs.append(energy_output(name, value))
-            else:
-                part, frame = frame_reference(builder, value, kpath)
-                outputs.append(frame_output(name, kind, part, frame, builder.q, builder.qd))
+        if kind == "reaction":
+            connector, _, which = str(value).rpartition(".")
+            if connector not in by_name:
+                builder.fail(kpath, f"unknown joint or constraint '{connector}' in '{value}' (write "
+                                    f"'<joint>.force', '.torque' or '.multipliers'); known: {', '.join(by_name)}")
+            make = functools.partial(reaction_output, name, by_name[connector], which)
+        elif kind == "energy":
+            make = functools.partial(energy_output, name, value)
+        else:
+            part, frame = frame_reference(builder, value, kpath)
+            make = functools.partial(frame_output, name, kind, part, frame, builder.q, builder.qd)
+        try:  # the model's own errors get the file and line here (the builder's have them)
+            outputs.append(make())
         except ModelError as err:
             builder.fail(kpath, str(err))
     return tuple(outputs)

@@ -11,6 +11,7 @@ assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 """
 
 import functools
+import numbers
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -168,21 +169,24 @@ class System:
     def resolved_parameters(self, values, p=None, check_parts=True):
         """The parameter values (an array in the model's order) with ``values`` ({name:
         value}) set over ``p`` (default: the model's): parameters defined by expressions of
-        others follow. Raises ModelError for a name the model has no parameter of, a
-        non-finite value, or (``check_parts``) a part that reads a changed parameter and
+        others follow. A value is a real number or a real array of one element (its scalar).
+        Raises ModelError for a name the model has no parameter of, a value that is no real
+        number (a string, a complex number, an array of more elements) or not finite, or
+        (``check_parts``) a part that reads a changed parameter and
         whose M or Q is then not finite or M not positive semi-definite at the initial state."""
         unknown = sorted(set(values) - set(self.parameters))
         if unknown:
             raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
                              f"it has {sorted(self.parameters)}")
-        bad = sorted(name for name, x in values.items() if not np.isfinite(float(x)))
+        values = {name: self._parameter_value(name, x) for name, x in values.items()}
+        bad = sorted(name for name, x in values.items() if not np.isfinite(x))
         if bad:
             raise ModelError(f"model '{self.name}': non-finite values for parameter(s) {bad}")
         old = self.parameter_values if p is None else np.asarray(p, dtype=float)
         new = old.copy()
         for i, name in enumerate(self.parameters):
             if name in values:
-                new[i] = float(values[name])
+                new[i] = values[name]
         if self.definitions:  # parameters defined by expressions of earlier ones follow, in order
             subs = {}
             for i, name in enumerate(self.parameters):
@@ -195,6 +199,25 @@ class System:
             if problems:
                 raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")
         return new
+
+    def _parameter_value(self, name, x):
+        """x as a float: a real number, or a real array of one element taken as its scalar
+        (a joint value is an array, ``-2*jv["hinge"].position`` one of shape (1,)). ModelError
+        naming the parameter for a string (even "3"), a complex number, a boolean, an array
+        of another size or anything else."""
+        if type(x) is float:  # the common case, at every control sample
+            return x
+        if isinstance(x, numbers.Real) and not isinstance(x, bool):  # a sympy or fractions number too
+            return float(x)
+        kind = np.asarray(x).dtype.kind if not isinstance(x, (str, bytes)) else "U"
+        size = np.size(x) if kind in "iuf" else 1
+        if kind in "iuf" and size == 1:
+            return float(np.reshape(x, ()))
+        got = {"U": f"the string {x!r}", "S": f"the bytes {x!r}", "c": f"the complex number {x!r}",
+               "b": f"the boolean {x!r}"}.get(kind, f"an array of shape {np.shape(x)}" if kind in "iuf" else
+                                          f"a {type(x).__name__}")
+        raise ModelError(f"model '{self.name}': parameter '{name}' takes a real number (or a real array of one "
+                         f"element), got {got}")
 
     def data(self):
         """A new workspace for a run on this System (data.Data): its parameter values, its

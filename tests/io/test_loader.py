@@ -117,6 +117,15 @@ def test_parameters_may_be_expressions_of_earlier_ones():
     assert system.parameters["Ic"] == pytest.approx(0.25)
 
 
+HINGED = """\
+parameters: {k: 2.0}
+world: {frames: {pivot: {axis: [0, 1, 0]}}}
+subsystems:
+  rod: {type: rigid_body, mass: 1, inertia: [1, 1, 1], frames: {top: {position: [0, 0, 1], axis: [0, 1, 0]}}}
+joints:
+  - {name: hinge, type: revolute, parent: world.pivot, child: rod.top}
+"""
+
 ERRORS = [
     ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*m*x_dot**2}\n",
      2, "unknown name 'm'"),
@@ -147,6 +156,11 @@ ERRORS = [
     ("parameters: {t: 1}\nsubsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\n", 1, "reserved"),
     ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nclosure: yes\n", 3,
      "expected 'auto' or 'none'"),
+    ("subsystems: {}\n", 1, "the mapping is empty: a model needs at least one part"),
+    (f"{HINGED}outputs: {{d: hinge.displacement}}\n", 7,
+     "unknown name 'hinge.displacement' ('hinge' has angle, rate)"),  # a revolute joint's values
+    (HINGED.replace("name: hinge", "name: world"), 6, "at joints[0].name: joint 'world' has the name of the world"),
+    (HINGED.replace("name: hinge", "name: k"), 6, "at joints[0].name: joint 'k' has the name of a parameter"),
 ]
 
 
@@ -157,6 +171,15 @@ def test_mistakes_name_file_line_and_key(text, line, fragment):
     message = str(err.value)
     assert message.startswith(f"bad.yaml:{line}:"), message
     assert fragment in message, message
+
+
+def test_an_unknown_reaction_joint_is_named_once_at_its_line():
+    """Its file:line prefix was printed twice."""
+    with pytest.raises(mb.ModelError) as err:
+        mb.loads(f"{HINGED}outputs: {{f: {{reaction: hing.force}}}}\n", name="bad.yaml")
+    message = str(err.value)
+    assert message.startswith("bad.yaml:7: at outputs.f.reaction: unknown joint or constraint 'hing'") and \
+        message.count("bad.yaml") == 1, message
 
 
 def test_missing_file_is_a_model_error(tmp_path):
