@@ -133,10 +133,15 @@ def test_every_command_runs_as_shown(line, workdir, request, monkeypatch, capsys
     assert code == VERDICTS_SHOWN.get(line, 0), f"{TO_RUN[line]}: mbsynth {line} exited {code}: {err or out}"
 
 
+BUILT = "docs/_build"  # made by `make docs` (the pages say so), absent from a fresh clone
+
+
 def test_every_path_the_pages_name_exists():
     missing = []
     for page in PAGES:
         for path in NAMED.findall(page.read_text()):
+            if path.startswith(BUILT):
+                continue
             if not (any(ROOT.glob(path)) if "*" in path else (ROOT / path).exists()):
                 missing.append(f"{page.relative_to(ROOT)}: {path}")
     assert missing == []

@@ -25,7 +25,7 @@ from mbsynth.view import screenshot as screenshot_module
 from mbsynth.view.screenshot import chromium, screenshot
 from mbsynth.analysis.trajectory import Trajectory
 from mbsynth.view.scene import build_scene, drawn_rows
-from test_cli_errors import HANG, ended_within, needs_proc, proc_stat, running
+from processes import HANG, ended_within, needs_proc, proc_stat, running
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE3 = ROOT / "models" / "paper" / "example3_two_masses.yaml"
