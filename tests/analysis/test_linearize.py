@@ -304,7 +304,8 @@ def test_modes_equilibrium_command_of_the_double_pendulum(capsys):
 
 def test_equilibrium_of_the_spatial_double_pendulum_in_body_coordinates():
     """double_pendulum_3d.yaml (14 body coordinates; Newton's steps on q̈ = 0 stalled after
-    50): both links hang below the pivot at (0, 0, 2), V at its minimum."""
+    50): both links hang below the pivot at (0, 0, 2), V at its minimum, and vibrate there
+    as the same pendulum in its two angles does."""
     system = mb.load(MODELS / "rigid" / "double_pendulum_3d.yaml")
     p = system.parameters
     q = dict(zip(system.coordinates, mb.equilibrium(system)))
@@ -313,6 +314,8 @@ def test_equilibrium_of_the_spatial_double_pendulum_in_body_coordinates():
                        pytest.approx([0, 0, 2 - p["L1"] - p["L2"] / 2], abs=1e-9)]
     V = system.energy(0.0, np.array(list(q.values())), np.zeros(system.n))[1]
     assert V == pytest.approx(hanging_potential(p) + 2 * p["g"] * (p["m1"] + p["m2"]), rel=1e-12)
+    angles = mb.modes(mb.load(MODELS / "rigid" / "double_pendulum_angles.yaml"), equilibrium=True)
+    assert omegas(mb.modes(system, equilibrium=True)) == pytest.approx(omegas(angles), rel=1e-9)  # the same pendulum
 
 
 UR5_HELD = """
