@@ -31,7 +31,7 @@ VERDICTS = {  # what exit 1 means for each command (none: the command has no ver
     "view": "the simulation had to stop (the motion up to there is drawn)",
     "validate": "a relative error exceeds --tolerance, or no comparison is possible",
     "modes": "no rest state (the state is not at rest, q̈ ≠ 0 at q̇ = 0; with --equilibrium: no static "
-             "equilibrium is found)",
+             "equilibrium is found, or the one found is not isolated; rows that prescribe a motion)",
     "robots": None,
 }
 
@@ -171,7 +171,8 @@ def _modes(commands):
                     "joints (or coordinates) that move most.")
     modes.add_argument("model", help="model file (YAML)")
     modes.add_argument("--equilibrium", action="store_true",
-                       help="first find the static equilibrium near the initial state (Newton)")
+                       help="first find the rest the model comes to from its initial state, its motion "
+                            "damped away (the stable equilibrium whose basin holds it)")
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.add_argument("--html", metavar="FILE.html",
                        help="write an HTML page animating each mode in meshcat (a selector per mode)")
