@@ -14,8 +14,9 @@ control sample): the integrator's f is computed afresh there.
 - CutIntegration (cut.py): otherwise, each interval integrated on its own, the last step
   cut short at its end, the state projected there and between as the drift asks.
 
-``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share how an integrator goes
-on from a state: the same explicit pair where it can (stepper.RESUMABLE), else a new one.
+``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share
+how an integrator goes on from a state: the same explicit pair where it can
+(stepper.RESUMABLE), else a new one.
 """
 
 import logging
@@ -28,7 +29,8 @@ log = logging.getLogger(__name__)
 
 class Integration:
     """What both strategies hold: the settings, the right-hand side ``f`` with its counts,
-    the integrator kept from interval to interval, and the state reached."""
+    the integrator kept from interval to interval, and the state reached. ``schedule``: the
+    run's output times and control samples (schedule.Schedule)."""
 
     def __init__(self, data, method, rtol, atol, stabilization, baumgarte, schedule):
         self.data, self.method, self.rtol, self.atol = data, method, rtol, atol
