@@ -30,7 +30,7 @@ def test_the_stops_are_the_outputs_and_samples_merged(t0, t_end, dt, h):
 
 def test_a_short_control_interval_takes_no_memory():
     """A billion samples (h = 1e-9 over 1 s) are computed as they come: making the schedule
-    and walking into it allocates next to nothing (it once made every sample first)."""
+    and walking into it allocates next to nothing."""
     h = 1e-9
     tracemalloc.start()
     schedule = Schedule(np.linspace(0.0, 1.0, 11), h)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rotations import E, G
 
 import mbsynth as mb
 from mbsynth.analysis.diagnose import diagnose
@@ -27,20 +28,6 @@ def seeded():
 
 def loads(text):
     return mb.loads(textwrap.dedent(text), name="model.yaml")
-
-
-def skew(v):
-    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-
-
-def E(u):
-    """ω_body = 2 E(u) u̇ (kinematics.body_rate_matrix, numerically)."""
-    return np.column_stack([-u[1:], u[0] * np.eye(3) - skew(u[1:])])
-
-
-def G(u):
-    """ω_world = 2 G(u) u̇."""
-    return np.column_stack([-u[1:], u[0] * np.eye(3) + skew(u[1:])])
 
 
 def random_body_state():
