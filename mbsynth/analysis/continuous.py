@@ -1,6 +1,6 @@
 """The continuous strategy of the run loop: where the compiled kernel puts a state back on
-the constraints itself (compiled/correction.py: a tree of kernel joints and bodies, no
-loops), with ``stabilization="projection"`` and an explicit Runge–Kutta pair (RK23, RK45,
+the constraints itself (compiled/correction.py: kernel joints and bodies, in a tree or
+closing loops), with ``stabilization="projection"`` and an explicit Runge–Kutta pair (RK23, RK45,
 DOP853).
 
 The steps are chosen by the error control alone, up to the next control sample or the end;

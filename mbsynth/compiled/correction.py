@@ -21,9 +21,10 @@ factorization (benchmarks/end_to_end_results.md).
 splits a block among the cores (``simulate``: the output times a step passed, with its
 end), each thread with its own Work.
 
-Only for Systems all of whose rows and coordinates the kernel's tree covers (rows.py's
-``covers``; no loops, no extra coordinates); elsewhere, and at any state the kernel
-declines, the caller projects with projection.py.
+Only for Systems all of whose rows and coordinates the kernel covers (rows.py's ``covers``:
+the rows of its tree and loop joints, no extra coordinates); elsewhere, and at any state the
+kernel declines, the caller projects with projection.py. With loops, each step's Schur step
+follows the drift rule (kernel.motion's ``drift``: the state's relative drift).
 """
 
 import threading
@@ -87,7 +88,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
                 break
             _negated(phi, shift)
             if step == MAX_STEPS or \
-                    motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0] != OK:
+                    motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, phi_max / size, general)[0] != OK:
                 declined = True
                 break
             reuse = step == 0 and largest(qdd) <= REUSE * size  # the Work keeps q's factorization
@@ -106,9 +107,9 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             for i in range(kind.shape[0]):
                 if kind[i] == RIGID:
                     shift[quat_row[i]] = 0.0  # met by _unit_rates, to rounding: the kernel redoes only the solve
-            status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED, general)[0]
+            status = motion(factored, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, REUSED, phi_max / size, general)[0]
         else:
-            status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, general)[0]
+            status = motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, phi_max / size, general)[0]
         if status != OK:
             continue
         before = psi_max

@@ -24,6 +24,7 @@ from ..core.equations import Motion
 from . import ahead, codegen, kernel, layout
 from .assembly import Work, make_work
 from .correction import Correction
+from .rows import Rows
 from .packing import pack, views
 from .threads import THREADS, pool
 
@@ -87,6 +88,10 @@ class Engine:
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
         self.corrections = []  # the Correction, once made (a list: ``at``'s copies share it)
+        # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with loops
+        # (``drift_motion``), where they are all of its rows; None elsewhere (that drift is the exact path's)
+        rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
+        self.rows = rows if rows is not None and rows.covers else None
 
     def at(self, p):
         """This Engine at other parameter values that its Layout's numbers do not use (a
@@ -122,30 +127,42 @@ class Engine:
         ahead.finish()
         self.motion(0.0, q, qd)
 
-    def motion(self, t, q, qd, bshift=None):
+    @property
+    def drift_motion(self):
+        """Whether ``motion`` serves states off the constraint manifold (``drift``): always
+        without loops; with loops where the kernel's rows are all of the System's (the
+        relative drift of kernel.motion is theirs)."""
+        return not self.closes_loops or self.rows is not None
+
+    def motion(self, t, q, qd, bshift=None, drift=False):
         """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
-        bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ)."""
+        bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ); ``drift``: the
+        state may lie off the constraint manifold (an integrator's stage: the drift rule,
+        kernel.motion; only where ``drift_motion``)."""
         with self.lock:
-            status, residual = self._solved(t, q, qd, EMPTY if bshift is None else bshift)
+            status, residual = self._solved(t, q, qd, EMPTY if bshift is None else bshift, drift)
             if status != kernel.OK:
                 return None
             return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
 
     def derivative(self, t, y):
         """(q̇, q̈) stacked at the state y = (q, q̇) (a contiguous float array), as an
-        integrator's stage wants it, or None for the exact path: ``motion`` without a Motion."""
+        integrator's stage wants it (off the manifold: ``motion``'s drift), or None for the
+        exact path: ``motion`` without a Motion."""
         y = np.ascontiguousarray(y, dtype=float)
         q, qd = y[:self.n], y[self.n:]
         with self.lock:
-            status, _ = self._solved(t, q, qd, EMPTY)
+            status, _ = self._solved(t, q, qd, EMPTY, True)
             return np.concatenate((qd, self.W.qdd)) if status == kernel.OK else None
 
-    def _solved(self, t, q, qd, bshift):
+    def _solved(self, t, q, qd, bshift, drift):
         """kernel.motion's (status, residual) at (t, q, q̇), its q̈ and Qc left in this
-        Engine's Work (the caller holds the lock): the generated function, then the kernel."""
+        Engine's Work (the caller holds the lock): the generated function, then the kernel,
+        with the state's relative drift where ``drift`` and the model closes loops."""
         if self.module is not None:
             self.module.evaluate(float(t), q, qd, self.p, self.gen)
-        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, kernel.CHECKED, self.general)
+        delta = self.rows.relative_drift(q, qd) if drift and self.closes_loops else -1.0
+        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, kernel.CHECKED, delta, self.general)
 
     def motion_batch(self, t, q, qd):
         """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread

@@ -15,8 +15,13 @@ give a Schur matrix of rounding noise). A dropped
 direction must leave the right side alone (else the rows contradict: INCONSISTENT) and
 must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 
+Off the manifold (an integrator's stage, ``motion``'s ``drift``) the Schur step follows the
+drift rule of core/equations.py instead: directions the drift splits off dependent rows are
+dropped with their part of the right side (least squares), and a nearly dependent one the
+drift does not explain goes to the exact treatment (NEAR_SINGULAR).
+
 Status: OK, or why the caller must hand the problem to the exact treatment — a singular
-tree block (SINGULAR), the two cases above, a residual above ``RESIDUAL_MAX`` or a
+tree block (SINGULAR), the cases above, a residual above ``RESIDUAL_MAX`` or a
 non-finite result. ``residual`` is the relative residual of the equilibrated KKT
 equations M q̈ + Aᵀλ = Q + C, A q̈ = b (its numerator bounds that of (2.12), since
 P Aᵀ = 0 and ‖P‖ = 1).
@@ -34,9 +39,10 @@ from .joints import RIGID
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve
-from ..core.tolerances import KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL, SCHUR_ZERO_RTOL
+from ..core.tolerances import (DRIFT_RANK, KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL, SCHUR_DEPENDENT_RTOL,
+                               SCHUR_ZERO_RTOL, SPLIT_MOVES)
 
-OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE = range(6)
+OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE, NEAR_SINGULAR = range(7)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
 # checks): numpy integers, which numba types as int64 rather than as a literal per value (one compilation)
 RIGID_TREE, GENERAL = None, True  # ``motion``'s ``general``: numba prunes the branches on ``general is None``, so
@@ -92,10 +98,12 @@ def _moves(vec, nx, topology, segs, seg6, factored, y, w):
 
 
 @njit(**OPTIONS)
-def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam, multipliers):
+def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam, multipliers, drift):
     """Solve the Schur system of the extra rows and coordinates into lam (extra
     accelerations, then extra multipliers), then the tree into z (its multipliers too
-    where ``multipliers``: tree.solve). Returns a status."""
+    where ``multipliers``: tree.solve). Returns a status. ``drift``: negative on the
+    manifold (the rules of the module docstring), else the state's relative drift δ
+    (``motion``)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     S[:, :] = 0.0
     for x in range(nx):
@@ -116,6 +124,7 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     values = np.zeros(mx + nx)
     symmetric_eigen(S, vectors, values)
     top = max(np.abs(values).max(), 1.0) if values.shape[0] else 1.0
+    dependent = max(SCHUR_DEPENDENT_RTOL, (DRIFT_RANK * drift) ** 2) * top  # off the manifold: the drift's own
     lam[:] = 0.0
     dropped = size = 0.0
     for e in range(values.shape[0]):  # the right side's scale: before the tree's part cancels
@@ -129,11 +138,17 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         if abs(values[e]) > SCHUR_ZERO_RTOL * top:
             for c in range(values.shape[0]):
                 lam[c] += coef / values[e] * vectors[c, e]
-        else:
-            dropped += coef * coef
-            if _moves(vectors[:, e], nx, topology, segs, seg6, factored, y, w) > KERNEL_NULL_RTOL:
-                return NOT_UNIQUE
-    if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
+            continue
+        if drift >= 0.0 and abs(values[e]) > dependent:
+            return NEAR_SINGULAR  # not the drift's: for the exact drift rule (equations.py)
+        allowed = KERNEL_NULL_RTOL if drift < 0.0 else max(KERNEL_NULL_RTOL, SPLIT_MOVES * math.sqrt(abs(values[e]) / top))
+        if _moves(vectors[:, e], nx, topology, segs, seg6, factored, y, w) > allowed:
+            return NOT_UNIQUE
+        dropped += coef * coef
+        if drift >= 0.0:  # least squares: the rows' right side less its part along the dropped direction
+            for x in range(mx):
+                xb[x] -= coef * vectors[nx + x, e]
+    if drift < 0.0 and math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
         return INCONSISTENT
     _copy(ry, y)
     for x in range(mx):
@@ -313,7 +328,7 @@ def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx,
 
 
 @njit(**OPTIONS)
-def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general):
+def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     """(status, residual) at one state; on OK, the Work's qdd holds q̈ and its Qc M q̈ − Q.
     gen: the generated function's outputs at (t, q, q̇) — time enters only there; bshift:
     added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
@@ -390,7 +405,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, general):
     if general is not None and x_coord.shape[0] + xb.shape[0] > 0:
         solve(topology, factored, y, z0, False)  # _close solves again into z
         status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
-                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED)
+                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED, drift)
         if status != OK:
             return status, 0.0
     else:
@@ -413,5 +428,5 @@ def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, qdd, status):
     empty = np.zeros(0)
     qdd_view = view1(WF, WX, WORK.qdd)
     for row in range(q.shape[0]):
-        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED, general)[0]
+        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED, -1.0, general)[0]
         _copy(qdd_view, qdd[row])

@@ -152,3 +152,9 @@ class Rows:
         """(φ, φ̇, T, V, max|φ|, max|φ̇|, max|q|, max|q̇|) at (q, q̇): the arrays are this
         object's, overwritten by the next call."""
         return (self.phi, self.psi, *residuals_energy(q, qd, *self.packed, self.phi, self.psi, *self.work))
+
+    def relative_drift(self, q, qd):
+        """The largest |φ| over the largest coordinate (at least 1: a quaternion's unit),
+        φ alone (kernel.motion's ``drift``)."""
+        _, _, phi_max, _, q_max, _ = residuals_energy(q, qd, *self.packed, self.phi, self.psi, *self.work, False)
+        return phi_max / max(q_max, 1.0)

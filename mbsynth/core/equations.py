@@ -62,9 +62,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import SolveError
-from .tolerances import CONSISTENCY_RTOL, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL, SYMMETRY_RTOL
+from .tolerances import CONSISTENCY_RTOL, DRIFT_RANK, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL, SYMMETRY_RTOL
 
-DRIFT_RANK = 10.0  # a nearly dependent σ_i below this times the relative drift δ (× σ₁) counts as dependent
 TERM_FLOOR = 1e-3  # term_scales: the share of ‖A_i‖₁ ‖x‖∞ that a row with coordinates near zero keeps
 DRIFT_GAIN = 10.0  # a nearly dependent direction asking more than this times the rest's acceleration is drift
 

@@ -12,6 +12,7 @@ CONSISTENCY_RTOL = 1e-9  # least relative size of b ∉ range(A) or of wᵀ(Q + 
 SYMMETRY_RTOL = 1e-10  # largest |M − Mᵀ| accepted, relative to max |M|
 NAME_RTOL = 1e-6  # a component below this fraction of the largest one is not named in errors
 NEAR_SINGULAR = 1e-5  # σ_i below this fraction of σ₁ (of the equilibrated A): a nearly dependent direction
+DRIFT_RANK = 10.0  # off the manifold, a nearly dependent σ_i below this times the relative drift δ (× σ₁) is dependent
 VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off makes the verdict uncertain
 # (a mass ratio of 1e-9, 1e3 times the cut-off, is a legitimate model and is not flagged)
 
@@ -21,6 +22,10 @@ SCHUR_ZERO_RTOL = 1e-10  # kernel.py: Schur eigenvalues below this fraction of m
 KERNEL_CONSISTENCY_RTOL = 1e-10  # kernel.py: largest part of the right side along dropped directions,
 # relative to b's (tighter than CONSISTENCY_RTOL: the kernel hands a doubtful state to the exact path)
 KERNEL_NULL_RTOL = 1e-8  # kernel.py: largest acceleration a dropped (unit) direction may move
+SCHUR_DEPENDENT_RTOL = 1e-14  # kernel.py, off the manifold: Schur eigenvalues below this fraction (~50 ε) are
+# rounding of rows dependent on the manifold, whatever the drift
+SPLIT_MOVES = 1e4  # kernel.py, off the manifold: a dropped direction of Schur eigenvalue λ may move accelerations
+# up to this times √(λ / the largest) (the drift splits dependent rows by about that much)
 CORRECTION_RTOL = 1e-14  # correction.py: largest |φ| left, relative to the largest coordinate (at least 1): ~50 ε
 CORRECTION_RATE_RTOL = 1e-12  # correction.py: a velocity step must leave φ̇ below this, relative to the
 # largest coordinate (at least 1) times the largest rate (or cut it by SHRINK)

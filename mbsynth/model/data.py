@@ -196,7 +196,7 @@ class Data:
             engine = self.tree_engine(drift)
             if engine is not None:
                 shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
-                found = engine.motion(t, q, qd, shift)
+                found = engine.motion(t, q, qd, shift, drift)
                 if found is not None:
                     return found
         return self._kkt_motion(t, q, qd, method, baumgarte, drift)
@@ -218,10 +218,10 @@ class Data:
 
     def tree_engine(self, drift=False):
         """The compiled Engine that serves ``motion``, or None: the KKT path, or (``drift``)
-        a state off the manifold of a model with loops (the kernel's Schur step drops
-        dependent rows by its own rule, not by the drift rule of ``equations``)."""
+        a state off the manifold of a model whose loops the kernel cannot judge there
+        (Engine.drift_motion: rows other than the kernel's close them)."""
         engine = self.engine
-        return None if engine is None or (drift and engine.closes_loops) else engine
+        return None if engine is None or (drift and not engine.drift_motion) else engine
 
     def stage_motion(self, baumgarte=None, drift=False):
         """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
@@ -232,7 +232,7 @@ class Data:
             return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
 
         def stage(t, q, qd):
-            found = engine.motion(t, q, qd)
+            found = engine.motion(t, q, qd, None, drift)
             return found if found is not None else self._kkt_motion(t, q, qd, "fast", None, drift)
         return stage
 

@@ -99,7 +99,7 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     gen, qd = np.zeros(rest.outputs), np.zeros(q.size)
 
     def call(shift, mode):
-        status = kernel.motion(q, qd, gen, shift, *rest.buffers, mode, rest.general)[0]
+        status = kernel.motion(q, qd, gen, shift, *rest.buffers, mode, -1.0, rest.general)[0]
         assert status == kernel.OK
         return rest.W.qdd.copy()
 

@@ -559,7 +559,7 @@ def test_helpers_compile_the_argument_types_motion_passes(name, all_joints):
     assert engine.general is (kernel.RIGID_TREE if name == "rigid tree" else kernel.GENERAL)
     fresh = njit(error_model="numpy")(kernel.motion.py_func)  # not cached: compiled here
     q, qd = random_state(system, np.random.default_rng(3))
-    assert fresh(q, qd, engine.gen, np.zeros(0), *engine.buffers, kernel.CHECKED, engine.general)[0] == kernel.OK
+    assert fresh(q, qd, engine.gen, np.zeros(0), *engine.buffers, kernel.CHECKED, -1.0, engine.general)[0] == kernel.OK
     for group in range(len(ahead.GROUPS)):
         for dispatcher, types in ahead.functions(group, engine.general):
             assert types in dispatcher.overloads, (dispatcher.py_func.__name__, list(dispatcher.overloads))

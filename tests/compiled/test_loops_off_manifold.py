@@ -1,0 +1,164 @@
+"""The compiled kernel at states off the constraint manifold of models with loops (an
+integrator's stages): its Schur step follows the drift rule of core/equations.py
+(kernel.motion's ``drift``), so loops of kernel joints integrate on the compiled path.
+
+References: the KKT path's drift rule (equations.py, an SVD of all the rows), the exact
+one-degree-of-freedom motion of the N-four-bar (benchmarks/iftomm_reference.py) through its
+singular positions, and energy conservation.
+"""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbsynth as mb
+from mbsynth.compiled import kernel
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import iftomm_reference as ref  # noqa: E402
+
+LOOPS = ["bricard.yaml", "bennett.yaml", "sarrus.yaml", "four_bar_3d.yaml"]
+
+
+def rigid_n_four_bar(N, L=1.0, m=1.0):
+    """The IFToMM A02 N-four-bar of iftomm_reference.n_four_bar_yaml built of rigid bodies
+    (7 coordinates each) on revolute joints about z: in space every loop is
+    over-constrained (dependent rows on the whole manifold), and at the horizontal
+    positions N more rows become dependent (singular positions). The bars' own axial
+    inertia is a hundredth of the transverse one (the motion is planar: it does not enter)."""
+    small, rod = m * L**2 / 1200, m * L**2 / 12
+    lines = [f"name: rigid_n_four_bar_{N}", f"parameters: {{L: {L!r}, m: {m!r}, g: 9.81, speed: 1.0}}",
+             "gravity: [0, -g, 0]", "world:", "  frames:"]
+    lines += [f"    p{i}: {{position: [{i}*L, 0, 0]}}" for i in range(N + 1)]
+    lines.append("subsystems:")
+    for i in range(N + 1):
+        lines.append(f"  v{i}: {{type: rigid_body, mass: m, inertia: [{rod}, {small}, {rod}], "
+                     "frames: {bottom: {position: [0, -L/2, 0]}, top: {position: [0, L/2, 0]}}, "
+                     f"initial: {{position: [{i}*L, L/2, 0], velocity: [speed/2, 0, 0], "
+                     "angular_velocity: [0, 0, -speed/L]}}")
+    for i in range(N):
+        lines.append(f"  h{i}: {{type: rigid_body, mass: m, inertia: [{small}, {rod}, {rod}], "
+                     "frames: {left: {position: [-L/2, 0, 0]}, right: {position: [L/2, 0, 0]}}, "
+                     f"initial: {{position: [{i}*L + L/2, L, 0], velocity: [speed, 0, 0]}}}}")
+    lines.append("joints:")
+    lines += [f"  - {{name: ground{i}, type: revolute, parent: world.p{i}, child: v{i}.bottom}}" for i in range(N + 1)]
+    for i in range(N):
+        lines.append(f"  - {{name: left{i}, type: revolute, parent: v{i}.top, child: h{i}.left}}")
+        lines.append(f"  - {{name: right{i}, type: revolute, parent: v{i + 1}.top, child: h{i}.right}}")
+    return "\n".join(lines) + "\n"
+
+
+def drifted(system, rng, size):
+    """A state of ``system`` on its manifold in motion (0.3 s into its run), then moved off it
+    by ``size`` (relative, random directions) in positions and velocities."""
+    trajectory = mb.simulate(system, 0.3, dt=0.3)
+    q, qd = trajectory.q[-1], trajectory.qd[-1]
+    return (q + size * max(np.abs(q).max(), 1.0) * rng.standard_normal(q.size),
+            qd + size * np.abs(qd).max() * rng.standard_normal(qd.size))
+
+
+@pytest.mark.parametrize("name", LOOPS)
+def test_off_the_manifold_the_kernel_gives_the_drift_rules_motion(name):
+    """At stages 1e-9 off the manifold the kernel serves the motion (loops of kernel joints
+    only) and it is the KKT drift rule's to O(drift): both are least-squares motions, in
+    different metrics, of rows the drift made inconsistent."""
+    system = mb.load(ROOT / "models" / "mechanisms" / name)
+    data = system.data()
+    engine = data.tree_engine(drift=True)
+    assert engine is not None and engine.closes_loops
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        q, qd = drifted(system, rng, 1e-9)
+        compiled = engine.motion(0.0, q, qd, None, True)
+        assert compiled is not None  # served by the kernel, not handed to the KKT path
+        exact = data._kkt_motion(0.0, q, qd, "fast", None, True)
+        scale = np.abs(exact.qdd).max()
+        assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-6 * scale
+
+
+@pytest.mark.parametrize("name", LOOPS)
+def test_on_the_manifold_the_kernel_still_judges_consistency(name):
+    """A state 1e-5 off the manifold asked for without ``drift`` is judged as on it: the
+    dropped directions' right side contradicts the rows, and the kernel hands it to the
+    exact path (None) rather than give a least-squares motion."""
+    system = mb.load(ROOT / "models" / "mechanisms" / name)
+    engine = system.data().tree_engine(drift=True)
+    q, qd = drifted(system, np.random.default_rng(1), 1e-5)
+    assert engine.motion(0.0, q, qd) is None
+    assert engine.motion(0.0, q, qd, None, True) is not None
+
+
+def rigid_n_four_bar_state(system, N, psi, psi_dot, L=1.0):
+    """(q, q̇) of ``rigid_n_four_bar`` with every vertical bar at psi from the upward vertical
+    (clockwise: a turn of −psi about z) turning at psi' (iftomm_reference.n_four_bar_state's
+    motion, with unit quaternions)."""
+    index = {name: k for k, name in enumerate(system.coordinates)}
+    q, qd = np.zeros(system.n), np.zeros(system.n)
+    s, c, half = np.sin(psi), np.cos(psi), psi / 2
+    for i in range(N + 1):
+        for name, value, rate in (("x", i * L + L / 2 * s, L / 2 * c * psi_dot), ("y", L / 2 * c, -L / 2 * s * psi_dot),
+                                  ("qw", np.cos(half), -np.sin(half) * psi_dot / 2),
+                                  ("qz", -np.sin(half), -np.cos(half) * psi_dot / 2)):
+            q[index[f"v{i}.{name}"]], qd[index[f"v{i}.{name}"]] = value, rate
+    for i in range(N):
+        for name, value, rate in (("x", i * L + L / 2 + L * s, L * c * psi_dot), ("y", L * c, -L * s * psi_dot),
+                                  ("qw", 1.0, 0.0)):
+            q[index[f"h{i}.{name}"]], qd[index[f"h{i}.{name}"]] = value, rate
+    return q, qd
+
+
+def test_near_a_singular_position_the_kernel_leaves_the_stage_to_the_exact_drift_rule(tmp_path):
+    """The rigid N-four-bar 1e-6 rad before its horizontal position, 1e-12 off the manifold:
+    the nearly dependent direction of the rows is the singular position's, not the drift's,
+    so the kernel hands the stage on (None); the KKT drift rule names the rows and gives the
+    exact one-degree-of-freedom acceleration there."""
+    path = tmp_path / "rigid_n_four_bar.yaml"
+    path.write_text(rigid_n_four_bar(2))
+    system = mb.load(path)
+    data = system.data()
+    engine = data.tree_engine(drift=True)
+    psi, psi_dot = np.pi / 2 - 1e-6, 2.0
+    q, qd = rigid_n_four_bar_state(system, 2, psi, psi_dot)
+    rng = np.random.default_rng(5)
+    q, qd = q + 1e-12 * rng.standard_normal(q.size), qd + 1e-12 * rng.standard_normal(q.size)
+    assert engine.motion(0.0, q, qd, None, True) is None
+    motion = data.motion(0.0, q, qd, drift=True)
+    assert motion.singular
+    J, K = ref.n_four_bar_constants(2)
+    psi_ddot = K / J * np.sin(psi)
+    x_ddot = 0.5 * (np.cos(psi) * psi_ddot - np.sin(psi) * psi_dot**2)  # v0's centre
+    assert motion.qdd[system.coordinates.index("v0.x")] == pytest.approx(x_ddot, rel=1e-6)
+
+
+def test_the_rigid_n_four_bar_passes_its_singular_positions_on_the_exact_motion(tmp_path):
+    """The N-four-bar (N = 2) of rigid bodies, over-constrained in space, 8 s through eight
+    horizontal (singular) positions at the default tolerance, every stage served by the
+    kernel: the top B0 of the first bar within 1e-8 m of the exact one-degree-of-freedom
+    motion, no span integrated again more loosely."""
+    path = tmp_path / "rigid_n_four_bar.yaml"
+    path.write_text(rigid_n_four_bar(2))
+    system = mb.load(path)
+    statuses = set()
+    original = kernel.motion
+
+    def counted(*args):
+        found = original(*args)
+        statuses.add(int(found[0]))
+        return found
+    kernel.motion = counted
+    try:
+        trajectory = mb.simulate(system, 8.0, dt=0.05)
+    finally:
+        kernel.motion = original
+    assert trajectory.status == "completed" and not trajectory.stats["relaxed_spans"]
+    assert len(ref.n_four_bar_singular_times(2, 8.0)) == 8
+    assert kernel.OK in statuses and statuses <= {kernel.OK, kernel.NEAR_SINGULAR}
+    x, y = ref.n_four_bar_reference(trajectory.t, 2)
+    u = trajectory.q[:, system.coordinates.index("v0.qw"):][:, :4]
+    theta = 2 * np.arctan2(u[:, 3], u[:, 0])  # the bar's turn about z
+    bx = trajectory.column("v0.x") - 0.5 * np.sin(theta)
+    by = trajectory.column("v0.y") + 0.5 * np.cos(theta)
+    assert np.hypot(bx - x, by - y).max() <= 1e-8
