@@ -48,9 +48,10 @@ class ContinuousIntegration(CutIntegration):
             q, qd = super().advance(t_next, q, qd, loosen=isinstance(stop, Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
+        q, qd = self.form.to_state(y)
         if not bounded:
-            self.f.check(t_next, y)
-        q, qd = self._on_constraints(t_next, y, corrected)
+            self.f.check(t_next, q, qd)
+        q, qd = self._on_constraints(t_next, q, qd, corrected)
         return self.arrived(t_next, q, qd, None, corrected)
 
     def _reach(self, t_next, q, qd, t_stop):
@@ -61,7 +62,7 @@ class ContinuousIntegration(CutIntegration):
         self.f.begin(self.t_now, t_next, may_crawl=self.rtol < RELAXED_MAX)
         solver = self.solver
         if solver is None or self.forces_jumped:
-            solver = self.resumed(self.t_now, np.concatenate([q, qd]), t_stop, self.rtol, self.atol)
+            solver = self.resumed(self.t_now, q, qd, t_stop, self.rtol, self.atol)
             self.passed = {}
         while solver.t < t_next:
             self._step(solver, t_next)
@@ -85,8 +86,8 @@ class ContinuousIntegration(CutIntegration):
         taken = solver.t - start[0]
         if solver.t != solver.t_bound or self.next_step is None:  # a step cut at the bound proposes less
             self.next_step = solver.h_abs
-        self.f.check(solver.t, solver.y)
-        q, qd = solver.y[:self.n], solver.y[self.n:]
+        q, qd = self.form.to_state(solver.y)
+        self.f.check(solver.t, q, qd)
         redo, cap = next_cap(self.correction.drift(q, qd), taken, solver.max_step, solver.t_bound - solver.t,
                              self.f.span)
         if redo:
@@ -99,15 +100,15 @@ class ContinuousIntegration(CutIntegration):
         if times:
             stepper.interpolate(solver, times, states[:-1])
         states[-1] = solver.y
-        corrected = self.correction.block(states[:, :self.n], states[:, self.n:])
+        corrected = self.correction.block(*self.form.states(states))
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
-        q_on, qd_on = self._on_constraints(solver.t, solver.y, corrected[-1])
+        q_on, qd_on = self._on_constraints(solver.t, q, qd, corrected[-1])
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
-            y = np.concatenate([q_on, qd_on])
+            y = self.form.to_integrator(q_on, qd_on)
             stepper.move(solver, y, None if solver.status == "finished" else self.f(solver.t, y))
 
-    def _on_constraints(self, t, y, corrected):
-        """(q, q̇) of the state y on the constraints: ``corrected``'s where the kernel's
-        correction put it there (correction.Corrected), else projected (projection.py)."""
-        return project(self.data, t, y[:self.n], y[self.n:]) if corrected is None else corrected[:2]
+    def _on_constraints(self, t, q, qd, corrected):
+        """The state (q, q̇) on the constraints: ``corrected``'s where the kernel's correction
+        put it there (correction.Corrected), else projected (projection.py)."""
+        return project(self.data, t, q, qd) if corrected is None else corrected[:2]

@@ -74,7 +74,7 @@ class CutIntegration(Integration):
             rtol, atol = _looser(rtol, atol)
         while True:
             try:
-                y = self._span(t, t_next, np.concatenate([q, qd]), rtol, atol)
+                y = self._span(t, t_next, q, qd, rtol, atol)
                 break
             except Crawl:
                 self.solver, self.next_step = None, proposed  # stopped within a step; its steps are no guide
@@ -83,13 +83,15 @@ class CutIntegration(Integration):
             self.relaxed_spans.append(dict(t_from=t, t_to=t_next, rtol=rtol, atol=atol))
             log.info("near a singular position between t = %.6g and %.6g: integrated at rtol %g, atol %g",
                      t, t_next, rtol, atol)
-        self.f.check(t_next, y)
-        return y[:self.n], y[self.n:]
+        q, qd = self.form.to_state(y)
+        self.f.check(t_next, q, qd)
+        return q, qd
 
-    def _span(self, t, t_next, y, rtol, atol):
-        """The integrator's steps from (t, y) to t_next (its last step cut short there)."""
+    def _span(self, t, t_next, q, qd, rtol, atol):
+        """The integrator's steps from (t, q, q̇) to t_next (its last step cut short there);
+        its state y there (velocity_form.py)."""
         self.f.begin(t, t_next, relaxed=rtol != self.rtol, may_crawl=rtol < RELAXED_MAX)
-        solver = self.resumed(t, y, t_next, rtol, atol)
+        solver = self.resumed(t, q, qd, t_next, rtol, atol)
         while solver.status == "running":
             message = solver.step()
             if solver.status == "failed":

@@ -1,6 +1,7 @@
-"""The run loop's right-hand side: y' = (q̇, q̈) at the integrator's stages, q̈ from (2.14)
-(the compiled engine's where it covers the state, else the Data's stage motion), and what
-the stages tell about the run.
+"""The run loop's right-hand side: ẏ at the integrator's stages, y = (q, v) the integrator's
+form of the state (velocity_form.py: q̇ with each rigid body's quaternion rates replaced by
+its angular velocity), from (q̇, q̈) at the state, q̈ from (2.14) (the compiled engine's where
+it covers the state, else the Data's stage motion), and what the stages tell about the run.
 
 The stages lie off the constraint manifold by the integration error, so their motion follows
 the drift rule of ``equations`` (least squares where the drift explains an inconsistency of
@@ -40,10 +41,11 @@ class Crawl(Exception):
 
 
 class StateDerivative:
-    """f(t, y) of the run on ``data`` (its Data), y = (q, q̇), with ``baumgarte`` (α, β) or None."""
+    """f(t, y) of the run on ``data`` (its Data), y = (q, v) in ``form`` (a
+    velocity_form.VelocityForm), with ``baumgarte`` (α, β) or None."""
 
-    def __init__(self, data, baumgarte):
-        self.data, self.n, self.baumgarte = data, data.n, baumgarte
+    def __init__(self, data, baumgarte, form):
+        self.data, self.n, self.baumgarte, self.form = data, data.n, baumgarte, form
         self.evaluations = 0
         self.t_failed = float("nan")  # where the run was when it failed: its last stage or state looked at
         self.non_unique = False
@@ -75,9 +77,9 @@ class StateDerivative:
             if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
                 raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
-        found = None if self.fast is None else self.fast(t, y)  # unique, far from singular
+        found = None if self.fast is None else self.fast(t, self.form.stage_state(y))  # unique, far from singular
         if found is None:
-            q, qd = y[:self.n], y[self.n:]
+            q, qd = self.form.to_state(y)
             motion = self.stage_motion(t, q, qd)
             self.non_unique |= not motion.unique
             if motion.singular:
@@ -85,7 +87,7 @@ class StateDerivative:
                 self.singular_call = self.calls if self.singular_call is None else self.singular_call
         if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
             raise Crawl
-        return found if found is not None else np.concatenate([qd, motion.qdd])
+        return self.form.rates(y, found if found is not None else np.concatenate([qd, motion.qdd]))
 
     def note_singular(self):
         """One entry of ``singular_positions`` for the stages of the interval just done."""
@@ -101,17 +103,19 @@ class StateDerivative:
         largest accelerations (within a factor 10 of the largest): what the steps chase."""
         self.t_failed = t
         data = self.data
-        qdd = np.abs(data.motion(t, y[:self.n], y[self.n:], baumgarte=self.baumgarte, drift=True).qdd)
+        qdd = np.abs(data.motion(t, *self.form.to_state(y), baumgarte=self.baumgarte, drift=True).qdd)
         fastest = [(c, a) for c, a in zip(data.coordinates, qdd) if a >= qdd.max() / 10]
         return SolveError(f"step-size collapse, the integrator gave up ({why}); fastest changing: "
                           f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}",
                           coordinates=[c for c, _ in fastest])
 
-    def check(self, t, y):
-        """Raise SolveError naming the coordinates where y is not finite or beyond MAX_STATE."""
-        if np.abs(y).max(initial=0.0) <= MAX_STATE:  # false where any is NaN
+    def check(self, t, q, qd):
+        """Raise SolveError naming the coordinates where the state (q, q̇) is not finite or
+        beyond MAX_STATE."""
+        if np.abs(q).max(initial=0.0) <= MAX_STATE and np.abs(qd).max(initial=0.0) <= MAX_STATE:  # not if NaN
             return
         self.t_failed = t
+        y = np.concatenate([q, qd])
         names = [*self.data.coordinates, *(c + "_dot" for c in self.data.coordinates)]
         culprits = [names[i] for i in np.flatnonzero(~np.isfinite(y) | (np.abs(y) > MAX_STATE))]
         raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "

@@ -16,13 +16,15 @@ control sample): the integrator's f is computed afresh there.
 
 ``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share
 how an integrator goes on from a state: the same explicit pair where it can
-(stepper.RESUMABLE), else a new one.
+(stepper.RESUMABLE), else a new one. Both integrate y = (q, v), each rigid body's quaternion
+rates replaced by its angular velocity (velocity_form.py), and hand back (q, q̇).
 """
 
 import logging
 
 from . import stepper
 from .derivative import StateDerivative
+from .velocity_form import VelocityForm
 
 log = logging.getLogger(__name__)
 
@@ -35,7 +37,8 @@ class Integration:
     def __init__(self, data, method, rtol, atol, stabilization, baumgarte, schedule):
         self.data, self.method, self.rtol, self.atol = data, method, rtol, atol
         self.stabilization, self.schedule, self.n = stabilization, schedule, data.n
-        self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None)
+        self.form = VelocityForm(data)  # the integrator's y = (q, v) and (q, q̇)
+        self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None, self.form)
         self.steps = 0
         self.solver = None  # the integrator, kept from interval to interval (``resumed``)
         self.solver_tolerances = None  # its (rtol, atol)
@@ -66,18 +69,20 @@ class Integration:
         sample or the end, where a continuous integrator must stop."""
         raise NotImplementedError
 
-    def resumed(self, t, y, t_bound, rtol, atol):
-        """The integrator at (t, y), bound for t_bound, its first step the one it last
-        proposed: the same explicit pair where it stands at t with these tolerances
-        (stepper.RESUMABLE), moved to y — given f there — where a projection moved the state
+    def resumed(self, t, q, qd, t_bound, rtol, atol):
+        """The integrator at the state (t, q, q̇), bound for t_bound, its first step the one
+        it last proposed: the same explicit pair where it stands at t with these tolerances
+        (stepper.RESUMABLE), moved to the state — given f there — where a projection moved it
         or the forces jumped; else a new one, as ``solve_ivp`` would start it."""
         first = None if self.next_step is None else min(self.next_step, t_bound - t)
         solver = self.solver
         if isinstance(solver, stepper.RESUMABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
+            y = solver.y if self.form.represents(solver.y, q, qd) else self.form.to_integrator(q, qd)
             if self.forces_jumped or not stepper.stands_at(solver, y):
                 stepper.move(solver, y, self.f(t, y))
             stepper.resume(solver, t_bound, first)
         else:
+            y = self.form.to_integrator(q, qd)
             solver = self.solver = self.method(self.f, t, y, t_bound, rtol=rtol, atol=atol, first_step=first)
             self.solver_tolerances = (rtol, atol)
         self.forces_jumped = False

@@ -1,0 +1,160 @@
+"""The integrator's form of a run's state: y = (q, v), v being q̇ with each rigid body's four
+quaternion rates u̇ replaced by three numbers, half its body angular velocity:
+h = ω/2 = E(u) u̇ / |u|².
+
+An integrator's local error estimate then weighs the body's angular velocity, the physical
+rate, directly, not the four u̇ whose second derivative ü carries the unit-norm row's
+−|u̇|² u (in that second-order form a spinning body's ω strays past the tolerance: the
+tennis-racket flip). h is ω scaled to the size of u̇ (|u̇| = |ω|/2 for a unit u), so the
+tolerances weigh a body's rates as they weighed u̇, and an integrator takes about as many
+steps. Everything outside the integrator — the
+correction and projection onto the constraints, the recorded rows, the drift checks,
+Baumgarte, control — keeps (q, q̇); the stages convert here:
+
+- ``to_state`` (y → (q, q̇)): u̇ = E(u)ᵀ h (= ½ u ⊗ (0, ω)), which keeps uᵀu̇ = 0 exactly,
+  so the integrated |u| stays constant up to the integration error (the correction or
+  projection restores |u| = 1);
+- ``to_integrator`` ((q, q̇) → y): h = E(u) u̇ / |u|², half the body angular velocity of the
+  unit quaternion u/|u| (ω = 2 E(u) u̇ for a unit u); E(u) E(u)ᵀ = |u|² I makes the round
+  trip y → (q, q̇) → y exact in exact arithmetic for any u ≠ 0, and u̇'s component along u,
+  which turns nothing, is dropped;
+- ``rates`` (ẏ from the motion's q̈): q̇ as above and ḣ = E(u) ü / |u|² (the derivative of
+  E(u) u̇ / |u|², as E(u̇) u̇ = 0 and uᵀu̇ = 0).
+
+E(u) = [−u_v, u_w I − [u_v]ₓ] for u = (u_w, u_v) scalar-first, as mbsynth.core.kinematics'
+body_rate_matrix. Models without rigid bodies integrate (q, q̇) itself: the conversions are
+then views and copies, no per-body work.
+"""
+
+import numpy as np
+from numba import njit
+
+
+class VelocityForm:
+    """The conversions between a run's state (q, q̇) and the integrator's y = (q, v) of
+    ``data`` (its Data or System): ``size`` entries, 2n less one per rigid body."""
+
+    def __init__(self, data):
+        starts, start = [], 0
+        for part in data.parts:
+            if part.kind == "rigid_body":
+                starts.append(start + 3)  # its quaternion (qw, qx, qy, qz) after its position
+            start += len(part.coordinates)
+        self.n = start
+        self.starts = np.array(starts, dtype=np.int64)
+        self.size = 2 * self.n - len(starts)
+        self.stage = np.empty(2 * self.n)  # ``stage_state``'s array
+
+    def to_integrator(self, q, qd):
+        """y = (q, v) of the state (q, q̇)."""
+        if not self.starts.size:
+            return np.concatenate([q, qd])
+        y = np.empty(self.size)
+        _integrator_into(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float), self.starts, y)
+        return y
+
+    def state(self, y):
+        """(q, q̇) of y stacked in one array of 2n entries (y itself without rigid bodies)."""
+        if not self.starts.size:
+            return y
+        state = np.empty(2 * self.n)  # made here: cheaper than an array a numba function returns
+        _state_into(y, self.starts, state)
+        return state
+
+    def stage_state(self, y):
+        """``state(y)`` in an array of this form's, written over by the next call: for a
+        stage's motion, which keeps nothing of it."""
+        if not self.starts.size:
+            return y
+        _state_into(y, self.starts, self.stage)
+        return self.stage
+
+    def to_state(self, y):
+        """(q, q̇) of y."""
+        state = self.state(y)
+        return state[:self.n], state[self.n:]
+
+    def states(self, rows):
+        """(q, q̇) of y per row of ``rows`` (states stacked, B × size): two B × n arrays."""
+        if not self.starts.size:
+            return rows[:, :self.n], rows[:, self.n:]
+        stacked = np.empty((rows.shape[0], 2 * self.n))
+        _states_into(rows, self.starts, stacked)
+        return stacked[:, :self.n], stacked[:, self.n:]
+
+    def represents(self, y, q, qd):
+        """Whether y converts to exactly (q, q̇)."""
+        state = self.state(y)
+        return np.array_equal(state[:self.n], q) and np.array_equal(state[self.n:], qd)
+
+    def rates(self, y, state_rates):
+        """ẏ at y from ``state_rates`` = (q̇, q̈) stacked, the motion at ``to_state(y)``: a
+        view of ``state_rates`` (an array of the caller's, as an integrator's f is), written
+        over."""
+        if not self.starts.size:
+            return state_rates
+        _rates_into(y, state_rates, self.starts)
+        return state_rates[:self.size]
+
+
+@njit(cache=True)
+def _velocities(q, rates, starts, v):
+    """v from a state's q and its rates (q̇ or q̈): each body's four quaternion rates r
+    replaced by E(u) r / |u|², the other entries copied. v may be ``rates`` itself, written
+    over: each entry is written at or before the one read, a body's four read first."""
+    i, j = 0, 0  # where v and rates are read from
+    for s in starts:
+        while j < s:
+            v[i] = rates[j]
+            i, j = i + 1, j + 1
+        w, x, y, z = q[s], q[s + 1], q[s + 2], q[s + 3]
+        a, b, c, d = rates[s], rates[s + 1], rates[s + 2], rates[s + 3]
+        scale = 1.0 / (w * w + x * x + y * y + z * z)
+        v[i] = scale * (-x * a + w * b + z * c - y * d)
+        v[i + 1] = scale * (-y * a - z * b + w * c + x * d)
+        v[i + 2] = scale * (-z * a + y * b - x * c + w * d)
+        i, j = i + 3, s + 4
+    while j < rates.size:
+        v[i] = rates[j]
+        i, j = i + 1, j + 1
+
+
+@njit(cache=True)
+def _integrator_into(q, qd, starts, y):
+    y[:q.size] = q
+    _velocities(q, qd, starts, y[q.size:])
+
+
+@njit(cache=True)
+def _rates_into(y, state_rates, starts):
+    """ẏ into the first entries of ``state_rates``: q̇ stays, v̇ is written over q̈."""
+    n = state_rates.size // 2
+    _velocities(y[:n], state_rates[n:], starts, state_rates[n:])
+
+
+@njit(cache=True)
+def _state_into(y, starts, out):
+    """(q, q̇) of y into ``out`` (2n): u̇ = E(u)ᵀ h per body, the other entries copied."""
+    n = out.size // 2
+    out[:n] = y[:n]
+    i, j = n, 0  # where y's v is read and q̇ written
+    for s in starts:
+        while j < s:
+            out[n + j] = y[i]
+            i, j = i + 1, j + 1
+        w, x, yy, z = y[s], y[s + 1], y[s + 2], y[s + 3]
+        a, b, c = y[i], y[i + 1], y[i + 2]
+        out[n + s] = -x * a - yy * b - z * c
+        out[n + s + 1] = w * a - z * b + yy * c
+        out[n + s + 2] = z * a + w * b - x * c
+        out[n + s + 3] = -yy * a + x * b + w * c
+        i, j = i + 3, s + 4
+    while j < n:
+        out[n + j] = y[i]
+        i, j = i + 1, j + 1
+
+
+@njit(cache=True)
+def _states_into(rows, starts, out):
+    for r in range(rows.shape[0]):
+        _state_into(rows[r], starts, out[r])
