@@ -88,7 +88,8 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
                 break
             _negated(phi, shift)
             if step == MAX_STEPS or \
-                    motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, phi_max / size, general)[0] != OK:
+                    motion(q, rest, gen, shift, LI, LF_rest, LX, WI, WF, WX, UNCHECKED, phi_max / size,
+                           general)[0] != OK:
                 declined = True
                 break
             reuse = step == 0 and largest(qdd) <= REUSE * size  # the Work keeps q's factorization

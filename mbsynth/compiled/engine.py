@@ -1,7 +1,7 @@
 """The compiled path: a Template per model structure, an Engine per parameter values.
 
 ``Template.build(system)`` lays the System out (layout.build) and compiles its generated
-function (codegen.py), or returns None when the kernels cover no part of it. Systems that
+function (codegen.py), or returns None where layout.build does. Systems that
 differ only in parameter values (``System.with_parameters``, a Data's ``set_parameters``)
 share one Template: the parameters are arguments of the generated function, and the
 Layout's numbers (masses, inertias, frame offsets) are re-evaluated per parameter values
@@ -36,8 +36,9 @@ class Template:
     """What the Systems with one structure share: the Layout (with the numbers of the System
     it was built from, at parameter values ``p``) and the compiled generated function."""
 
-    def __init__(self, system, L, exprs):
+    def __init__(self, system, L, exprs, phi_outputs):
         self.L, self.n, self.p = L, system.n, system.parameter_values
+        self.phi_outputs = phi_outputs  # the generated function's last outputs: φ of the extra rows
         self.names = tuple(system.parameters)
         self.sources = layout.sources(L, system)  # the parts and joints its numbers are read from
         self.outputs = len(exprs)
@@ -88,10 +89,9 @@ class Engine:
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
         self.corrections = []  # the Correction, once made (a list: ``at``'s copies share it)
-        # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with loops
-        # (``drift_motion``), where they are all of its rows; None elsewhere (that drift is the exact path's)
-        rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
-        self.rows = rows if rows is not None and rows.covers else None
+        # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with extra rows
+        self.rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
+        self.generated_phi = slice(self.outputs - template.phi_outputs, self.outputs)  # φ of the extra rows in gen
 
     def at(self, p):
         """This Engine at other parameter values that its Layout's numbers do not use (a
@@ -127,18 +127,11 @@ class Engine:
         ahead.finish()
         self.motion(0.0, q, qd)
 
-    @property
-    def drift_motion(self):
-        """Whether ``motion`` serves states off the constraint manifold (``drift``): always
-        without loops; with loops where the kernel's rows are all of the System's (the
-        relative drift of kernel.motion is theirs)."""
-        return not self.closes_loops or self.rows is not None
-
     def motion(self, t, q, qd, bshift=None, drift=False):
         """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
         bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ); ``drift``: the
         state may lie off the constraint manifold (an integrator's stage: the drift rule,
-        kernel.motion; only where ``drift_motion``)."""
+        kernel.motion)."""
         with self.lock:
             status, residual = self._solved(t, q, qd, EMPTY if bshift is None else bshift, drift)
             if status != kernel.OK:
@@ -161,8 +154,16 @@ class Engine:
         with the state's relative drift where ``drift`` and the model closes loops."""
         if self.module is not None:
             self.module.evaluate(float(t), q, qd, self.p, self.gen)
-        delta = self.rows.relative_drift(q, qd) if drift and self.closes_loops else -1.0
+        delta = self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
         return kernel.motion(q, qd, self.gen, bshift, *self.buffers, kernel.CHECKED, delta, self.general)
+
+    def relative_drift(self, q, qd):
+        """The state's largest |φ| (the kernel's rows and the extra rows, from ``gen`` as the
+        generated function left it at this state) over its largest coordinate, at least 1."""
+        delta = self.rows.relative_drift(q, qd)
+        if self.generated_phi.start < self.outputs:
+            delta = max(delta, np.abs(self.gen[self.generated_phi]).max() / max(np.abs(q).max(), 1.0))
+        return delta
 
     def motion_batch(self, t, q, qd):
         """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread

@@ -15,6 +15,11 @@ give a Schur matrix of rounding noise). A dropped
 direction must leave the right side alone (else the rows contradict: INCONSISTENT) and
 must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 
+Where the extra coordinates' mass block is positive definite (planar bodies, particles and
+energy-defined parts of positive mass), their accelerations are eliminated first and the
+Schur matrix is the rows' alone, A_x M_x⁻¹ A_xᵀ + G K⁻¹ Gᵀ (``_close_reduced``): smaller,
+and semi-definite, its eigenvalues scaling as the rows' σ² as in the tree-only case.
+
 Off the manifold (an integrator's stage, ``motion``'s ``drift``) the Schur step follows the
 drift rule of core/equations.py instead: directions the drift splits off dependent rows are
 dropped with their part of the right side (least squares), and a nearly dependent one the
@@ -38,9 +43,9 @@ from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
-from .tree import factor, solve
-from ..core.tolerances import (DRIFT_RANK, KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL, SCHUR_DEPENDENT_RTOL,
-                               SCHUR_ZERO_RTOL, SPLIT_MOVES)
+from .tree import factor, solve, spd_inverse
+from ..core.tolerances import (DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL,
+                               SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE, NEAR_SINGULAR = range(7)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
@@ -105,6 +110,14 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     manifold (the rules of the module docstring), else the state's relative drift δ
     (``motion``)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
+    if nx > 0:
+        inverse, work = Mx.copy(), np.zeros((nx, nx))
+        largest = 0.0
+        for x in range(nx):
+            largest = max(largest, Mx[x, x])
+        if spd_inverse(inverse, nx, np.full(nx, largest), work):
+            return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors,
+                                  rhs, lam, multipliers, drift)
     S[:, :] = 0.0
     for x in range(nx):
         rhs[x] = Fx[x]
@@ -141,7 +154,9 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
             continue
         if drift >= 0.0 and abs(values[e]) > dependent:
             return NEAR_SINGULAR  # not the drift's: for the exact drift rule (equations.py)
-        allowed = KERNEL_NULL_RTOL if drift < 0.0 else max(KERNEL_NULL_RTOL, SPLIT_MOVES * math.sqrt(abs(values[e]) / top))
+        allowed = KERNEL_NULL_RTOL
+        if drift >= 0.0:  # rows the drift split move accelerations by about their σ
+            allowed = max(KERNEL_NULL_RTOL, SPLIT_MOVES * math.sqrt(abs(values[e]) / top))
         if _moves(vectors[:, e], nx, topology, segs, seg6, factored, y, w) > allowed:
             return NOT_UNIQUE
         dropped += coef * coef
@@ -155,6 +170,87 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         _scatter(x, -lam[nx + x], segs, seg6, y)
     solve(topology, factored, y, z, multipliers)
     return OK
+
+
+@njit(**OPTIONS)
+def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
+                   multipliers, drift):
+    """``_close`` where the extra coordinates' mass Mx is positive definite (``inverse``: Mx⁻¹,
+    tree.spd_inverse): their accelerations q̈_x = Mx⁻¹ (F_x − A_xᵀ λ) are eliminated,
+    leaving the rows' Schur matrix A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ (positive semi-definite,
+    m_x × m_x; its eigenvalues scale as σ² of the rows, as the tree-only case's) for λ. The
+    motion is unique (the masses are), so dropped directions are dependent rows: judged for
+    consistency on the manifold, least squares off it (``drift``)."""
+    mx, nx = Ax.shape[0], Ax.shape[1]
+    Sc, Vc = S[:mx, :mx], vectors[:mx, :mx]
+    qx, W = np.zeros(nx), np.zeros((mx, nx))  # Mx⁻¹ F_x; Mx⁻¹ A_xᵀ, a row per extra row
+    for c in range(nx):
+        for d in range(nx):
+            qx[c] += inverse[c, d] * Fx[d]
+            for x in range(mx):
+                W[x, c] += inverse[c, d] * Ax[x, d]
+    for x in range(mx):
+        y[:] = 0.0
+        _scatter(x, 1.0, segs, seg6, y)
+        solve(topology, factored, y, w, False)
+        for r in range(mx):
+            total = _row_dot(r, segs, seg6, w)
+            for c in range(nx):
+                total += Ax[r, c] * W[x, c]
+            Sc[r, x] = total
+        total = -xb[x] + _row_dot(x, segs, seg6, z0)
+        for c in range(nx):
+            total += Ax[x, c] * qx[c]
+        rhs[x] = total
+    values = np.zeros(mx)
+    symmetric_eigen(Sc, Vc, values)
+    top = max(np.abs(values).max(), 1.0) if mx else 1.0
+    dependent = max(SCHUR_DEPENDENT_RTOL, (DRIFT_RANK * drift) ** 2) * top
+    lam[:] = 0.0
+    dropped = size = 0.0
+    for x in range(mx):
+        size += rhs[x] * rhs[x] + xb[x] * xb[x]
+    for e in range(mx):
+        coef = 0.0
+        for c in range(mx):
+            coef += Vc[c, e] * rhs[c]
+        if abs(values[e]) > SCHUR_ZERO_RTOL * top:
+            for c in range(mx):
+                lam[nx + c] += coef / values[e] * Vc[c, e]
+            continue
+        if drift >= 0.0 and abs(values[e]) > dependent:
+            return NEAR_SINGULAR
+        dropped += coef * coef
+        if drift >= 0.0:  # least squares: the rows' right side takes the dropped part (their residual)
+            for x in range(mx):
+                xb[x] += coef * Vc[x, e]
+    if drift < 0.0 and math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
+        return INCONSISTENT
+    for c in range(nx):  # q̈_x = Mx⁻¹ F_x − (Mx⁻¹ A_xᵀ) λ
+        total = qx[c]
+        for x in range(mx):
+            total -= W[x, c] * lam[nx + x]
+        lam[c] = total
+    _copy(ry, y)
+    for x in range(mx):
+        _scatter(x, -lam[nx + x], segs, seg6, y)
+    solve(topology, factored, y, z, multipliers)
+    return OK
+
+
+@njit(**OPTIONS)
+def _uneven_masses(v, H, Mx):
+    """Whether the diagonal of the masses (divided by the largest: H per node, Mx) spans more
+    than DRIFT_MASS_SPREAD (or has a zero): off the manifold the Schur eigenvalues, in the
+    mass metric, then do not stand for the rows' singular values that the drift rule
+    judges (``motion``'s ``drift``)."""
+    least = 1.0
+    for i in range(v.shape[0]):
+        for a in range(v[i]):
+            least = min(least, H[i, a, a])
+    for x in range(Mx.shape[0]):
+        least = min(least, Mx[x, x])
+    return not least >= DRIFT_MASS_SPREAD
 
 
 @njit(**OPTIONS)
@@ -338,9 +434,16 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     left, for a call with the same M and A (the same q) and another right side; when that
     call was at the same state, at rest (q̇ = 0) with the same forces, and this one's shifts
     leave the unit-norm rows alone (``_shifts_only``: a correction's velocity step), only
-    the right side is rebuilt and solved, not the masses and rows. ``general``:
-    RIGID_TREE for a Layout of rigid bodies on tree joints only (compiled without the rest),
-    else GENERAL."""
+    the right side is rebuilt and solved, not the masses and rows. ``drift``: negative for
+    a state on the constraint manifold, else its relative drift δ (Engine.relative_drift),
+    by which the Schur step of the extra rows follows the drift rule of core/equations.py:
+    a direction whose eigenvalue is below (DRIFT_RANK δ)² (or SCHUR_DEPENDENT_RTOL) of the
+    largest is rows dependent on the manifold that the drift split, dropped with its part
+    of the right side (least squares: no INCONSISTENT); one between that and
+    SCHUR_ZERO_RTOL (a singular position near) is the exact rule's to judge
+    (NEAR_SINGULAR), as is every stage of a model whose masses are uneven
+    (``_uneven_masses``: a millimetre four-bar's bar inertias). ``general``: RIGID_TREE for
+    a Layout of rigid bodies on tree joints only (compiled without the rest), else GENERAL."""
     q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
     mass, mg, inertia = view1(LF, LX, LAYOUT.node_mass), view2(LF, LX, LAYOUT.node_mg), view3(LF, LX, LAYOUT.node_J)
@@ -389,6 +492,8 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
             mu = max(mu, abs(Mx[x, c]))
     mu = mu if mu > 0 else 1.0
     divide_masses(mu, H, F, Mx, Fx)
+    if drift >= 0.0 and xb.shape[0] and _uneven_masses(v, H, Mx):
+        return NEAR_SINGULAR, 0.0
     tree_rows(q, qd, bshift, kind, start, node_joint, view1(LI, LX, LAYOUT.node_end), parent,
               rows, nu, s, Rs, joints, joint_row, scratch, J, P, rb, rscale, general)
     if general is not None and xb.shape[0]:

@@ -10,9 +10,10 @@ joint path reaches) picks each node's parent joint: those joints form the tree
 Everything else enters through ONE generated function (codegen.py) of (t, q, q̇, p):
 the force elements' Q, every constraint's C, the M and Q of the other parts (their
 coordinates are the *extra coordinates*), and the rows a, b of the other constraints
-(extra rows too). ``build`` returns the Layout and that function's expressions, in the
-order of its outputs: Q additions, C, M entries of the extra coordinates, entries of
-extra rows, b of extra rows.
+(extra rows too; rows that vanish identically are left out). ``build`` returns the Layout
+and that function's expressions, in the order of its outputs: Q additions, C, M entries of
+the extra coordinates, entries of extra rows, b of extra rows, φ of extra rows (for the
+relative drift off the manifold, Engine.relative_drift).
 
 Masses, inertias, gravity forces, frame offsets and rotations and rod lengths are the
 *numbers* of a Layout, evaluated at the System's parameter values; every other array
@@ -31,6 +32,9 @@ from ..core.joint_kinds import COMPONENT, JOINT_KINDS, KINDS, MAX_ROWS
 from .joints import PARTICLE, RIGID, WORLD
 from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
 
+# a System with no kernel node is one dense Schur system (kernel.py), its extra coordinates and rows: up to this
+# size (Jacobi's eigendecomposition, O(p³)) it costs less than the KKT path
+DENSE_SCHUR_MAX = 64
 # the parts' ``kind`` of the kernel's nodes: the model is read through its parts' and joints'
 # attributes (``kind``, ``joint_kind``, masses, frames), not their classes
 RIGID_BODY, PARTICLE_PART = "rigid_body", "particle"
@@ -120,8 +124,10 @@ class _Symbols(_Numbers):
 
 
 def build(system):
-    """(Layout, generated expressions) of ``system``, or None when no part is a kernel node
-    or a joint has Coulomb friction (its C depends on q̈: system.motion iterates)."""
+    """(Layout, generated expressions, how many of the last are φ of extra rows) of
+    ``system``, or None when a joint has Coulomb friction (its C depends on q̈:
+    system.motion iterates) or no part is a kernel node and the dense Schur system of its
+    coordinates and rows would exceed DENSE_SCHUR_MAX."""
     if any(getattr(con, "coulomb", None) for con in system.connectors):
         return None
     number = _Numbers(system.parameters)
@@ -130,8 +136,6 @@ def build(system):
     quat = {c.name: r for c, r in zip(system.connectors, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.parts, starts)
              if (_kind(part) == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or _kind(part) == PARTICLE_PART]
-    if not nodes:
-        return None
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
     quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _kind(part) == RIGID_BODY}
     joints, others = [], []
@@ -140,7 +144,10 @@ def build(system):
             continue
         (joints if _kernel_joint(con, node_of, number) else others).append((con, int(row)))
     parent, pjoint, order = _tree(len(nodes), joints, node_of)
-    return _Builder(system, number, starts, nodes, node_of, quat, joints, others, parent, pjoint, order).layout()
+    found = _Builder(system, number, starts, nodes, node_of, quat, joints, others, parent, pjoint, order).layout()
+    if not nodes and found[0].x_coord.size + found[0].xrow_row.size > DENSE_SCHUR_MAX:
+        return None
+    return found
 
 
 def _kernel_joint(con, node_of, number):
@@ -281,7 +288,7 @@ class _Builder:
             for r in range(con.size):
                 xrow_row.append(row + r)
                 segs.append(ends)
-        exprs, gen = self._generated(xrow_row, segs)
+        exprs, gen, phi_outputs = self._generated(xrow_row, segs)
         seg_ptr = np.cumsum([0] + [len(s) for s in segs])
         kernel = [self._joint(con) for con, _ in joints]
         numbers = _numbers([part for part, _ in nodes], [con for con, _ in joints], self.number)
@@ -304,7 +311,7 @@ class _Builder:
             quat_row=_ints([self.quat[f"{part.name}.unit_quaternion"] if r else -1
                             for (part, _), r in zip(nodes, rigid)]),
             sizes=_ints(sizes), **numbers, **gen)
-        return layout, exprs
+        return layout, exprs, phi_outputs
 
     def _end_of(self, i, j):
         if j < 0:
@@ -361,9 +368,11 @@ class _Builder:
                 for b in range(len(part.coordinates)):
                     if part.M[a, b] != 0:
                         M.append((x_index[int(start) + a], x_index[int(start) + b], part.M[a, b]))
-        rows, b, placed = [], [], sum(len(s) for s in segs)
+        rows, b, phi, placed = [], [], [], sum(len(s) for s in segs)
         for con, row in self.others:
             for r in range(con.size):
+                if con.b[r] == 0 and all(con.a[r, int(i)] == 0 for i in con.indices):
+                    continue  # a row that vanishes identically (a planar body's out-of-plane rows): no extra row
                 xr = len(xrow_row)
                 xrow_row.append(row + r)
                 touched = sorted({node_at[int(i)][0] for i in con.indices if int(i) in node_at
@@ -381,10 +390,12 @@ class _Builder:
                         rows.append((xr, -1, x_index[int(i)], entry))
                 if con.b[r] != 0:
                     b.append((xr, con.b[r]))
+                if con.phi is not None and con.phi[r] != 0 and con.phi[r] is not sp.nan:
+                    phi.append(con.phi[r])
         exprs = (list(Q.values()) + list(C.values()) + [e for *_, e in M] + [e for *_, e in rows]
-                 + [e for _, e in b])
+                 + [e for _, e in b] + phi)
         gen = dict(gen_q=_ints(list(Q)), gen_c=_ints(list(C)), gen_mi=_ints([x[0] for x in M]),
                    gen_mj=_ints([x[1] for x in M]), gen_arow=_ints([x[0] for x in rows]),
                    gen_aseg=_ints([x[1] for x in rows]), gen_acol=_ints([x[2] for x in rows]),
                    gen_brow=_ints([x[0] for x in b]))
-        return exprs, gen
+        return exprs, gen, len(phi)

@@ -114,7 +114,7 @@ def _null_space_components(J, r0, k, S, Jr, G):
                 t += J[r0 + 3 + b, 3 + e] * J[r0 + 3 + c, 3 + e]
             G[b, c] = t
         G[8, b] = G[b, b]
-    if not _spd_inverse(G, n, G[8], G[3:6]):
+    if not spd_inverse(G, n, G[8], G[3:6]):
         return False
     for e in range(3):  # T into S[3:6, :6 − k]
         for x in range(3):
@@ -212,7 +212,7 @@ def _components_closed(J, r0, k, S, Jr):
 
 
 @njit(**OPTIONS)
-def _spd_inverse(A, m, scale, L):
+def spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
     for j in range(m):
@@ -315,7 +315,7 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
                 t += Si[a, e] * Ui[a, f]
             Ni[e, f] = t
             Ni[f, e] = t
-    if not _spd_inverse(Ni, m, G[0], G[1:7]):
+    if not spd_inverse(Ni, m, G[0], G[1:7]):
         return False
     p = parent[i]
     if p < 0:  # a root passes nothing on

@@ -24,6 +24,8 @@ KERNEL_CONSISTENCY_RTOL = 1e-10  # kernel.py: largest part of the right side alo
 KERNEL_NULL_RTOL = 1e-8  # kernel.py: largest acceleration a dropped (unit) direction may move
 SCHUR_DEPENDENT_RTOL = 1e-14  # kernel.py, off the manifold: Schur eigenvalues below this fraction (~50 ε) are
 # rounding of rows dependent on the manifold, whatever the drift
+DRIFT_MASS_SPREAD = 1e-4  # kernel.py, off the manifold: masses (diagonal, over the largest) spanning more than this
+# send a model's stages to the exact drift rule (the Schur eigenvalues mix masses with the rows' geometry)
 SPLIT_MOVES = 1e4  # kernel.py, off the manifold: a dropped direction of Schur eigenvalue λ may move accelerations
 # up to this times √(λ / the largest) (the drift splits dependent rows by about that much)
 CORRECTION_RTOL = 1e-14  # correction.py: largest |φ| left, relative to the largest coordinate (at least 1): ~50 ε

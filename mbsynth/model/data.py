@@ -217,11 +217,9 @@ class Data:
         return solve(arrays.C)
 
     def tree_engine(self, drift=False):
-        """The compiled Engine that serves ``motion``, or None: the KKT path, or (``drift``)
-        a state off the manifold of a model whose loops the kernel cannot judge there
-        (Engine.drift_motion: rows other than the kernel's close them)."""
-        engine = self.engine
-        return None if engine is None or (drift and not engine.drift_motion) else engine
+        """The compiled Engine that serves ``motion`` (on the manifold and, ``drift``, off it),
+        or None: the KKT path."""
+        return self.engine
 
     def stage_motion(self, baumgarte=None, drift=False):
         """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
