@@ -79,6 +79,8 @@ class StateDerivative:
             self.t_mark = t
         found = None if self.fast is None else self.fast(t, self.form.stage_state(y))  # unique, far from singular
         if found is None:
+            if not np.abs(y).max(initial=0.0) <= MAX_STATE:  # a stage of a trial step gone wild (NaN included):
+                return np.full(self.form.size, np.nan)  # its error estimate, NaN, makes the integrator reject the step
             q, qd = self.form.to_state(y)
             motion = self.stage_motion(t, q, qd)
             self.non_unique |= not motion.unique
