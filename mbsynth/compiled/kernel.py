@@ -15,10 +15,9 @@ give a Schur matrix of rounding noise). A dropped
 direction must leave the right side alone (else the rows contradict: INCONSISTENT) and
 must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 
-Where the extra coordinates' mass block is positive definite (planar bodies, particles and
-energy-defined parts of positive mass), their accelerations are eliminated first and the
-Schur matrix is the rows' alone, A_x M_x⁻¹ A_xᵀ + G K⁻¹ Gᵀ (``_close_reduced``): smaller,
-and semi-definite, its eigenvalues scaling as the rows' σ² as in the tree-only case.
+Where the extra coordinates' mass block is positive definite (planar bodies, energy-defined
+parts of positive mass), their accelerations are eliminated first and the Schur matrix is the
+rows' alone, A_x M_x⁻¹ A_xᵀ + G K⁻¹ Gᵀ (``_close_reduced``): smaller, and semi-definite.
 
 Off the manifold (an integrator's stage, ``motion``'s ``drift``) the Schur step follows the
 drift rule of core/equations.py instead: directions the drift splits off dependent rows are
@@ -117,7 +116,7 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
             largest = max(largest, Mx[x, x])
         if spd_inverse(inverse, nx, np.full(nx, largest), work):
             return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors,
-                                  rhs, lam, multipliers, drift)
+                                  rhs, lam, multipliers)
     S[:, :] = 0.0
     for x in range(nx):
         rhs[x] = Fx[x]
@@ -165,22 +164,29 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
                 xb[x] -= coef * vectors[nx + x, e]
     if drift < 0.0 and math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
         return INCONSISTENT
-    _copy(ry, y)
-    for x in range(mx):
-        _scatter(x, -lam[nx + x], segs, seg6, y)
-    solve(topology, factored, y, z, multipliers)
+    _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
     return OK
 
 
 @njit(**OPTIONS)
+def _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers):
+    """z ← the tree's solution (its multipliers too where ``multipliers``) with the extra
+    rows' multipliers lam[nx:] acting on it."""
+    _copy(ry, y)
+    for x in range(mx):
+        _scatter(x, -lam[nx + x], segs, seg6, y)
+    solve(topology, factored, y, z, multipliers)
+
+
+@njit(**OPTIONS)
 def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
-                   multipliers, drift):
+                   multipliers):
     """``_close`` where the extra coordinates' mass Mx is positive definite (``inverse``: Mx⁻¹,
     tree.spd_inverse): their accelerations q̈_x = Mx⁻¹ (F_x − A_xᵀ λ) are eliminated,
     leaving the rows' Schur matrix A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ (positive semi-definite,
-    m_x × m_x; its eigenvalues scale as σ² of the rows, as the tree-only case's) for λ. The
-    motion is unique (the masses are), so dropped directions are dependent rows: judged for
-    consistency on the manifold, least squares off it (``drift``)."""
+    m_x × m_x) for λ. The motion is unique (the masses are), so dropped directions are
+    dependent rows, judged for consistency. On the manifold only: off it, ``motion`` hands
+    a model with extra coordinates to the exact drift rule."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     Sc, Vc = S[:mx, :mx], vectors[:mx, :mx]
     qx, W = np.zeros(nx), np.zeros((mx, nx))  # Mx⁻¹ F_x; Mx⁻¹ A_xᵀ, a row per extra row
@@ -205,7 +211,6 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
     values = np.zeros(mx)
     symmetric_eigen(Sc, Vc, values)
     top = max(np.abs(values).max(), 1.0) if mx else 1.0
-    dependent = max(SCHUR_DEPENDENT_RTOL, (DRIFT_RANK * drift) ** 2) * top
     lam[:] = 0.0
     dropped = size = 0.0
     for x in range(mx):
@@ -217,24 +222,16 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
         if abs(values[e]) > SCHUR_ZERO_RTOL * top:
             for c in range(mx):
                 lam[nx + c] += coef / values[e] * Vc[c, e]
-            continue
-        if drift >= 0.0 and abs(values[e]) > dependent:
-            return NEAR_SINGULAR
-        dropped += coef * coef
-        if drift >= 0.0:  # least squares: the rows' right side takes the dropped part (their residual)
-            for x in range(mx):
-                xb[x] += coef * Vc[x, e]
-    if drift < 0.0 and math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
+        else:
+            dropped += coef * coef
+    if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
         return INCONSISTENT
     for c in range(nx):  # q̈_x = Mx⁻¹ F_x − (Mx⁻¹ A_xᵀ) λ
         total = qx[c]
         for x in range(mx):
             total -= W[x, c] * lam[nx + x]
         lam[c] = total
-    _copy(ry, y)
-    for x in range(mx):
-        _scatter(x, -lam[nx + x], segs, seg6, y)
-    solve(topology, factored, y, z, multipliers)
+    _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
     return OK
 
 
@@ -441,8 +438,10 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     largest is rows dependent on the manifold that the drift split, dropped with its part
     of the right side (least squares: no INCONSISTENT); one between that and
     SCHUR_ZERO_RTOL (a singular position near) is the exact rule's to judge
-    (NEAR_SINGULAR), as is every stage of a model whose masses are uneven
-    (``_uneven_masses``: a millimetre four-bar's bar inertias). ``general``: RIGID_TREE for
+    (NEAR_SINGULAR), as is every stage of a model with extra rows whose masses are uneven
+    (``_uneven_masses``: a millimetre four-bar's bar inertias) or that has extra coordinates
+    (planar bodies, energy-defined parts: the kernel's rule measured worse than the exact one
+    through their singular positions). ``general``: RIGID_TREE for
     a Layout of rigid bodies on tree joints only (compiled without the rest), else GENERAL."""
     q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
@@ -492,8 +491,8 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
             mu = max(mu, abs(Mx[x, c]))
     mu = mu if mu > 0 else 1.0
     divide_masses(mu, H, F, Mx, Fx)
-    if drift >= 0.0 and xb.shape[0] and _uneven_masses(v, H, Mx):
-        return NEAR_SINGULAR, 0.0
+    if drift >= 0.0 and xb.shape[0] and (x_coord.shape[0] or _uneven_masses(v, H, Mx)):
+        return NEAR_SINGULAR, 0.0  # the drift rule's to judge (``drift``)
     tree_rows(q, qd, bshift, kind, start, node_joint, view1(LI, LX, LAYOUT.node_end), parent,
               rows, nu, s, Rs, joints, joint_row, scratch, J, P, rb, rscale, general)
     if general is not None and xb.shape[0]:
