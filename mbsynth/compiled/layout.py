@@ -136,6 +136,8 @@ def build(system):
     quat = {c.name: r for c, r in zip(system.connectors, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.parts, starts)
              if (_kind(part) == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or _kind(part) == PARTICLE_PART]
+    if not nodes and system.n > DENSE_SCHUR_MAX:  # its Schur system has at least its n coordinates
+        return None
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
     quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _kind(part) == RIGID_BODY}
     joints, others = [], []
