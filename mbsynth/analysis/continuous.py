@@ -32,7 +32,7 @@ class ContinuousIntegration(CutIntegration):
     def fits(data, method, stabilization):
         """Whether a run on ``data`` (its Data) with the OdeSolver class ``method`` and
         ``stabilization`` can be integrated continuously."""
-        engine = data.tree_engine(True)
+        engine = data.engine
         return engine is not None and engine.correction() is not None \
             and issubclass(method, stepper.RESUMABLE) and stabilization == "projection"
 

@@ -59,7 +59,7 @@ class Integration:
         jump, so the integrator's f is computed afresh): its stages' motion and its compiled
         correction, where the kernel covers the model."""
         self.forces_jumped = True
-        engine = self.data.tree_engine(True)
+        engine = self.data.engine
         self.f.use(engine)
         self.correction = None if engine is None else engine.correction()
         self.compiled_energy = self.correction is not None and all(f.V == 0 for f in self.data.forces)

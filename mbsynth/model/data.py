@@ -193,7 +193,7 @@ class Data:
     def _solved(self, t, q, qd, method, baumgarte, drift):
         """The Motion of ``motion``, without its multipliers."""
         if method == "fast":
-            engine = self.tree_engine(drift)
+            engine = self.engine
             if engine is not None:
                 shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
                 found = engine.motion(t, q, qd, shift, drift)
@@ -216,16 +216,11 @@ class Data:
             return friction.coulomb_motion(system.connectors, arrays, solve, t, q, qd, self.p)
         return solve(arrays.C)
 
-    def tree_engine(self, drift=False):
-        """The compiled Engine that serves ``motion`` (on the manifold and, ``drift``, off it),
-        or None: the KKT path."""
-        return self.engine
-
     def stage_motion(self, baumgarte=None, drift=False):
         """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
         without ``lam``: the compiled engine's own call where ``motion`` would make it anyway
         (no Baumgarte shift), skipping the checks and bookkeeping of each call."""
-        engine = self.tree_engine(drift)
+        engine = self.engine
         if engine is None or baumgarte is not None:
             return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
 

@@ -29,7 +29,7 @@ def compiled_path(monkeypatch):
 
 
 def correction_of(system):
-    engine = system.data().tree_engine(True)
+    engine = system.data().engine
     assert engine is not None
     correction = engine.correction()
     assert correction is not None
@@ -94,7 +94,7 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     system = mb.load(ROOT / "models" / model)
     rng = np.random.default_rng(8)
     q = drifted_state(system, rng, 1e-6)[0]
-    rest = system.data().tree_engine(True).at_rest()
+    rest = system.data().engine.at_rest()
     quat = [r for r in rest.L.quat_row if r >= 0]
     gen, qd = np.zeros(rest.outputs), np.zeros(q.size)
 

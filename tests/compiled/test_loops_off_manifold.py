@@ -67,7 +67,7 @@ def test_off_the_manifold_the_kernel_gives_the_drift_rules_motion(name):
     different metrics, of rows the drift made inconsistent."""
     system = mb.load(ROOT / "models" / "mechanisms" / name)
     data = system.data()
-    engine = data.tree_engine(drift=True)
+    engine = data.engine
     assert engine is not None and engine.closes_loops
     rng = np.random.default_rng(7)
     for _ in range(5):
@@ -85,7 +85,7 @@ def test_on_the_manifold_the_kernel_still_judges_consistency(name):
     dropped directions' right side contradicts the rows, and the kernel hands it to the
     exact path (None) rather than give a least-squares motion."""
     system = mb.load(ROOT / "models" / "mechanisms" / name)
-    engine = system.data().tree_engine(drift=True)
+    engine = system.data().engine
     q, qd = drifted(system, np.random.default_rng(1), 1e-5)
     assert engine.motion(0.0, q, qd) is None
     assert engine.motion(0.0, q, qd, None, True) is not None
@@ -119,7 +119,7 @@ def test_near_a_singular_position_the_kernel_leaves_the_stage_to_the_exact_drift
     path.write_text(rigid_n_four_bar(2))
     system = mb.load(path)
     data = system.data()
-    engine = data.tree_engine(drift=True)
+    engine = data.engine
     psi, psi_dot = np.pi / 2 - 1e-6, 2.0
     q, qd = rigid_n_four_bar_state(system, 2, psi, psi_dot)
     rng = np.random.default_rng(5)
