@@ -1,0 +1,117 @@
+"""Craig–Bampton and free-interface reductions of the strip: the fixed-interface modes of a
+beam held at both ends are the clamped–clamped beam's (analytic), the reduced clamped–free
+beam's frequencies converge from above to the full FE model's as modes are added (lumped,
+singular M too), a tip load's static deflection is PL³/3EI whatever the number of modes,
+and the free-interface modes are the free–free beam's."""
+
+import re
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from flexible_beams import FREE_FREE, STRIP, LENGTH, euler_bernoulli, plane_share, strip
+from mbsynth.core.errors import ModelError
+from mbsynth.model.flexible.reduction import craig_bampton, free_interface, normal_modes
+
+N = 60  # elements
+
+
+def clamped_free(M, K):
+    """ω of a reduced model (interface root then tip, Craig–Bampton) with the root held; M
+    may be singular (lumped: the tip's rotations carry no mass), its infinite ω dropped."""
+    keep = np.arange(6, len(M))
+    lam = scipy.linalg.eigvals(K[np.ix_(keep, keep)], M[np.ix_(keep, keep)])
+    return np.sqrt(np.sort(lam[np.isfinite(lam)].real))
+
+
+def test_fixed_interface_modes_are_the_clamped_clamped_beams():
+    """Held at both ends (the interface), the beam's modes are clamped–clamped ones, whose
+    βL are the free–free beam's; the basis is M-orthonormal there and K-orthogonal to the
+    constraint modes, and η's interface columns are the interface nodes' DOFs."""
+    fe = strip(100)
+    reduced = craig_bampton(fe, [0, 100], count=12)
+    full = reduced.basis[:, reduced.modes]
+    xy = reduced.frequencies[plane_share(fe.mass, full, "xy") > 0.5][:3]
+    np.testing.assert_allclose(xy, euler_bernoulli(FREE_FREE, STRIP["Iz"]), rtol=1e-6)
+    m, k = reduced.modes, len(reduced.frequencies)
+    np.testing.assert_allclose(reduced.mass[m, m], np.eye(k), atol=1e-10)
+    np.testing.assert_allclose(reduced.stiffness[m, m], np.diag(reduced.frequencies**2), rtol=1e-9,
+                               atol=1e-9 * reduced.frequencies.max() ** 2)
+    assert np.abs(reduced.stiffness[:12, m]).max() < 1e-9 * np.abs(reduced.stiffness).max()
+    for position, node in enumerate((0, 100)):
+        rows, columns = reduced.node_rows(node), reduced.interface_columns(node)
+        np.testing.assert_array_equal(columns, np.arange(6 * position, 6 * position + 6))
+        expected = np.zeros((6, reduced.size))
+        expected[:, columns] = np.eye(6)
+        np.testing.assert_array_equal(reduced.basis[rows], expected)
+
+
+@pytest.mark.parametrize("mass", ["consistent", "lumped"])
+def test_craig_bampton_converges_to_the_full_model_as_modes_are_added(mass):
+    """Interface at the root and the tip, root then held: each of the first five clamped–free
+    frequencies approaches the unreduced FE model's from above (Rayleigh–Ritz), never
+    worse for more modes, within 1e-6 (the first three) with 32 modes. Lumped: M singular."""
+    fe = strip(N, mass=mass)
+    free = np.arange(6, fe.size)
+    exact, _ = normal_modes(fe.mass[free][:, free], fe.stiffness[free][:, free], count=5)
+    errors = []
+    for count in (0, 4, 8, 16, 32):
+        reduced = craig_bampton(fe, [0, N], count=count)
+        errors.append(clamped_free(reduced.mass, reduced.stiffness)[:5] / exact - 1)
+    errors = np.array(errors)
+    assert np.all(errors > -1e-10)
+    assert np.all(np.diff(errors, axis=0) < 1e-10)
+    assert errors[-1, :3].max() < 1e-6 and errors[0, 0] > 1e-3
+
+
+@pytest.mark.parametrize("theory, extra", [("euler_bernoulli", {}), ("timoshenko", dict(shear_factor=5 / 6))])
+@pytest.mark.parametrize("count", [0, 8])
+def test_a_tip_load_deflects_the_reduced_beam_as_the_closed_form(theory, extra, count):
+    """Root held, a force P along y at the tip: the tip's deflection is PL³/3EI (+ PL/κGA)
+    and its rotation PL²/2EI, exactly (constraint modes are static solutions)."""
+    fe = strip(N, theory=theory, **extra)
+    reduced = craig_bampton(fe, [0, N], count=count)
+    keep = np.arange(6, reduced.size)
+    load = np.zeros(len(keep))
+    load[1] = P = 3.0
+    u = np.linalg.solve(reduced.stiffness[np.ix_(keep, keep)], load)
+    E, I, G = STRIP["E"], STRIP["Iz"], STRIP["E"] / (2 * (1 + STRIP["nu"]))
+    shear = P * LENGTH / (extra["shear_factor"] * G * STRIP["area"]) if extra else 0.0
+    np.testing.assert_allclose(u[[1, 5]], [P * LENGTH**3 / (3 * E * I) + shear, P * LENGTH**2 / (2 * E * I)], rtol=1e-8)
+    np.testing.assert_allclose(reduced.basis[reduced.node_rows(N)] @ np.r_[np.zeros(6), u], u[:6], rtol=1e-15)
+
+
+def test_modes_by_frequency_are_every_mode_up_to_it():
+    """max_frequency past the first batch of eigsh: the modes are the count-chosen ones
+    up to that frequency, no more, no fewer."""
+    fe = strip(N)
+    by_count = craig_bampton(fe, [0, N], count=40).frequencies
+    cut = (by_count[29] + by_count[30]) / 2 / (2 * np.pi)
+    by_frequency = craig_bampton(fe, [0, N], max_frequency=cut).frequencies
+    np.testing.assert_allclose(by_frequency, by_count[:30], rtol=1e-10)
+
+
+def test_free_interface_modes_are_the_free_beams():
+    fe = strip(100)
+    with_rigid = free_interface(fe, [0, 100], count=8)
+    assert np.all(with_rigid.frequencies[:6] < 1e-4 * with_rigid.frequencies[6])  # rounding of K
+    flexible = free_interface(fe, [0, 100], count=8, rigid=False)
+    np.testing.assert_allclose(flexible.frequencies[:2], with_rigid.frequencies[6:], rtol=1e-9)
+    xy = flexible.frequencies[plane_share(fe.mass, flexible.basis, "xy") > 0.5][:3]
+    np.testing.assert_allclose(xy, euler_bernoulli(FREE_FREE, STRIP["Iz"]), rtol=1e-6)
+    np.testing.assert_allclose(flexible.mass, np.eye(8), atol=1e-10)
+    with pytest.raises(ModelError, match=re.escape("node 100 has no coordinates of its own in this free_interface")):
+        flexible.interface_columns(100)
+
+
+def test_bad_reductions_are_refused():
+    fe = strip(4)
+    with pytest.raises(ModelError, match="choose the modes by count or by max_frequency"):
+        craig_bampton(fe, [0], count=2, max_frequency=10.0)
+    with pytest.raises(ModelError, match=re.escape("node 5 is not one of its 5 nodes (0..4)")):
+        craig_bampton(fe, [0, 5], count=2)
+    with pytest.raises(ModelError, match=re.escape("interface nodes [0, 0] repeat a node")):
+        craig_bampton(fe, [0, 0], count=2)
+    with pytest.raises(ModelError, match="K \\+ s M is singular for every s"):
+        free_interface(strip(4, mass="lumped"), count=2)  # the twist about the axis: no mass, no stiffness
