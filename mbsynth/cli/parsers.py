@@ -137,6 +137,12 @@ def _view(commands):
     view.add_argument("--html", metavar="FILE.html", help="write the animation to this file instead of serving it")
     view.add_argument("--axes", action="store_true", help="draw a triad at every body and frame")
     view.add_argument("--joints", action="store_true", help="mark the frames of every joint")
+    camera = view.add_mutually_exclusive_group()
+    camera.add_argument("--follow", dest="follow", action="store_const", const=True, default=None,
+                        help="the camera follows the model's centre of mass (default: when it travels further "
+                             "than the model's size)")
+    camera.add_argument("--no-follow", dest="follow", action="store_const", const=False,
+                        help="the camera stays on the box that holds the whole motion")
     return view
 
 

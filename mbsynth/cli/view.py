@@ -22,7 +22,7 @@ def run(args):
         except SimulationError as err:
             traj, status = err.trajectory, 1
             print(f"error: {err}; drawing the motion up to there", file=sys.stderr)
-    options = {"axes": args.axes, "joints": args.joints}
+    options = {"axes": args.axes, "joints": args.joints, "follow": args.follow}
     if args.html:
         path = viewer.to_html(system, traj, args.html, **options)
         print(f"wrote {path}: {system.name}, t = {traj.t[0]:.6g} to {traj.t[-1]:.6g} s")

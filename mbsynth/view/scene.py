@@ -12,6 +12,18 @@ Lines (``line:`` shapes between two frames of a part, spring parts, distance joi
 force elements that expose their two ``points``) are nodes whose transform maps the
 unit segment (0, 0, 0)–(1, 0, 0) onto the segment between their ends: its first column
 is p_B − p_A, so it scales. All poses are one compiled function of (t, q, p).
+
+A model that declares no geometry is drawn as its structure: a rolling disk as a wheel
+of its radius about its frame's z axis, a body as rods from its centre of mass (a small
+sphere) to its frames (its own and those its joints and contacts attach to), a particle
+as a sphere whose radius grows as the cube root of its mass. Default sizes are fractions
+of the model's own length (``Scene.length``: the largest extent of the drawn points at
+one time), not of the box its motion fills, so a travelling model keeps its proportions.
+
+The camera looks at ``Scene.targets``, one point per drawn time: the centre of mass
+(mass-weighted over bodies and particles; the middle of the drawn points if nothing has
+mass) when the view follows the model, else the middle of the box that holds the whole
+motion.
 """
 
 from dataclasses import dataclass, field
@@ -21,6 +33,7 @@ import sympy as sp
 
 from ..core.errors import ModelError
 from ..io.parts import COLORS
+from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from ..symbolic.derive import T_SYMBOL, compile_function
 
@@ -29,7 +42,15 @@ PALETTE = ("blue", "orange", "green", "red", "purple", "yellow")
 LINE_COLOR = [0.35, 0.35, 0.35, 1.0]
 ROD_COLOR = [0.1, 0.1, 0.1, 1.0]
 POINT_LIKE = ("particle",)
-BODIES = ("rigid_body", "planar_body")
+BODIES = ("rigid_body", "planar_body", "euler_body")
+# default sizes, as fractions of the model's length (Scene.length)
+LINE_RADIUS = 0.004  # springs, distance joints, line: shapes
+ROD_RADIUS = 0.008  # a body's rods from its centre of mass to its frames
+COM_RADIUS = 0.02  # the sphere at a body's centre of mass
+PARTICLE_RADIUS = 0.05  # the heaviest particle; a lighter one by the cube root of its share
+MASSLESS_RADIUS = 0.01  # a massless particle
+WHEEL_WIDTH = 0.1  # a wheel's width, of its radius
+WHEEL_OPACITY = 0.45  # a wheel lets the rods behind it show
 
 
 @dataclass
@@ -45,17 +66,30 @@ class Node:
 
 @dataclass
 class Scene:
-    """The nodes, the times they are drawn at, and the box that holds the motion."""
+    """The nodes, the times they are drawn at, the box that holds the motion (``lower``,
+    ``upper``), the model's own length, and the camera's targets.
+
+    ``targets`` (rows × 3): the world point at the middle of the view at each drawn time;
+    ``follow``: whether they follow the model's centre of mass (else they all are the
+    middle of ``lower``–``upper``); ``view_lower``, ``view_upper``: the box, relative to
+    the target, that holds what is drawn at every time."""
 
     times: np.ndarray
     nodes: list
     lower: np.ndarray
     upper: np.ndarray
+    length: float
+    targets: np.ndarray
+    follow: bool
+    view_lower: np.ndarray
+    view_upper: np.ndarray
 
     @property
     def size(self):
-        """A length for default sizes: the diagonal of the bounding box (1 if it is a point)."""
-        return float(np.linalg.norm(self.upper - self.lower)) or 1.0
+        """The diameter of the sphere about the target that holds the view box (the
+        diagonal of the motion's box when the camera stays still; 1 if it is a point)."""
+        reach = np.maximum(np.abs(self.view_lower), np.abs(self.view_upper))
+        return 2 * float(np.linalg.norm(reach)) or 1.0
 
 
 @dataclass
@@ -65,15 +99,19 @@ class _Spec:
     path: str
     pose: int
     shapes: list
-    default: str = None  # the shape drawn when there is none: "sphere", "box" or "marker"
+    default: str = None  # the shape drawn when there is none: "sphere", "marker", "com" or "particle"
     color: list = None
     axes: bool = False
+    mass: float = 0.0  # a particle's, for its default sphere
 
 
-def build_scene(system, trajectory, axes=False, joints=False, fps=FPS):
+def build_scene(system, trajectory, axes=False, joints=False, fps=FPS, follow=None):
     """The Scene of ``trajectory``, at most ``fps`` rows per second of motion.
 
-    axes: a triad at every body and frame; joints: a marker at both frames of every joint.
+    axes: a triad at every body and frame; joints: a marker at both frames of every joint;
+    follow: the camera follows the centre of mass (True), stays on the box that holds the
+    whole motion (False), or (None) follows when the centre of mass travels further than
+    the model's length.
     """
     if tuple(trajectory.coordinates) != tuple(system.coordinates):
         raise ModelError(f"the trajectory's coordinates ({', '.join(trajectory.coordinates)}) are not those "
@@ -82,31 +120,55 @@ def build_scene(system, trajectory, axes=False, joints=False, fps=FPS):
     poses = _Poses()
     specs, lines = [], []
     model_drawn = any(_has_geometry(part) for part in system.parts)
-    for i, part in enumerate(system.parts):
-        color = [*COLORS[PALETTE[i % len(PALETTE)]], 1.0]
-        specs += _part_specs(part, poses, color, axes, model_drawn)
+    masses = _masses(system, trajectory.q[rows[0]])
+    colors = {part.name: [*COLORS[PALETTE[i % len(PALETTE)]], 1.0] for i, part in enumerate(system.parts)}
+    for part in system.parts:
+        specs += _part_specs(part, poses, colors[part.name], axes, model_drawn, masses.get(part.name, 0.0))
         lines += _part_lines(part, poses)
+    if not model_drawn:
+        wheels, rods = _structure(system, poses, colors)
+        specs, lines = specs + wheels, lines + rods
     joint_lines, markers = _joint_items(system, poses, joints)
     specs = [s for s in specs + markers if s.shapes or s.default or s.axes]
     lines += joint_lines
     for element in system.forces:
         ends = getattr(element, "points", None)  # a force element between two points may expose them
         if ends is not None:
-            lines.append((element.name, *(poses.add_point(p) for p in ends), LINE_COLOR))
+            lines.append((f"lines/{element.name}", *(poses.add_point(p) for p in ends), LINE_COLOR, LINE_RADIUS))
     if not specs and not lines:
         raise ModelError(f"model '{system.name}' has nothing to draw: give its lagrangian parts frames "
                          "(positions in their coordinates) with geometry")
+    centre_poses = [(poses.add(part, ORIGIN), masses[part.name]) for part in system.parts if part.name in masses]
     transforms = poses.evaluate(system, trajectory.t[rows], trajectory.q[rows])
     positions = transforms[:, :, :3, 3]
-    lower, upper = _bounds(specs, lines, transforms)
-    scene = Scene(trajectory.t[rows], [], lower, upper)
+    lows, highs = _instant_bounds(specs, lines, transforms)
+    lower, upper = lows.min(axis=0), highs.max(axis=0)
+    length = float(np.linalg.norm(highs - lows, axis=1).max()) or float(np.linalg.norm(upper - lower)) or 1.0
+    centres = centre_of_mass(centre_poses, positions)
+    if centres is None:
+        centres = (lows + highs) / 2
+    if follow is None:
+        follow = bool(np.linalg.norm(centres.max(axis=0) - centres.min(axis=0)) > length)
+    targets = centres if follow else np.tile((lower + upper) / 2, (len(rows), 1))
+    scene = Scene(trajectory.t[rows], [], lower, upper, length, targets, bool(follow),
+                  (lows - targets).min(axis=0), (highs - targets).max(axis=0))
+    heaviest = max((s.mass for s in specs if s.default == "particle"), default=0.0)
     for spec in specs:
-        scene.nodes.append(Node(spec.path, transforms[spec.pose], spec.shapes or _default_shapes(spec, scene.size),
-                                spec.axes))
-    for name, a, b, color in lines:
-        scene.nodes.append(Node(f"lines/{name}", segment_transforms(positions[a], positions[b]),
-                                [{"shape": "line", "size": [0.004 * scene.size], "color": color}]))
+        scene.nodes.append(Node(spec.path, transforms[spec.pose],
+                                spec.shapes or _default_shapes(spec, length, heaviest), spec.axes))
+    for path, a, b, color, radius in lines:
+        scene.nodes.append(Node(path, segment_transforms(positions[a], positions[b]),
+                                [{"shape": "line", "size": [radius * length], "color": color}]))
     return scene
+
+
+def centre_of_mass(weighted, positions):
+    """(rows × 3) Σ mᵢ rᵢ / Σ mᵢ of (pose index, mass) pairs at ``positions`` (poses ×
+    rows × 3); None when they have no mass."""
+    total = sum(m for _, m in weighted)
+    if total <= 0:
+        return None
+    return sum(m * positions[i] for i, m in weighted) / total
 
 
 def drawn_rows(t, fps=FPS):
@@ -138,9 +200,9 @@ def segment_transforms(a, b):
     return T
 
 
-def _bounds(specs, lines, transforms):
-    """The box holding every drawn node and line end, and each shape's bounding sphere
-    about its centre, over all rows."""
+def _instant_bounds(specs, lines, transforms):
+    """(lows, highs), rows × 3: at each row, the box holding every drawn node and line end
+    and each given shape's bounding sphere about its centre."""
     points = [transforms[i][:, :3, 3] for line in lines for i in line[1:3]]
     for spec in specs:
         T = transforms[spec.pose]
@@ -148,7 +210,7 @@ def _bounds(specs, lines, transforms):
         for shape in spec.shapes:
             centre = T[:, :3, :3] @ np.asarray(shape.get("position", [0, 0, 0]), dtype=float) + T[:, :3, 3]
             points += [centre - shape_radius(shape), centre + shape_radius(shape)]
-    points = np.concatenate(points)
+    points = np.stack(points)
     return points.min(axis=0), points.max(axis=0)
 
 
@@ -161,15 +223,18 @@ def shape_radius(shape):
             "capsule": lambda: size[0] + size[1] / 2}.get(shape["shape"], lambda: 0.0)()
 
 
-def _default_shapes(spec, size):
-    """A small sphere for points, a smaller one for joint markers, a small box for bodies."""
-    if spec.default == "sphere":
-        return [{"shape": "sphere", "size": [0.02 * size], "color": spec.color}]
-    if spec.default == "marker":
-        return [{"shape": "sphere", "size": [0.012 * size], "color": spec.color}]
-    if spec.default == "box":
-        return [{"shape": "box", "size": [0.05 * size] * 3, "color": spec.color}]
-    return []
+def _default_shapes(spec, length, heaviest):
+    """A small sphere for points, a smaller one for joint markers, a dark one at a body's
+    centre of mass, and for a particle a sphere whose radius is PARTICLE_RADIUS ×
+    (m / heaviest)^(1/3) of the model's length (at least MASSLESS_RADIUS)."""
+    if spec.default == "particle":
+        share = np.cbrt(spec.mass / heaviest) if heaviest > 0 else 0.0
+        return [{"shape": "sphere", "size": [max(PARTICLE_RADIUS * share, MASSLESS_RADIUS) * length],
+                 "color": spec.color}]
+    radius = {"sphere": 0.02, "marker": 0.012, "com": COM_RADIUS}.get(spec.default)
+    if radius is None:
+        return []
+    return [{"shape": "sphere", "size": [radius * length], "color": ROD_COLOR if spec.default == "com" else spec.color}]
 
 
 def _joint_items(system, poses, markers):
@@ -181,7 +246,7 @@ def _joint_items(system, poses, markers):
             continue
         ends = [poses.add(part, frame) for part, frame in zip(con.parts, con.frames)]
         if con.joint_kind == "distance":
-            lines.append((con.name, *ends, ROD_COLOR))
+            lines.append((f"lines/{con.name}", *ends, ROD_COLOR, LINE_RADIUS))
         elif markers:
             specs += [_Spec(f"joints/{con.name}.{end}", key, [], "marker", ROD_COLOR) for end, key in zip("AB", ends)]
     return lines, specs
@@ -191,18 +256,18 @@ def _has_geometry(part):
     return bool(part.geometry) or any(f.geometry for f in part.frames.values())
 
 
-def _part_specs(part, poses, color, axes, model_drawn):
+def _part_specs(part, poses, color, axes, model_drawn, mass):
     """The node of the part's own pose and one per frame (line shapes apart). A part with
-    no geometry gets a default: a sphere for a particle; for a body a box, or only its
-    axes when the model draws other parts (a robot's frame-like links)."""
+    no geometry gets a default: a sphere sized by its ``mass`` for a particle; for a body
+    the sphere at its centre of mass (``_structure`` adds its rods), or only its axes when
+    the model draws other parts (a robot's frame-like links)."""
     drawn = _has_geometry(part)
     specs = []
     if part.kind != "spring":
         body = part.kind in BODIES and not drawn
-        default = "sphere" if part.kind in POINT_LIKE and not drawn else "box" if body and not model_drawn else None
-        origin = Frame(part.name, "origin", sp.zeros(3, 1), sp.eye(3))
-        specs.append(_Spec(part.name, poses.add(part, origin), _solid(part.geometry), default, color,
-                           (axes or (body and model_drawn)) and part.kind != "lagrangian"))
+        default = "particle" if part.kind in POINT_LIKE and not drawn else "com" if body and not model_drawn else None
+        specs.append(_Spec(part.name, poses.add(part, ORIGIN), _solid(part.geometry), default, color,
+                           (axes or (body and model_drawn)) and part.kind != "lagrangian", mass))
     for frame in part.frames.values():
         default = "sphere" if part.kind == "lagrangian" and not drawn else None
         specs.append(_Spec(f"{part.name}.{frame.name}", poses.add(part, frame), _solid(frame.geometry), default,
@@ -211,16 +276,69 @@ def _part_specs(part, poses, color, axes, model_drawn):
 
 
 def _part_lines(part, poses):
-    """(name, pose A, pose B, colour) of the ``line:`` shapes on a part's frames; a spring
-    part is the line between its ends."""
+    """(path, pose A, pose B, colour, radius) of the ``line:`` shapes on a part's frames; a
+    spring part is the line between its ends."""
     if part.kind == "spring":
-        return [(part.name, poses.add(part, part.frames["end1"]), poses.add(part, part.frames["end2"]), LINE_COLOR)]
-    return [(f"{part.name}.{frame.name}-{shape['to']}", poses.add(part, frame), poses.add(part, part.frames[shape["to"]]),
-             shape["color"]) for frame in part.frames.values() for shape in frame.geometry if shape["shape"] == "line"]
+        return [(f"lines/{part.name}", poses.add(part, part.frames["end1"]), poses.add(part, part.frames["end2"]),
+                 LINE_COLOR, LINE_RADIUS)]
+    return [(f"lines/{part.name}.{frame.name}-{shape['to']}", poses.add(part, frame),
+             poses.add(part, part.frames[shape["to"]]), shape["color"], LINE_RADIUS)
+            for frame in part.frames.values() for shape in frame.geometry if shape["shape"] == "line"]
+
+
+def _structure(system, poses, colors):
+    """(wheel specs, rod lines) of a model that declares no geometry: each rolling disk a
+    wheel at ``wheels/<contact>`` (a see-through disk of its radius and WHEEL_WIDTH about
+    its frame's z axis, with a dark spoke along its x axis that shows the spin); each
+    body's rods at ``structure/<part>.<frame>``, from its centre of mass to each of its
+    frames away from it, its own and those its joints and contacts attach to."""
+    values = dict(zip(system.parameter_symbols, system.parameter_values))
+    attached, wheels = {}, []
+    for con in system.connectors:
+        if getattr(con, "joint_kind", None) is not None:
+            ends = zip(con.parts, con.frames)
+        elif isinstance(con, (RollingDisk, KnifeEdge)):
+            ends = [(con.part, con.frame)]
+        else:
+            continue
+        for part, frame in ends:
+            if part is not None:
+                attached.setdefault(part.name, {})[frame.name] = frame
+        if isinstance(con, RollingDisk):
+            R = float(sp.sympify(con.radius).xreplace(values))
+            wheels.append(_Spec(f"wheels/{con.name}", poses.add(con.part, con.frame),
+                                [{"shape": "cylinder", "size": [R, WHEEL_WIDTH * R],
+                                  "color": [*colors[con.part.name][:3], WHEEL_OPACITY]},
+                                 {"shape": "box", "size": [2 * R, 0.15 * R, 1.2 * WHEEL_WIDTH * R], "color": ROD_COLOR}]))
+    rods = []
+    for part in system.parts:
+        if part.kind not in BODIES:
+            continue
+        centre = poses.add(part, ORIGIN)
+        for frame in {**part.frames, **attached.get(part.name, {})}.values():
+            if sp.Matrix(frame.position).is_zero_matrix is not True:
+                rods.append((f"structure/{part.name}.{frame.name}", centre, poses.add(part, frame),
+                             colors[part.name], ROD_RADIUS))
+    return wheels, rods
+
+
+def _masses(system, q):
+    """{part name: mass} of the bodies and particles (M's first diagonal entry, at ``q``)."""
+    p, masses, start = system.parameter_values, {}, 0
+    for part in system.parts:
+        n = len(part.coordinates)
+        if part.kind in BODIES + POINT_LIKE:
+            M, _ = part.evaluate(0.0, q[start:start + n], np.zeros(n), p)
+            masses[part.name] = float(M[0, 0])
+        start += n
+    return masses
 
 
 def _solid(shapes):
     return [s for s in shapes if s["shape"] != "line"]
+
+
+ORIGIN = Frame("", "origin", sp.zeros(3, 1), sp.eye(3))  # a part's own pose (pose keys are by frame name)
 
 
 class _Poses:

@@ -15,8 +15,11 @@ itself; the server that ``Visualizer()`` starts outlives a killed parent, so
 ``MeshcatView`` starts meshcat's server itself, with a thread that ends it when its stdin
 closes; it has no camera helpers (``set_cam_pos``/``set_cam_target``, which Pinocchio's
 viewer calls), so the camera is placed through the position property of
-``/Cameras/default/rotated/<object>`` and the model is moved so that the middle of its
-motion sits at the origin the camera looks at.
+``/Cameras/default/rotated/<object>`` and the world is moved under it instead: the model,
+the world axes and the grid are placed so that the scene's target (``Scene.targets``: the
+middle of the whole motion, or the centre of mass when the view follows the model) sits
+at the origin the camera looks at. Following, they move along the animation; the grid
+moves by whole cells, so its lines stay where they are on the floor.
 """
 
 import contextlib
@@ -39,9 +42,13 @@ AXES_LENGTH = 0.5  # meshcat's world axes
 STOP_SECONDS = 5.0
 
 
-def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS):
-    """Write the animation of ``trajectory`` as one self-contained HTML file; returns its Path."""
-    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps)
+def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS, follow=None):
+    """Write the animation of ``trajectory`` as one self-contained HTML file; returns its Path.
+
+    follow: the camera follows the centre of mass (True), stays on the box that holds the
+    whole motion (False), or (None) follows when the centre of mass travels further than
+    the model's length (``scene.build_scene``)."""
+    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps, follow=follow)
     with MeshcatView() as view:
         view.draw(scene)
         html = view.html()
@@ -50,15 +57,16 @@ def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS):
     return path
 
 
-def show(system, trajectory, *, axes=False, joints=False, fps=FPS, block=True, ready=None):
-    """Serve the animation of ``trajectory`` in a live meshcat viewer on this machine.
+def show(system, trajectory, *, axes=False, joints=False, fps=FPS, follow=None, block=True, ready=None):
+    """Serve the animation of ``trajectory`` in a live meshcat viewer on this machine
+    (``follow`` as in ``to_html``).
 
     block=True serves until interrupted (Ctrl-C or SIGTERM), calling ``ready(url)`` once
     the scene is up, then stops the server and raises KeyboardInterrupt (the command
     exits 130). block=False returns the running ``MeshcatView`` (``.url``; ``close()`` it,
     or use it in a ``with`` block). The server also ends when this process dies.
     """
-    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps)
+    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps, follow=follow)
     if not block:
         view = MeshcatView()
         try:
@@ -143,23 +151,22 @@ class MeshcatView:
                     target[f"{i}.{j}"].set_object(geometry, _material(shape["color"], g))
                     target[f"{i}.{j}"].set_transform(inner)
             if node.axes:
-                target["axes"].set_object(g.triad(0.04 * scene.size))
+                target["axes"].set_object(g.triad(0.04 * scene.length))
             target.set_transform(node.transforms[0])
         self.frame(scene)
         if len(scene.times) > 1:
             self.vis.set_animation(self._animation(scene), play=True, repetitions=float("inf"))
 
     def frame(self, scene):
-        """Point the camera at the box that holds the motion; keep the world axes (as long
-        as a grid cell) at the world origin and the grid on the floor (z = 0, or lower when
-        the motion goes lower), its cells 1, 2 or 5 × 10^k, about a fifth of the scene."""
-        centre = (scene.lower + scene.upper) / 2
-        self.vis["model"].set_transform(_translation(-centre))
+        """Point the camera at the view box about the first target; keep the world axes (as
+        long as a grid cell) at the world origin and the grid on the floor (z = 0, or lower
+        when the motion goes lower), its cells 1, 2 or 5 × 10^k, about a fifth of the view."""
         spacing = grid_spacing(scene.size)
-        self.vis["/Axes"].set_transform(_pose(-centre, scale=[spacing / AXES_LENGTH] * 3))
-        floor = np.array([0.0, 0.0, min(0.0, scene.lower[2])])
-        self.vis["/Grid"].set_transform(_pose(floor - centre, scale=[spacing / GRID_SPACING] * 3))
-        eye = view_direction(scene.upper - scene.lower) * 1.2 * scene.size / 2 / np.tan(FIELD_OF_VIEW / 2)
+        tracks = world_tracks(scene)
+        self.vis["model"].set_transform(_translation(tracks["model"][1][0]))
+        self.vis["/Axes"].set_transform(_pose(tracks["/Axes"][1][0], scale=[spacing / AXES_LENGTH] * 3))
+        self.vis["/Grid"].set_transform(_pose(tracks["/Grid"][1][0], scale=[spacing / GRID_SPACING] * 3))
+        eye = view_direction(scene.view_upper - scene.view_lower) * 1.2 * scene.size / 2 / np.tan(FIELD_OF_VIEW / 2)
         self.vis[CAMERA].set_property("position", [eye[0], eye[2], -eye[1]])  # the camera's frame is y-up
 
     def html(self):
@@ -190,9 +197,14 @@ class MeshcatView:
         self.process.stdout.close()
 
     def _animation(self, scene):
-        """One clip per node: position, quaternion (and scale for lines) at each drawn time."""
+        """One clip per node: position, quaternion (and scale for lines) at each drawn time;
+        following, one per moved world object (``world_tracks``): its position."""
         animation = self.meshcat.animation
         clips = {}
+        if scene.follow:
+            for path, (keys, positions) in world_tracks(scene).items():
+                track = animation.AnimationTrack("position", "vector3", list(keys), positions.tolist())
+                clips[self.vis[path].path] = animation.AnimationClip({"position": track}, fps=1)
         times = list(scene.times - scene.times[0])
         for node in scene.nodes:
             position, quaternion, scale = decompose(node.transforms)
@@ -227,6 +239,32 @@ def decompose(transforms):
         if quaternions[k] @ quaternions[k - 1] < 0:
             quaternions[k] = -quaternions[k]
     return transforms[:, :3, 3], quaternions[:, [1, 2, 3, 0]], scale
+
+
+GRID_JUMP = 1e-3  # a grid's jump by whole cells takes this fraction of the interval between two drawn times
+
+
+def world_tracks(scene):
+    """{meshcat path: (key times, positions)} of what is moved so that the scene's target
+    sits at the origin: ``model`` and ``/Axes`` at −target; ``/Grid`` on the floor at the
+    target's x, y rounded to whole cells, minus the target. A jump of the rounded x, y
+    between two drawn times is keyed just before the later one, so the grid's lines stay
+    put. Times are seconds from the first drawn time."""
+    times = scene.times - scene.times[0]
+    targets = scene.targets
+    spacing = grid_spacing(scene.size)
+    floor = min(0.0, scene.lower[2])
+    cells = np.column_stack([np.round(targets[:, :2] / spacing) * spacing, np.full(len(times), floor)])
+    keys, grid = [], []
+    for k in range(len(times)):
+        if k > 0 and np.any(cells[k] != cells[k - 1]):
+            before = times[k] - GRID_JUMP * (times[k] - times[k - 1])
+            target = targets[k] - GRID_JUMP * (targets[k] - targets[k - 1])
+            keys.append(before)
+            grid.append(cells[k - 1] - target)
+        keys.append(times[k])
+        grid.append(cells[k] - targets[k])
+    return {"model": (times, -targets), "/Axes": (times, -targets), "/Grid": (np.array(keys), np.array(grid))}
 
 
 def grid_spacing(size):

@@ -89,10 +89,11 @@ def test_rigid_and_planar_bodies_are_drawn_at_their_pose():
     assert node(scene, "slab").shapes == [] and node(scene, "slab").axes  # no geometry: axes, as the body has some
 
 
-def test_bodies_without_geometry_get_a_box_when_nothing_is_drawn():
+def test_bodies_without_geometry_show_their_structure_when_nothing_is_drawn():
     system = mb.loads(BODIES.replace("    geometry: {box: [0.2, 0.1, 0.1]}\n", ""))
     scene = build_scene(system, trajectory_of(system, system.initial_state()[0]))
-    assert [(n.path, n.shapes[0]["shape"]) for n in scene.nodes] == [("body", "box"), ("slab", "box")]
+    assert [(n.path, n.shapes[0]["shape"]) for n in scene.nodes] == [
+        ("body", "sphere"), ("slab", "sphere"), ("structure/body.tip", "line"), ("structure/slab.corner", "line")]
 
 
 def test_three_js_quaternion_of_a_turn_about_z():

@@ -32,9 +32,11 @@ def _velocity(position, q, qd):
 
 class RollingDisk(Connector):
     """A disk (``frame`` on the rigid ``part``) rolling on the ground z = ``height``:
-    rows ``height``, ``slip_x``, ``slip_y``."""
+    rows ``height``, ``slip_x``, ``slip_y``. Keeps ``part``, ``frame`` and ``radius``
+    (the viewer draws the wheel)."""
 
     def __init__(self, name, part, frame, radius, height, q, qd, params):
+        self.part, self.frame, self.radius = part, frame, radius
         p, R = part.pose(frame)
         a, n = R[:, 2], sp.Matrix([0, 0, 1])
         d = n * a.dot(a) - a.dot(n) * a
@@ -46,9 +48,11 @@ class RollingDisk(Connector):
 
 
 class KnifeEdge(Connector):
-    """A blade along the x axis of ``frame`` on ``part``: y_f · v_p = 0."""
+    """A blade along the x axis of ``frame`` on ``part``: y_f · v_p = 0. Keeps ``part``
+    and ``frame``."""
 
     def __init__(self, name, part, frame, q, qd, params):
+        self.part, self.frame = part, frame
         p, R = part.pose(frame)
         a, b, phi, psi = mixed([], [R[:, 1].dot(_velocity(p, q, qd))], q, qd)
         super().__init__(name, "nonholonomic", a, b, sp.zeros(len(q), 1), phi, psi, q, qd, params)
