@@ -266,6 +266,19 @@ def test_rolling_disk_without_geometry_is_a_wheel_that_the_camera_follows(tmp_pa
                                -np.repeat(centres[:1], len(times), axis=0), atol=1e-9)
 
 
+def test_declared_geometry_wins():
+    system = mb.load(DISK)  # its disk declares a cylinder
+    scene = build_scene(system, trajectory_of(system, system.initial_state()[0]))
+    assert [(n.path, [s["shape"] for s in n.shapes]) for n in scene.nodes] == [("disk", ["cylinder"])]
+    assert node(scene, "disk").shapes[0]["size"] == pytest.approx([0.1, 0.01], rel=1e-12)  # [R, R/10]
+    drawn = mb.loads(TWO_WHEELER.replace("      hub: {axis: [0, 1, 0]}\n    initial: {position: [0, 0, rR]}",
+                                         "      hub: {axis: [0, 1, 0], geometry: {cylinder: [rR, 0.02]}}\n"
+                                         "    initial: {position: [0, 0, rR]}"))
+    scene = build_scene(drawn, trajectory_of(drawn, drawn.initial_state()[0]))
+    assert [n.path for n in scene.nodes if n.shapes] == ["rear_wheel.hub"]  # the other bodies: only their axes
+    assert all(n.axes for n in scene.nodes if n.path in MASSES and n.path != "rear_wheel")
+
+
 def test_live_view_follows_too(tmp_path):
     system = mb.load(stripped_disk(tmp_path))
     times = np.arange(0, 0.5 + 1e-9, 1 / 30)
