@@ -12,9 +12,9 @@ DOFs), with reduced matrices Tᵀ M T and Tᵀ K T.
   nodes' DOFs are rows of T.
 
 Modes are chosen by ``count`` or ``max_frequency`` (Hz, every mode up to it). ``normal_modes``
-solves K φ = ω² M φ by scipy's ``eigsh`` in shift-invert mode about a negative shift (so
-rigid-body modes, K singular, are found too); M may be singular (lumped: rotations without
-mass), its infinite eigenvalues are never returned. The Ritz vectors are refined by the
+solves K φ = ω² M φ in shift-invert form about a negative shift (so rigid-body modes, K
+singular, are found too), by scipy's ``eigsh`` or, for small models, a dense solver; M may be
+singular (lumped: rotations without mass), its infinite eigenvalues are never returned. The Ritz vectors are refined by the
 projected problem, so returned modes are M-orthonormal to rounding.
 """
 
@@ -31,6 +31,8 @@ from .matrices import FEModel
 SHIFT_RTOL = 1e-8  # the default shift: −SHIFT_RTOL · tr K / tr M (below every mode; rigid ones factor)
 RIGID_RTOL = 1e-9  # a mode with ω² below RIGID_RTOL · tr K / tr M is a rigid-body mode
 FIRST_BATCH = 12  # modes asked for first when they are chosen by frequency (doubled until past it)
+DENSE_MODES_MAX = 120  # up to this many DOFs the modes come from a dense solver, every finite one at once
+FINITE_RTOL = 1e-12  # a dense mode with 1/(λ + shift) below FINITE_RTOL / shift is an infinite one (M φ = 0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,39 +113,73 @@ def free_interface(fe, interface=(), *, count=None, max_frequency=None, rigid=Tr
 def normal_modes(M, K, *, count=None, max_frequency=None, shift=None, source="FE model"):
     """(ω in rad/s ascending, shapes n × k M-orthonormal) of K φ = ω² M φ: the ``count``
     lowest, or every one with ω ≤ 2π ``max_frequency``. ``shift`` (ω², > 0): the
-    shift-invert point is −shift (default SHIFT_RTOL · tr K / tr M)."""
+    shift-invert point is −shift (default SHIFT_RTOL · tr K / tr M). Up to DENSE_MODES_MAX
+    DOFs a dense solver, above it eigsh."""
     if (count is None) == (max_frequency is None):
         raise ModelError(f"{source}: choose the modes by count or by max_frequency (one of them)")
     M, K = scipy.sparse.csc_array(M), scipy.sparse.csc_array(K)
     n = M.shape[0]
-    if count is not None and not (isinstance(count, (int, np.integer)) and 0 <= count <= n - 2):
-        raise ModelError(f"{source}: the mode count must be an integer from 0 to {n - 2} (n − 2 for eigsh), not {count!r}")
+    most = n if n <= DENSE_MODES_MAX else n - 2
+    if count is not None and not (isinstance(count, (int, np.integer)) and 0 <= count <= most):
+        raise ModelError(f"{source}: the mode count must be an integer from 0 to {most}, not {count!r}")
     if max_frequency is not None and not max_frequency >= 0:
         raise ModelError(f"{source}: max_frequency must be ≥ 0 Hz, not {max_frequency!r}")
     if count == 0 or n == 0:
         return np.zeros(0), np.zeros((n, 0))
     sigma = -(shift if shift is not None else SHIFT_RTOL * _scale(M, K))
+    limit = None if max_frequency is None else (2 * np.pi * max_frequency) ** 2
+    if n <= DENSE_MODES_MAX:
+        lam, vectors = _dense_modes(M, K, sigma, source)
+        if count is not None and count > len(lam):
+            raise ModelError(f"{source}: {count} modes asked for, but the mass matrix gives only {len(lam)} "
+                             "finite ones (a lumped mass gives rotations none)")
+    else:
+        lam, vectors = _sparse_modes(M, K, sigma, count, limit, max_frequency, source)
+    keep = slice(count) if limit is None else lam <= limit
+    return np.sqrt(np.clip(lam[keep], 0.0, None)), vectors[:, keep]
+
+
+def _dense_modes(M, K, sigma, source):
+    """Every finite mode, by the symmetric form of shift-invert: with K − σM = LLᵀ, the
+    eigenvalues μ = 1/(λ − σ) of L⁻¹ M L⁻ᵀ (μ = 0: an infinite mode of a singular M)."""
+    try:
+        L = np.linalg.cholesky((K - sigma * M).toarray())
+    except np.linalg.LinAlgError as err:
+        raise ModelError(_NEITHER.format(source)) from err
+    half = scipy.linalg.solve_triangular(L, M.toarray(), lower=True)
+    mu, Y = scipy.linalg.eigh(scipy.linalg.solve_triangular(L, half.T, lower=True))
+    finite = mu * -sigma > FINITE_RTOL
+    vectors = scipy.linalg.solve_triangular(L.T, Y[:, finite][:, ::-1], lower=False)
+    return _ritz(M, K, vectors, source)
+
+
+def _sparse_modes(M, K, sigma, count, limit, max_frequency, source):
+    """The ``count`` lowest modes, or enough to pass ``limit`` (ω²), by eigsh."""
+    n = M.shape[0]
     try:
         inverse = scipy.sparse.linalg.splu(K - sigma * M)
     except RuntimeError as err:
-        raise ModelError(f"{source}: K + s M is singular for every s: some motion has neither mass nor "
-                         "stiffness (with a lumped mass, a free beam's twist about its own axis)") from err
+        raise ModelError(_NEITHER.format(source)) from err
     operator = scipy.sparse.linalg.LinearOperator((n, n), matvec=inverse.solve, dtype=float)
     k = count if count is not None else min(FIRST_BATCH, n - 2)
-    limit = None if max_frequency is None else (2 * np.pi * max_frequency) ** 2
     while True:
-        lam, vectors = scipy.sparse.linalg.eigsh(K, k=k, M=M, sigma=sigma, OPinv=operator, which="LM")
+        try:
+            lam, vectors = scipy.sparse.linalg.eigsh(K, k=k, M=M, sigma=sigma, OPinv=operator, which="LM")
+        except scipy.sparse.linalg.ArpackError as err:
+            raise ModelError(f"{source}: eigsh found no {k} modes ({err}); fewer modes, or more than the mass "
+                             "matrix has finite ones?") from err
         lam, vectors = _ritz(M, K, vectors, source)
         if limit is None or lam[-1] > limit or k == n - 2:
             break
         k = min(2 * k, n - 2)
-    if limit is not None:
-        if lam[-1] <= limit:
-            raise ModelError(f"{source}: more than {k} modes lie below {max_frequency} Hz (eigsh takes at most n − 2): "
-                             "choose them by count, or a lower max_frequency")
-        keep = lam <= limit
-        lam, vectors = lam[keep], vectors[:, keep]
-    return np.sqrt(np.clip(lam, 0.0, None)), vectors
+    if limit is not None and lam[-1] <= limit:
+        raise ModelError(f"{source}: more than {k} modes lie below {max_frequency} Hz (eigsh takes at most n − 2): "
+                         "choose them by count, or a lower max_frequency")
+    return lam, vectors
+
+
+_NEITHER = ("{}: K + s M is singular for every s: some motion has neither mass nor stiffness "
+            "(with a lumped mass, a free beam's twist about its own axis)")
 
 
 def _ritz(M, K, vectors, source):

@@ -115,3 +115,23 @@ def test_bad_reductions_are_refused():
         craig_bampton(fe, [0, 0], count=2)
     with pytest.raises(ModelError, match="K \\+ s M is singular for every s"):
         free_interface(strip(4, mass="lumped"), count=2)  # the twist about the axis: no mass, no stiffness
+
+
+@pytest.mark.parametrize("elements", [3, 30])  # 18 DOFs: the dense solver; 180: eigsh
+def test_a_singular_lumped_mass_gives_the_statically_condensed_modes(elements):
+    """Clamped–free with lumped mass (rotations massless): the modes are those of the
+    classical static condensation, K* = K_tt − K_tr K_rr⁻¹ K_rt against the translation
+    masses; all 3 × elements of them finite, no more."""
+    fe = strip(elements, mass="lumped")
+    free = np.arange(6, fe.size)
+    M, K = fe.mass[free][:, free].toarray(), fe.stiffness[free][:, free].toarray()
+    t = np.diag(M) > 0
+    condensed = K[np.ix_(t, t)] - K[np.ix_(t, ~t)] @ np.linalg.solve(K[np.ix_(~t, ~t)], K[np.ix_(~t, t)])
+    exact = np.sqrt(scipy.linalg.eigh(condensed, M[np.ix_(t, t)], eigvals_only=True))
+    count = 3 * elements if elements == 3 else 8
+    omega, shapes = normal_modes(M, K, count=count)
+    np.testing.assert_allclose(omega, exact[:count], rtol=1e-9)
+    np.testing.assert_allclose(shapes.T @ M @ shapes, np.eye(count), atol=1e-10)
+    if elements == 3:
+        with pytest.raises(ModelError, match="10 modes asked for, but the mass matrix gives only 9 finite ones"):
+            normal_modes(M, K, count=10)
