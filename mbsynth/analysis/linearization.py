@@ -19,6 +19,24 @@ dependent loop coordinates and massless coordinates fixed by a holonomic balance
   A = [[0, I], [(∂f/∂q, ∂f/∂q̇) T restricted to the rows u]] — exact at any state on the
   manifold, at rest or moving.
 
+Non-holonomic rows (a rolling disk's slip, a knife edge) restrict velocities only: the
+state is then x = [δu; δv], the k independent coordinates and s < k independent speeds v,
+s of the q̇ picked by coordinate partitioning of the null space of all velocity rows
+W = [Φ_q; A_v] (or named by the caller); δq̇ = S δv + c with S that null space's basis,
+the identity on v, and W c = −Ψ_W N δu, c zero on v (the tangent of ψ = 0 for every
+velocity row). A = [[rows u of T's velocity part], [v̇'s rows of dq̈ T]].
+
+Steady motions. Linearized about a moving state, A is the variational equation of the
+motion through that state; where the state is a steady motion (only cyclic coordinates
+move, at constant rates: a bicycle rolling upright, a disk rolling in a circle, each body
+turned by angles whose spin is the last, model/parts/euler_body.py), A is the same at every
+instant of it and its eigenvalues are the motion's stability exponents. A cyclic coordinate
+drives only other cyclic ones and a conserved speed changes at zero rate, so A is block
+triangular in them: ``Linearization.eigenvalues`` takes the diagonal blocks of that form
+(``blocks``; the zeros exact, named in ``cyclic``) and splits off the null directions
+within a block, so an exponent near zero (a bicycle at its capsize speed) keeps its
+accuracy next to the zeros.
+
 Massless parts. The independent state is that of the masses: a massless coordinate is
 fixed, at every instant, by its balance wᵀ(Q + C) = 0 (model/balances.py). Written as a
 holonomic row (``closure: auto`` appends it so when it involves no velocities), the
@@ -46,9 +64,9 @@ directions, so the choice of λ does not matter there.
 Refused, with a SolveError naming the rows or coordinates: NaN or infinite input, states
 off the manifold, rows that depend on time (a servo's prescribed motion) at a state that
 moves (q̇ ≠ 0, or ∂φ/∂t ≠ 0: the motion about it is a time-varying system, its
-eigenvalues at one instant no measure of stability), non-unique motion, non-holonomic
-and acceleration-level rows (they restrict velocities or accelerations only, not the
-state's manifold), Coulomb friction (not differentiable), a configuration near a singular
+eigenvalues at one instant no measure of stability), non-unique motion,
+acceleration-level rows (a balance with velocities: a first-order equation of its own,
+outside the state), Coulomb friction (not differentiable), a configuration near a singular
 position (Φ_q nearly rank deficient: a loop near a change point) or at one (rows
 dependent here whose dependency does not persist along the tangent directions, detected
 by the rows' second derivatives).
@@ -60,12 +78,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse
+import scipy.sparse.csgraph
 import sympy as sp
 
 from ..core.errors import SolveError
 from .projection import relative_drift
 from ..symbolic.derive import T_SYMBOL, compile_function, jacobian
-from ..core.tolerances import CHANGE_POINT_RTOL, NAME_RTOL, NEAR_SINGULAR, ON_MANIFOLD_RTOL, RANK_RTOL
+from ..core.tolerances import (CHANGE_POINT_RTOL, NAME_RTOL, NEAR_SINGULAR, ON_MANIFOLD_RTOL, RANK_RTOL,
+                               STRUCTURAL_ZERO_RTOL)
 
 _CACHE_SIZE = 8
 _cache = OrderedDict()  # (ids of the parts, rows and forces) -> (those tuples, Derivatives)
@@ -73,11 +94,13 @@ _cache = OrderedDict()  # (ids of the parts, rows and forces) -> (those tuples, 
 
 @dataclass(frozen=True)
 class Linearization:
-    """ẋ = A x + B u about (t, q, q̇) in k independent coordinates (module docstring).
+    """ẋ = A x + B u about (t, q, q̇) in k independent coordinates and s independent
+    speeds (s = k without non-holonomic rows; module docstring).
 
-    ``A`` (2k × 2k) and ``B`` (2k × len(inputs)) act on the state x = [δq_ind; δq̇_ind];
-    ``basis`` (n × k) maps δq_ind to the model's δq; ``state_map`` (2n × 2k) maps x to
-    (δq, δq̇); ``state_names`` are the independent coordinates and their ``_dot``;
+    ``A`` ((k + s) × (k + s)) and ``B`` ((k + s) × len(inputs)) act on the state
+    x = [δq_ind; δv]; ``basis`` (n × k) maps δq_ind to the model's δq; ``state_map``
+    (2n × (k + s)) maps x to (δq, δq̇); ``state_names`` are the independent coordinates,
+    then the coordinates whose rates are the speeds with ``_dot``;
     ``input_names`` are the parameters B is taken for; ``qdd`` is q̈ at the state.
     """
 
@@ -100,17 +123,71 @@ class Linearization:
 
     @property
     def eigenvalues(self):
-        """The eigenvalues of A (rad/s), ordered by imaginary part then real part."""
-        values = np.linalg.eigvals(self.A) if self.A.size else np.zeros(0, complex)
+        """The eigenvalues of A (1/s), ordered by imaginary part then real part: those of the
+        diagonal blocks of A's block-triangular form (``blocks``), so the zeros of cyclic
+        coordinates and conserved speeds are exact and leave the others untouched (a
+        defective zero block taken whole spreads into ±√ε), and within each block the
+        directions A sends to zero (a cyclic direction mixed into the block, as a heading
+        with the absolute yaw of a steered part) are split off first
+        (``_deflated_eigenvalues``)."""
+        A = self._structural
+        values = [_deflated_eigenvalues(A[np.ix_(b, b)]) for b in self.blocks]
+        values = np.concatenate(values).astype(complex) if values else np.zeros(0, complex)
         return values[np.lexsort((values.real, values.imag))]
 
+    @property
+    def blocks(self):
+        """The state indices of the diagonal blocks of A's block-triangular form: the strongly
+        connected components of the graph i ← j where |A_ij| > STRUCTURAL_ZERO_RTOL times its
+        row's largest entry."""
+        links = self._structural != 0
+        if not links.size:
+            return []
+        count, label = scipy.sparse.csgraph.connected_components(scipy.sparse.csr_matrix(links), connection="strong")
+        return [np.flatnonzero(label == c) for c in range(count)]
 
-def linearize(system, t, q, qd, inputs=None):
+    @property
+    def cyclic(self):
+        """The states alone in their block with eigenvalue 0: cyclic coordinates (nothing
+        depends on them but other such states: the wheel angles, the position and heading on
+        the ground) and conserved speeds (their rate is zero: the forward speed)."""
+        A = self._structural
+        return tuple(self.state_names[b[0]] for b in self.blocks if b.size == 1 and A[b[0], b[0]] == 0)
+
+    @property
+    def _structural(self):
+        """A with the entries below STRUCTURAL_ZERO_RTOL times their row's largest set to 0."""
+        scale = np.abs(self.A).max(axis=1, keepdims=True, initial=0.0)
+        return np.where(np.abs(self.A) > STRUCTURAL_ZERO_RTOL * scale, self.A, 0.0)
+
+
+def _deflated_eigenvalues(A):
+    """The eigenvalues of the square A: zero for each direction of its null space (singular
+    values below STRUCTURAL_ZERO_RTOL times the largest), split off by the orthogonal change
+    of basis [Z W] (A Z = 0 makes it block-triangular), and again on WᵀAW until none is
+    left; then those of what remains. Exact zeros stay zero and a small eigenvalue near
+    them (a mode at its stability boundary) keeps its accuracy."""
+    zeros = 0
+    while A.size:
+        _, sv, Vt = np.linalg.svd(A)
+        null = sv <= STRUCTURAL_ZERO_RTOL * sv[0] if sv[0] > 0 else np.ones(sv.size, bool)
+        if not null.any():
+            break
+        W = Vt[~null].T
+        A = W.T @ A @ W
+        zeros += int(null.sum())
+    rest = np.linalg.eigvals(A) if A.size else np.zeros(0)
+    return np.concatenate([rest.astype(complex), np.zeros(zeros, complex)])
+
+
+def linearize(system, t, q, qd, inputs=None, speeds=None):
     """The ``Linearization`` of ``system``'s motion about (t, q, q̇) (module docstring).
 
     ``inputs``: parameter names B is taken for (they must enter only the forces Q + C);
     by default the robots' joint torques ``tau_*`` and the parameters named ``tau_*`` or
-    ``u_*``. Raises SolveError where no linearization on the manifold exists."""
+    ``u_*``. ``speeds``: with non-holonomic rows, the coordinates whose rates are the
+    independent speeds (by default picked by coordinate partitioning). Raises SolveError
+    where no linearization on the manifold exists."""
     q, qd = finite_state(system, q, qd)
     inputs = default_inputs(system) if inputs is None else tuple(inputs)
     _refuse_unsupported(system, t, q, qd)
@@ -127,12 +204,15 @@ def linearize(system, t, q, qd, inputs=None):
     N, pivots = tangent_basis(system, held.Phi_q, held.position_rows)
     _check_change_point(system, derivatives, t, q, qd, held, N)
     n, k = system.n, N.shape[1]
-    T = np.zeros((2 * n, 2 * k))
+    S, speeds = _speeds(system, held, N, pivots, speeds)
+    s = S.shape[1]
+    T = np.zeros((2 * n, k + s))
     T[:n, :k] = N
-    T[n:, k:] = N
-    dependent = np.setdiff1d(np.arange(n), pivots)
-    if held.Phi_q.size and dependent.size:
-        T[n + dependent, :k] = -np.linalg.lstsq(held.Phi_q[:, dependent], held.Psi_q @ N, rcond=None)[0]
+    T[n:, k:] = S
+    W, Psi_q = held.velocity_matrices
+    dependent = np.setdiff1d(np.arange(n), speeds)
+    if W.size and dependent.size:
+        T[n + dependent, :k] = -np.linalg.lstsq(W[:, dependent], Psi_q @ N, rcond=None)[0]
     R_q, R_qd, S_q, S_qd, F_p = derivatives.motion(system, t, q, qd, motion.qdd, motion.lam, inputs)
     m = arrays.A.shape[0]
     kkt = np.block([[arrays.M, -arrays.A.T], [arrays.A, np.zeros((m, m))]])
@@ -140,12 +220,34 @@ def linearize(system, t, q, qd, inputs=None):
                        np.vstack([F_p, np.zeros((m, len(inputs)))])])
     scale = np.abs(kkt).max(axis=1, keepdims=True)
     scale[scale == 0] = 1.0
-    dqdd = np.linalg.lstsq(kkt / scale, right / scale, rcond=None)[0][:n, :][pivots]
-    A = np.vstack([T[n:][pivots], dqdd[:, :2 * k]])
-    B = np.vstack([np.zeros((k, len(inputs))), dqdd[:, 2 * k:]])
-    names = [system.coordinates[i] for i in pivots]
-    return Linearization(A, B, N, T, tuple(names) + tuple(f"{c}_dot" for c in names), inputs, system.coordinates,
-                         float(t), q, qd, motion.qdd)
+    dqdd = np.linalg.lstsq(kkt / scale, right / scale, rcond=None)[0][:n, :][speeds]
+    A = np.vstack([T[n:][pivots], dqdd[:, :k + s]])
+    B = np.vstack([np.zeros((k, len(inputs))), dqdd[:, k + s:]])
+    names = tuple(system.coordinates[i] for i in pivots) + tuple(f"{system.coordinates[i]}_dot" for i in speeds)
+    return Linearization(A, B, N, T, names, inputs, system.coordinates, float(t), q, qd, motion.qdd)
+
+
+def _speeds(system, held, N, pivots, names):
+    """(S, speeds): the basis S (n × s) of the velocities every row allows at the state
+    (null of Φ_q and of the non-holonomic rows' A), the identity on the s independent
+    speeds at indices ``speeds``: the coordinates ``names`` when given, else those picked
+    by coordinate partitioning (``tangent_basis``). Without non-holonomic rows, (N, pivots)."""
+    W, _ = held.velocity_matrices
+    if names is None:
+        if not held.velocity_rows.any():
+            return N, pivots
+        return tangent_basis(system, W, held.position_rows | held.velocity_rows)
+    unknown = [c for c in names if c not in system.coordinates]
+    if unknown:
+        raise SolveError(f"model '{system.name}': unknown speed coordinate(s) {unknown}", coordinates=unknown)
+    S, _ = tangent_basis(system, W, held.position_rows | held.velocity_rows)
+    speeds = np.array(sorted(system.coordinates.index(c) for c in names), dtype=int)
+    if speeds.size != S.shape[1] or np.linalg.matrix_rank(S[speeds]) < S.shape[1]:
+        raise SolveError(f"model '{system.name}': speeds {list(names)} do not fix the velocities the rows allow "
+                         f"({S.shape[1]} independent speed(s) here, e.g. "
+                         f"{[system.coordinates[i] for i in tangent_basis(system, W)[1]]})",
+                         coordinates=list(names))
+    return S @ np.linalg.inv(S[speeds]), speeds
 
 
 def default_inputs(system):
@@ -199,12 +301,12 @@ def _refuse_unsupported(system, t, q, qd):
         raise SolveError(f"model '{system.name}': Coulomb friction at {friction} is not differentiable; "
                          "no linearization", constraints=friction)
     phi, psi = system.constraint_residuals(t, q, qd)
-    velocity_only = [name for name, x in zip(system.constraint_names, phi) if np.isnan(x)]
-    if velocity_only:
-        raise SolveError(f"model '{system.name}': rows {velocity_only} restrict velocities or accelerations only "
-                         "(non-holonomic or acceleration-level): the linearization covers holonomic rows "
-                         "(write a massless part's balance as a holonomic row, or use closure: auto)",
-                         constraints=velocity_only)
+    acceleration_only = [name for name, x, y in zip(system.constraint_names, phi, psi) if np.isnan(x) and np.isnan(y)]
+    if acceleration_only:
+        raise SolveError(f"model '{system.name}': rows {acceleration_only} restrict accelerations only (a balance "
+                         "with velocities, a servo's acceleration row): they are first-order equations of their own, "
+                         "outside the state (q, speeds) the linearization takes (write a massless part's balance as "
+                         "a holonomic row, or use closure: auto)", constraints=acceleration_only)
     moving = prescribed_motion(system, t, q, qd)
     if moving:
         why = "q̇ ≠ 0" if np.any(qd) else f"∂φ/∂t ≠ 0 at t = {t:g}"
@@ -286,11 +388,20 @@ def _named(names, weights):
 
 @dataclass(frozen=True)
 class HeldRows:
-    """The position-level rows at a state: which rows (mask), Φ_q and Ψ_q = ∂ψ/∂q."""
+    """The rows at a state: the position-level rows (mask), their Φ_q and Ψ_q = ∂ψ/∂q; the
+    velocity-level (non-holonomic) rows (mask), their A_v and their ∂ψ/∂q, Ψv_q."""
 
     position_rows: np.ndarray
     Phi_q: np.ndarray
     Psi_q: np.ndarray
+    velocity_rows: np.ndarray
+    A_v: np.ndarray
+    Psi_v_q: np.ndarray
+
+    @property
+    def velocity_matrices(self):
+        """(W, Ψ_W): every row that restricts velocities, [Φ_q; A_v], and its ∂ψ/∂q."""
+        return np.vstack([self.Phi_q, self.A_v]), np.vstack([self.Psi_q, self.Psi_v_q])
 
 
 NON_ANALYTIC = (sp.Abs, sp.sign, sp.atan2, sp.Piecewise, sp.Min, sp.Max, sp.floor, sp.ceiling, sp.Heaviside,
@@ -374,15 +485,15 @@ class Derivatives:
 
     def rows(self, system, t, q, qd):
         """``HeldRows`` at (t, q, q̇)."""
-        phi, _ = system.constraint_residuals(t, q, qd)
-        position = ~np.isnan(phi)
+        phi, psi = system.constraint_residuals(t, q, qd)
+        position, velocity = ~np.isnan(phi), np.isnan(phi) & ~np.isnan(psi)
         A = system.evaluate(t, q, qd).A
         Psi_q = np.zeros((len(phi), system.n))
         p = system.parameter_values
         for i, rows, f in self._rows:
             k = rows.stop - rows.start
             Psi_q[rows, i] = f.jacobians(t, q[i], qd[i], np.zeros(len(i)), np.zeros(k), p)[0][len(i) + k:]
-        return HeldRows(position, A[position], Psi_q[position])
+        return HeldRows(position, A[position], Psi_q[position], velocity, A[velocity], Psi_q[velocity])
 
     def motion(self, system, t, q, qd, qdd, lam, inputs):
         """(R_q, R_q̇, S_q, S_q̇, F_u): the derivatives of R = Mq̈ − Q − C − Aᵀλ and S = Aq̈ − b

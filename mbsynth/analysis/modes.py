@@ -41,7 +41,11 @@ class Mode:
 
 @dataclass(frozen=True)
 class Modes:
-    """The modes of ``system_name`` at (t, q), lowest frequency first, and the linearization."""
+    """The modes of ``system_name`` at (t, q) (moving at ``qd`` about a steady motion),
+    lowest frequency first, and the linearization; ``cyclic``: the states whose zero
+    eigenvalues are not modes (cyclic coordinates, conserved speeds); ``zeros``: how many
+    zero eigenvalues those and any others make (0 at a holonomic rest, whose zeros are
+    free modes)."""
 
     system_name: str
     coordinates: tuple
@@ -49,6 +53,9 @@ class Modes:
     q: np.ndarray
     modes: tuple
     linearization: object
+    qd: np.ndarray = None
+    cyclic: tuple = ()
+    zeros: int = 0
 
     @property
     def frequencies(self):
@@ -67,35 +74,80 @@ class Modes:
         return bool(np.all(values.real <= MODE_ZERO_RTOL * scale))
 
 
-def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL):
+def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, qd=None, steady=False):
     """The ``Modes`` of ``system`` at rest at ``q`` (default: the initial positions); with
-    ``equilibrium=True`` at the static equilibrium found from there (statics.py). Raises
-    NoEquilibrium when the model does not rest at q (q̈ ≠ 0 at q̇ = 0) or none is found,
+    ``equilibrium=True`` at the static equilibrium found from there (statics.py); with
+    ``steady=True`` about the steady motion (q, q̇) (default: the initial state; a bicycle
+    rolling upright, a disk rolling in a circle): its eigenvalues are the motion's stability
+    exponents, and its cyclic coordinates and conserved speeds (``Modes.cyclic``) give
+    exact zeros that are not listed as modes. Raises NoEquilibrium when the model does not
+    rest at q (q̈ ≠ 0 at q̇ = 0), or the motion is not steady, or no equilibrium is found;
     SolveError where the linearization is refused (linearization.py)."""
-    q = system.initial_state()[0] if q is None else np.array(q, dtype=float)
+    q0, qd0 = system.initial_state()
+    q = q0 if q is None else np.array(q, dtype=float)
     if equilibrium:
         q = find_equilibrium(system, q, t)
-    q, zero = finite_state(system, q, np.zeros(system.n))
-    moving = prescribed_motion(system, t, q, zero)
+    qd = (qd0 if qd is None else np.array(qd, dtype=float)) if steady else np.zeros(system.n)
+    q, qd = finite_state(system, q, qd)
+    moving = [] if steady else prescribed_motion(system, t, q, qd)
     if moving:
         raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration: rows {moving} prescribe a "
                             f"motion at t = {t:g} (∂φ/∂t ≠ 0); modes are taken at rest", constraints=moving)
-    lin = linearize(system, t, q, zero)
+    lin = linearize(system, t, q, qd)
+    _check_steady(system, lin, tolerance, steady)
     k = lin.k
-    worst = int(np.argmax(np.abs(lin.qdd))) if lin.qdd.size else 0
-    if lin.qdd.size and abs(lin.qdd[worst]) > tolerance * (1 + np.abs(lin.A[k:, :k]).max(initial=0.0)):
-        raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
-                         f"along {system.coordinates[worst]}): modes are taken at an equilibrium "
-                         "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
-    values, vectors = scipy.linalg.eig(lin.A) if k else (np.zeros(0, complex), np.zeros((0, 0), complex))
+    values = lin.eigenvalues
     scale = np.abs(values).max(initial=0.0)
     free = np.abs(values) <= MODE_ZERO_RTOL * scale
-    found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
-    for s, v in zip(values[~free], vectors.T[~free]):
+    found = []
+    if _holonomic_rest(lin):  # zeros in pairs: a free direction and its rate
+        found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
+    for s in values[~free]:
         if s.imag >= -MODE_ZERO_RTOL * scale:  # one of each conjugate pair
-            found.append(_mode(system, t, q, lin, s, v[:k], scale))
+            found.append(_mode(system, t, q, lin, s, _eigenvector(lin.A, s)[:k], scale))
     found.sort(key=lambda m: (m.frequency, m.eigenvalue.real))
-    return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin)
+    cyclic = () if _holonomic_rest(lin) else lin.cyclic
+    return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin, qd, cyclic,
+                 0 if _holonomic_rest(lin) else int(free.sum()))
+
+
+def _holonomic_rest(lin):
+    """Whether ``lin`` is about a rest with as many speeds as coordinates (no
+    non-holonomic rows): its free directions are double zeros, one mode each."""
+    return lin.A.shape[0] == 2 * lin.k and not np.any(lin.qd)
+
+
+def _check_steady(system, lin, tolerance, steady):
+    """NoEquilibrium unless the state is a rest (q̈ = 0) or, ``steady``, a steady motion:
+    the speeds do not change and no coordinate moves but the cyclic ones."""
+    k = lin.k
+    size = 1 + np.abs(lin.A[k:, :k]).max(initial=0.0)
+    speeds = [name[:-4] for name in lin.state_names[k:]]
+    index = {c: i for i, c in enumerate(system.coordinates)}
+    accelerations = np.array([lin.qdd[index[c]] for c in speeds])
+    if not steady:
+        worst = int(np.argmax(np.abs(lin.qdd))) if lin.qdd.size else 0
+        if lin.qdd.size and abs(lin.qdd[worst]) > tolerance * size:
+            raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
+                                f"along {system.coordinates[worst]}): modes are taken at an equilibrium "
+                                "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
+        return
+    rates = np.array([lin.qd[index[c]] for c in lin.state_names[:k]])
+    moving = [c for c, x in zip(lin.state_names[:k], rates) if c not in lin.cyclic
+              and abs(x) > tolerance * (1 + np.abs(lin.qd).max())]
+    changing = [c for c, x in zip(speeds, accelerations) if abs(x) > tolerance * size]
+    if moving or changing:
+        raise NoEquilibrium(f"model '{system.name}' does not move steadily here: "
+                            + "; ".join(([f"{moving} move but the dynamics depends on them"] if moving else [])
+                                        + ([f"the rates of {changing} change"] if changing else []))
+                            + " (a steady motion moves only cyclic coordinates, at constant speeds: a spin angle "
+                              "of a body with rotation: zxy, not a quaternion)", coordinates=moving + changing)
+
+
+def _eigenvector(A, s):
+    """A unit eigenvector of A for its eigenvalue s: the right singular vector of A − sI of
+    the smallest singular value."""
+    return np.linalg.svd(A - s * np.eye(A.shape[0]))[2][-1].conj()
 
 
 def _free_directions(lin, count):
@@ -156,16 +208,23 @@ def format_modes(result, digits=6):
     joint values, the coordinates) that move most, relative to the largest."""
     lin = result.linearization
     independent = ", ".join(lin.state_names[:lin.k]) or "none"
-    lines = [f"modes of {result.system_name} at t = {result.t:g}: {lin.k} degree(s) of freedom "
-             f"(independent coordinates: {independent})",
+    about = "about its steady motion" if np.any(lin.qd) else "at rest"
+    speeds = (f", {lin.A.shape[0] - lin.k} independent speed(s): {', '.join(lin.state_names[lin.k:])}"
+              if lin.A.shape[0] != 2 * lin.k or np.any(lin.qd) else "")
+    lines = [f"modes of {result.system_name} {about} at t = {result.t:g}: {lin.k} degree(s) of freedom "
+             f"(independent coordinates: {independent}{speeds})",
              f"{'#':>3}  {'frequency [Hz]':>15}  {'damping ratio':>13}  {'kind':<10}  {'eigenvalue [rad/s]':<26}"
              "  largest motion"]
     for i, mode in enumerate(result.modes, 1):
         s = mode.eigenvalue
         lines.append(f"{i:>3}  {mode.frequency:>15.{digits}g}  {mode.damping_ratio:>13.4g}  {mode.kind:<10}  "
                      f"{f'{s.real:.{digits}g}{s.imag:+.{digits}g}j':<26}  {_largest(result, mode)}")
+    if result.zeros:
+        named = f" (cyclic coordinates and conserved speeds: {', '.join(result.cyclic)})" if result.cyclic else ""
+        lines.append(f"zero eigenvalues: {result.zeros}{named}")
     if not result.stable:
-        lines.append("unstable: an eigenvalue has a positive real part (the equilibrium is not a rest one keeps)")
+        lines.append("unstable: an eigenvalue has a positive real part (the equilibrium is not a rest one keeps)"
+                     if not np.any(lin.qd) else "unstable: an eigenvalue has a positive real part")
     return "\n".join(lines)
 
 
@@ -194,6 +253,10 @@ def to_dict(result):
     lin = result.linearization
     out = {"model": result.system_name, "t": result.t, "q": dict(zip(result.coordinates, map(float, result.q))),
            "degrees_of_freedom": lin.k, "independent_coordinates": list(lin.state_names[:lin.k]),
+           "independent_speeds": list(lin.state_names[lin.k:]), "steady_motion": bool(np.any(lin.qd)),
+           "qd": dict(zip(result.coordinates, map(float, lin.qd))),
+           "eigenvalues": [[float(x.real), float(x.imag)] for x in lin.eigenvalues],
+           "zero_eigenvalues": result.zeros, "cyclic": list(result.cyclic),
            "stable": result.stable, "modes": []}
     for mode in result.modes:
         entry = {"eigenvalue": [mode.eigenvalue.real, mode.eigenvalue.imag], "frequency_hz": mode.frequency,

@@ -13,7 +13,7 @@ from .parsers import check_flags
 def run(args):
     check_flags(args, outputs=(("--html", (".html",)),))
     system = load(args.model)
-    result = modes(system, equilibrium=args.equilibrium)
+    result = modes(system, equilibrium=args.equilibrium, steady=args.steady)
     if args.html:
         write_html(system, result, args.html)
     if args.json:

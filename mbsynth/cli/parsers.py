@@ -31,7 +31,8 @@ VERDICTS = {  # what exit 1 means for each command (none: the command has no ver
     "view": "the simulation had to stop (the motion up to there is drawn)",
     "validate": "a relative error exceeds --tolerance, or no comparison is possible",
     "modes": "no rest state (the state is not at rest, q̈ ≠ 0 at q̇ = 0; with --equilibrium: no static "
-             "equilibrium is found, or the one found is not isolated; rows that prescribe a motion)",
+             "equilibrium is found, or the one found is not isolated; with --steady: the motion is not steady; "
+             "rows that prescribe a motion)",
     "robots": None,
 }
 
@@ -169,16 +170,21 @@ def _validate(commands):
 
 def _modes(commands):
     modes = commands.add_parser(
-        "modes", help="natural frequencies, damping ratios and mode shapes about a rest state",
-        description="Linearize the model about its initial state (or, with --equilibrium, the static "
-                    "equilibrium nearest it) in independent coordinates of its constraints' tangent "
-                    "space, massless parts closed by their balances, and print one row per mode: "
+        "modes", help="natural frequencies, damping ratios and mode shapes about a rest state or a steady motion",
+        description="Linearize the model about its initial configuration at rest (or, with --equilibrium, the "
+                    "static equilibrium nearest it; with --steady, about its initial motion, a steady one) in "
+                    "independent coordinates of its constraints' tangent space and independent speeds of its "
+                    "non-holonomic rows, massless parts closed by their balances, and print one row per mode: "
                     "frequency, damping ratio, kind (vibration, overdamped, unstable, free) and the "
                     "joints (or coordinates) that move most.")
     modes.add_argument("model", help="model file (YAML)")
     modes.add_argument("--equilibrium", action="store_true",
                        help="first find the rest the model comes to from its initial state, its motion "
                             "damped away (the stable equilibrium whose basin holds it)")
+    modes.add_argument("--steady", action="store_true",
+                       help="linearize about the model's initial motion, a steady one (a bicycle rolling upright, a "
+                            "disk rolling in a circle: only cyclic coordinates move, at constant rates): its "
+                            "eigenvalues are the motion's stability exponents")
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.add_argument("--html", metavar="FILE.html",
                        help="write an HTML page animating each mode in meshcat (a selector per mode)")

@@ -85,3 +85,32 @@ def matrix_quaternion(R):
     vals, vecs = np.linalg.eigh(K)
     u = vecs[:, -1]
     return u if u[0] >= 0 else -u
+
+
+def axis_rotation(axis, angle):
+    """The rotation by ``angle`` about the coordinate axis ``axis`` ("x", "y" or "z"), sympy."""
+    c, s = sp.cos(angle), sp.sin(angle)
+    return {"x": sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]]),
+            "y": sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "z": sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
+
+
+def euler_rotation(sequence, angles):
+    """R = R_a(α₁) R_b(α₂) R_c(α₃) of the intrinsic sequence ``sequence`` = "abc" (each turn
+    about the axis the previous ones carried along), sympy."""
+    R = sp.eye(3)
+    for axis, angle in zip(sequence, angles):
+        R = R * axis_rotation(axis, angle)
+    return R
+
+
+def euler_rate_matrix(sequence, angles):
+    """H(α): ω_body = H(α) α̇ for the intrinsic sequence ``sequence``: the column of α̇ᵢ is
+    the axis of turn i in the body's axes, R_c(α₃)ᵀ … R_{i+1}(α_{i+1})ᵀ eᵢ."""
+    columns = []
+    for i, axis in enumerate(sequence):
+        column = sp.Matrix([1 if a == axis else 0 for a in "xyz"])
+        for later, angle in zip(sequence[i + 1:], angles[i + 1:]):
+            column = axis_rotation(later, angle).T * column
+        columns.append(column)
+    return sp.Matrix.hstack(*columns)

@@ -42,6 +42,8 @@ COULOMB_LOAD_RTOL = 1e-12  # friction.py: Coulomb loads N have converged when th
 # ---- analysis (analysis/)
 PROJECTION_RTOL = 1e-12  # projection.py: largest residual accepted after projection, relative to the row's terms
 ON_MANIFOLD_RTOL = 1e-8  # linearization.py: largest φ, ψ residual accepted, relative to its row's terms
+STRUCTURAL_ZERO_RTOL = 1e-12  # linearization.py: an entry of A below this times its row's largest is zero
+# (a cyclic coordinate's column, a conserved speed's row): it splits A into blocks whose eigenvalues are taken apart
 CHANGE_POINT_RTOL = 1e-7  # linearization.py: a dependency's second derivative on the tangent space above
 # this (relative) marks a change point
 ACCELERATION_TOL = 1e-10  # statics.py: largest |q̈| (SI units) accepted at an equilibrium, relative to

@@ -15,7 +15,7 @@ from .joints import frame_reference
 from .parts import read_nonnegative
 from .schema import FORCE_SECTIONS
 
-TURNING = ("rigid_body", "planar_body")  # parts with an orientation a torque can act on
+TURNING = ("rigid_body", "euler_body", "planar_body")  # parts with an orientation a torque can act on
 
 
 def read_forces(builder):

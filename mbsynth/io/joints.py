@@ -12,7 +12,7 @@ from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
 
 # ground contacts (their keys: schema.py): the part kinds they may sit on
-CONTACT_TYPES = {"rolling_disk": ("rigid_body",), "knife_edge": ("rigid_body", "planar_body")}
+CONTACT_TYPES = {"rolling_disk": ("rigid_body", "euler_body"), "knife_edge": ("rigid_body", "euler_body", "planar_body")}
 
 
 def read_world(builder):

@@ -10,7 +10,8 @@ import numpy as np
 import sympy as sp
 
 from ..core.kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
-from ..model.parts import Frame, Particle, PlanarBody, RigidBody, Spring
+from ..model.parts import EulerBody, Frame, Particle, PlanarBody, RigidBody, Spring
+from ..model.parts.euler_body import SEQUENCES, angle_rates_of, angles_of, coordinates
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
 SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None, "line": None}
@@ -24,11 +25,20 @@ def read_rigid_body(builder, name, spec, path):
     builder.section(spec, path, "rigid_body")
     mass = read_mass(builder, spec, path)
     inertia = read_inertia(builder, spec["inertia"], path + ("inertia",))
-    q, qd = builder.part_symbols(name, RigidBody.COORDINATES)
+    sequence = spec.get("rotation", "quaternion")
+    if sequence != "quaternion" and sequence not in SEQUENCES:
+        builder.fail(path + ("rotation",), f"rotation {sequence!r}: quaternion or one of {', '.join(SEQUENCES)}")
+    euler = sequence != "quaternion"
+    q, qd = builder.part_symbols(name, coordinates(sequence) if euler else RigidBody.COORDINATES)
     frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=True)
-    initial = read_body_initial(builder, spec.get("initial"), path + ("initial",), planar=False)
+    initial = read_body_initial(builder, spec.get("initial"), path + ("initial",), planar=False,
+                                sequence=sequence if euler else None)
+    geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
+    if euler:
+        return EulerBody(name, sequence, q, qd, mass, inertia, builder.gravity, builder.param_symbols.values(),
+                         frames, geometry, initial)
     return RigidBody(name, q, qd, mass, inertia, builder.gravity, builder.param_symbols.values(), frames,
-                     read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
+                     geometry, initial)
 
 
 def read_particle(builder, name, spec, path):
@@ -155,9 +165,10 @@ def read_frames(builder, part, node, path, offsets, symbols=None):
     return frames
 
 
-def read_body_initial(builder, node, path, planar):
+def read_body_initial(builder, node, path, planar, sequence=None):
     """Coordinate values from ``position``, an orientation (``theta`` when planar),
-    ``velocity`` and ``angular_velocity`` (world axes)."""
+    ``velocity`` and ``angular_velocity`` (world axes); the angles of ``sequence`` and their
+    rates for a body with angles (euler_body.py), else its quaternion and its rates."""
     node = builder.section(node, path, "initial_planar_body" if planar else "initial_rigid_body")
     size = 2 if planar else 3
     names = ("x", "y", "z")[:size]
@@ -171,6 +182,21 @@ def read_body_initial(builder, node, path, planar):
             values["theta"] = builder.numbers([node["theta"]], path + ("theta",), 1)[0]
         if "angular_velocity" in node:
             values["theta_dot"] = builder.numbers([node["angular_velocity"]], path + ("angular_velocity",), 1)[0]
+        return values
+    if sequence is not None:
+        names = coordinates(sequence)[3:]
+        angles = np.zeros(3)
+        if any(k in node for k in ORIENTATION_KEYS):
+            angles = angles_of(sequence, read_rotation(builder, node, path))
+            values.update(zip(names, angles))
+        if "angular_velocity" in node:
+            omega = builder.numbers(node["angular_velocity"], path + ("angular_velocity",), 3)
+            rates = angle_rates_of(sequence, angles, omega)
+            if rates is None:
+                builder.fail(path + ("angular_velocity",), f"the angles {sequence} are at their singular position "
+                             f"here ({', '.join(f'{a:.6g}' for a in angles)} rad): no angle rates give this angular "
+                             "velocity; turn the body's axes, or choose another rotation sequence")
+            values.update(zip((c + "_dot" for c in names), rates))
         return values
     u = matrix_quaternion(read_rotation(builder, node, path))
     if any(k in node for k in ORIENTATION_KEYS):

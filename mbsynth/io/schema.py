@@ -134,11 +134,17 @@ SECTIONS = {section.name: section for section in (
                  "{theta: -c*theta_dot}", default="{}"),
              _FRAMES, _GEOMETRY, _DESCRIPTION)),
     Section("rigid_body", "``subsystems: {NAME: {type: rigid_body, ...}}``",
-            "A rigid body in space: coordinates x, y, z and the unit quaternion qw, qx, qy, qz.",
+            "A rigid body in space: coordinates x, y, z and the unit quaternion qw, qx, qy, qz; with "
+            "``rotation: zxy`` (or another intrinsic sequence) three angles instead, ``angle_z``, "
+            "``angle_x``, ``angle_y``, of turns about the body's axes in that order (``angle_z2`` for a "
+            "second turn about z, as in zxz); a wheel's spin axis last makes its spin angle cyclic, for "
+            "steady motions.",
             (_TYPE_KEY["rigid_body"], _MASS,
              _required("inertia", "list of 3, or 3 × 3 list, of " + _EXPRS,
                        "principal moments [Ixx, Iyy, Izz] or the inertia matrix about the centre of mass",
                        "[0.1, 0.1, 0.2]"),
+             Key("rotation", "string", "``quaternion``, or an intrinsic angle sequence: three different "
+                 "axes (xyz, xzy, yxz, yzx, zxy, zyx) or proper Euler (xyx, xzx, yxy, yzy, zxz, zyz)", "zxy", default="quaternion"),
              _FRAMES, _GEOMETRY,
              Key("initial", "mapping (section *initial_rigid_body*)", "initial pose and velocities",
                  "{position: [0, 0, 1]}", default="at rest at the origin"), _DESCRIPTION)),

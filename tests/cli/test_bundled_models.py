@@ -14,10 +14,11 @@ from mbsynth.cli import main
 MODELS = Path(__file__).resolve().parents[2] / "models"
 
 # what `mbsynth modes` answers, per model: "rests" (exit 0 at the initial state),
-# "equilibrium" (exit 0 with --equilibrium), or (flags, exit status, a phrase of the message)
+# "equilibrium" (exit 0 with --equilibrium), "steady" (exit 0 with --steady), or (flags, exit status, a phrase of the message)
 NOT_ISOLATED = "the equilibrium is not isolated"
 NOT_UNIQUE = "the motion is not unique"
-VELOCITY_ROWS = "restrict velocities or accelerations only"
+ACCELERATION_ROWS = "restrict accelerations only"
+NOT_STEADY = "does not move steadily"
 MODES = {
     "forces/spring_part_chain.yaml": "equilibrium",
     "forces/spring_pendulum.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the rod spins freely about itself
@@ -42,7 +43,7 @@ MODES = {
     "paper/example2_massless_particle.yaml": ([], 2, NOT_UNIQUE),
     "paper/example3_m1_zero.yaml": "equilibrium",
     "paper/example3_m1_zero_auto.yaml": "equilibrium",
-    "paper/example3_m2_zero.yaml": ([], 2, VELOCITY_ROWS),  # its balance is an acceleration-level row
+    "paper/example3_m2_zero.yaml": ([], 2, ACCELERATION_ROWS),  # its balance is an acceleration-level row
     "paper/example3_m2_zero_auto.yaml": "equilibrium",
     "paper/example3_two_masses.yaml": "equilibrium",
     "rigid/double_pendulum_3d.yaml": "equilibrium",
@@ -54,8 +55,10 @@ MODES = {
     "robots/two_arms_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the wrists turn the hanging bar
     "robots/ur5_holding_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),
     "robots/ur5_payload.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the vertical shoulder axis
-    "rolling/knife_edge.yaml": ([], 2, VELOCITY_ROWS),
-    "rolling/rolling_disk.yaml": ([], 2, VELOCITY_ROWS),
+    "rolling/bicycle.yaml": "steady",
+    "rolling/knife_edge.yaml": (["--steady"], 1, NOT_STEADY),  # its turning grows
+    "rolling/rolling_disk.yaml": (["--steady"], 1, NOT_STEADY),  # a quaternion: the spin is not cyclic
+    "rolling/turning_disk.yaml": "steady",
 }
 
 
@@ -78,11 +81,17 @@ def test_model_checks_simulates_and_gives_its_modes(capsys, name):
     assert code == 0 and err == "", err
     assert json.loads(out)["status"] == "completed"
     expected = MODES[name]
-    if expected in ("rests", "equilibrium"):
-        code, out, err = run(capsys, "modes", path, "--json", *(["--equilibrium"] if expected == "equilibrium" else []))
+    if expected in ("rests", "equilibrium", "steady"):
+        flag = {"rests": [], "equilibrium": ["--equilibrium"], "steady": ["--steady"]}[expected]
+        code, out, err = run(capsys, "modes", path, "--json", *flag)
         assert code == 0 and err == "", err
         result = json.loads(out)
-        assert result["modes"] and len(result["modes"]) >= result["degrees_of_freedom"] / 2
+        if expected == "steady":  # each eigenvalue is a mode's (two for a complex pair) or a zero of a cyclic direction
+            assert result["steady_motion"] and result["modes"]
+            assert len(result["eigenvalues"]) == result["zero_eigenvalues"] + sum(
+                2 if m["eigenvalue"][1] else 1 for m in result["modes"])
+        else:
+            assert result["modes"] and len(result["modes"]) >= result["degrees_of_freedom"] / 2
     else:
         flags, status, phrase = expected
         code, out, err = run(capsys, "modes", path, *flags)

@@ -1,0 +1,105 @@
+"""A rigid body in 6 coordinates: its centre of mass r in the world and three angles of
+an intrinsic sequence (``rotation: zxy`` in a model file; Tait–Bryan with three different
+axes, or proper Euler such as zxz).
+
+The choice for bodies that spin: with the spin axis last in the sequence, the spin angle
+is a coordinate that nothing in an axisymmetric body's M and Q, nor in a joint or a
+rolling contact on its axis, depends on (it is cyclic), so a steady motion is a state
+whose other coordinates stay still (analysis/linearization.py). The price: the angles
+are singular where H below loses rank: the middle turn at ±90° (Tait–Bryan) or at 0 and
+180° (proper Euler: zxz for a disk whose axis is its z axis, singular only when it lies
+flat)."""
+
+import functools
+import warnings
+
+import numpy as np
+import sympy as sp
+from scipy.spatial.transform import Rotation
+
+from ...core.kinematics import euler_rate_matrix, euler_rotation
+from ...symbolic.cache import placeholder, remembered
+from .base import Part
+
+SEQUENCES = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx",  # Tait–Bryan: three different axes
+             "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")  # proper Euler: the first axis again last
+
+
+class EulerBody(Part):
+    """M = blockdiag(m I₃, HᵀJH), Q = [m g;  −Hᵀ(J Ḣ α̇ + ω × J ω)] with ω = H(α) α̇ the
+    body-axes angular velocity (``euler_rate_matrix``): Euler's equations J ω̇ + ω × Jω = τ
+    premultiplied by Hᵀ, as virtual turns are H δα. M is regular away from the angles'
+    singular position; the body adds no constraint of its own."""
+
+    kind = "euler_body"
+    groups = (("x", "y", "z"),)
+
+    def __init__(self, name, sequence, q, qd, mass, inertia, gravity, params, frames=(), geometry=(),
+                 initial=None):
+        if sequence not in SEQUENCES:
+            raise ValueError(f"rotation sequence {sequence!r}: one of {', '.join(SEQUENCES)}")
+        self.sequence = sequence
+        slots, placeholders, (M, Q, T, V) = _template(sequence)
+        J = sp.Matrix(inertia)
+        self.mass, self.inertia, self.gravity = mass, J, sp.Matrix(gravity)
+        constants = list(zip(placeholders, [mass, *J, *self.gravity]))
+        super().__init__(name, coordinates(sequence), q, qd, M, Q, T, V, params, frames, geometry, initial,
+                         shared=(*slots, constants))
+
+    def pose(self, frame):
+        R = euler_rotation(self.sequence, self.q[3:])
+        return sp.Matrix(self.q[:3]) + R * frame.position, R * frame.rotation
+
+    def angular_velocity(self):
+        return euler_rotation(self.sequence, self.q[3:]) * euler_rate_matrix(self.sequence, self.q[3:]) \
+            * sp.Matrix(self.qd[3:])
+
+
+def coordinates(sequence):
+    """The coordinate names: x, y, z and ``angle_<axis>`` for each turn of ``sequence``
+    (``angle_<axis>2`` for the second turn about the same axis)."""
+    return ("x", "y", "z", *(f"angle_{axis}{'2' if axis in sequence[:i] else ''}" for i, axis in enumerate(sequence)))
+
+
+def angles_of(sequence, R):
+    """The angles of ``sequence`` whose rotation is the numeric matrix R (the middle turn in
+    [−90°, 90°] for Tait–Bryan, [0, 180°] for proper Euler; at the singular position the
+    last angle is 0)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # scipy's "gimbal lock": the last angle is set to 0
+        return Rotation.from_matrix(np.asarray(R, dtype=float)).as_euler(sequence.upper())
+
+
+def angle_rates_of(sequence, angles, omega_world):
+    """α̇ of the world angular velocity ``omega_world`` at ``angles``: H(α)⁻¹ Rᵀ ω; None at
+    the angles' singular position (H singular: not every ω has angle rates)."""
+    a = sp.symbols("a0:3")
+    values = dict(zip(a, angles))
+    R = np.array(euler_rotation(sequence, a).subs(values), dtype=float)
+    H = np.array(euler_rate_matrix(sequence, a).subs(values), dtype=float)
+    if np.linalg.svd(H, compute_uv=False)[-1] < 1e-9:
+        return None
+    return np.linalg.solve(H, R.T @ np.asarray(omega_world, dtype=float))
+
+
+@functools.lru_cache(maxsize=len(SEQUENCES))
+def _template(sequence):
+    """(coordinate slots, placeholders (m, J row by row, g), (M, Q, T, V)) of a body whose
+    angles follow ``sequence``, derived once (base.Part's ``shared``)."""
+    return remembered("euler-body", (sequence,), lambda: _derive_template(sequence))
+
+
+def _derive_template(sequence):
+    names = coordinates(sequence)
+    q, qd = [placeholder(f"euler_{c}") for c in names], [placeholder(f"euler_{c}_dot") for c in names]
+    mass, gravity = placeholder("euler_m"), sp.Matrix([placeholder(f"euler_g{i}") for i in range(3)])
+    J = sp.Matrix(3, 3, [placeholder(f"euler_J{i}") for i in range(9)])
+    r, alpha, rd, alpha_d = sp.Matrix(q[:3]), q[3:], sp.Matrix(qd[:3]), sp.Matrix(qd[3:])
+    H = euler_rate_matrix(sequence, alpha)
+    H_dot = sum((H.diff(a) * ad for a, ad in zip(alpha, alpha_d)), sp.zeros(3, 3))
+    omega = H * alpha_d
+    M = sp.diag(mass * sp.eye(3), H.T * J * H)
+    Q = sp.Matrix.vstack(mass * gravity, -H.T * (J * H_dot * alpha_d + omega.cross(J * omega)))
+    T = mass * (rd.T * rd)[0] / 2 + (omega.T * J * omega)[0] / 2
+    V = -mass * (gravity.T * r)[0]
+    return (list(q), list(qd)), [mass, *J, *gravity], (M, Q, T, V)

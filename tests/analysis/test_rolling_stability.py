@@ -1,0 +1,201 @@
+"""Linearization with non-holonomic rows about steady motions (analysis/linearization.py):
+the stability exponents of rolling disks, a sleigh on a massless blade and the Whipple
+bicycle, against closed forms, an independent derivation by Kane's method (sympy), and
+the bicycle benchmark's published eigenvalues and self-stable speeds."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+from scipy.optimize import brentq
+
+import mbsynth as mb
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
+
+# J. P. Meijaard, J. M. Papadopoulos, A. Ruina, A. L. Schwab, Proc. R. Soc. A 463 (2007)
+# 1955-1982, Table 2: the benchmark bicycle's eigenvalues (1/s) at 4, 5 and 10 m/s, and its
+# weave and capsize speeds (m/s), printed to 14 decimals.
+TABLE_2 = {4.0: [-12.15861426576450, -1.42944427361326, 0.41325331521125 - 3.07910818603206j,
+                 0.41325331521125 + 3.07910818603206j],
+           5.0: [-14.07838969279822, -0.32286642900409, -0.77534188219585 - 4.46486771378823j,
+                 -0.77534188219585 + 4.46486771378823j],
+           10.0: [-24.62459635017404, 0.16105338653172, -3.72016840437287 - 10.90681139476287j,
+                  -3.72016840437287 + 10.90681139476287j]}
+WEAVE_SPEED, CAPSIZE_SPEED = 4.29238253634111, 6.02426201538837
+STILL = [-5.53094371765393, -3.13164324790656, 3.13164324790656, 5.53094371765393]  # Table 2 at v = 0
+
+
+def _nonzero(values):
+    return np.sort_complex(values[values != 0])
+
+
+@pytest.fixture(scope="module")
+def bicycle():
+    return mb.load(MODELS / "rolling" / "bicycle.yaml")
+
+
+def _bicycle_at(bicycle, v):
+    moving = bicycle.with_parameters(v=v)
+    return mb.linearize(moving, 0.0, *moving.initial_state())
+
+
+@pytest.mark.parametrize("v", sorted(TABLE_2))
+def test_bicycle_eigenvalues_equal_table_2(bicycle, v):
+    lin = _bicycle_at(bicycle, v)
+    assert lin.k == 7 and lin.A.shape == (10, 10)  # x, y, heading, lean, steer, two wheel angles; 3 speeds
+    got = _nonzero(lin.eigenvalues)
+    assert np.abs(got - np.sort_complex(TABLE_2[v])).max() < 1e-8
+    assert np.count_nonzero(lin.eigenvalues == 0) == 6  # position, heading, wheel angles, forward speed
+
+
+def test_bicycle_standing_still_is_two_inverted_pendulums(bicycle):
+    lin = mb.linearize(bicycle, 0.0, bicycle.initial_q, np.zeros(bicycle.n))
+    assert np.abs(_nonzero(lin.eigenvalues) - np.array(STILL)).max() < 1e-8
+
+
+def test_bicycle_self_stable_speeds(bicycle):
+    """The weave speed (the weave pair crosses the imaginary axis) and the capsize speed
+    (the capsize eigenvalue crosses zero), found from mb.linearize by root finding."""
+    def least_stable(v):
+        return _nonzero(_bicycle_at(bicycle, v).eigenvalues).real.max()
+
+    assert least_stable(5.0) < 0 < least_stable(4.0) and 0 < least_stable(7.0)
+    assert abs(brentq(least_stable, 4.0, 5.0, xtol=1e-12) - WEAVE_SPEED) < 1e-7
+    assert abs(brentq(least_stable, 5.5, 7.0, xtol=1e-12) - CAPSIZE_SPEED) < 1e-7
+
+
+def test_bicycle_modes_cli_reports_the_steady_motion(capsys):
+    from mbsynth.cli import main
+    import json
+    assert main(["modes", str(MODELS / "rolling" / "bicycle.yaml"), "--steady", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["steady_motion"] and result["zero_eigenvalues"] == 6
+    values = np.array([complex(*x) for x in result["eigenvalues"]])
+    assert np.abs(_nonzero(values) - np.sort_complex(TABLE_2[5.0])).max() < 1e-8
+    assert result["stable"]
+
+
+UPRIGHT_DISK = """
+name: upright_disk
+parameters: {m: 1.0, R: 0.1, g: 9.81, A: m*R**2/4, C: m*R**2/2, w: 12.0}
+gravity: [0, 0, -g]
+subsystems:
+  disk:
+    type: rigid_body
+    rotation: zxz
+    mass: m
+    inertia: [A, A, C]
+initial: {disk.z: R, disk.angle_x: -pi/2, disk.x_dot: R*w, disk.angle_z2_dot: w}
+joints:
+  - {name: contact, type: rolling_disk, child: disk, radius: R}
+"""
+
+
+@pytest.mark.parametrize("w", [6.0, 12.0, 30.0])
+def test_upright_rolling_disk_closed_form(w):
+    """A disk rolling straight and upright at spin rate w: (A + mR²) φ̈ + (C(C + mR²)w²/A − mgR) φ = 0
+    for the lean φ; stable iff w² > mgRA/(C(C + mR²)) (g/3R for a uniform disk)."""
+    disk = mb.loads(UPRIGHT_DISK).with_parameters(w=w)
+    lin = mb.linearize(disk, 0.0, *disk.initial_state())
+    m, R, g = 1.0, 0.1, 9.81
+    A, C = m * R**2 / 4, m * R**2 / 2
+    s2 = -(C * (C + m * R**2) * w**2 / A - m * g * R) / (A + m * R**2)
+    expected = np.sort_complex(np.array([-1, 1]) * np.sqrt(complex(s2)))
+    assert np.abs(_nonzero(lin.eigenvalues) - expected).max() < 1e-9 * abs(expected[0])
+    assert set(lin.cyclic) >= {"disk.x", "disk.y", "disk.angle_z", "disk.angle_z2"}
+    assert (w**2 > g / (3 * R)) == bool(np.all(lin.eigenvalues.real <= 1e-9))
+
+
+def _kane_disk():
+    """The rolling disk by Kane's method (sympy.physics.mechanics): yaw q1, lean q2 (of the
+    disk's plane from the vertical), spin q3; body rates u1 (lean rate), u2 (along the
+    axis), u3; rolling built into the velocity of the centre. Returns the reduced vector
+    field f(θ, u1, u2, u3) and its Jacobian, with symbols (θ, a2, a3) for (q2, u2, u3) at u1 = 0."""
+    from sympy.physics.mechanics import KanesMethod, Point, ReferenceFrame, RigidBody, dot, dynamicsymbols, inertia
+    q1, q2, q3 = dynamicsymbols("q1 q2 q3")
+    u1, u2, u3 = dynamicsymbols("u1 u2 u3")
+    r, m, g = 0.1, 1.0, 9.81
+    N = ReferenceFrame("N")
+    Y = N.orientnew("Y", "Axis", [q1, N.z])
+    L = Y.orientnew("L", "Axis", [q2, Y.x])
+    D = L.orientnew("D", "Axis", [q3, L.y])
+    w = D.ang_vel_in(N)
+    D.set_ang_vel(N, u1 * L.x + u2 * L.y + u3 * L.z)
+    contact = Point("contact")
+    contact.set_vel(N, 0)
+    centre = contact.locatenew("centre", r * L.z)
+    centre.v2pt_theory(contact, N, D)
+    method = KanesMethod(N, q_ind=[q1, q2, q3], u_ind=[u1, u2, u3], kd_eqs=[dot(D.ang_vel_in(N) - w, e) for e in L])
+    method.kanes_equations([RigidBody("disk", centre, D, m, (inertia(L, m * r**2 / 4, m * r**2 / 2, m * r**2 / 4),
+                                                                 centre))], [(centre, -m * g * Y.z)])
+    rates = method.kindiffdict()
+    state = [q2, u1, u2, u3]
+    f = sp.Matrix([rates[q2.diff()], *method.mass_matrix.LUsolve(method.forcing)]).subs(rates)
+    theta, a2, a3 = sp.symbols("theta a2 a3")
+    held = {q2: theta, u1: 0, u2: a2, u3: a3}
+    return f.xreplace(held), f.jacobian(state).xreplace(held), (theta, a2, a3)
+
+
+@pytest.mark.parametrize("omega", [2.0, 5.0])
+def test_turning_disk_against_kanes_method(omega):
+    """A disk rolling in a steady circle (models/rolling/turning_disk.yaml, lean 0.3 rad,
+    heading rate Ω): its exponents are those of Kane's reduced equations linearized at the
+    same steady motion, where the characteristic polynomial is s²(s² + K) and the closed
+    form K(θ, Ω) > 0 is the condition of stability (a lean oscillation); K < 0 at Ω = 5."""
+    f, J, (theta, a2, a3) = _kane_disk()
+    turn = omega * np.cos(0.3)  # u3: the heading rate's component normal to the axis, in the disk's plane
+    along = float(sp.solve(f[1].subs({theta: 0.3, a3: turn}), a2)[0])  # the steady condition
+    jacobian = np.array(J.subs({theta: 0.3, a2: along, a3: turn}), dtype=float)
+    s = sp.Symbol("s")
+    K = sp.Poly(sp.Matrix(jacobian).charpoly(s).as_expr(), s).all_coeffs()[2]
+    disk = mb.load(MODELS / "rolling" / "turning_disk.yaml").with_parameters(Omega=omega)
+    q, qd = disk.initial_state()
+    lin = mb.linearize(disk, 0.0, q, qd)
+    got = _nonzero(lin.eigenvalues)
+    expected = np.sort_complex(np.linalg.eigvals(jacobian)[np.abs(np.linalg.eigvals(jacobian)) > 1e-9])
+    assert got.size == 2 and np.abs(got - expected).max() < 1e-9 * np.abs(expected).max()
+    assert (float(K) > 0) == bool(np.all(np.abs(got.real) < 1e-9)) == (omega == 2.0)
+    assert abs(abs(disk.parameters["w_axis"]) - abs(along)) < 1e-12 * abs(along)
+
+
+SLEIGH = """
+name: sleigh_on_a_massless_blade
+parameters: {m: 1.0, I: 0.02, a: 0.2, u0: 1.0}
+subsystems:
+  carrier: {type: planar_body, mass: 0, inertia: 0, frames: {weld: {position: [-a, 0, 0]}}}
+  sleigh: {type: planar_body, mass: m, inertia: I, frames: {weld: {position: [0, 0, 0]}}}
+initial: {carrier.x: a, carrier.x_dot: u0, sleigh.x_dot: u0}
+joints:
+  - {name: weld, type: fixed, parent: sleigh.weld, child: carrier.weld}
+  - {name: blade, type: knife_edge, child: carrier}
+"""
+
+
+@pytest.mark.parametrize("u0", [1.0, -0.5])
+def test_sleigh_on_a_massless_blade(u0):
+    """The Chaplygin sleigh with its blade on a massless part welded a ahead of the centre of
+    mass, running straight at u: ω̇ = m a u ω/(I + m a²), so one exponent m a u/(I + m a²)
+    (unstable forward, stable backward) and zeros for the position, heading and speed."""
+    sleigh = mb.loads(SLEIGH).with_parameters(u0=u0)
+    lin = mb.linearize(sleigh, 0.0, *sleigh.initial_state())
+    m, I, a = 1.0, 0.02, 0.2
+    assert np.allclose(_nonzero(lin.eigenvalues), [m * a * u0 / (I + m * a**2)], rtol=1e-12, atol=0)
+    assert lin.eigenvalues.size == 5 and np.count_nonzero(lin.eigenvalues == 0) == 4
+
+
+def test_acceleration_rows_are_still_refused():
+    with pytest.raises(mb.SolveError, match="restrict accelerations only"):
+        system = mb.load(MODELS / "paper" / "example3_m2_zero.yaml")
+        mb.linearize(system, 0.0, *system.initial_state())
+
+
+def test_speeds_can_be_chosen_and_are_checked(bicycle):
+    v = 5.0
+    moving = bicycle.with_parameters(v=v)
+    chosen = mb.linearize(moving, 0.0, *moving.initial_state(),
+                          speeds=["rear_frame.x", "rear_frame.angle_x", "front_frame.angle_z"])
+    assert np.abs(_nonzero(chosen.eigenvalues) - np.sort_complex(TABLE_2[v])).max() < 1e-8
+    with pytest.raises(mb.SolveError, match="do not fix the velocities"):
+        mb.linearize(moving, 0.0, *moving.initial_state(), speeds=["rear_frame.x", "rear_wheel.x", "front_wheel.x"])
