@@ -31,8 +31,8 @@ first moment of mass about the frame's origin (Γ_t: unit translations of every 
 Mapping ν to a part's coordinates (a quaternion's rates, ω = 2E(u)u̇) is the part's.
 
 With Craig–Bampton's constraint modes, Φ holds the rigid-body motion too: a part pins
-the frame to it (reference conditions, e.g. an interface node's six DOFs held at the
-frame), or takes free-interface modes without rigid-body ones.
+the frame to it (reference conditions: ``Reduction.hold(node)``, an interface node held at
+the frame), or takes free-interface modes without rigid-body ones.
 """
 
 from dataclasses import dataclass

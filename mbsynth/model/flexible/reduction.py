@@ -6,19 +6,21 @@ DOFs), with reduced matrices Tᵀ M T and Tᵀ K T.
   displacements and rotations; p the amplitudes of the fixed-interface normal modes
   (u_b = 0). T = [Ψ Φ]: the constraint modes Ψ (u_b = I, the rest at static equilibrium,
   −K_ii⁻¹ K_ib) and the modes Φ (M-orthonormal, K_ii Φ = M_ii Φ Ω²). A static load at
-  the interface is reproduced exactly, whatever the number of modes.
+  the interface is reproduced exactly, whatever the number of modes. ``hold(node)`` removes
+  an interface node's columns: that node then moves with a floating frame.
 - ``free_interface(fe, interface, ...)``: η = amplitudes of the lowest normal modes of the
   whole unconstrained model (rigid-body modes kept unless ``rigid=False``); the interface
   nodes' DOFs are rows of T.
 
 Modes are chosen by ``count`` or ``max_frequency`` (Hz, every mode up to it). ``normal_modes``
 solves K φ = ω² M φ in shift-invert form about a negative shift (so rigid-body modes, K
-singular, are found too), by scipy's ``eigsh`` or, for small models, a dense solver; M may be
-singular (lumped: rotations without mass), its infinite eigenvalues are never returned. The Ritz vectors are refined by the
-projected problem, so returned modes are M-orthonormal to rounding.
+singular, are found too), by scipy's ``eigsh`` or, for small models, a dense solver; M may
+be singular (lumped: rotations without mass), its infinite eigenvalues are never returned.
+The Ritz vectors are refined by the projected problem: the modes are M-orthonormal to
+rounding.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg
@@ -40,7 +42,8 @@ class Reduction:
     """A reduced FE model: u = ``basis`` @ η (n × r), ``mass`` and ``stiffness`` (r × r);
     ``interface`` (FE node indices), ``modes`` (the columns of η that are modal
     amplitudes, a slice), ``frequencies`` (their normal modes' ω, rad/s: fixed-interface for
-    Craig–Bampton, free for free-interface), ``method`` and the ``fe`` model it reduces."""
+    Craig–Bampton, free for free-interface), ``method``, the ``fe`` model it reduces and the
+    interface nodes ``held`` at zero (``hold``)."""
 
     fe: FEModel
     method: str
@@ -50,6 +53,7 @@ class Reduction:
     stiffness: np.ndarray
     modes: slice
     frequencies: np.ndarray
+    held: tuple = ()
 
     @property
     def size(self):
@@ -61,12 +65,24 @@ class Reduction:
 
     def interface_columns(self, node):
         """Craig–Bampton: the columns of η that are ``node``'s DOFs themselves."""
-        if self.method != "craig_bampton" or node not in self.interface:
-            raise ModelError(f"{self.fe.source}: node {node} has no coordinates of its own in this "
-                             f"{self.method} reduction (interface nodes: {list(self.interface)})")
+        if self.method != "craig_bampton" or node not in self.interface or node in self.held:
+            why = "is held (it moves with the frame)" if node in self.held else "has no coordinates of its own"
+            raise ModelError(f"{self.fe.source}: node {node} {why} in this {self.method} reduction "
+                             f"(interface nodes: {list(self.interface)}, held: {list(self.held)})")
         d = self.fe.dofs_per_node
-        k = self.interface.index(node)
+        k = [j for j in self.interface if j not in self.held].index(node)
         return np.arange(k * d, (k + 1) * d)
+
+    def hold(self, node):
+        """This Craig–Bampton reduction with the interface ``node``'s DOFs held at zero (their
+        columns removed): the node moves with a floating frame, the reference condition that
+        leaves the frame the only rigid-body motion (invariants.py)."""
+        columns = self.interface_columns(node)
+        keep = np.setdiff1d(np.arange(self.size), columns)
+        shift = len(columns)
+        return replace(self, basis=self.basis[:, keep], mass=self.mass[np.ix_(keep, keep)],
+                       stiffness=self.stiffness[np.ix_(keep, keep)], held=self.held + (node,),
+                       modes=slice(self.modes.start - shift, self.modes.stop - shift))
 
 
 def craig_bampton(fe, interface, *, count=None, max_frequency=None, shift=None):

@@ -176,3 +176,18 @@ def test_a_free_flexible_body_conserves_energy_and_momentum():
     assert abs(np.abs(run.y[12:16, -1]).max()) > 1e-4  # it did vibrate
     np.testing.assert_allclose(end[0], start[0], rtol=1e-8)
     np.testing.assert_allclose(end[1:], start[1:], rtol=1e-8, atol=1e-8 * np.abs(start[1:]).max())
+
+
+def test_holding_an_interface_node_leaves_the_frame_the_only_rigid_motion(model):
+    """Craig–Bampton's constraint modes can move the beam rigidly, as the frame does: M(0)
+    has six null directions (rounding: 1e-12 of its largest eigenvalue); with the root held
+    at the frame (``hold``) M(η) is positive definite."""
+    _, loose = model
+    reduction = craig_bampton(strip(8, Iz=2e-9), [0, 8], count=3).hold(0)
+    held = invariants(reduction)
+    assert held.modes == loose.modes - 6 == reduction.size
+    eta = 1e-2 * np.random.default_rng(7).normal(size=loose.modes)
+    spectrum = np.linalg.eigvalsh(loose.mass(0 * eta))
+    assert np.all(np.abs(spectrum[:6]) < 1e-12 * spectrum[-1]) and spectrum[6] > 1e-9 * spectrum[-1]
+    spectrum = np.linalg.eigvalsh(held.mass(eta[6:]))
+    assert spectrum[0] > 1e-9 * spectrum[-1]
