@@ -97,7 +97,8 @@ def read_contact(builder, spec, path, names):
     name = _joint_name(builder, spec, path, names)
     part, frame = frame_reference(builder, spec["child"], path + ("child",))
     if part is None or part.kind not in hosts:
-        builder.fail(path + ("child",), f"a {kind} is a frame on a {' or '.join(hosts)}, not on "
+        named = dict.fromkeys("rigid_body" if h == "euler_body" else h for h in hosts)  # a model file's types
+        builder.fail(path + ("child",), f"a {kind} is a frame on a {' or '.join(named)}, not on "
                                         f"{'the world' if part is None else 'a ' + part.kind}")
     args = (builder.q, builder.qd, builder.param_symbols.values())
     if kind == "knife_edge":
