@@ -10,7 +10,8 @@ Iy + Iz. Each bending plane uses the interdependent interpolation of Friedman & 
 Euler–Bernoulli's cubic Hermite for Φ = 0), its element matrices integrated exactly by
 Gauss quadrature. Euler–Bernoulli mass has no rotary inertia of bending (the classical
 theory's), Timoshenko's has ρI. ``mass="lumped"``: ρAL/2 on each translation of each
-element end and nothing on rotations, so M is singular.
+element end and nothing on rotations, so M is singular. ``geometric_stiffness`` gives the
+same beam's K_G under axial forces (buckling, stiffening by tension).
 """
 
 import numpy as np
@@ -51,23 +52,43 @@ def beam(length, elements, *, area, Iy, Iz, J, E, density, G=None, nu=None, shea
     frame = _section_axes(axis, up, where)
     h = length / elements
     local_K, local_M = _element(h, area, Iy, Iz, J, E, G, density, shear_factor, theory, mass)
-    T = np.kron(np.eye(4), frame)  # local components = T @ global components
-    Ke, Me = T.T @ local_K @ T, T.T @ local_M @ T
-    rows, cols, k_values, m_values = [], [], [], []
-    for e in range(elements):
-        dofs = np.arange(6 * e, 6 * e + 12)
-        rows.append(np.repeat(dofs, 12))
-        cols.append(np.tile(dofs, 12))
-        k_values.append(Ke.ravel())
-        m_values.append(Me.ravel())
-    n = 6 * (elements + 1)
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    K = scipy.sparse.coo_array((np.concatenate(k_values), (rows, cols)), shape=(n, n)).tocsr()
-    M = scipy.sparse.coo_array((np.concatenate(m_values), (rows, cols)), shape=(n, n)).tocsr()
-    K, M = (K + K.T) / 2, (M + M.T) / 2  # rounding of the rotation products
+    K, M = _assemble(local_K, frame, np.ones(elements)), _assemble(local_M, frame, np.ones(elements))
     nodes = np.asarray(start, float) + np.outer(np.linspace(0.0, length, elements + 1), frame[0])
     label = f"beam ({theory}, {mass} mass, {elements} elements)"
     return fe_model(M, K, nodes, dofs_per_node=6, where=dict(mass=label, stiffness=label, nodes=label))
+
+
+def geometric_stiffness(length, elements, force, *, axis=(1.0, 0.0, 0.0)):
+    """K_G of the beam of ``beam(length, elements, axis=axis, ...)`` under the axial force
+    ``force`` (tension > 0; a number, or one per element): ∫ N (v'² + w'²) dx with the cubic
+    deflection line's slopes, the classical consistent geometric stiffness (used for
+    Timoshenko beams too). K + K_G is the stiffness about a state under that force: its
+    buckling (K + λK_G singular) and its stiffening (spinning beams' centrifugal tension)."""
+    where = "beam geometric stiffness"
+    forces = np.broadcast_to(np.asarray(force, float), (elements,)) if np.ndim(force) == 0 else np.asarray(force, float)
+    if forces.shape != (elements,) or not np.isfinite(forces).all():
+        raise ModelError(f"{where}: force must be a finite number or {elements} of them (one per element), "
+                         f"got shape {forces.shape}")
+    frame = _section_axes(axis, np.eye(3)[np.argmin(np.abs(axis))], where)  # any section axes: K_G is round
+    unit = np.zeros((12, 12))
+    slope = _bending(length / elements, 0.0, 0.0, 0.0, 1.0)[1]  # ∫ w'ᵀ w' dx: the rotary term with ρI = 1, Φ = 0
+    for dofs, sign in (([1, 5, 7, 11], 1.0), ([2, 4, 8, 10], -1.0)):
+        S = np.diag([1.0, sign, 1.0, sign])
+        unit[np.ix_(dofs, dofs)] = S @ slope @ S
+    return _assemble(unit, frame, forces)
+
+
+def _assemble(local, frame, scales):
+    """The sparse sum over elements e of scales[e] × ``local`` (12 × 12, section axes) turned
+    to world axes, element e joining nodes e and e + 1."""
+    T = np.kron(np.eye(4), frame)  # local components = T @ global components
+    block = T.T @ local @ T
+    elements = len(scales)
+    dofs = 6 * np.arange(elements)[:, None] + np.arange(12)
+    rows, cols = np.repeat(dofs, 12, axis=1).ravel(), np.tile(dofs, 12).ravel()
+    n = 6 * (elements + 1)
+    A = scipy.sparse.coo_array((np.multiply.outer(scales, block).ravel(), (rows, cols)), shape=(n, n)).tocsr()
+    return (A + A.T) / 2  # rounding of the rotation products
 
 
 def _section_axes(axis, up, where):

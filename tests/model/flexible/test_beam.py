@@ -1,17 +1,19 @@
 """The beam generator against closed forms: its element matrices against the textbook's
-(Przemieniecki's Timoshenko stiffness, the cubic Hermite consistent mass), the analytic
-Euler–Bernoulli frequencies of free–free and clamped–free beams, Timoshenko's frequencies
-of a simply supported stubby beam, the static tip deflection and twist of a beam along a
-slanted axis, and lumped and consistent mass converging to one another."""
+(Przemieniecki's Timoshenko stiffness, the cubic Hermite consistent mass and geometric
+stiffness), the analytic Euler–Bernoulli frequencies of free–free and clamped–free beams,
+Timoshenko's frequencies of a simply supported stubby beam, the static tip deflection and
+twist of a beam along a slanted axis, lumped and consistent mass converging to one
+another, Euler's buckling load and the frequencies of a beam under tension."""
 
 import re
 
 import numpy as np
 import pytest
+import scipy.linalg
 
-from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_modes, strip
+from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_modes, plane_share, strip
 from mbsynth.core.errors import ModelError
-from mbsynth.model.flexible.beam import _bending, beam
+from mbsynth.model.flexible.beam import _bending, beam, geometric_stiffness
 from mbsynth.model.flexible.reduction import normal_modes
 
 
@@ -29,6 +31,11 @@ def test_bending_matrices_are_the_textbooks():
         [156, 22 * h, 54, -13 * h], [22 * h, 4 * h * h, 13 * h, -3 * h * h],
         [54, 13 * h, 156, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]])
     np.testing.assert_allclose(M, expected, rtol=1e-13, atol=1e-15)
+    KG = geometric_stiffness(h, 1, 2.0).toarray()[np.ix_([1, 5, 7, 11], [1, 5, 7, 11])]
+    expected = 2.0 / (30 * h) * np.array([
+        [36, 3 * h, -36, 3 * h], [3 * h, 4 * h * h, -3 * h, -h * h],
+        [-36, -3 * h, 36, -3 * h], [3 * h, -h * h, -3 * h, 4 * h * h]])
+    np.testing.assert_allclose(KG, expected, rtol=1e-13, atol=1e-15)
 
 
 @pytest.mark.parametrize("plane, I", [("xy", STRIP["Iz"]), ("xz", STRIP["Iy"])])
@@ -156,3 +163,38 @@ def test_a_slanted_beam_deflects_and_twists_as_the_closed_forms_say():
 def test_bad_beams_are_refused_by_name(change, message):
     with pytest.raises(ModelError, match="^beam: " + re.escape(message)):
         beam(LENGTH, 4, **{**STRIP, **change})
+
+
+def test_a_slanted_cantilever_buckles_at_eulers_load():
+    """K + K_G(−P) turns singular first at P = π²EI/4L² (the weaker plane): with 40
+    elements to 1e-6."""
+    axis = np.array([2.0, -1.0, 2.0]) / 3
+    fe = beam(LENGTH, 40, **STRIP, axis=axis, up=(0.0, 1.0, 0.0))
+    free = np.arange(6, fe.size)
+    K = fe.stiffness[free][:, free].toarray()
+    KG = geometric_stiffness(LENGTH, 40, 1.0, axis=axis)[free][:, free].toarray()
+    largest = scipy.linalg.eigh(KG, K, eigvals_only=True, subset_by_index=[len(free) - 1, len(free) - 1])[0]
+    np.testing.assert_allclose(1 / largest, np.pi**2 * STRIP["E"] * STRIP["Iz"] / (4 * LENGTH**2), rtol=1e-6)
+
+
+def test_tension_stiffens_a_simply_supported_beam_as_the_closed_form_says():
+    """ω_n² = ((nπ/L)⁴ EI + (nπ/L)² P) / ρA for a simply supported beam under tension P
+    (here P doubling the first frequency's square); per-element forces given as an array."""
+    E, I, A, rho, N = STRIP["E"], STRIP["Iz"], STRIP["area"], STRIP["density"], 100
+    P = (np.pi / LENGTH) ** 2 * E * I
+    fe = strip(N)
+    K = fe.stiffness + geometric_stiffness(LENGTH, N, np.full(N, P))
+    held = np.r_[0, 1, 2, 3, 6 * N + 1, 6 * N + 2]
+    keep = np.setdiff1d(np.arange(fe.size), held)
+    omega, shapes = normal_modes(fe.mass[keep][:, keep], K[keep][:, keep], count=6)
+    k = np.arange(1, 4) * np.pi / LENGTH
+    exact = np.sqrt((k**4 * E * I + k**2 * P) / (rho * A))
+    full = np.zeros((fe.size, 6))
+    full[keep] = shapes
+    np.testing.assert_allclose(omega[plane_share(fe.mass, full, "xy") > 0.5][:3], exact, rtol=1e-6)
+
+
+def test_a_geometric_stiffness_needs_one_force_per_element():
+    message = "force must be a finite number or 4 of them (one per element), got shape (3,)"
+    with pytest.raises(ModelError, match=re.escape(message)):
+        geometric_stiffness(LENGTH, 4, [1.0, 2.0, 3.0])
