@@ -98,11 +98,11 @@ def craig_bampton(fe, interface, *, count=None, max_frequency=None, shift=None):
     T[b, np.arange(len(b))] = 1.0
     if len(b):
         try:
-            solve = scipy.sparse.linalg.factorized(Kii.tocsc())
+            interior = scipy.sparse.linalg.splu(Kii.tocsc())
         except RuntimeError as err:
             raise ModelError(f"{fe.source}: with the interface nodes {nodes} held, the stiffness is singular: "
                              "the interface does not stop every rigid-body motion (add interface nodes)") from err
-        T[i, :] = -np.column_stack([solve(Kib[:, [k]].toarray().ravel()) for k in range(len(b))])
+        T[i, :] = -interior.solve(Kib.toarray())
         if not np.isfinite(T).all():
             raise ModelError(f"{fe.source}: with the interface nodes {nodes} held, the stiffness is singular")
     omega, shapes = normal_modes(M[i][:, i], Kii, count=count, max_frequency=max_frequency, shift=shift,

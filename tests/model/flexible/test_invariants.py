@@ -2,8 +2,8 @@
 written out from the frame's pose (world positions of the deformed nodes, differentiated
 by complex step) and the full FE mass matrix. Its Lagrange equations (by central
 differences) match the invariants' M(η)ν̇ − h at random states, its gravity potential their
-gravity force; the rigid block is the rod's closed form; a free flexible body conserves
-energy, linear and angular momentum."""
+gravity force; the rigid block is the rod's closed form, and a point-mass cloud's inertia
+tensor; a free flexible body conserves energy, linear and angular momentum."""
 
 import numpy as np
 import pytest
@@ -11,6 +11,7 @@ import scipy.integrate
 
 from flexible_beams import LENGTH, STRIP, strip
 from mbsynth.model.flexible.invariants import invariants
+from mbsynth.model.flexible.matrices import fe_model
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface
 
 
@@ -191,3 +192,27 @@ def test_holding_an_interface_node_leaves_the_frame_the_only_rigid_motion(model)
     assert np.all(np.abs(spectrum[:6]) < 1e-12 * spectrum[-1]) and spectrum[6] > 1e-9 * spectrum[-1]
     spectrum = np.linalg.eigvalsh(held.mass(eta[6:]))
     assert spectrum[0] > 1e-9 * spectrum[-1]
+
+
+def test_point_masses_on_springs_have_the_rigid_inertia_of_their_cloud():
+    """A solid-like model (3 DOFs per node): ten point masses, every pair joined by an axial
+    spring (a rigid truss: six rigid-body modes only). M(0)'s rigid block is m, the first moment Σ mᵢxᵢ and the inertia tensor
+    Σ mᵢ(|xᵢ|²I − xᵢxᵢᵀ) about the frame's origin; gravity's torque is Σ xᵢ × mᵢa."""
+    rng = np.random.default_rng(11)
+    x, m = rng.normal(size=(10, 3)), rng.uniform(0.5, 2.0, 10)
+    K = np.zeros((30, 30))
+    for i, j in zip(*np.triu_indices(10, 1)):
+        e = (x[j] - x[i]) / np.linalg.norm(x[j] - x[i])
+        for a, b, sign in ((i, i, 1), (j, j, 1), (i, j, -1), (j, i, -1)):
+            K[3 * a:3 * a + 3, 3 * b:3 * b + 3] += sign * 1e3 * np.outer(e, e)
+    fe = fe_model(np.diag(np.repeat(m, 3)), K, x)
+    reduction = free_interface(fe, count=4, rigid=False)
+    assert reduction.frequencies[0] > 1e-3 * reduction.frequencies[-1]  # no mechanism left
+    inv = invariants(reduction)
+    first = m @ x
+    inertia = sum(mi * (xi @ xi * np.eye(3) - np.outer(xi, xi)) for mi, xi in zip(m, x))
+    skew = np.array([[0, -first[2], first[1]], [first[2], 0, -first[0]], [-first[1], first[0], 0]])
+    expected = np.block([[m.sum() * np.eye(3), -skew], [skew, inertia]])
+    np.testing.assert_allclose(inv.mass(np.zeros(4))[:6, :6], expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    a = np.array([0.0, -9.81, 0.0])
+    np.testing.assert_allclose(inv.gravity(np.zeros(4), a)[3:6], np.cross(m[:, None] * x, a).sum(0), rtol=1e-12)
