@@ -23,7 +23,7 @@ _LAZY = {
     "simulate": "analysis.simulate", "sweep": "studies.sweep", "Trajectory": "analysis.trajectory",
     "load_trajectory": "analysis.trajectory", "equilibrium": "analysis.statics",
     "linearize": "analysis.linearization", "Linearization": "analysis.linearization",
-    "modes": "analysis.modes", "Modes": "analysis.modes",
+    "modes": "analysis.modes", "Modes": "analysis.modes", "steady_motion": "analysis.steady",
 }
 # Public submodules imported on first use: mb.viewer.show, mb.viewer.to_html.
 _SUBMODULES = {"viewer": "view.viewer"}

@@ -18,6 +18,7 @@ from ..core.errors import NoEquilibrium
 from .linearization import finite_state, linearize, prescribed_motion
 from .projection import project_positions
 from .statics import equilibrium as find_equilibrium
+from .steady import check_steady
 from .trajectory import Trajectory
 from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL
 
@@ -94,7 +95,7 @@ def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, 
         raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration: rows {moving} prescribe a "
                             f"motion at t = {t:g} (∂φ/∂t ≠ 0); modes are taken at rest", constraints=moving)
     lin = linearize(system, t, q, qd)
-    _check_steady(system, lin, tolerance, steady)
+    _check_rest_or_steady(system, lin, tolerance, steady)
     k = lin.k
     values = lin.eigenvalues
     scale = np.abs(values).max(initial=0.0)
@@ -117,31 +118,17 @@ def _holonomic_rest(lin):
     return lin.A.shape[0] == 2 * lin.k and not np.any(lin.qd)
 
 
-def _check_steady(system, lin, tolerance, steady):
-    """NoEquilibrium unless the state is a rest (q̈ = 0) or, ``steady``, a steady motion:
-    the speeds do not change and no coordinate moves but the cyclic ones."""
-    k = lin.k
-    size = 1 + np.abs(lin.A[k:, :k]).max(initial=0.0)
-    speeds = [name[:-4] for name in lin.state_names[k:]]
-    index = {c: i for i, c in enumerate(system.coordinates)}
-    accelerations = np.array([lin.qdd[index[c]] for c in speeds])
-    if not steady:
-        worst = int(np.argmax(np.abs(lin.qdd))) if lin.qdd.size else 0
-        if lin.qdd.size and abs(lin.qdd[worst]) > tolerance * size:
-            raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
-                                f"along {system.coordinates[worst]}): modes are taken at an equilibrium "
-                                "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
+def _check_rest_or_steady(system, lin, tolerance, steady):
+    """NoEquilibrium unless the state is a rest (q̈ = 0) or, ``steady``, a steady motion
+    (steady.check_steady)."""
+    if steady:
+        check_steady(system, lin, tolerance)
         return
-    rates = np.array([lin.qd[index[c]] for c in lin.state_names[:k]])
-    moving = [c for c, x in zip(lin.state_names[:k], rates) if c not in lin.cyclic
-              and abs(x) > tolerance * (1 + np.abs(lin.qd).max())]
-    changing = [c for c, x in zip(speeds, accelerations) if abs(x) > tolerance * size]
-    if moving or changing:
-        raise NoEquilibrium(f"model '{system.name}' does not move steadily here: "
-                            + "; ".join(([f"{moving} move but the dynamics depends on them"] if moving else [])
-                                        + ([f"the rates of {changing} change"] if changing else []))
-                            + " (a steady motion moves only cyclic coordinates, at constant speeds: a spin angle "
-                              "of a body with rotation: zxy, not a quaternion)", coordinates=moving + changing)
+    worst = int(np.argmax(np.abs(lin.qdd))) if lin.qdd.size else 0
+    if lin.qdd.size and abs(lin.qdd[worst]) > tolerance * (1 + np.abs(lin.A[lin.k:, :lin.k]).max(initial=0.0)):
+        raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration (q̈ = {lin.qdd[worst]:.3g} "
+                            f"along {system.coordinates[worst]}): modes are taken at an equilibrium "
+                            "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
 
 
 def _eigenvector(A, s):

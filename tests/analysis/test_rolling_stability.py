@@ -199,3 +199,26 @@ def test_speeds_can_be_chosen_and_are_checked(bicycle):
     assert np.abs(_nonzero(chosen.eigenvalues) - np.sort_complex(TABLE_2[v])).max() < 1e-8
     with pytest.raises(mb.SolveError, match="do not fix the velocities"):
         mb.linearize(moving, 0.0, *moving.initial_state(), speeds=["rear_frame.x", "rear_wheel.x", "front_wheel.x"])
+
+
+def test_steady_motion_from_a_forward_speed(bicycle):
+    """mb.steady_motion from the rear wheel's spin rate v/rR alone: the bicycle rolls upright
+    at v (the least-energy velocities leave no lean or steer rate), as the model file's
+    initial state written by hand; its eigenvalues are Table 2's."""
+    q, qd = mb.steady_motion(bicycle, {"rear_wheel.angle_y": 4.0 / 0.3})
+    q0, qd0 = bicycle.with_parameters(v=4.0).initial_state()
+    assert np.abs(q - q0).max() < 1e-12 and np.abs(qd - qd0).max() < 1e-12 * np.abs(qd0).max()
+    lin = mb.linearize(bicycle, 0.0, q, qd)
+    assert np.abs(_nonzero(lin.eigenvalues) - np.sort_complex(TABLE_2[4.0])).max() < 1e-8
+
+
+def test_steady_motion_solves_for_a_disks_spin():
+    """Given the lean (its initial angles) and the heading rate, the spin rate that makes the
+    circle steady is the closed form the model file writes (the steady condition)."""
+    disk = mb.load(MODELS / "rolling" / "turning_disk.yaml")
+    q0, qd0 = disk.initial_state()
+    q, qd = mb.steady_motion(disk, {"disk.angle_z": 2.0, "disk.angle_z2": 0.0}, q=q0, solve=["disk.angle_z2_dot"])
+    spin = disk.coordinates.index("disk.angle_z2")
+    assert abs(qd[spin] - disk.parameters["spin"]) < 1e-10 * abs(disk.parameters["spin"])
+    with pytest.raises(mb.NoEquilibrium, match="does not move steadily"):
+        mb.steady_motion(disk, {"disk.angle_z": 2.0, "disk.angle_z2": 0.0}, q=q0)
