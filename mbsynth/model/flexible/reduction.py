@@ -34,6 +34,7 @@ SHIFT_RTOL = 1e-8  # the default shift: −SHIFT_RTOL · tr K / tr M (below ever
 RIGID_RTOL = 1e-9  # a mode with ω² below RIGID_RTOL · tr K / tr M is a rigid-body mode
 FIRST_BATCH = 12  # modes asked for first when they are chosen by frequency (doubled until past it)
 DENSE_MODES_MAX = 120  # up to this many DOFs the modes come from a dense solver, every finite one at once
+INTERIOR_PIVOT_RTOL = 1e-14  # a pivot of K_ii below this fraction of the largest: the interface leaves K_ii singular
 FINITE_RTOL = 1e-12  # a dense mode with 1/(λ + shift) below FINITE_RTOL / shift is an infinite one (M φ = 0)
 
 
@@ -97,14 +98,16 @@ def craig_bampton(fe, interface, *, count=None, max_frequency=None, shift=None):
     T = np.zeros((fe.size, len(b)))
     T[b, np.arange(len(b))] = 1.0
     if len(b):
+        singular = (f"{fe.source}: with the interface nodes {list(nodes)} held, the stiffness is singular: the "
+                    "interface does not stop every rigid-body motion (add interface nodes)")
         try:
             interior = scipy.sparse.linalg.splu(Kii.tocsc())
         except RuntimeError as err:
-            raise ModelError(f"{fe.source}: with the interface nodes {nodes} held, the stiffness is singular: "
-                             "the interface does not stop every rigid-body motion (add interface nodes)") from err
+            raise ModelError(singular) from err
+        pivots = np.abs(interior.U.diagonal())
+        if pivots.min() <= INTERIOR_PIVOT_RTOL * pivots.max():
+            raise ModelError(singular)
         T[i, :] = -interior.solve(Kib.toarray())
-        if not np.isfinite(T).all():
-            raise ModelError(f"{fe.source}: with the interface nodes {nodes} held, the stiffness is singular")
     omega, shapes = normal_modes(M[i][:, i], Kii, count=count, max_frequency=max_frequency, shift=shift,
                                  source=fe.source)
     Phi = np.zeros((fe.size, len(omega)))

@@ -1,9 +1,11 @@
 """Shared by the flexible-body tests (imported by name): a steel strip, the analytic
-Euler–Bernoulli frequencies, and the FE modes of one bending plane."""
+Euler–Bernoulli frequencies, the FE modes of one bending plane, and a point-mass truss
+(3 DOFs per node)."""
 
 import numpy as np
 
 from mbsynth.model.flexible.beam import beam
+from mbsynth.model.flexible.matrices import fe_model
 from mbsynth.model.flexible.reduction import normal_modes
 
 # a steel strip, 2 m long, its stiffer bending plane 2× higher in frequency (Iy = 4 Iz)
@@ -40,3 +42,16 @@ def plane_modes(fe, held, plane, count):
     full = np.zeros((fe.size, shapes.shape[1]))
     full[keep] = shapes
     return omega[(plane_share(fe.mass, full, plane) > 0.5) & (omega > 1e-4 * omega.max())][:count]
+
+
+def truss(seed=11):
+    """Ten point masses at random places, every pair joined by an axial spring of 1e3 N/m: a
+    rigid truss (six rigid-body modes only), its M diagonal."""
+    rng = np.random.default_rng(seed)
+    x, m = rng.normal(size=(10, 3)), rng.uniform(0.5, 2.0, 10)
+    K = np.zeros((30, 30))
+    for i, j in zip(*np.triu_indices(10, 1)):
+        e = (x[j] - x[i]) / np.linalg.norm(x[j] - x[i])
+        for a, b, sign in ((i, i, 1), (j, j, 1), (i, j, -1), (j, i, -1)):
+            K[3 * a:3 * a + 3, 3 * b:3 * b + 3] += sign * 1e3 * np.outer(e, e)
+    return fe_model(np.diag(np.repeat(m, 3)), K, x)

@@ -9,9 +9,8 @@ import numpy as np
 import pytest
 import scipy.integrate
 
-from flexible_beams import LENGTH, STRIP, strip
+from flexible_beams import LENGTH, STRIP, strip, truss
 from mbsynth.model.flexible.invariants import invariants
-from mbsynth.model.flexible.matrices import fe_model
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface
 
 
@@ -195,17 +194,11 @@ def test_holding_an_interface_node_leaves_the_frame_the_only_rigid_motion(model)
 
 
 def test_point_masses_on_springs_have_the_rigid_inertia_of_their_cloud():
-    """A solid-like model (3 DOFs per node): ten point masses, every pair joined by an axial
-    spring (a rigid truss: six rigid-body modes only). M(0)'s rigid block is m, the first moment Σ mᵢxᵢ and the inertia tensor
-    Σ mᵢ(|xᵢ|²I − xᵢxᵢᵀ) about the frame's origin; gravity's torque is Σ xᵢ × mᵢa."""
-    rng = np.random.default_rng(11)
-    x, m = rng.normal(size=(10, 3)), rng.uniform(0.5, 2.0, 10)
-    K = np.zeros((30, 30))
-    for i, j in zip(*np.triu_indices(10, 1)):
-        e = (x[j] - x[i]) / np.linalg.norm(x[j] - x[i])
-        for a, b, sign in ((i, i, 1), (j, j, 1), (i, j, -1), (j, i, -1)):
-            K[3 * a:3 * a + 3, 3 * b:3 * b + 3] += sign * 1e3 * np.outer(e, e)
-    fe = fe_model(np.diag(np.repeat(m, 3)), K, x)
+    """A solid-like model (3 DOFs per node), the point-mass truss: M(0)'s rigid block is m,
+    the first moment Σ mᵢxᵢ and the inertia tensor Σ mᵢ(|xᵢ|²I − xᵢxᵢᵀ) about the frame's
+    origin; gravity's torque is Σ xᵢ × mᵢa."""
+    fe = truss()
+    x, m = fe.nodes, fe.mass.diagonal()[::3]
     reduction = free_interface(fe, count=4, rigid=False)
     assert reduction.frequencies[0] > 1e-3 * reduction.frequencies[-1]  # no mechanism left
     inv = invariants(reduction)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from flexible_beams import FREE_FREE, STRIP, LENGTH, euler_bernoulli, plane_share, strip
+from flexible_beams import FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
 from mbsynth.core.errors import ModelError
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface, normal_modes
 
@@ -115,6 +115,16 @@ def test_bad_reductions_are_refused():
         craig_bampton(fe, [0, 0], count=2)
     with pytest.raises(ModelError, match="K \\+ s M is singular for every s"):
         free_interface(strip(4, mass="lumped"), count=2)  # the twist about the axis: no mass, no stiffness
+
+
+def test_an_interface_that_leaves_a_rigid_motion_is_refused():
+    """A truss of point masses (3 DOFs per node) held at one node still turns about it, held
+    at two about their line: K_ii is singular (exactly, or to rounding); three nodes hold it."""
+    fe = truss()
+    for interface in ([0], [0, 1]):
+        with pytest.raises(ModelError, match=re.escape(f"with the interface nodes {interface} held, the stiffness is singular")):
+            craig_bampton(fe, interface, count=2)
+    assert craig_bampton(fe, [0, 1, 2], count=2).size == 11
 
 
 @pytest.mark.parametrize("elements", [3, 30])  # 18 DOFs: the dense solver; 180: eigsh
