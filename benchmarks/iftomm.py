@@ -21,6 +21,13 @@ which uses no mbsynth):
 - ``sarrus`` — Sarrus' linkage on a spring, 5 s: energy and the plate's pure translation.
 - ``pendulum_1km`` — the simple pendulum with L = 1000 m in SI units, 120 s: the bob
   against the exact solution, the rod constraint relative to L^2.
+- ``flyball`` — A05, the stiff flyball governor (springs of 8e5 N/m and dampers of
+  4e4 N s/m in place of its coupler rods), 10 s: the slider's height s against the
+  four-coordinate Lagrange equations written by hand (the library's own time history was
+  not found in the sources searched); energy against E(0) minus the dampers' work.
+- ``slider_crank_3d`` — the IFToMM library's spatial rigid slider-crank, 5 s: the
+  slider's x against the crank angle's one equation written by hand, and against the
+  library's published solution (M. González) every 0.1 s.
 
 Columns: *reference quantity* and its *reference value* at the end of the run, the
 *mbsynth value* there, *error* (the largest over all output times where the reference
@@ -30,7 +37,9 @@ is a trajectory), *energy drift* (max |E(t) - E(0)| over max(|E(0)|, max kinetic
 failure message and the values up to the last good state.
 
 Writes benchmarks/iftomm_results.md (``--quick``: shortened runs, printed, no file
-unless ``--out`` is given).
+unless ``--out`` is given). With ``--only``, an existing results file keeps its other
+rows and notes: the problems run replace their own rows (or are added after the others)
+and a line under the header says which rows were run again, when and how.
 """
 
 import argparse
@@ -182,6 +191,52 @@ def _sarrus_eval(system, traj):
     return "0", f"{max(drift, turn):.3e}", max(drift, turn), notes
 
 
+def _unwrapped_angle(qw, qaxis):
+    """The angle of rotations about one fixed axis from their quaternions (w, axis part)."""
+    return np.unwrap(2 * np.arctan2(qaxis, qw))
+
+
+def _flyball_eval(system, traj):
+    s = traj.column("slider.z")
+    r = ref.flyball_reference(traj.t)
+    qw, qz = traj.column("shaft.qw"), traj.column("shaft.qz")
+    omega = 2 * (qw * traj.column("shaft.qz_dot") - qz * traj.column("shaft.qw_dot"))
+    err = float(np.max(np.abs(s - r["s"])))
+    notes = [f"slider between {s.min():.4f} and {s.max():.4f} m; shaft at t_end: {omega[-1]:.10g} rad/s "
+             f"(reference {r['phi_dot'][-1]:.10g}), max |omega - reference| = "
+             f"{np.max(np.abs(omega - r['phi_dot'])):.2e} rad/s",
+             f"dampers' work by t_end {r['W'][-1]:.6g} J (reference); the library's own s(t) was not found "
+             "in the sources searched: the reference is the four-coordinate equations in iftomm_reference.py"]
+    return _fmt((r["s"][-1], r["phi_dot"][-1])), _fmt((s[-1], omega[-1])), err, notes
+
+
+def _flyball_energy(system, traj):
+    """max |E(t) - E(0) + W(t)| over max(|E(0)|, max kinetic energy), W the reference's
+    dissipated work: the energy balance with the dampers."""
+    W = ref.flyball_reference(traj.t)["W"]
+    E = traj.energy
+    scale = max(abs(E[0]), float(np.max(np.abs(traj.kinetic))))
+    return float(np.max(np.abs(E - E[0] + W)) / scale) if scale else 0.0
+
+
+def _slider_crank_3d_eval(system, traj):
+    x = traj.column("slider.x")
+    xr, theta_r = ref.slider_crank_3d_reference(traj.t)
+    theta = _unwrapped_angle(traj.column("crank.qw"), traj.column("crank.qx"))
+    err = float(np.max(np.abs(x - xr)))
+    published = ref.SLIDER_CRANK_3D_PUBLISHED
+    at = [(i, k) for k, tp in enumerate(published[:, 0])
+          for i in np.flatnonzero(np.isclose(traj.t, tp, atol=1e-9))]
+    notes = [f"crank angle at t_end {theta[-1]:.10g} rad (reference {theta_r[-1]:.10g}), max |theta - reference| = "
+             f"{np.max(np.abs(theta - theta_r)):.2e} rad"]
+    if at:
+        rows, cols = map(list, zip(*at))
+        notes.append(f"the library's published solution (González) at {len(at)} times to {published[cols[-1], 0]:g} s: "
+                     f"mbsynth within {np.max(np.abs(x[rows] - published[cols, 1])):.2e} m of it, the reference "
+                     f"equation within {np.max(np.abs(xr[rows] - published[cols, 1])):.2e} m")
+    return _fmt(xr[-1]), _fmt(x[-1]), err, notes
+
+
 def problems():
     return [
         Problem("pendulum", "A01 simple pendulum (1 m, from horizontal)",
@@ -210,6 +265,13 @@ def problems():
         Problem("pendulum_1km", "simple pendulum, L = 1000 m (SI)",
                 lambda: mb.load(MODELS / "pendulum_1km.yaml"), 120.0, 1.0, 10.0, 1.0,
                 "bob (x, y) at t_end [m]; error: max over outputs", _pendulum_eval),
+        Problem("flyball", "A05 stiff flyball governor",
+                lambda: mb.load(MODELS / "flyball_governor.yaml"), 10.0, 0.05, 1.0, 0.05,
+                "(slider height s [m], shaft rate [rad/s]) at t_end; error: s, max over outputs",
+                _flyball_eval, _flyball_energy),
+        Problem("slider_crank_3d", "IFToMM spatial rigid slider-crank",
+                lambda: mb.load(MODELS / "slider_crank_3d.yaml"), 5.0, 0.01, 0.5, 0.01,
+                "slider x at t_end [m]; error: max over outputs", _slider_crank_3d_eval),
     ]
 
 
@@ -266,21 +328,68 @@ def table(results):
     return "\n".join(lines) + ("\n\nNotes:\n\n" + "\n".join(notes) if notes else "") + "\n"
 
 
-def header(argv):
-    cores = os.cpu_count()
+TITLE = "# mbsynth on the IFToMM/LIM benchmark problems and the IVP test set's `andrews` (issue 18)"
+REFERENCES = ("References (benchmarks/iftomm_reference.py, no mbsynth inside): the pendulum's exact motion (Jacobi's "
+              "sn), the N-four-bar's exact one-degree-of-freedom motion (scipy DOP853 at 1e-13), the IVP test set's "
+              "Andrews angles at 0.03 s (andrews.f, SOLN), for the over-constrained loops energy conservation "
+              "and the joints' gaps computed from the bodies' coordinates, for the flyball governor its "
+              "four-coordinate Lagrange equations written by hand (scipy DOP853 at 1e-12; the library's own s(t) "
+              "was not found), and for the spatial slider-crank its crank angle's equation written by hand (DOP853 "
+              "at 1e-13) beside the library's published solution (M. González; the IFToMM benchmark's "
+              "Spatial_rigid_slider-crank_mechanism_Gonzalez.txt as copied in jgerstmayr/EXUDYN "
+              "docs/verification/Slidercrank3DiftommBenchmark/). `simulate` with its defaults (DOP853, "
+              "rtol = atol = 1e-10, projection at each output time); *error* is the largest over all output times "
+              "where the reference is a trajectory; *energy drift* relative to max(|E(0)|, max kinetic energy) "
+              "(Andrews: with the motor's work subtracted); *max residual*: mbsynth's own largest constraint "
+              "residual; *wall s*: `simulate` alone; the flyball governor's energy drift is E(t) - E(0) plus the "
+              "dampers' work.")
+
+
+def run_line(argv, what="written by"):
+    """Date, machine, versions and the command that ran (``what`` it did)."""
     quick = " " + " ".join(argv) if argv else ""
-    return (f"# mbsynth on the IFToMM/LIM benchmark problems and the IVP test set's `andrews` (issue 18)\n\n"
-            f"{datetime.date.today().isoformat()}, {platform.platform()}, {platform.machine()}, {cores} cores, "
-            f"Python {platform.python_version()}, mbsynth {getattr(mb, '__version__', '?')}; written by "
-            f"`PYTHONPATH=. .venv/bin/python benchmarks/iftomm.py{quick}`.\n\n"
-            "References (benchmarks/iftomm_reference.py, no mbsynth inside): the pendulum's exact motion (Jacobi's "
-            "sn), the N-four-bar's exact one-degree-of-freedom motion (scipy DOP853 at 1e-13), the IVP test set's "
-            "Andrews angles at 0.03 s (andrews.f, SOLN), and for the over-constrained loops energy conservation "
-            "and the joints' gaps computed from the bodies' coordinates. `simulate` with its defaults (DOP853, "
-            "rtol = atol = 1e-10, projection at each output time); *error* is the largest over all output times "
-            "where the reference is a trajectory; *energy drift* relative to max(|E(0)|, max kinetic energy) "
-            "(Andrews: with the motor's work subtracted); *max residual*: mbsynth's own largest constraint "
-            "residual; *wall s*: `simulate` alone.\n\n")
+    return (f"{datetime.date.today().isoformat()}, {platform.platform()}, {platform.machine()}, {os.cpu_count()} "
+            f"cores, Python {platform.python_version()}, mbsynth {getattr(mb, '__version__', '?')}; {what} "
+            f"`PYTHONPATH=. .venv/bin/python benchmarks/iftomm.py{quick}`.")
+
+
+def header(argv):
+    return f"{TITLE}\n\n{run_line(argv)}\n\n{REFERENCES}\n\n"
+
+
+def _table_parts(text):
+    """(the text before the table, its rows keyed by problem title, the notes lines)."""
+    head, mark, rest = text.partition("| problem |")
+    lines = (mark + rest).splitlines()
+    rows = {}
+    for line in lines[2:]:
+        if not line.startswith("| "):
+            break
+        rows[line[2:].split(" | ")[0]] = line
+    notes = [line for line in lines if line.startswith("- ")]
+    return head, rows, notes
+
+
+def merge(old, results, argv):
+    """The results file text ``old`` with the rows and notes of ``results`` in place of
+    their own (added after the others when new), its run line kept and a line added saying
+    which rows were run again, when and how; the title and references as they are now."""
+    head, rows, notes = _table_parts(old)
+    if not rows:
+        return header(argv) + table(results)
+    _, new_rows, new_notes = _table_parts(table(results))
+    rows.update(new_rows)                      # replaced in place, new ones last
+    paragraphs = head.strip().split("\n\n")
+    runs = paragraphs[1] if len(paragraphs) > 1 else ""
+    again = run_line(argv, f"rows {'; '.join(new_rows)} run again by")
+
+    def note_of(title, pool):
+        return next((n for n in pool if n.startswith(f"- {title}: ")), None)
+    merged_notes = [note_of(t, new_notes) if t in new_rows else note_of(t, notes) for t in rows]
+    merged_notes = [n for n in merged_notes if n]
+    lines = table([]).splitlines()[:2] + list(rows.values())
+    return (f"{TITLE}\n\n{runs}\n{again}\n\n{REFERENCES}\n\n" + "\n".join(lines)
+            + ("\n\nNotes:\n\n" + "\n".join(merged_notes) if merged_notes else "") + "\n")
 
 
 def main(argv=None):
@@ -305,7 +414,8 @@ def main(argv=None):
     print(text)
     out = args.out or (None if args.quick else HERE / "iftomm_results.md")
     if out is not None:
-        Path(out).write_text(text)
+        out = Path(out)
+        out.write_text(merge(out.read_text(), results, shown) if args.only and out.exists() else text)
     return results
 
 

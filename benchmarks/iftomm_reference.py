@@ -11,6 +11,11 @@ Used by ``benchmarks/iftomm.py`` and ``tests/test_benchmark_problems.py``:
 - ``loop_gaps``: how far apart the two frames of every revolute joint are (positions and
   axes), computed from the bodies' coordinates with quaternions written out here, not
   with mbsynth's constraint rows: the loop closure of Bricard's and Bennett's linkages.
+- ``flyball_reference``: the stiff flyball governor (IFToMM A05) in its four coordinates,
+  Lagrange's equations written by hand (the library's own time history was not found).
+- ``slider_crank_3d_reference``: the IFToMM library's spatial rigid slider-crank, the
+  crank angle's one equation written by hand; ``SLIDER_CRANK_3D_PUBLISHED``: the
+  library's published solution (M. González), the slider's x every 0.1 s.
 """
 
 import math
@@ -240,3 +245,177 @@ BRICARD_JOINTS = [
     (("link4", (-0.5, 0, 0), (0, 0, 1)), ("link5", (0, -0.5, 0), (0, 0, 1))),
     (("link5", (0, 0.5, 0), (1, 0, 0)), (None, (0, 0, 1), (1, 0, 0))),
 ]
+
+
+# ---------------------------------------------------------------------------------------
+# A05: the stiff flyball governor (models/mechanisms/flyball_governor.yaml)
+
+# The benchmark's data (the library's A05 specification; restated in
+# RehabEngGroup/MBSbenchmarksInOpenSim src/A05-FlyballGovernor/createModel.cpp and
+# modelProperties.h, and in Exudyn's Examples/stiffFlyballGovernorKT.py): bars of
+# 1 m x 0.01 m x 0.01 m at 3000 kg/m^3, a 0.1 m cube of 3 kg, 5 kg point masses, springs
+# k = 8e5 N/m, c = 4e4 N s/m, rest length 0.5 m, pins at (+-0.05, 0, 1) m, slider at
+# s = 0.5 m, rods 30 degrees below the horizontal, shaft turning freely at 2 pi rad/s.
+# The library's own reference time history (s(t)) could not be read from the sources
+# searched (only the header of A05_specification.xml is stored; the OpenSim restatement
+# shows it as a plot only), so the reference here is independent: flyball_reference.
+FLYBALL = dict(rho=3000.0, a=0.01, L=1.0, b=0.1, ms=3.0, mb=5.0, d=0.05, alpha=math.pi / 6, s0=0.5,
+               k=8.0e5, c=4.0e4, l0=0.5, omega0=2 * math.pi, g=9.81)
+
+
+def flyball_reference(times, rtol=1e-12, atol=1e-12, **data):
+    """The flyball governor's motion in its four coordinates, at ``times``.
+
+    Coordinates: the shaft angle phi, the slider height s (its centre above the shaft's
+    foot), and each rod's angle beta_i below the horizontal. In the shaft's turning frame
+    rod i's direction is u_i = (+-cos beta_i, 0, -sin beta_i) from its pin (+-d, 0, L); the
+    rod (mass m_r, inertia It across and Ia along about its middle) turns at
+    phi' e_z + beta_i' e_y, its middle and its point mass at L/2 and L along u_i. Every
+    point p = (x, 0, z) of the turning frame moves at |v|^2 = x'^2 + z'^2 + phi'^2 x^2, so
+    the kinetic energy is T = 1/2 [M_phi phi'^2 + m_s s'^2 + M_b (beta_1'^2 + beta_2'^2)] with
+        M_phi = I_shaft + I_slider + sum_i [It - (It - Ia) sin^2 beta_i
+                + m_r (d + L/2 cos beta_i)^2 + m_b (d + L cos beta_i)^2],
+        M_b = It + m_r L^2/4 + m_b L^2;
+    the potential is g [m_s s + sum_i (m_r (L - L/2 sin beta_i) + m_b (L - L sin beta_i))]
+    + sum_i k (l_i - l0)^2 / 2, l_i the length of spring i from the slider's side
+    (+-d, 0, s) to rod i's middle: (L/2 cos beta_i, L - L/2 sin beta_i - s) in the plane;
+    the dampers dissipate c l_i'^2. Lagrange's equations: (M_phi phi')' = 0 (phi cyclic),
+    m_s s'' = Q_s, M_b beta_i'' = 1/2 dM_phi/dbeta_i phi'^2 + Q_i, with Q the spring,
+    damper and gravity forces. Integrated by scipy's DOP853 at rtol = atol = 1e-12 (the
+    dampers' fast mode, about 2 c sin^2(alpha)/m_s = 7e3 1/s, only bounds its steps).
+    Returns a dict of arrays: phi, s, beta1, beta2, their rates (phi_dot, s_dot, ...), and
+    W, the work the dampers dissipated since t = 0 (E(t) = E(0) - W)."""
+    p = dict(FLYBALL, **data)
+    a, L, d, g, k, c, l0 = p["a"], p["L"], p["d"], p["g"], p["k"], p["c"], p["l0"]
+    m_bar = p["rho"] * a * a * L
+    It, Ia = m_bar * (L * L + a * a) / 12, m_bar * 2 * a * a / 12
+    I_axis = m_bar * 2 * a * a / 12 + p["ms"] * 2 * p["b"] ** 2 / 12    # shaft and slider about z
+    ms, mb = p["ms"], p["mb"]
+    Mb = It + m_bar * L * L / 4 + mb * L * L
+
+    def M_phi(beta):
+        s, co = math.sin(beta), math.cos(beta)
+        return It - (It - Ia) * s * s + m_bar * (d + L / 2 * co) ** 2 + mb * (d + L * co) ** 2
+
+    def dM_phi(beta):
+        s, co = math.sin(beta), math.cos(beta)
+        return -2 * (It - Ia) * s * co - m_bar * (d + L / 2 * co) * L * s - 2 * mb * (d + L * co) * L * s
+
+    def spring(s_, beta, s_dot, beta_dot):
+        """(force along the spring, dl/ds, dl/dbeta, l')."""
+        hx, hz = L / 2 * math.cos(beta), L - L / 2 * math.sin(beta) - s_
+        length = math.hypot(hx, hz)
+        dl_ds = -hz / length
+        dl_db = (hx * (-L / 2 * math.sin(beta)) + hz * (-L / 2 * math.cos(beta))) / length
+        rate = dl_ds * s_dot + dl_db * beta_dot
+        return k * (length - l0) + c * rate, dl_ds, dl_db, rate
+
+    def rhs(t, y):
+        _, s_, b1, b2, w, sd, bd1, bd2, _ = y
+        M = I_axis + M_phi(b1) + M_phi(b2)
+        f1, ds1, db1, r1 = spring(s_, b1, sd, bd1)
+        f2, ds2, db2, r2 = spring(s_, b2, sd, bd2)
+        Qs = -ms * g - f1 * ds1 - f2 * ds2
+        Q1 = g * (m_bar * L / 2 + mb * L) * math.cos(b1) - f1 * db1
+        Q2 = g * (m_bar * L / 2 + mb * L) * math.cos(b2) - f2 * db2
+        w_dot = -(dM_phi(b1) * bd1 + dM_phi(b2) * bd2) * w / M
+        return (w, sd, bd1, bd2, w_dot, Qs / ms, (0.5 * dM_phi(b1) * w * w + Q1) / Mb,
+                (0.5 * dM_phi(b2) * w * w + Q2) / Mb, c * (r1 * r1 + r2 * r2))
+
+    times = np.asarray(times, dtype=float)
+    y0 = (0.0, p["s0"], p["alpha"], p["alpha"], p["omega0"], 0.0, 0.0, 0.0, 0.0)
+    sol = solve_ivp(rhs, (0.0, float(times.max())), y0, method="DOP853", rtol=rtol, atol=atol,
+                    dense_output=True)
+    y = sol.sol(times)
+    names = ("phi", "s", "beta1", "beta2", "phi_dot", "s_dot", "beta1_dot", "beta2_dot", "W")
+    return dict(zip(names, y))
+
+
+# ---------------------------------------------------------------------------------------
+# The IFToMM library's spatial rigid slider-crank (models/mechanisms/slider_crank_3d.yaml)
+
+# Data of the IFToMM problem (as restated in Exudyn's TestModels/sliderCrank3Dbenchmark.py):
+# crank 0.08 m, 0.12 kg, Ixx = 1e-4 kg m^2, turning about x at A = (0, 0.1, 0.12) m;
+# rod 0.3 m, 0.5 kg, 4e-4 along and 4e-3 across (kg m^2); slider 2 kg on the x axis;
+# spherical joint at B, universal joint at C; gravity 9.81 m/s^2 along -z; crank angle 0
+# (straight up) turning at 6 rad/s; 5 s.
+SLIDER_CRANK_3D = dict(l1=0.08, l2=0.3, ya=0.1, za=0.12, m1=0.12, m2=0.5, m3=2.0, I1=1.0e-4,
+                       I_along=4.0e-4, I_across=4.0e-3, omega0=6.0, g=9.81)
+
+# The library's published solution by M. González (University of A Coruña), the slider's
+# x [m] every 0.01 s for 5 s, file "Spatial_rigid_slider-crank_mechanism_Gonzalez.txt" of
+# the IFToMM benchmark (copied in jgerstmayr/EXUDYN, docs/verification/
+# Slidercrank3DiftommBenchmark/, commit 657f9c6392c48831530f98e18cbccb81a9097953): here
+# its values every 0.1 s, as printed there (9 digits). It agrees with the independent
+# minimal-coordinate solution (slider_crank_3d_reference) to 7e-5 m over the 5 s, 1.8e-6 m
+# at 0.1 s; the other published solutions copied there differ more (Masarati's by 7e-4 m
+# at 1 s; Chaojie's starts from another geometry).
+SLIDER_CRANK_3D_PUBLISHED = np.array([
+    (0.0, 0.2), (0.1, 0.226785384), (0.2, 0.263034975), (0.3, 0.28194126), (0.4, 0.222848664),
+    (0.5, 0.184952803), (0.6, 0.205149298), (0.7, 0.233436939), (0.8, 0.272248997),
+    (0.9, 0.269894777), (1.0, 0.211754668), (1.1, 0.187182557), (1.2, 0.210516025),
+    (1.3, 0.240573702), (1.4, 0.281610048), (1.5, 0.25696554), (1.6, 0.201710317),
+    (1.7, 0.191482337), (1.8, 0.216149918), (1.9, 0.248250449), (2.0, 0.289063554),
+    (2.1, 0.24408996), (2.2, 0.193077751), (2.3, 0.196281891), (2.4, 0.22210812),
+    (2.5, 0.256509783), (2.6, 0.288514279), (2.7, 0.231657711), (2.8, 0.186751704),
+    (2.9, 0.201300274), (3.0, 0.228450093), (3.1, 0.26535947), (3.2, 0.279033697),
+    (3.3, 0.219906306), (3.4, 0.185121916), (3.5, 0.206512886), (3.6, 0.235235487),
+    (3.7, 0.274692757), (3.8, 0.266571846), (3.9, 0.209037413), (4.0, 0.188208161),
+    (4.1, 0.211955412), (4.2, 0.242522956), (4.3, 0.283917157), (4.4, 0.25357518),
+    (4.5, 0.199295373), (4.6, 0.192711279), (4.7, 0.217680687), (4.8, 0.250365225),
+    (4.9, 0.289954884), (5.0, 0.240761815),
+])
+
+
+def _slider_crank_3d_kinematics(theta, p):
+    """(slider x, J(theta), dV/dtheta) at crank angle theta (complex-safe: J's derivative is
+    taken by a complex step).
+
+    B = A + l1 (0, -sin theta, cos theta); the slider x = sqrt(l2^2 - B_y^2 - B_z^2) (the
+    branch x > 0); the rod's axis e = (C - B)/l2, the cross's rod axis u = e x e_x / |.|
+    and w = e x u; per unit crank rate the rod turns at e x e' + (u' . w) e (its spin about
+    e is u' . w). With both centres of mass at the middles,
+        J = I1 + m1 |B'/2|^2 + m2 |(B' + C')/2|^2 + I_across e'.e' + I_along (u'.w)^2 + m3 x'^2
+    is the mechanism's inertia about the crank axis (T = J theta'^2/2), and
+    V = g (m1 (z_A + B_z)/2 + m2 B_z/2) (the centres' heights; C stays at z = 0)."""
+    l1, l2 = p["l1"], p["l2"]
+    s, co = np.sin(theta), np.cos(theta)
+    By, Bz = p["ya"] - l1 * s, p["za"] + l1 * co
+    dBy, dBz = -l1 * co, -l1 * s
+    x = np.sqrt(l2 * l2 - By * By - Bz * Bz)
+    dx = -(By * dBy + Bz * dBz) / x
+    e = np.array([x, -By, -Bz]) / l2
+    de = np.array([dx, -dBy, -dBz]) / l2
+    n, dn = np.array([0 * x, e[2], -e[1]]), np.array([0 * x, de[2], -de[1]])   # e x e_x and its rate
+    norm = np.sqrt(n @ n)
+    u = n / norm
+    du = dn / norm - n * (n @ dn) / norm**3
+    w = np.cross(e, u)
+    spin = du @ w
+    J = (p["I1"] + p["m1"] * (dBy * dBy + dBz * dBz) / 4 + p["m2"] * (dx * dx + dBy * dBy + dBz * dBz) / 4
+         + p["I_across"] * (de @ de) + p["I_along"] * spin * spin + p["m3"] * dx * dx)
+    dV = p["g"] * (p["m1"] + p["m2"]) * dBz / 2
+    return x, J, dV
+
+
+def slider_crank_3d_reference(times, rtol=1e-13, atol=1e-13, **data):
+    """The spatial slider-crank's slider x and crank angle theta at ``times``.
+
+    One degree of freedom: Lagrange's equation of the crank angle,
+    J(theta) theta'' + 1/2 J'(theta) theta'^2 + V'(theta) = 0, with J and V' from
+    _slider_crank_3d_kinematics (J' by a complex step, exact to rounding), from theta = 0,
+    theta' = omega0, integrated by scipy's DOP853 at rtol = atol = 1e-13. Returns
+    (x, theta) arrays."""
+    p = dict(SLIDER_CRANK_3D, **data)
+    h = 1e-30
+
+    def rhs(t, y):
+        _, J, dV = _slider_crank_3d_kinematics(y[0], p)
+        dJ = _slider_crank_3d_kinematics(y[0] + 1j * h, p)[1].imag / h
+        return (y[1], -(0.5 * dJ * y[1] ** 2 + dV) / J)
+
+    times = np.asarray(times, dtype=float)
+    sol = solve_ivp(rhs, (0.0, float(times.max())), (0.0, p["omega0"]), method="DOP853", rtol=rtol,
+                    atol=atol, dense_output=True)
+    theta = sol.sol(times)[0]
+    return np.array([_slider_crank_3d_kinematics(th, p)[0] for th in theta]), theta

@@ -1,12 +1,15 @@
 """The field's benchmark problems (issue 18) run to the end and meet independent references.
 
 IFToMM/LIM A01 (simple pendulum), A02 (N-four-bar through its singular positions), A03 /
-the IVP test set's `andrews`, A04 (Bricard's over-constrained loop), Bennett's and
+the IVP test set's `andrews`, A04 (Bricard's over-constrained loop), A05 (the stiff
+flyball governor), the IFToMM library's spatial rigid slider-crank, Bennett's and
 Sarrus' over-constrained linkages and a 1 km pendulum in SI units. The references are in
 benchmarks/iftomm_reference.py and use no mbsynth: Jacobi's elliptic functions for the
 pendulum, the N-four-bar's exact one-degree-of-freedom equation integrated by scipy at
-1e-13, the test set's published angles at 0.03 s, energy conservation, and the joints'
-gaps computed from the bodies' coordinates with quaternions written out there.
+1e-13, the test set's published angles at 0.03 s, energy conservation, the joints'
+gaps computed from the bodies' coordinates with quaternions written out there, the
+flyball governor's and the spatial slider-crank's equations in their own few coordinates
+written by hand, and the slider-crank library's published solution.
 
 They fail on a solver that stops at, or mis-steps through, a configuration where the
 dependent rows change (Bricard, the N-four-bar) or that judges consistency with an
@@ -57,6 +60,8 @@ def energy_change(traj):
     ("bricard.yaml", 35, 1),     # Grübler 0, mobility 1: one dependent joint row
     ("bennett.yaml", 21, 3),     # Grübler -2, mobility 1
     ("sarrus.yaml", 35, 1),      # Grübler 0, mobility 1
+    ("flyball_governor.yaml", 34, 0),
+    ("slider_crank_3d.yaml", 21, 0),
 ])
 def test_model_verdicts(name, n, dependent):
     d = diagnose(load(name))
@@ -79,6 +84,30 @@ def test_n_four_bar_generator_matches_the_file():
     q, qd = system.initial_state()
     phi, psi = system.constraint_residuals(0.0, q, qd)
     assert np.abs(phi).max() < 1e-14 and np.abs(psi).max() < 1e-14   # consistent as written
+
+
+def test_flyball_and_slider_crank_3d_degrees_of_freedom():
+    """The flyball governor: shaft angle, slider height and two rod angles; the spatial
+    slider-crank: the crank angle (the universal joint fixes the rod's spin)."""
+    for name, dof in (("flyball_governor.yaml", 4), ("slider_crank_3d.yaml", 1)):
+        d = diagnose(load(name))
+        assert d.n - d.rank_A == dof, name
+
+
+def test_slider_crank_3d_starts_as_the_benchmark_states():
+    """Crank straight up, B = A + (0, 0, l1), C = (0.2, 0, 0), the rod's x along BC and the
+    cross's rod axis (frame C's z, the rod's y) perpendicular to the rail (x) and to BC."""
+    system = load("slider_crank_3d.yaml")
+    q, qd = system.initial_state()
+    r_crank, R_crank = ref.body_pose(system.coordinates, q, "crank")
+    r_rod, R_rod = ref.body_pose(system.coordinates, q, "rod")
+    B = r_crank + R_crank @ (0, 0, 0.04)
+    np.testing.assert_allclose(B, (0, 0.1, 0.2), atol=1e-15)
+    np.testing.assert_allclose(r_rod - R_rod @ (0.15, 0, 0), B, atol=1e-15)
+    np.testing.assert_allclose(r_rod + R_rod @ (0.15, 0, 0), (0.2, 0, 0), atol=1e-15)
+    assert abs(R_rod[0, 1]) < 1e-15     # the rod's y axis has no x component
+    index = {c: i for i, c in enumerate(system.coordinates)}
+    assert qd[index["slider.x"]] == pytest.approx(0.24, abs=1e-14)
 
 
 def test_bricard_initial_loop_is_closed():
@@ -114,6 +143,18 @@ def test_n_four_bar_reference_conserves_energy_and_crosses_singularities():
     t = np.linspace(0, 20, 2001)
     x, y = ref.n_four_bar_reference(t, 2)
     assert np.allclose(x**2 + y**2, 1.0, atol=1e-12)
+
+
+def test_slider_crank_3d_reference_meets_the_published_solution():
+    """The crank angle's equation written by hand against the IFToMM library's published
+    solution (M. González, slider x every 0.1 s for 5 s, printed to 9 digits): within
+    1e-4 m over the 5 s (7.0e-5 m), 2e-6 m at 0.1 s (1.8e-6 m; the published solution's
+    own accuracy)."""
+    published = ref.SLIDER_CRANK_3D_PUBLISHED
+    x, theta = ref.slider_crank_3d_reference(published[:, 0])
+    assert x[0] == pytest.approx(0.2, abs=1e-15) and theta[0] == 0
+    error = np.abs(x - published[:, 1])
+    assert error.max() < 1e-4 and error[1] < 2e-6
 
 
 # --- the runs ------------------------------------------------------------------------------
@@ -212,6 +253,55 @@ def test_pendulum_1km_runs_120_s_with_the_rod_held():
     xr, yr = ref.pendulum_exact(traj.t, L, 9.81, 0.3)
     assert np.max(np.hypot(x - xr, y - yr)) < 1e-6 * L
     assert energy_change(traj) < 1e-8
+
+
+def test_flyball_governor_follows_its_four_coordinate_equations():
+    """A05, 1 s of the stiff flyball governor (dampers' fast mode about -7e3 1/s) at the
+    default tolerance: the slider's height and the shaft's rate on the Lagrange equations
+    written by hand, and the energy E(t) = E(0) minus the dampers' work."""
+    traj = mb.simulate(load("flyball_governor.yaml"), 1.0, dt=0.05)
+    assert traj.status == "completed"
+    r = ref.flyball_reference(traj.t)
+    assert np.max(np.abs(traj.column("slider.z") - r["s"])) < 1e-9
+    assert traj.column("slider.z").max() > 0.7         # the slider does swing up
+    qw, qz = traj.column("shaft.qw"), traj.column("shaft.qz")
+    omega = 2 * (qw * traj.column("shaft.qz_dot") - qz * traj.column("shaft.qw_dot"))
+    assert np.max(np.abs(omega - r["phi_dot"])) < 1e-9
+    E = traj.energy
+    assert np.max(np.abs(E - E[0] + r["W"])) < 1e-9 * abs(E[0])
+
+
+def test_slider_crank_3d_follows_the_crank_equation_and_the_published_solution():
+    """The IFToMM spatial slider-crank, 1 s: the slider on the crank angle's equation, and
+    within the published solution's own 5e-5 m of it at its 0.1 s samples."""
+    traj = mb.simulate(load("slider_crank_3d.yaml"), 1.0, dt=0.1)
+    assert traj.status == "completed"
+    x = traj.column("slider.x")
+    xr, _ = ref.slider_crank_3d_reference(traj.t)
+    assert np.max(np.abs(x - xr)) < 1e-9
+    published = ref.SLIDER_CRANK_3D_PUBLISHED[:11]
+    np.testing.assert_allclose(traj.t, published[:, 0], atol=1e-12)
+    assert np.max(np.abs(x - published[:, 1])) < 5e-5
+    assert energy_change(traj) < 1e-8
+
+
+def test_only_merges_its_rows_into_an_existing_table(tmp_path):
+    """--only with an existing results file: the problem run replaces its own row and
+    note, every other row stays, and a line says which rows were run again."""
+    import iftomm
+    out = tmp_path / "results.md"
+    old = (ROOT / "benchmarks" / "iftomm_results.md").read_text()
+    out.write_text(old)
+    iftomm.main(["--quick", "--only", "pendulum", "--out", str(out)])
+    text = out.read_text()
+    _, old_rows, _ = iftomm._table_parts(old)
+    _, rows, notes = iftomm._table_parts(text)
+    title = "A01 simple pendulum (1 m, from horizontal)"
+    assert list(rows) == list(old_rows) and len(rows) > 1
+    assert all(rows[t] == old_rows[t] for t in rows if t != title)
+    assert rows[title].startswith(f"| {title} | 1 |") and rows[title] != old_rows[title]
+    assert f"rows {title} run again by" in text and "iftomm.py --quick --only pendulum`" in text
+    assert sum(n.startswith(f"- {title}: ") for n in notes) == 1
 
 
 def test_benchmark_script_quick_writes_its_table(tmp_path):

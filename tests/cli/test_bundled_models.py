@@ -30,6 +30,7 @@ MODES = {
     "mechanisms/bennett.yaml": "equilibrium",
     "mechanisms/bricard.yaml": "equilibrium",
     "mechanisms/double_pendulum_rods.yaml": "equilibrium",
+    "mechanisms/flyball_governor.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the shaft turns freely
     "mechanisms/four_bar.yaml": "equilibrium",
     "mechanisms/four_bar_3d.yaml": "equilibrium",
     "mechanisms/massless_link.yaml": ([], 2, NOT_UNIQUE),  # the massless link's free spin
@@ -39,6 +40,7 @@ MODES = {
     "mechanisms/sarrus.yaml": "equilibrium",
     "mechanisms/simple_pendulum.yaml": "equilibrium",
     "mechanisms/slider_crank.yaml": "equilibrium",
+    "mechanisms/slider_crank_3d.yaml": "equilibrium",  # the crank straight up (unstable)
     "paper/example1_wheel.yaml": (["--equilibrium"], 1, "no static equilibrium found"),  # it rolls down for ever
     "paper/example2_massless_particle.yaml": ([], 2, NOT_UNIQUE),
     "paper/example3_m1_zero.yaml": "equilibrium",
