@@ -4,14 +4,14 @@ import json
 
 from ..analysis.diagnose import diagnose
 from ..compiled.background import default_mode
-from ..io import load
+from .parsers import model_of
 
 
 def run(args):
     # a handful of evaluations at one state: compiling kernels (numba) in the background
     # would only compete with them (MBSYNTH_FAST set by the user is kept)
     with default_mode("off"):
-        system = load(args.model)
+        system = model_of(args)
         report = diagnose(system)
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))

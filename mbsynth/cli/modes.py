@@ -5,14 +5,13 @@ import json
 import tempfile
 from pathlib import Path
 
-from ..io import load
 from ..analysis.modes import format_modes, mode_motion, modes, to_dict
-from .parsers import check_flags
+from .parsers import check_flags, model_of
 
 
 def run(args):
     check_flags(args, outputs=(("--html", (".html",)),))
-    system = load(args.model)
+    system = model_of(args)
     result = modes(system, equilibrium=args.equilibrium, steady=args.steady)
     if args.html:
         write_html(system, result, args.html)

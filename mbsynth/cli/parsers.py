@@ -61,6 +61,34 @@ def parser():
     return top
 
 
+def _model_argument(command):
+    """The model file and ``--set NAME=VALUE`` (repeatable): parameter values over the file's."""
+    command.add_argument("model", help="model file (YAML)")
+    command.add_argument("--set", action="append", type=_assignment, default=[], metavar="NAME=VALUE",
+                         help="a parameter's value instead of the model file's (repeatable; parameters defined "
+                              "by expressions of it, and initial values written with it, follow)")
+
+
+def _assignment(text):
+    """(name, value) of NAME=VALUE, VALUE a real number."""
+    name, sep, value = text.partition("=")
+    try:
+        number = float(value)
+    except ValueError:
+        number = None
+    if not sep or not name.strip() or number is None or not math.isfinite(number):
+        raise argparse.ArgumentTypeError(f"{text!r}: write NAME=VALUE with a finite number, e.g. v=4.6")
+    return name.strip(), number
+
+
+def model_of(args):
+    """The System of ``args.model`` with the ``--set`` values (ModelError naming an unknown
+    parameter)."""
+    from ..io import load
+    system = load(args.model)
+    return system.with_parameters(**dict(args.set)) if args.set else system
+
+
 def _check(commands):
     check = commands.add_parser(
         "check", help="is the motion of a model unique? (Result 3 at the initial state)",
@@ -70,7 +98,7 @@ def _check(commands):
                     "A model with joints gets its accelerations as joint accelerations (a revolute "
                     "joint's angle, a prismatic joint's displacement, ...: the time derivatives of "
                     "the joints' rates) and the joints each indeterminate direction moves.")
-    check.add_argument("model", help="model file (YAML)")
+    _model_argument(check)
     check.add_argument("--json", action="store_true",
                        help="print one JSON object (both 'qdd', per coordinate, and 'joints')")
     check.add_argument("--coordinates", choices=("joints", "maximal"), default="joints",
@@ -84,7 +112,7 @@ def _simulate(commands):
         "simulate", help="integrate a model over time",
         description="Integrate the model from its initial state (made consistent with the constraints) "
                     "to --t-end, keeping the constraints by projection; print a summary.")
-    sim.add_argument("model", help="model file (YAML)")
+    _model_argument(sim)
     sim.add_argument("--t-end", type=float, required=True, help="end time [s]")
     sim.add_argument("--dt", type=float, help="output interval [s] (default t_end/500)")
     sim.add_argument("--out", help="trajectory file (.npz or .csv), written as the run goes")
@@ -132,7 +160,7 @@ def _view(commands):
         description="Simulate the model (or read --trajectory) and draw its motion in meshcat: served live "
                     "on this machine (the URL is printed; Ctrl-C stops it), or with --html written as one "
                     "HTML file that plays offline in any browser.")
-    view.add_argument("model", help="model file (YAML)")
+    _model_argument(view)
     view.add_argument("--t-end", type=float, default=5.0, help="end time of the simulation [s] (default 5)")
     view.add_argument("--trajectory", metavar="FILE.npz", help="draw this saved trajectory instead of simulating")
     view.add_argument("--html", metavar="FILE.html", help="write the animation to this file instead of serving it")
@@ -177,7 +205,7 @@ def _modes(commands):
                     "non-holonomic rows, massless parts closed by their balances, and print one row per mode: "
                     "frequency, damping ratio, kind (vibration, overdamped, unstable, free) and the "
                     "joints (or coordinates) that move most.")
-    modes.add_argument("model", help="model file (YAML)")
+    _model_argument(modes)
     modes.add_argument("--equilibrium", action="store_true",
                        help="first find the rest the model comes to from its initial state, its motion "
                             "damped away (the stable equilibrium whose basin holds it)")

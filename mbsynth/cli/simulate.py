@@ -5,10 +5,9 @@ import sys
 import time
 
 from ..core.errors import ModelError, SimulationError
-from ..io import load
 from ..analysis.simulate import simulate
 from ..analysis.trajectory import output_file
-from .parsers import check_flags
+from .parsers import check_flags, model_of
 from .report import ProgressBar, on_terminal
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # scipy solve_ivp's methods
@@ -23,7 +22,7 @@ def run(args):
     if args.plot_vars and not args.plot:
         raise ModelError(f"--plot-vars {' '.join(args.plot_vars)}: chooses what the figure draws; "
                          "give the figure's file with --plot FILE.png too")
-    system = load(args.model)
+    system = model_of(args)
     if args.plot_vars:
         check_plot_vars(system, args.plot_vars)
     bar = ProgressBar(args.t_end) if on_terminal(args) else None

@@ -4,15 +4,14 @@ import sys
 
 from ..view import viewer
 from ..core.errors import SimulationError
-from ..io import load
 from ..analysis.simulate import simulate
 from ..analysis.trajectory import load_trajectory
-from .parsers import check_flags
+from .parsers import check_flags, model_of
 
 
 def run(args):
     check_flags(args, positive=("--t-end",), outputs=(("--html", (".html",)),))
-    system = load(args.model)
+    system = model_of(args)
     status = 0
     if args.trajectory:
         traj = load_trajectory(args.trajectory)

@@ -15,7 +15,6 @@ import warnings
 
 import numpy as np
 import sympy as sp
-from scipy.spatial.transform import Rotation
 
 from ...core.kinematics import euler_rate_matrix, euler_rotation
 from ...symbolic.cache import placeholder, remembered
@@ -65,6 +64,7 @@ def angles_of(sequence, R):
     """The angles of ``sequence`` whose rotation is the numeric matrix R (the middle turn in
     [−90°, 90°] for Tait–Bryan, [0, 180°] for proper Euler; at the singular position the
     last angle is 0)."""
+    from scipy.spatial.transform import Rotation  # at load time only: building a robot imports no scipy
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # scipy's "gimbal lock": the last angle is set to 0
         return Rotation.from_matrix(np.asarray(R, dtype=float)).as_euler(sequence.upper())
