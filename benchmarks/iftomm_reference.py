@@ -419,3 +419,35 @@ def slider_crank_3d_reference(times, rtol=1e-13, atol=1e-13, **data):
                     atol=atol, dense_output=True)
     theta = sol.sol(times)[0]
     return np.array([_slider_crank_3d_kinematics(th, p)[0] for th in theta]), theta
+
+
+# --- the Whipple bicycle (Meijaard, Papadopoulos, Ruina & Schwab, Proc. R. Soc. A 463 (2007)
+# 1955-1982, doi 10.1098/rspa.2007.1857) ----------------------------------------------------
+# The benchmark's linearized equations M q'' + v C1 q' + (g K0 + v^2 K2) q = 0 for q = (lean,
+# steer), with the matrices the paper prints for its benchmark parameters (its eq. 5.4), and
+# its Table 2: the eigenvalues at 4, 5 and 10 m/s and the weave and capsize speeds.
+WHIPPLE_M = np.array([[80.81722, 2.31941332208709], [2.31941332208709, 0.29784188199686]])
+WHIPPLE_C1 = np.array([[0.0, 33.86641391492494], [-0.85035641456978, 1.68540397397560]])
+WHIPPLE_K0 = np.array([[-80.95, -2.59951685249872], [-2.59951685249872, -0.80329488458618]])
+WHIPPLE_K2 = np.array([[0.0, 76.59734589573222], [0.0, 2.65431523794604]])
+WHIPPLE_TABLE_2 = {4.0: [-12.15861426576450, -1.42944427361326, 0.41325331521125 - 3.07910818603206j,
+                         0.41325331521125 + 3.07910818603206j],
+                   5.0: [-14.07838969279822, -0.32286642900409, -0.77534188219585 - 4.46486771378823j,
+                         -0.77534188219585 + 4.46486771378823j],
+                   10.0: [-24.62459635017404, 0.16105338653172, -3.72016840437287 - 10.90681139476287j,
+                          -3.72016840437287 + 10.90681139476287j]}
+WHIPPLE_WEAVE_SPEED, WHIPPLE_CAPSIZE_SPEED = 4.29238253634111, 6.02426201538837
+
+
+def whipple_linear_lean(times, v, lean_rate, g=9.81, rtol=1e-13, atol=1e-15):
+    """The lean angle of the benchmark's linearized equations at speed v after a lean rate
+    ``lean_rate`` at t = 0 (lean, steer and steer rate 0), at ``times`` (scipy DOP853)."""
+    K = g * WHIPPLE_K0 + v * v * WHIPPLE_K2
+
+    def rhs(t, y):
+        return np.concatenate([y[2:], np.linalg.solve(WHIPPLE_M, -v * WHIPPLE_C1 @ y[2:] - K @ y[:2])])
+
+    times = np.asarray(times, dtype=float)
+    sol = solve_ivp(rhs, (0.0, float(times.max())), (0.0, 0.0, lean_rate, 0.0), method="DOP853", rtol=rtol,
+                    atol=atol, dense_output=True)
+    return sol.sol(times)[0]
