@@ -3,6 +3,7 @@ the stability exponents of rolling disks, a sleigh on a massless blade and the W
 bicycle, against closed forms, an independent derivation by Kane's method (sympy), and
 the bicycle benchmark's published eigenvalues and self-stable speeds."""
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -12,18 +13,16 @@ from scipy.optimize import brentq
 
 import mbsynth as mb
 
-MODELS = Path(__file__).resolve().parents[2] / "models"
+ROOT = Path(__file__).resolve().parents[2]
+MODELS = ROOT / "models"
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import iftomm_reference as ref  # noqa: E402
 
 # J. P. Meijaard, J. M. Papadopoulos, A. Ruina, A. L. Schwab, Proc. R. Soc. A 463 (2007)
 # 1955-1982, Table 2: the benchmark bicycle's eigenvalues (1/s) at 4, 5 and 10 m/s, and its
-# weave and capsize speeds (m/s), printed to 14 decimals.
-TABLE_2 = {4.0: [-12.15861426576450, -1.42944427361326, 0.41325331521125 - 3.07910818603206j,
-                 0.41325331521125 + 3.07910818603206j],
-           5.0: [-14.07838969279822, -0.32286642900409, -0.77534188219585 - 4.46486771378823j,
-                 -0.77534188219585 + 4.46486771378823j],
-           10.0: [-24.62459635017404, 0.16105338653172, -3.72016840437287 - 10.90681139476287j,
-                  -3.72016840437287 + 10.90681139476287j]}
-WEAVE_SPEED, CAPSIZE_SPEED = 4.29238253634111, 6.02426201538837
+# weave and capsize speeds (m/s), printed to 14 decimals (benchmarks/iftomm_reference.py).
+TABLE_2 = ref.WHIPPLE_TABLE_2
+WEAVE_SPEED, CAPSIZE_SPEED = ref.WHIPPLE_WEAVE_SPEED, ref.WHIPPLE_CAPSIZE_SPEED
 STILL = [-5.53094371765393, -3.13164324790656, 3.13164324790656, 5.53094371765393]  # Table 2 at v = 0
 
 
@@ -48,6 +47,17 @@ def test_bicycle_eigenvalues_equal_table_2(bicycle, v):
     got = _nonzero(lin.eigenvalues)
     assert np.abs(got - np.sort_complex(TABLE_2[v])).max() < 1e-8
     assert np.count_nonzero(lin.eigenvalues == 0) == 6  # position, heading, wheel angles, forward speed
+
+
+@pytest.mark.parametrize("v", [0.5, 2.0, 4.6, 6.5, 8.0])
+def test_bicycle_eigenvalues_equal_the_benchmarks_linear_equations(bicycle, v):
+    """At any speed: the roots of det(s² M + s v C1 + g K0 + v² K2) with the matrices the paper
+    prints (its eq. 5.4, 14 digits), as the first-order companion form's eigenvalues."""
+    M, C1 = ref.WHIPPLE_M, ref.WHIPPLE_C1
+    K = 9.81 * ref.WHIPPLE_K0 + v * v * ref.WHIPPLE_K2
+    companion = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -v * np.linalg.solve(M, C1)]])
+    expected = np.sort_complex(np.linalg.eigvals(companion))
+    assert np.abs(_nonzero(_bicycle_at(bicycle, v).eigenvalues) - expected).max() < 1e-9 * np.abs(expected).max()
 
 
 def test_bicycle_standing_still_is_two_inverted_pendulums(bicycle):
