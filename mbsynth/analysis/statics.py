@@ -88,7 +88,8 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
             return q
         if lin.A.shape[0] != 2 * k:
             raise SolveError(f"model '{system.name}': its non-holonomic rows leave {lin.A.shape[0] - k} of {k} "
-                             "speeds free: no static equilibrium search (it moves on the holonomic rows only)")
+                             "speeds free: mb.equilibrium does not search models with rows that restrict "
+                             "velocities only (its steps move along every direction the holonomic rows allow)")
         K = lin.A[k:, :k]
         resolution = tolerance * (1.0 + np.abs(K).max())
         model = None

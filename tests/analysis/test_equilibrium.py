@@ -176,3 +176,10 @@ def test_a_saddle_the_steps_come_to_is_left_downhill():
     assert mb.equilibrium(system, np.array([0.0, 1.0]), nearest=True) == pytest.approx([0.0, 0.0], abs=1e-9)
     assert mb.equilibrium(system, np.array([0.1, 0.5]), nearest=True) == pytest.approx([0.0, 0.0], abs=1e-9)
     assert mb.equilibrium(system, np.array([0.8, 0.3]), nearest=True) == pytest.approx([1 / np.sqrt(2), 0], abs=1e-9)
+
+
+def test_non_holonomic_rows_are_refused():
+    """A knife edge (one row on its velocities): the search, which moves along every direction
+    the holonomic rows allow, is refused with a SolveError that says why."""
+    with pytest.raises(mb.SolveError, match=r"non-holonomic rows leave 2 of 3 speeds free"):
+        mb.equilibrium(mb.load(MODELS / "rolling" / "knife_edge.yaml"))
