@@ -9,10 +9,11 @@ world pose of its named frames for connectors and force elements.
 
 from .base import LINK_FRAME, Frame, Part
 from .euler_body import EulerBody
+from .flexible_body import FlexibleBody
 from .lagrangian import LagrangianPart
 from .particle import Particle
 from .planar_body import PlanarBody
 from .rigid_body import RigidBody
 from .spring import Spring
 
-__all__ = ["LINK_FRAME", "EulerBody", "Frame", "Part", "LagrangianPart", "Particle", "PlanarBody", "RigidBody", "Spring"]
+__all__ = ["LINK_FRAME", "EulerBody", "FlexibleBody", "Frame", "Part", "LagrangianPart", "Particle", "PlanarBody", "RigidBody", "Spring"]
