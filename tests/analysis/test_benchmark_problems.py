@@ -287,7 +287,7 @@ def test_slider_crank_3d_follows_the_crank_equation_and_the_published_solution()
 
 def test_only_merges_its_rows_into_an_existing_table(tmp_path):
     """--only with an existing results file: the problem run replaces its own row and
-    note, every other row stays, and a line says which rows were run again."""
+    note, every other row stays, and one line says which rows were run again."""
     import iftomm
     out = tmp_path / "results.md"
     old = (ROOT / "benchmarks" / "iftomm_results.md").read_text()
@@ -302,6 +302,8 @@ def test_only_merges_its_rows_into_an_existing_table(tmp_path):
     assert rows[title].startswith(f"| {title} | 1 |") and rows[title] != old_rows[title]
     assert f"rows {title} run again by" in text and "iftomm.py --quick --only pendulum`" in text
     assert sum(n.startswith(f"- {title}: ") for n in notes) == 1
+    iftomm.main(["--quick", "--only", "pendulum", "--out", str(out)])     # again: one line says so
+    assert out.read_text().count(f"rows {title} run again by") == 1
 
 
 def test_benchmark_script_quick_writes_its_table(tmp_path):
