@@ -99,10 +99,10 @@ def test_simulate(capsys, tmp_path, runaway, monkeypatch):
 def test_an_interrupted_run_says_whether_it_wrote_anything(capsys, tmp_path, monkeypatch):
     """Ctrl-C before the run began (here: while the model loads): nothing was written, and
     it says so; an earlier run's file is left as it was, and said to be."""
-    def interrupted(path):
+    def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(simulate_command, "load", interrupted)
+    monkeypatch.setattr(simulate_command, "model_of", interrupted)
     out = tmp_path / "run.npz"
     code, _, err = run(capsys, "simulate", EXAMPLE3, "--t-end", "1", "--out", out)
     assert code == 130 and err == f"error: interrupted; nothing was written to {out}\n" and not out.exists()
