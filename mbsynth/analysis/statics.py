@@ -154,7 +154,6 @@ class _Model:
         """The model of a rest's neighbourhood with its negative curvature kept: its steps go
         down along it (the trust region's hard case)."""
         self.c, self.d = np.zeros_like(self.c), self.curvature
-        return self
 
     def size(self, p):
         """‖p‖_M."""
@@ -249,6 +248,8 @@ class _Merit:
 
 @dataclass(frozen=True)
 class _Point:
+    """A configuration on the constraints with its q̈, F = M q̈ at rest and V (None where V is not Ψ)."""
+
     q: np.ndarray
     qdd: np.ndarray
     force: np.ndarray
