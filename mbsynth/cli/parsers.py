@@ -207,8 +207,8 @@ def _modes(commands):
                     "joints (or coordinates) that move most.")
     _model_argument(modes)
     modes.add_argument("--equilibrium", action="store_true",
-                       help="first find the rest the model comes to from its initial state, its motion "
-                            "damped away (the stable equilibrium whose basin holds it)")
+                       help="first find a stable rest from the initial state: a minimum of the potential on "
+                            "the constraints that steps down from it reach (mb.equilibrium)")
     modes.add_argument("--steady", action="store_true",
                        help="linearize about the model's initial motion, a steady one (a bicycle rolling upright, a "
                             "disk rolling in a circle: only cyclic coordinates move, at constant rates): its "
