@@ -199,8 +199,8 @@ def _validate(commands):
 def _modes(commands):
     modes = commands.add_parser(
         "modes", help="natural frequencies, damping ratios and mode shapes about a rest state or a steady motion",
-        description="Linearize the model about its initial configuration at rest (or, with --equilibrium, the "
-                    "static equilibrium nearest it; with --steady, about its initial motion, a steady one) in "
+        description="Linearize the model about its initial configuration at rest (or, with --equilibrium, a "
+                    "stable rest found from it; with --steady, about its initial motion, a steady one) in "
                     "independent coordinates of its constraints' tangent space and independent speeds of its "
                     "non-holonomic rows, massless parts closed by their balances, and print one row per mode: "
                     "frequency, damping ratio, kind (vibration, overdamped, unstable, free) and the "
