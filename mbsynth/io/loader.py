@@ -20,6 +20,7 @@ from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..model.parts import LagrangianPart
 from ..symbolic.derive import T_SYMBOL, joint_values_in
 from ..model.system import System
+from .flexible import read_flexible_body
 from .forces import read_forces
 from .joints import read_joints, read_world
 from .outputs import read_outputs
@@ -409,7 +410,7 @@ class _Builder:
 
 SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,
                    "particle": read_particle, "planar_body": read_planar_body, "spring": read_spring,
-                   "robot": read_robot}
+                   "robot": read_robot, "flexible_body": read_flexible_body}
 
 
 def _real(expr, values):

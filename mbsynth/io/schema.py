@@ -60,6 +60,7 @@ _TYPE = {  # the ``type`` key of a part; its value selects the section
     "planar_body": "rigid body in the xy plane",
     "spring": "spring (with optional mass) between two free ends",
     "robot": "a whole robot from a URDF, one rigid body per link",
+    "flexible_body": "a reduced finite-element body on a floating frame (docs/flexible.md)",
 }
 _DESCRIPTION = Key("description", "string", "free text, ignored by the loader", "'the left wheel'")
 _NAME = Key("name", "plain name", "the element's name in reports", "spring_1", default="<type>_<index>")
@@ -95,7 +96,7 @@ SECTIONS = {section.name: section for section in (
                  "particles, planar bodies and spring masses [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
              Key("world", "mapping (section *world*)", "frames fixed in the world", "{frames: {pin: {}}}"),
              _required("subsystems", "mapping name → part", "the parts, each with a ``type`` "
-                       "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*)", "{wheel: {type: particle, mass: m}}"),
+                       "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*, *flexible_body*)", "{wheel: {type: particle, mass: m}}"),
              Key("constraints", "list of constraints (section *constraint*)",
                  "constraints written as equations in the parts' coordinates", "[{holonomic: a.x - b.x}]",
                  default="[]"),
@@ -183,6 +184,91 @@ SECTIONS = {section.name: section for section in (
              Key("initial", "mapping URDF joint name → " + _EXPR, "initial position of each movable joint "
                  "[rad or m]: the links start where the URDF's kinematics puts them", "{elbow_joint: 0.5}",
                  default="0 for every joint"), _DESCRIPTION)),
+    Section("flexible_body", "``subsystems: {NAME: {type: flexible_body, ...}}``",
+            "A flexible body: a finite-element model (``beam`` or ``fe``, exactly one) reduced to a few "
+            "coordinates, on a floating frame. Coordinates x, y, z (the frame's origin, which is the FE "
+            "model's origin), the unit quaternion qw, qx, qy, qz of its axes and the reduced coordinates "
+            "eta1, eta2, …; every interface node is a frame ``node_<index>``, whose pose follows the "
+            "node's elastic displacement and rotation.",
+            (_TYPE_KEY["flexible_body"],
+             Key("beam", "mapping (section *flexible_beam*)", "a straight beam from the built-in generator",
+                 "{length: 1.0, elements: 20, area: 1e-4, Iy: 1e-9, Iz: 1e-9, J: 2e-9, E: 2.1e11, nu: 0.3, "
+                 "density: 7850}"),
+             Key("fe", "mapping (section *flexible_fe*)", "an FE model's mass and stiffness matrices and nodes "
+                 "from files", "{bundle: rod.npz}"),
+             _required("reduction", "mapping (section *flexible_reduction*)", "how the FE model is reduced",
+                       "{method: craig_bampton, interface: [0, 20], modes: 4}"),
+             Key("damping", "mapping (section *flexible_damping*)", "structural damping of the reduced "
+                 "coordinates", "{modal: 0.02}", default="none"),
+             Key("frames", "mapping name → node frame (section *flexible_frame*)", "named frames at FE nodes, "
+                 "besides the interface nodes' ``node_<index>``", "{tip: {node: 20}}", default="{}"),
+             _GEOMETRY,
+             Key("initial", "mapping (section *initial_flexible_body*)", "initial pose, velocities and "
+                 "amplitudes", "{position: [0, 0, 1]}", default="at rest at the origin, undeformed"),
+             _DESCRIPTION)),
+    Section("flexible_beam", "``beam:`` of a flexible_body",
+            "A uniform straight beam of two-node elements (6 DOFs per node) from the origin along ``axis``: "
+            "node 0 at the origin, node ``elements`` at the far end. Give exactly one of G and nu.",
+            (_required("length", _EXPR + ", > 0", "length [m]", "1.0"),
+             _required("elements", "integer ≥ 1", "number of elements", "20"),
+             _required("area", _EXPR + ", > 0", "cross-section area [m²]", "1e-4"),
+             _required("Iy", _EXPR + ", > 0", "second moment about the section's y axis [m⁴] (bending in "
+                       "the x–z plane)", "1e-9"),
+             _required("Iz", _EXPR + ", > 0", "second moment about the section's z axis [m⁴] (bending in "
+                       "the x–y plane)", "1e-9"),
+             _required("J", _EXPR + ", > 0", "torsion constant [m⁴]", "2e-9"),
+             _required("E", _EXPR + ", > 0", "Young's modulus [Pa]", "2.1e11"),
+             _required("density", _EXPR + ", > 0", "density [kg/m³]", "7850"),
+             Key("G", _EXPR + ", > 0", "shear modulus [Pa]", "8.1e10"),
+             Key("nu", _EXPR, "Poisson's ratio (G = E / 2(1 + ν))", "0.3"),
+             Key("shear_factor", _EXPR + ", > 0", "Timoshenko's shear factor κ (timoshenko only)", "0.8333"),
+             Key("theory", "string", "``euler_bernoulli`` or ``timoshenko``", "timoshenko",
+                 default="euler_bernoulli"),
+             Key("mass", "string", "``consistent`` or ``lumped`` (nothing on rotations: M singular)", "lumped",
+                 default="consistent"),
+             Key("axis", "list of 3 " + _EXPRS, "the beam's direction (the section's x axis)", "[1, 0, 0]",
+                 default="[1, 0, 0]"),
+             Key("up", "list of 3 " + _EXPRS, "the section's z axis (made normal to axis)", "[0, 0, 1]",
+                 default="[0, 0, 1]"))),
+    Section("flexible_fe", "``fe:`` of a flexible_body",
+            "FE matrices from files relative to the model file: one ``bundle`` (.npz with nodes, mass, "
+            "stiffness) or all three of mass, stiffness, nodes (Matrix Market .mtx or .npz; nodes also "
+            ".csv or .txt). DOFs node by node, 6 (ux uy uz θx θy θz) or 3 per node.",
+            (Key("bundle", "file name", "an .npz holding nodes, mass and stiffness", "rod.npz"),
+             Key("mass", "file name", "the mass matrix", "rod_M.mtx"),
+             Key("stiffness", "file name", "the stiffness matrix", "rod_K.mtx"),
+             Key("nodes", "file name", "the node coordinates (N × 3)", "rod_nodes.csv"),
+             Key("dofs_per_node", "3 or 6", "DOFs per node", "6", default="n / N"))),
+    Section("flexible_reduction", "``reduction:`` of a flexible_body",
+            "Exactly one of modes and max_frequency. Craig–Bampton's coordinates are the interface nodes' "
+            "DOFs (6 each, but the reference node's, held at the part's frame) and the fixed-interface modes; "
+            "free-interface modes are those of the free model, without its rigid-body modes.",
+            (_required("method", "string", "``craig_bampton`` or ``free_interface``", "craig_bampton"),
+             Key("interface", "list of node indices", "the nodes joints attach to (each a frame "
+                 "``node_<index>``)", "[0, 20]", default="[]"),
+             Key("modes", "integer ≥ 0", "number of (fixed-interface or free) normal modes", "4"),
+             Key("max_frequency", _EXPR + ", ≥ 0", "every normal mode up to this frequency [Hz]", "500"),
+             Key("reference", "node index", "Craig–Bampton: the interface node that moves with the part's frame",
+                 "0", default="the first interface node"))),
+    Section("flexible_damping", "``damping:`` of a flexible_body", "Exactly one key.",
+            (Key("rayleigh", "list of 2 " + _EXPRS + ", ≥ 0", "[α, β]: D = α M_r + β K_r", "[0.0, 1e-4]"),
+             Key("modal", _EXPR + ", ≥ 0", "one damping ratio ζ for every mode of the reduced model with its "
+                 "frame held", "0.02"))),
+    Section("flexible_frame", "each entry of ``frames:`` of a flexible_body",
+            "A frame at an FE node, turned by at most one orientation key; it moves with the node.",
+            (_required("node", "node index", "the FE node", "20"), *_ORIENTATION)),
+    Section("initial_flexible_body", "``initial:`` of a flexible_body",
+            "The frame's origin and axes as a rigid body's (velocities in world axes), and the reduced "
+            "coordinates.",
+            (Key("position", "list of 3 " + _EXPRS, "position of the frame's origin", "[0, 0, 1]",
+                 default="[0, 0, 0]"),
+             Key("velocity", "list of 3 " + _EXPRS, "velocity of the frame's origin", "[1, 0, 0]",
+                 default="[0, 0, 0]"),
+             Key("angular_velocity", "list of 3 " + _EXPRS, "angular velocity (world axes)", "[0, 0, 2]",
+                 default="[0, 0, 0]"), *_ORIENTATION,
+             Key("amplitudes", "list of " + _EXPRS, "eta1, eta2, … (one per reduced coordinate)", "[0.001]",
+                 default="zeros"),
+             Key("amplitude_rates", "list of " + _EXPRS, "their rates", "[0.0]", default="zeros"))),
     Section("initial_rigid_body", "``initial:`` of a rigid_body",
             "Velocities are in world axes.",
             (Key("position", "list of 3 " + _EXPRS, "position of the centre of mass", "[0, 0, 1]",

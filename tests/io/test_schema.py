@@ -26,6 +26,11 @@ BASE = {"parameters": {"m": 1.0, "k": 10.0, "L": 0.5, "R": 0.2, "g": 9.81, "F": 
             "link": {"type": "planar_body", "mass": 1, "inertia": 0.1, "frames": {"top": {"position": [0, 0.5, 0]}}},
             "point": {"type": "particle", "mass": 1}}}
 
+# a flexible body of one mode (the section examples' beam has 20 elements)
+ROD = {"type": "flexible_body", "beam": {"length": 1.0, "elements": 20, "area": 1e-4, "Iy": 1e-9, "Iz": 1e-9, "J": 2e-9,
+                                         "E": 2.1e11, "nu": 0.3, "density": 7850},
+       "reduction": {"method": "craig_bampton", "interface": [0], "modes": 1}}
+
 # Where each section's mapping sits: (path of the mapping in the model, its minimal valid
 # content, the model's other entries it needs). Keys are then added to that mapping.
 HOSTS = {
@@ -62,10 +67,18 @@ HOSTS = {
     "force_force": (("forces", 0), {"type": "force", "at": "body.tip", "value": [0, 0, 1]}, {}),
     "force_torque": (("forces", 0), {"type": "torque", "part": "body", "value": [0, 0, 1]}, {}),
     "output": (("outputs", "watch"), {}, {}),
+    "flexible_body": (("subsystems", "rod"), dict(ROD), {}),
+    "flexible_beam": (("subsystems", "rod", "beam"), dict(ROD["beam"]), {("subsystems", "rod"): dict(ROD)}),
+    "flexible_fe": (("subsystems", "rod", "fe"), {}, {("subsystems", "rod"): {k: v for k, v in ROD.items() if k != "beam"}}),
+    "flexible_reduction": (("subsystems", "rod", "reduction"), dict(ROD["reduction"]), {("subsystems", "rod"): dict(ROD)}),
+    "flexible_damping": (("subsystems", "rod", "damping"), {}, {("subsystems", "rod"): dict(ROD)}),
+    "flexible_frame": (("subsystems", "rod", "frames", "tip"), {"node": 20}, {("subsystems", "rod"): dict(ROD)}),
+    "initial_flexible_body": (("subsystems", "rod", "initial"), {}, {("subsystems", "rod"): dict(ROD)}),
 }
 # Keys of which a mapping takes at most one: each is tried in a model of its own.
 EXCLUSIVE = [{"rpy", "axis", "quaternion"}, {"box", "sphere", "cylinder", "capsule", "mesh", "line"},
-             {"holonomic", "nonholonomic", "acceleration"}, {"reaction", "position", "velocity", "energy"}]
+             {"holonomic", "nonholonomic", "acceleration"}, {"reaction", "position", "velocity", "energy"},
+             {"beam", "fe"}, {"G", "nu"}, {"modes", "max_frequency"}, {"rayleigh", "modal"}]
 
 
 def _place(model, path, value):

@@ -1,0 +1,157 @@
+"""Reading a flexible body (``type: flexible_body``, issue 46): its FE model from the beam
+generator (``beam:``) or from files (``fe:``, relative to the model file), its reduction,
+damping, frames at FE nodes and initial state (sections in schema.py). Every error of the
+FE layer is reported at the key that caused it, with the model file and line."""
+
+from ..core.errors import ModelError
+from ..model.parts import FlexibleBody
+from ..model.parts.flexible_body import coordinates, modal_damping, rayleigh_damping
+from .parts import read_body_initial, read_geometry, read_rotation
+from .source import LineDict
+
+BEAM_NUMBERS = ("length", "area", "Iy", "Iz", "J", "E", "density", "G", "nu", "shear_factor")
+AMPLITUDES = ("amplitudes", "amplitude_rates")
+
+
+def read_flexible_body(builder, name, spec, path):
+    builder.section(spec, path, "flexible_body")
+    fe = _read_fe(builder, spec, path)
+    reduction = _read_reduction(builder, fe, spec.get("reduction"), path + ("reduction",))
+    r = reduction.size
+    damping = _read_damping(builder, reduction, spec.get("damping"), path + ("damping",))
+    frames = _read_frames(builder, fe, spec.get("frames"), path + ("frames",))
+    initial = _read_initial(builder, spec.get("initial"), path + ("initial",), r)
+    q, qd = builder.part_symbols(name, coordinates(r))
+    geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
+    return _fe_layer(builder, path, FlexibleBody, name, q, qd, reduction, builder.gravity,
+                     builder.param_symbols.values(), frames, damping, geometry, initial)
+
+
+def _read_fe(builder, spec, path):
+    """The FE model of ``beam:`` or ``fe:`` (exactly one)."""
+    from ..model.flexible.beam import beam  # scipy: loaded only by models with flexible bodies
+    from ..model.flexible.files import read_fe
+
+    given = [k for k in ("beam", "fe") if k in spec]
+    if len(given) != 1:
+        builder.fail(path, f"a flexible body needs exactly one of beam (the beam generator) and fe (FE matrix "
+                           f"files); got {', '.join(given) or 'neither'}")
+    key = given[0]
+    node = builder.section(spec[key], path + (key,), f"flexible_{key}")
+    where = path + (key,)
+    if key == "beam":
+        numbers = {k: builder.value(builder.constant(node[k], where + (k,))) for k in BEAM_NUMBERS if k in node}
+        elements = node["elements"]
+        if not isinstance(elements, int) or isinstance(elements, bool):
+            builder.fail(where + ("elements",), f"elements must be a positive integer, got {elements!r}")
+        vectors = {k: builder.numbers(node[k], where + (k,), 3) for k in ("axis", "up") if k in node}
+        return _fe_layer(builder, where, beam, numbers.pop("length"), elements, **numbers, **vectors,
+                         theory=node.get("theory", "euler_bernoulli"), mass=node.get("mass", "consistent"))
+    files = {k: str(_file(builder, node[k], where + (k,))) for k in ("bundle", "mass", "stiffness", "nodes") if k in node}
+    if ("bundle" in files) == any(k in files for k in ("mass", "stiffness", "nodes")) or \
+            ("bundle" not in files and len(files) != 3):
+        builder.fail(where, "give either bundle (one .npz) or all three of mass, stiffness and nodes")
+    dofs = node.get("dofs_per_node")
+    if "bundle" in files:
+        return _fe_layer(builder, where, read_fe, files["bundle"], dofs_per_node=dofs)
+    return _fe_layer(builder, where, read_fe, **files, dofs_per_node=dofs)
+
+
+def _fe_layer(builder, path, function, *args, **kwargs):
+    """``function(*args, **kwargs)`` of the FE layer, its ModelError reported at ``path``."""
+    try:
+        return function(*args, **kwargs)
+    except ModelError as err:
+        builder.fail(path, str(err))
+
+
+def _file(builder, text, path):
+    if not isinstance(text, str) or not text:
+        builder.fail(path, f"expected a file name, got {text!r}")
+    file = builder.doc.folder / text
+    if not file.is_file():
+        builder.fail(path, f"file {text!r} not found (looked for {file})")
+    return file
+
+
+def _read_reduction(builder, fe, node, path):
+    """Craig–Bampton with its reference node held at the frame, or free-interface modes
+    without rigid ones."""
+    from ..model.flexible.reduction import craig_bampton, free_interface
+
+    node = builder.section(node, path, "flexible_reduction")
+    method = node["method"]
+    interface = node.get("interface", [])
+    if not isinstance(interface, list) or not all(isinstance(j, int) and not isinstance(j, bool) for j in interface):
+        builder.fail(path + ("interface",), f"interface must be a list of node indices, got {interface!r}")
+    chosen = [k for k in ("modes", "max_frequency") if k in node]
+    if len(chosen) != 1:
+        builder.fail(path, f"choose the modes by exactly one of modes (a count) and max_frequency (Hz); got "
+                           f"{', '.join(chosen) or 'neither'}")
+    count = node.get("modes")
+    limit = builder.value(builder.constant(node["max_frequency"], path + ("max_frequency",))) \
+        if "max_frequency" in node else None
+    if method == "craig_bampton":
+        if not interface:
+            builder.fail(path + ("interface",), "Craig–Bampton needs at least one interface node")
+        reference = node.get("reference", interface[0])
+        if reference not in interface:
+            builder.fail(path + ("reference",), f"the reference node {reference!r} (held at the part's frame) "
+                                                f"must be one of the interface nodes {interface}")
+        reduction = _fe_layer(builder, path, craig_bampton, fe, interface, count=count, max_frequency=limit)
+        return _fe_layer(builder, path, reduction.hold, reference)
+    if method == "free_interface":
+        if "reference" in node:
+            builder.fail(path + ("reference",), "free-interface modes hold no node at the frame: reference is "
+                                                "for craig_bampton")
+        return _fe_layer(builder, path, free_interface, fe, interface, count=count, max_frequency=limit, rigid=False)
+    builder.fail(path + ("method",), f"method must be craig_bampton or free_interface, got {method!r}")
+
+
+def _read_damping(builder, reduction, node, path):
+    if node is None:
+        return None
+    node = builder.section(node, path, "flexible_damping")
+    if len(node) != 1:
+        builder.fail(path, f"give exactly one of rayleigh and modal; got {', '.join(node) or 'neither'}")
+    if "rayleigh" in node:
+        alpha, beta = builder.numbers(node["rayleigh"], path + ("rayleigh",), 2)
+        if alpha < 0 or beta < 0:
+            builder.fail(path + ("rayleigh",), f"α and β must be ≥ 0, got {alpha}, {beta}")
+        return rayleigh_damping(reduction, alpha, beta)
+    ratio = builder.value(builder.constant(node["modal"], path + ("modal",)))
+    if ratio < 0:
+        builder.fail(path + ("modal",), f"the damping ratio must be ≥ 0, got {ratio}")
+    return modal_damping(reduction, ratio)
+
+
+def _read_frames(builder, fe, node, path):
+    """{name: (FE node, rotation)} of ``frames:``."""
+    node = builder.mapping(node, path, set(node) if isinstance(node, dict) else set())
+    frames = {}
+    for name, spec in node.items():
+        fpath = path + (name,)
+        builder.identifier(name, fpath, "frame name")
+        spec = builder.section(spec, fpath, "flexible_frame")
+        at = spec["node"]
+        if not isinstance(at, int) or isinstance(at, bool) or not 0 <= at < len(fe.nodes):
+            builder.fail(fpath + ("node",), f"node must be one of the FE model's nodes, 0 to {len(fe.nodes) - 1}; "
+                                            f"got {at!r}")
+        frames[name] = (at, read_rotation(builder, spec, fpath))
+    return frames
+
+
+def _read_initial(builder, node, path, modes):
+    """The frame's pose and rates (as a rigid body's, for the frame's origin) and the modal
+    amplitudes and their rates (lists of the reduction's size)."""
+    node = builder.section(node, path, "initial_flexible_body")
+    rigid = LineDict({k: v for k, v in node.items() if k not in AMPLITUDES})
+    values = read_body_initial(builder, rigid, path, planar=False)
+    for key, suffix in zip(AMPLITUDES, ("", "_dot")):
+        if key in node:
+            if not isinstance(node[key], list) or len(node[key]) != modes:
+                builder.fail(path + (key,), f"{key}: a list of {modes} numbers, one per coordinate eta1..eta{modes} "
+                                            "of the reduction")
+            values.update({f"eta{k + 1}{suffix}": v for k, v in enumerate(builder.numbers(node[key], path + (key,), modes))})
+    return values
+
