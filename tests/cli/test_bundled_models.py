@@ -20,6 +20,7 @@ NOT_UNIQUE = "the motion is not unique"
 ACCELERATION_ROWS = "restrict accelerations only"
 NOT_STEADY = "does not move steadily"
 MODES = {
+    "flexible/cantilever.yaml": "rests",
     "forces/spring_part_chain.yaml": "equilibrium",
     "forces/spring_pendulum.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the rod spins freely about itself
     "joints/cart_pole_servo.yaml": ([], 1, "rows ['servo'] prescribe a motion at t = 0"),
