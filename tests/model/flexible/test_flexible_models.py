@@ -5,7 +5,7 @@ body spinning in free flight keeping its energy."""
 import numpy as np
 
 import mbsynth as mb
-from flexible_beams import CLAMPED_FREE, LENGTH, STRIP, euler_bernoulli
+from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli
 
 STRIP_FILE = ", ".join(f"{k}: {v}" for k, v in STRIP.items())
 
@@ -29,6 +29,26 @@ joints:
     expected = np.sort(np.concatenate([euler_bernoulli(CLAMPED_FREE, STRIP["Iz"]),
                                        euler_bernoulli(CLAMPED_FREE[:2], STRIP["Iy"])])) / (2 * np.pi)
     assert len(found) == 8
+    np.testing.assert_allclose(found[:5], expected, rtol=1e-6)
+
+
+def test_a_free_beams_modes_are_the_analytic_free_free_ones():
+    """The same strip alone in space, six free-interface modes: mb.modes finds six free
+    (rigid-body) modes of the frame and vibrations whose five lowest are the free–free
+    βL = 4.7300407, 7.8532046, 10.9956078 with Iz and the first two with Iy, to 1e-6."""
+    model = mb.loads(f"""
+subsystems:
+  beam:
+    type: flexible_body
+    beam: {{length: {LENGTH}, elements: 100, {STRIP_FILE}}}
+    reduction: {{method: free_interface, modes: 6}}
+""")
+    modes = mb.modes(model).modes
+    assert sum(m.kind == "free" for m in modes) == 6
+    found = np.array([m.frequency for m in modes if m.kind == "vibration"])
+    expected = np.sort(np.concatenate([euler_bernoulli(FREE_FREE, STRIP["Iz"]),
+                                       euler_bernoulli(FREE_FREE[:2], STRIP["Iy"])])) / (2 * np.pi)
+    assert len(found) == 6
     np.testing.assert_allclose(found[:5], expected, rtol=1e-6)
 
 
