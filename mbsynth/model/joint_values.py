@@ -150,12 +150,13 @@ def _expressions(kind, parent, child, frames, q, qd):
     the report frame's origin and rotation, R_A, R_B, and the report frame's Jacobian."""
     pA, RA = pose(parent, frames[0])
     pB, RB = child.pose(frames[1])
-    positions, rates = _relative(kind, parent, child, pA, RA, pB, RB, q, qd)
+    positions, rates = _relative(kind, parent, child, frames, pA, RA, pB, RB, q, qd)
     rates = sp.Matrix(rates) if rates else sp.zeros(0, 1)
     rate_a = jacobian(rates, qd)
     rate_b = -(jacobian(rates, q) * sp.Matrix(qd)) - sp.diff(rates, T_SYMBOL) if rates else sp.zeros(0, 1)
     pR, RR = child.pose(frames[2])
-    frame_rate = sp.Matrix.vstack(sp.Matrix([time_derivative(x, q, qd) for x in pR]), child.angular_velocity())
+    frame_rate = sp.Matrix.vstack(sp.Matrix([time_derivative(x, q, qd) for x in pR]),
+                                  child.frame_angular_velocity(frames[2]))
     J = jacobian(frame_rate, list(child.qd))
     return [sp.Matrix(positions) if positions else sp.zeros(0, 1), rates, rate_a, rate_b, sp.Matrix(pR),
             sp.Matrix(RR), sp.Matrix(RA), sp.Matrix(RB), J]
@@ -184,7 +185,7 @@ def value_expressions(joint):
     q, qd = joint_coordinates(parent, child)
     pA, RA = pose(parent, joint.frames[0])
     pB, RB = child.pose(joint.frames[1])
-    scalars, rate_exprs = _relative(kind.name, parent, child, pA, RA, pB, RB, q, qd)
+    scalars, rate_exprs = _relative(kind.name, parent, child, joint.frames, pA, RA, pB, RB, q, qd)
     return dict(zip(kind.positions[:len(scalars)] + kind.rates, list(scalars) + list(rate_exprs)))
 
 
@@ -208,11 +209,13 @@ def constraint_symbols(joint):
     return exprs
 
 
-def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):
-    """(scalar position expressions, rate expressions) of a joint of ``kind``."""
+def _relative(kind, parent, child, frames, pA, RA, pB, RB, q, qd):
+    """(scalar position expressions, rate expressions) of a joint of ``kind`` between ``frames``
+    (A, B) at (pA, RA), (pB, RB)."""
     xa, ya, za = RA[:, 0], RA[:, 1], RA[:, 2]
     xb, yb, zb = RB[:, 0], RB[:, 1], RB[:, 2]
-    omega = child.angular_velocity() - (parent.angular_velocity() if parent is not None else sp.zeros(3, 1))
+    omega = child.frame_angular_velocity(frames[1]) - (parent.frame_angular_velocity(frames[0]) if parent is not None
+                                                       else sp.zeros(3, 1))
     angle = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
     displacement = za.dot(pB - pA)
     if kind == "revolute":
@@ -227,7 +230,7 @@ def _relative(kind, parent, child, pA, RA, pB, RB, q, qd):
         return [], list(RB.T * omega)
     if kind == "free":
         velocity = sp.Matrix([time_derivative(x, q, qd) for x in pB])
-        return [], list(RB.T * velocity) + list(RB.T * child.angular_velocity())
+        return [], list(RB.T * velocity) + list(RB.T * child.frame_angular_velocity(frames[1]))
     return [], []
 
 

@@ -85,7 +85,8 @@ class Joint(Connector):
         kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
         phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
         a, b, psi = differentiated(phis, q, qd)
-        self._motions, self._motion_put = _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd), None
+        self._motions, self._motion_put = _free_motions(kind, parent, child, (frame_a, frame_b), pA, RA, pB, RB, q,
+                                                        qd), None
         C = sp.SparseMatrix(len(q), 1, {}) if friction is None else friction.viscous_force(self, qd)
         super().__init__(name, "holonomic", a, b, C, phis, psi, q, qd, params, labels)
         self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
@@ -210,15 +211,16 @@ def _named(parts):
     return " or ".join(f"'{p.name}'" for p in parts if p is not None)
 
 
-def _free_motions(kind, parent, child, pA, RA, pB, RB, q, qd):
-    """(angle, angle rate, displacement, displacement rate) of a joint, None where it has none."""
+def _free_motions(kind, parent, child, frames, pA, RA, pB, RB, q, qd):
+    """(angle, angle rate, displacement, displacement rate) of a joint between ``frames``, None
+    where it has none."""
     xa, za = RA[:, 0], RA[:, 2]
     motions = [None] * 4
     if KINDS[kind].turns:
         xb = RB[:, 0]
-        omega_a = parent.angular_velocity() if parent else sp.zeros(3, 1)
+        omega_a = parent.frame_angular_velocity(frames[0]) if parent else sp.zeros(3, 1)
         motions[0] = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
-        motions[1] = za.dot(child.angular_velocity() - omega_a)
+        motions[1] = za.dot(child.frame_angular_velocity(frames[1]) - omega_a)
     if KINDS[kind].slides:
         motions[2] = za.dot(pB - pA)
         motions[3] = time_derivative(motions[2], q, qd)
@@ -272,7 +274,7 @@ def _derive_template(kind, parent, child, at, has_length):
     phis, labels = joint_equations(kind, pA, RA, pB, RB, _LENGTH if has_length else None)
     phis = [sp.sympify(phi) for phi in phis]
     rows = [differentiate(phi, list(slots[0]), list(slots[1])) for phi in phis]
-    motions = _free_motions(kind, parent, child, pA, RA, pB, RB, list(slots[0]), list(slots[1]))
+    motions = _free_motions(kind, parent, child, at.frames[:2], pA, RA, pB, RB, list(slots[0]), list(slots[1]))
     motions = tuple(None if m is None else sp.sympify(m).xreplace(to_slots) for m in motions)
     gradients = tuple(None if m is None or k % 2 == 0 else tuple(jacobian([m], slots[1])) for k, m in enumerate(motions))
     return (slots, tuple(phis), tuple(labels), tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows),

@@ -122,6 +122,11 @@ class Part:
         """The part's angular velocity in world axes (zero for point-like parts)."""
         return sp.zeros(3, 1)
 
+    def frame_angular_velocity(self, frame):
+        """The world angular velocity of ``frame``: the part's own, for frames fixed on it
+        (a flexible body's frames turn with their nodes)."""
+        return self.angular_velocity()
+
     def idle_directions(self, q):
         """Orthonormal columns (over the part's coordinates, at its coordinates ``q``) of
         the directions that move nothing: none for most parts."""

@@ -18,7 +18,8 @@ Frames sit at FE nodes: node j at x_j + u_j(η) in the part's axes, turned by th
 elastic rotation θ_j(η) (its rotation DOFs; none for 3-DOF nodes) through the Cayley map
 (1 − |θ|²/4) I + ½θθᵀ + [θ]× over 1 + |θ|²/4 — orthogonal, and the linear theory's
 I + [θ]× to first order — so joints and forces attach to them as to a rigid body's frames.
-``angular_velocity()`` is the floating frame's, without the nodes' elastic rotation rates.
+``angular_velocity()`` is the floating frame's; ``frame_angular_velocity(frame)`` adds a node
+frame's elastic turn rate (joint rates, actuation and springs along a joint, reaction frames).
 """
 
 import numpy as np
@@ -60,18 +61,21 @@ class FlexibleBody(Part):
         named = {f"node_{j}": j for j in reduction.interface}
         named.update(frames or {})
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
-        made = [self._node_frame(name, label, spec, q[7:]) for label, spec in named.items()]
+        self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
+        made = [self._node_frame(name, label, spec, q[7:], qd[7:]) for label, spec in named.items()]
         M, Q, T, V = _equations(self.invariants, reduction.stiffness, self.damping, q, qd, self.gravity)
         super().__init__(name, coordinates(r), q, qd, M, Q, T, V, params, made, geometry, initial)
 
-    def _node_frame(self, part, label, spec, eta):
+    def _node_frame(self, part, label, spec, eta, eta_dot):
         node, turn = spec if isinstance(spec, tuple) else (spec, np.eye(3))
         rows = self.reduction.node_rows(node)  # raises for a node the FE model lacks
         Phi = _numbers(self.reduction.basis[rows])
         position = sp.Matrix(self.reduction.fe.nodes[node]) + Phi[:3, :] * sp.Matrix(eta)
         if len(rows) == 6:
-            half = Phi[3:, :] * sp.Matrix(eta) / 2
+            half, half_rate = Phi[3:, :] * sp.Matrix(eta) / 2, Phi[3:, :] * sp.Matrix(eta_dot) / 2
             elastic = rotation([1, *half]) / (1 + (half.T * half)[0])
+            # the Cayley map's angular velocity (Rodrigues parameters g = θ/2): 2(ġ + g × ġ)/(1 + gᵀg)
+            self._turn_rates[label] = 2 * (half_rate + half.cross(half_rate)) / (1 + (half.T * half)[0])
         else:
             elastic = sp.eye(3)
         return Frame(part, label, position, elastic * sp.Matrix(turn))
@@ -89,6 +93,13 @@ class FlexibleBody(Part):
 
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:7]) * sp.Matrix(self.qd[3:7])
+
+    def frame_angular_velocity(self, frame):
+        """The floating frame's angular velocity plus, for a frame at a node with rotation DOFs,
+        the node's elastic turn's (turned to world axes)."""
+        rate = self._turn_rates.get(frame.name) if frame.part == self.name else None
+        own = self.angular_velocity()
+        return own if rate is None else own + rotation(self.q[3:7]) * rate
 
     def idle_directions(self, q):
         """The quaternion's own direction: scaling u turns nothing."""

@@ -169,6 +169,24 @@ def test_node_frames_follow_the_deformed_nodes(beam):
     assert sorted(part.frames) == ["node_0", "node_8"]
 
 
+def test_a_node_frames_angular_velocity_is_its_rotations_rate(beam):
+    """frame_angular_velocity(node_8) = vee(Ṙ Rᵀ) of the frame's world rotation R(q(t)) along
+    q + q̇t (central differences, 1e-8), and differs from the floating frame's own by the node's
+    elastic turn rate."""
+    reduction, part, _ = beam
+    rng = np.random.default_rng(12)
+    q, qd, _ = random_state(reduction.size, rng)
+    frame = part.frames["node_8"]
+    R = sp.lambdify([part.q], part.pose(frame)[1])
+    values = {**dict(zip(part.q, q)), **dict(zip(part.qd, qd))}
+    omega = np.array(part.frame_angular_velocity(frame).xreplace(values), dtype=float).ravel()
+    step = 1e-6
+    W = (np.array(R(q + step * qd)) - np.array(R(q - step * qd))) / (2 * step) @ np.array(R(q)).T
+    np.testing.assert_allclose(omega, [W[2, 1], W[0, 2], W[1, 0]], rtol=1e-8, atol=1e-8 * np.abs(omega).max())
+    own = np.array(part.angular_velocity().xreplace(values), dtype=float).ravel()
+    assert np.linalg.norm(omega - own) > 1e-2 * np.linalg.norm(omega)
+
+
 def test_modal_damping_damps_each_reduced_mode_at_its_ratio():
     """D = modal_damping(r, ζ) with M_r, K_r: the reduced model's eigenvalues are
     −ζω ± iω√(1 − ζ²) of its undamped ω."""
