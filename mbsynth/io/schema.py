@@ -93,7 +93,7 @@ SECTIONS = {section.name: section for section in (
              Key("parameters", "mapping name → expression", "named constants; each may use those before it",
                  "{m: 2.0, R: 0.3, I: 0.5*m*R**2}", default="{}"),
              Key("gravity", "list of 3 " + _EXPRS, "gravitational acceleration acting on rigid bodies, "
-                 "particles, planar bodies and spring masses [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
+                 "particles, planar bodies, spring masses and flexible bodies [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
              Key("world", "mapping (section *world*)", "frames fixed in the world", "{frames: {pin: {}}}"),
              _required("subsystems", "mapping name → part", "the parts, each with a ``type`` "
                        "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*, *flexible_body*)", "{wheel: {type: particle, mass: m}}"),
