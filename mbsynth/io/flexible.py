@@ -19,7 +19,7 @@ def read_flexible_body(builder, name, spec, path):
     reduction = _read_reduction(builder, fe, spec.get("reduction"), path + ("reduction",))
     r = reduction.size
     damping = _read_damping(builder, reduction, spec.get("damping"), path + ("damping",))
-    frames = _read_frames(builder, fe, spec.get("frames"), path + ("frames",))
+    frames = _read_frames(builder, fe, reduction.interface, spec.get("frames"), path + ("frames",))
     initial = _read_initial(builder, spec.get("initial"), path + ("initial",), r)
     q, qd = builder.part_symbols(name, coordinates(r))
     geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
@@ -125,8 +125,9 @@ def _read_damping(builder, reduction, node, path):
     return modal_damping(reduction, ratio)
 
 
-def _read_frames(builder, fe, node, path):
-    """{name: (FE node, rotation)} of ``frames:``."""
+def _read_frames(builder, fe, interface, node, path):
+    """{name: (FE node, rotation, geometry)} of ``frames:`` (a ``line`` may run to another of
+    them or to an interface node's frame)."""
     node = builder.mapping(node, path, set(node) if isinstance(node, dict) else set())
     frames = {}
     for name, spec in node.items():
@@ -137,7 +138,9 @@ def _read_frames(builder, fe, node, path):
         if not isinstance(at, int) or isinstance(at, bool) or not 0 <= at < len(fe.nodes):
             builder.fail(fpath + ("node",), f"node must be one of the FE model's nodes, 0 to {len(fe.nodes) - 1}; "
                                             f"got {at!r}")
-        frames[name] = (at, read_rotation(builder, spec, fpath))
+        names = (set(node) | {f"node_{j}" for j in interface}) - {name}
+        frames[name] = (at, read_rotation(builder, spec, fpath),
+                        read_geometry(builder, spec.get("geometry"), fpath + ("geometry",), names))
     return frames
 
 

@@ -255,8 +255,12 @@ SECTIONS = {section.name: section for section in (
              Key("modal", _EXPR + ", ≥ 0", "one damping ratio ζ for every mode of the reduced model with its "
                  "frame held", "0.02"))),
     Section("flexible_frame", "each entry of ``frames:`` of a flexible_body",
-            "A frame at an FE node, turned by at most one orientation key; it moves with the node.",
-            (_required("node", "node index", "the FE node", "20"), *_ORIENTATION)),
+            "A frame at an FE node, turned by at most one orientation key; it moves with the node. A "
+            "``line`` in its geometry may run to another frame of the part: lines between frames along "
+            "the body draw it deformed.",
+            (_required("node", "node index", "the FE node", "20"),
+             Key("geometry", "shape or list of shapes", "what the viewer draws at the frame", "{sphere: 0.01}"),
+             *_ORIENTATION)),
     Section("initial_flexible_body", "``initial:`` of a flexible_body",
             "The frame's origin and axes as a rigid body's (velocities in world axes), and the reduced "
             "coordinates.",

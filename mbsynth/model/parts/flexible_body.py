@@ -40,7 +40,7 @@ class FlexibleBody(Part):
     """A reduced FE model ``reduction`` (a Reduction whose basis carries no rigid-body
     motion: Craig–Bampton with one interface node held, ``Reduction.hold``, or free-interface
     modes without rigid ones) on a floating frame. ``frames``: {name: node} or {name: (node,
-    rotation 3 × 3)}; every interface node also gets a frame ``node_<j>``. ``damping``: an
+    rotation 3 × 3[, drawing geometry])}; every interface node also gets a frame ``node_<j>``. ``damping``: an
     r × r matrix D (``rayleigh_damping``, ``modal_damping``), default none. ``gravity``:
     sympy 3-vector of parameters. ``frame_nodes``: {frame name: FE node}."""
 
@@ -67,7 +67,7 @@ class FlexibleBody(Part):
         super().__init__(name, coordinates(r), q, qd, M, Q, T, V, params, made, geometry, initial)
 
     def _node_frame(self, part, label, spec, eta, eta_dot):
-        node, turn = spec if isinstance(spec, tuple) else (spec, np.eye(3))
+        node, turn, geometry = (*spec, ())[:3] if isinstance(spec, tuple) else (spec, np.eye(3), ())
         rows = self.reduction.node_rows(node)  # raises for a node the FE model lacks
         Phi = _numbers(self.reduction.basis[rows])
         position = sp.Matrix(self.reduction.fe.nodes[node]) + Phi[:3, :] * sp.Matrix(eta)
@@ -78,7 +78,7 @@ class FlexibleBody(Part):
             self._turn_rates[label] = 2 * (half_rate + half.cross(half_rate)) / (1 + (half.T * half)[0])
         else:
             elastic = sp.eye(3)
-        return Frame(part, label, position, elastic * sp.Matrix(turn))
+        return Frame(part, label, position, elastic * sp.Matrix(turn), tuple(geometry))
 
     def own_constraints(self, q, qd, params):
         """The frame's quaternion has unit norm (the rigid body's row, rigid_body.py)."""
