@@ -14,7 +14,7 @@ import numpy as np
 import scipy.optimize
 
 from ..core.errors import NoEquilibrium, SolveError
-from ..core.tolerances import ACCELERATION_TOL
+from ..core.tolerances import ACCELERATION_TOL, RANK_RTOL
 from .linearization import finite_state, linearize
 from .projection import project_positions
 
@@ -35,7 +35,7 @@ def steady_motion(system, rates, q=None, t=0.0, solve=(), tolerance=ACCELERATION
         raise SolveError(f"model '{system.name}': unknown coordinate(s) {unknown}", coordinates=unknown)
     given = {index[c]: float(x) for c, x in rates.items()}
     if solve:
-        q, given = _solved(system, t, q, given, solve, index, tolerance)
+        q, given = _solved(system, t, q, given, solve, index)
     qd = _least_energy_velocities(system, t, q, given)
     check_steady(system, linearize(system, t, q, qd), tolerance)
     return finite_state(system, q, qd)
@@ -53,13 +53,13 @@ def _least_energy_velocities(system, t, q, given):
     right = np.concatenate([-arrays.psi[rows], list(given.values())])
     particular = np.linalg.lstsq(W, right, rcond=None)[0]
     _, s, Vt = np.linalg.svd(W)
-    free = Vt[int(np.sum(s > 1e-12 * s[0])):].T if s.size else np.eye(n)
+    free = Vt[int(np.sum(s > RANK_RTOL * s[0])):].T if s.size else np.eye(n)
     M = system.evaluate(t, q, particular).M
     y = np.linalg.lstsq(free.T @ M @ free, -free.T @ M @ particular, rcond=None)[0] if free.size else []
     return particular + free @ y if free.size else particular
 
 
-def _solved(system, t, q, given, solve, index, tolerance):
+def _solved(system, t, q, given, solve, index):
     """(q, given) with the ``solve`` entries adjusted (least squares) so that q̈ = 0 along the
     speeds of the linearization at the first guess."""
     start = linearize(system, t, q, _least_energy_velocities(system, t, q, given))

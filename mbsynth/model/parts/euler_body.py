@@ -17,6 +17,7 @@ import numpy as np
 import sympy as sp
 
 from ...core.kinematics import euler_rate_matrix, euler_rotation
+from ...core.tolerances import NEAR_SINGULAR
 from ...symbolic.cache import placeholder, remembered
 from .base import Part
 
@@ -77,7 +78,8 @@ def angle_rates_of(sequence, angles, omega_world):
     values = dict(zip(a, angles))
     R = np.array(euler_rotation(sequence, a).subs(values), dtype=float)
     H = np.array(euler_rate_matrix(sequence, a).subs(values), dtype=float)
-    if np.linalg.svd(H, compute_uv=False)[-1] < 1e-9:
+    singular = np.linalg.svd(H, compute_uv=False)
+    if singular[-1] < NEAR_SINGULAR * singular[0]:
         return None
     return np.linalg.solve(H, R.T @ np.asarray(omega_world, dtype=float))
 
