@@ -6,7 +6,10 @@ tangential acceleration a (q̈ = N a: at rest A q̈ = b = 0 for scleronomic rows
 K = ∂a/∂u. With the tangential mass M_t = Nᵀ M N the tangential force is F_t = M_t a,
 and each step solves a trust-region problem in the norm of the mass, ‖p‖²_M = pᵀ M_t p ≤ Δ²,
 moves q by N p (shortened to STEP_LIMIT in a coordinate) and puts it back on φ = 0
-(projection.project_positions, the retraction). A step is taken where its actual decrease
+(projection.project_positions, the retraction; it holds the flexible bodies' elastic
+coordinates where the others can close the constraints: its correction, O(|p|²), would
+otherwise land partly on them, and at their stiffness its strain energy, which the
+quadratic model does not see, outweighs the step's whole fall). A step is taken where its actual decrease
 of the merit Ψ is at least ETA of the decrease the quadratic model predicts; Δ shrinks by
 SHRINK after a refused step and grows by EXPAND after a good one that reached it, so near
 the answer the steps are Newton's (quadratic).
@@ -79,6 +82,7 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
         raise NoEquilibrium(f"model '{system.name}': no static equilibrium at t = {t:g}: rows {moving} prescribe a "
                             "motion then (∂φ/∂t ≠ 0)", constraints=moving)
     merit = _Merit(system, t, nearest)
+    elastic = _elastic_coordinates(system)
     q = project_positions(system, t, q)
     radius = None
     for iteration in range(max_iterations):
@@ -102,7 +106,7 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
         model = model or _Model(system, t, q, lin, K, nearest, resolution)
         if radius is None:
             radius = model.size(model.along_force) * limit / np.abs(lin.basis @ model.along_force).max()
-        q, radius = _step(system, t, q, lin, model, merit, radius, limit)
+        q, radius = _step(system, t, q, lin, model, merit, radius, limit, elastic)
     worst = int(np.argmax(np.abs(lin.qdd)))
     raise NoEquilibrium(f"model '{system.name}': no static equilibrium found from the given configuration: after "
                         f"{max_iterations} steps down the potential it still accelerates (largest q̈ "
@@ -185,11 +189,11 @@ def _trust_region(c, d, radius):
     return y(max(shift, np.nextafter(low, np.inf)))
 
 
-def _step(system, t, q, lin, model, merit, radius, limit):
+def _step(system, t, q, lin, model, merit, radius, limit, elastic):
     """(q moved by the trust-region step p of the largest radius, from ``radius`` down
     (shortened where its move N p exceeds ``limit`` in a coordinate), that can be put back on
-    the constraints and along which Ψ falls by at least ETA of the predicted fall; the
-    radius for the next step)."""
+    the constraints (``_retract``, holding ``elastic``) and along which Ψ falls by at least ETA
+    of the predicted fall; the radius for the next step)."""
     here = merit.at(q, lin.qdd)
     for _ in range(HALVINGS):
         y = _trust_region(model.c, model.d, radius)
@@ -202,7 +206,7 @@ def _step(system, t, q, lin, model, merit, radius, limit):
         if not predicted > 0:
             break
         try:
-            moved = project_positions(system, t, q + move)
+            moved = _retract(system, t, q + move, elastic)
             there = merit.at(moved, system.motion(t, moved, np.zeros(system.n)).qdd)
         except SolveError:
             there = None
@@ -219,6 +223,29 @@ def _step(system, t, q, lin, model, merit, radius, limit):
     raise NoEquilibrium(f"model '{system.name}': no static equilibrium found from the given configuration: no "
                         f"step down the {merit.name} is left (largest q̈ {lin.qdd[worst]:.3g} along "
                         f"{system.coordinates[worst]})", coordinates=[system.coordinates[worst]])
+
+
+def _elastic_coordinates(system):
+    """Indices of the flexible bodies' elastic coordinates (their own, past the floating
+    frame's position and quaternion)."""
+    found, start = [], 0
+    for part in system.parts:
+        if part.kind == "flexible_body":
+            frame = sum(len(group) for group in part.groups)
+            found += range(start + frame, start + len(part.coordinates))
+        start += len(part.coordinates)
+    return found
+
+
+def _retract(system, t, q, elastic):
+    """q put back on the constraints, the coordinates ``elastic`` held where the others can
+    close them (else all move)."""
+    if elastic:
+        try:
+            return project_positions(system, t, q, fixed=elastic)
+        except SolveError:
+            pass
+    return project_positions(system, t, q)
 
 
 class _Merit:
