@@ -9,10 +9,10 @@ moves q by N p (shortened to STEP_LIMIT in a coordinate) and puts it back on φ 
 (projection.project_positions, the retraction; it holds the flexible bodies' elastic
 coordinates where the others can close the constraints: its correction, O(|p|²), would
 otherwise land partly on them, and at their stiffness its strain energy, which the
-quadratic model does not see, outweighs the step's whole fall). A step is taken where its actual decrease
-of the merit Ψ is at least ETA of the decrease the quadratic model predicts; Δ shrinks by
-SHRINK after a refused step and grows by EXPAND after a good one that reached it, so near
-the answer the steps are Newton's (quadratic).
+quadratic model does not see, outweighs the step's whole fall). A step is taken where its
+actual decrease of the merit Ψ is at least ETA of the decrease the quadratic model
+predicts; Δ shrinks by SHRINK after a refused step and grows by EXPAND after a good one
+that reached it, so near the answer the steps are Newton's (quadratic).
 
 Two contracts:
 
