@@ -63,11 +63,11 @@ def unreduced_tip(fe):
     return np.array([[c, -s], [s, c]]) @ (fe.nodes[-1, :2] + u[-3:-1])
 
 
-def reduced_tip(modes):
-    """The tip at T_END of the flexible part with ``modes`` fixed-interface modes (both bending
-    planes alike: half of them in the plane of the swing)."""
+def pendulum_yaml(modes):
+    """The model file of the pendulum as a flexible part with ``modes`` fixed-interface modes
+    (both bending planes alike: half of them in the plane of the swing)."""
     numbers = ", ".join(f"{k}: {v!r}" for k, v in SECTION.items())
-    model = mb.loads(f"""
+    return f"""
 gravity: [0, -{G}, 0]
 subsystems:
   rod:
@@ -79,8 +79,12 @@ joints:
   - {{name: pin, type: revolute, parent: world, child: rod.node_0}}
 outputs:
   tip: {{position: rod.tip}}
-""")
-    run = mb.simulate(model, T_END, dt=T_END / 10, rtol=1e-8, atol=1e-10)
+"""
+
+
+def reduced_tip(modes):
+    """The tip at T_END of the flexible part with ``modes`` fixed-interface modes."""
+    run = mb.simulate(mb.loads(pendulum_yaml(modes)), T_END, dt=T_END / 10, rtol=1e-8, atol=1e-10)
     return np.array([run.column("tip[x]")[-1], run.column("tip[y]")[-1]])
 
 
