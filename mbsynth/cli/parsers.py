@@ -166,6 +166,9 @@ def _view(commands):
     view.add_argument("--html", metavar="FILE.html", help="write the animation to this file instead of serving it")
     view.add_argument("--axes", action="store_true", help="draw a triad at every body and frame")
     view.add_argument("--joints", action="store_true", help="mark the frames of every joint")
+    view.add_argument("--deformation-scale", type=float, default=1.0, metavar="K",
+                      help="draw flexible bodies' elastic displacements K times as large (the drawing only; "
+                           "default 1)")
     camera = view.add_mutually_exclusive_group()
     camera.add_argument("--follow", dest="follow", action="store_const", const=True, default=None,
                         help="the camera follows the model's centre of mass (default: when it travels further "

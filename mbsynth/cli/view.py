@@ -10,7 +10,7 @@ from .parsers import check_flags, model_of
 
 
 def run(args):
-    check_flags(args, positive=("--t-end",), outputs=(("--html", (".html",)),))
+    check_flags(args, positive=("--t-end", "--deformation-scale"), outputs=(("--html", (".html",)),))
     system = model_of(args)
     status = 0
     if args.trajectory:
@@ -21,7 +21,8 @@ def run(args):
         except SimulationError as err:
             traj, status = err.trajectory, 1
             print(f"error: {err}; drawing the motion up to there", file=sys.stderr)
-    options = {"axes": args.axes, "joints": args.joints, "follow": args.follow}
+    options = {"axes": args.axes, "joints": args.joints, "follow": args.follow,
+               "deformation_scale": args.deformation_scale}
     if args.html:
         path = viewer.to_html(system, traj, args.html, **options)
         print(f"wrote {path}: {system.name}, t = {traj.t[0]:.6g} to {traj.t[-1]:.6g} s")

@@ -13,6 +13,12 @@ force elements that expose their two ``points``) are nodes whose transform maps 
 unit segment (0, 0, 0)–(1, 0, 0) onto the segment between their ends: its first column
 is p_B − p_A, so it scales. All poses are one compiled function of (t, q, p).
 
+A flexible body (``flexible_body``) without geometry of its own is drawn as its deformed FE
+mesh: a polyline through its nodes in their order (a beam's from end to end), node j at
+R + A (x_j + s Φ_j η) with s the ``deformation_scale``. The scale multiplies the elastic
+coordinates η wherever a flexible body's poses are drawn (its node frames and their
+geometry too): a drawing only, so a scaled node no longer meets the parts joined to it.
+
 A model that declares no geometry is drawn as its structure: a rolling disk as a wheel
 of its radius about its frame's z axis, a body as rods from its centre of mass (a small
 sphere) to its frames (its own and those its joints and contacts attach to), a particle
@@ -105,26 +111,27 @@ class _Spec:
     mass: float = 0.0  # a particle's, for its default sphere
 
 
-def build_scene(system, trajectory, axes=False, joints=False, fps=FPS, follow=None):
+def build_scene(system, trajectory, axes=False, joints=False, fps=FPS, follow=None, deformation_scale=1.0):
     """The Scene of ``trajectory``, at most ``fps`` rows per second of motion.
 
     axes: a triad at every body and frame; joints: a marker at both frames of every joint;
     follow: the camera follows the centre of mass (True), stays on the box that holds the
     whole motion (False), or (None) follows when the centre of mass travels further than
-    the model's length.
+    the model's length; deformation_scale: the factor on flexible bodies' elastic
+    displacements in the drawing (module docstring).
     """
     if tuple(trajectory.coordinates) != tuple(system.coordinates):
         raise ModelError(f"the trajectory's coordinates ({', '.join(trajectory.coordinates)}) are not those "
                          f"of model '{system.name}' ({', '.join(system.coordinates)})")
     rows = drawn_rows(trajectory.t, fps)
-    poses = _Poses()
+    poses = _Poses(deformation_scale)
     specs, lines = [], []
     model_drawn = any(_has_geometry(part) for part in system.parts)
     masses = _masses(system, trajectory.q[rows[0]])
     colors = {part.name: [*COLORS[PALETTE[i % len(PALETTE)]], 1.0] for i, part in enumerate(system.parts)}
     for part in system.parts:
         specs += _part_specs(part, poses, colors[part.name], axes, model_drawn, masses.get(part.name, 0.0))
-        lines += _part_lines(part, poses)
+        lines += _part_lines(part, poses) + _mesh_lines(part, poses, colors[part.name])
     if not model_drawn:
         wheels, rods = _structure(system, poses, colors)
         specs, lines = specs + wheels, lines + rods
@@ -286,6 +293,20 @@ def _part_lines(part, poses):
             for frame in part.frames.values() for shape in frame.geometry if shape["shape"] == "line"]
 
 
+def _mesh_lines(part, poses, color):
+    """(path, pose A, pose B, colour, radius) of the segments between consecutive FE nodes of a
+    flexible body without geometry of its own, at ``mesh/<part>.<j>``."""
+    if part.kind != "flexible_body" or part.geometry:
+        return []
+    reduction = part.reduction
+    eta = sp.Matrix(part.q[len(part.coordinates) - reduction.size:])
+    ends = []
+    for j, place in enumerate(reduction.fe.nodes):
+        shift = sp.Matrix(reduction.basis[reduction.node_rows(j)[:3]].tolist()) * eta
+        ends.append(poses.add(part, Frame(part.name, f"<FE node {j}>", sp.Matrix(place) + shift, sp.eye(3))))
+    return [(f"mesh/{part.name}.{j}", a, b, color, LINE_RADIUS) for j, (a, b) in enumerate(zip(ends, ends[1:]))]
+
+
 def _structure(system, poses, colors):
     """(wheel specs, rod lines) of a model that declares no geometry: each rolling disk a
     wheel at ``wheels/<contact>`` (a see-through disk of its radius and WHEEL_WIDTH about
@@ -342,16 +363,21 @@ ORIGIN = Frame("", "origin", sp.zeros(3, 1), sp.eye(3))  # a part's own pose (po
 
 
 class _Poses:
-    """World poses (4 × 4, sympy) to evaluate along the motion in one compiled function."""
+    """World poses (4 × 4, sympy) to evaluate along the motion in one compiled function; a
+    flexible body's with its elastic coordinates times ``deformation_scale``."""
 
-    def __init__(self):
+    def __init__(self, deformation_scale=1.0):
         self.exprs, self.index = [], {}
+        self.scale = deformation_scale
 
     def add(self, part, frame):
         """The index of ``frame``'s pose on ``part`` (None: a frame fixed in the world)."""
         key = (part.name if part is not None else "world", frame.name)
         if key not in self.index:
             p, R = (sp.Matrix(frame.position), sp.Matrix(frame.rotation)) if part is None else part.pose(frame)
+            if part is not None and part.kind == "flexible_body" and self.scale != 1:
+                scaled = {x: self.scale * x for x in part.q[len(part.coordinates) - part.reduction.size:]}
+                p, R = p.xreplace(scaled), R.xreplace(scaled)
             self.index[key] = self._append(p, R)
         return self.index[key]
 
@@ -373,12 +399,12 @@ class _Poses:
 
 
 def normalized_quaternions(system, q):
-    """q with every rigid body's quaternion (its coordinates qw..qz) scaled to unit norm:
-    R(u) of kinematics.rotation is a rotation only for a unit u."""
+    """q with every rigid or flexible body's quaternion (its coordinates qw..qz) scaled to
+    unit norm: R(u) of kinematics.rotation is a rotation only for a unit u."""
     q = np.array(q, dtype=float)
     start = 0
     for part in system.parts:
-        if part.kind == "rigid_body":
+        if part.kind in ("rigid_body", "flexible_body"):
             u = slice(start + 3, start + 7)
             q[u] /= np.linalg.norm(q[u])
         start += len(part.coordinates)

@@ -42,13 +42,15 @@ AXES_LENGTH = 0.5  # meshcat's world axes
 STOP_SECONDS = 5.0
 
 
-def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS, follow=None):
+def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS, follow=None, deformation_scale=1.0):
     """Write the animation of ``trajectory`` as one self-contained HTML file; returns its Path.
 
     follow: the camera follows the centre of mass (True), stays on the box that holds the
     whole motion (False), or (None) follows when the centre of mass travels further than
-    the model's length (``scene.build_scene``)."""
-    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps, follow=follow)
+    the model's length (``scene.build_scene``); deformation_scale: flexible bodies' elastic
+    displacements drawn times this (the drawing only)."""
+    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps, follow=follow,
+                        deformation_scale=deformation_scale)
     with MeshcatView() as view:
         view.draw(scene)
         html = view.html()
@@ -57,16 +59,18 @@ def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS, foll
     return path
 
 
-def show(system, trajectory, *, axes=False, joints=False, fps=FPS, follow=None, block=True, ready=None):
+def show(system, trajectory, *, axes=False, joints=False, fps=FPS, follow=None, block=True, ready=None,
+         deformation_scale=1.0):
     """Serve the animation of ``trajectory`` in a live meshcat viewer on this machine
-    (``follow`` as in ``to_html``).
+    (``follow`` and ``deformation_scale`` as in ``to_html``).
 
     block=True serves until interrupted (Ctrl-C or SIGTERM), calling ``ready(url)`` once
     the scene is up, then stops the server and raises KeyboardInterrupt (the command
     exits 130). block=False returns the running ``MeshcatView`` (``.url``; ``close()`` it,
     or use it in a ``with`` block). The server also ends when this process dies.
     """
-    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps, follow=follow)
+    scene = build_scene(system, trajectory, axes=axes, joints=joints, fps=fps, follow=follow,
+                        deformation_scale=deformation_scale)
     if not block:
         view = MeshcatView()
         try:
