@@ -7,6 +7,9 @@ natural frequency ω/2π (Hz) and damping ratio ζ = −Re s/|s|; a real s is an
 eigenvector's position part mapped to the model's coordinates, δq = N x, scaled so that
 its largest component is 1, and in joint values: a joint's position changes at the rate
 its ``rate`` gives for q̇ = δq (System.joint_values; exact, the rates being linear in q̇).
+A flexible body's share of a shape is also given in FE terms: its elastic coordinates' part
+δη gives the nodal displacements Φ δη in the part's axes (each node's translation and, for
+6-DOF nodes, rotation), so a mode reads as bending, stretching or twisting of the mesh.
 """
 
 from dataclasses import dataclass
@@ -23,14 +26,16 @@ from .trajectory import Trajectory
 from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL
 
 SHOWN = 3  # coordinates named per mode in the table
+NODE_SHAPE_RTOL = 1e-9  # a flexible body's elastic coordinates below this share of a shape's largest: it does not bend
 
 
 @dataclass(frozen=True)
 class Mode:
     """One mode: ``eigenvalue`` s (rad/s), ``frequency`` |s|/2π (Hz), ``damping_ratio``
     −Re s/|s| (NaN for a free mode), ``kind`` ("vibration", "overdamped", "unstable" or
-    "free"), ``shape`` (n complex, largest component 1) and ``joint_shape``
-    ({joint: complex array of its positions' changes})."""
+    "free"), ``shape`` (n complex, largest component 1), ``joint_shape``
+    ({joint: complex array of its positions' changes}) and ``node_shape`` ({flexible body
+    whose elastic coordinates the shape moves: NodeShape})."""
 
     eigenvalue: complex
     frequency: float
@@ -38,6 +43,23 @@ class Mode:
     kind: str
     shape: np.ndarray
     joint_shape: dict
+    node_shape: dict = None
+
+
+@dataclass(frozen=True)
+class NodeShape:
+    """A flexible body's nodal displacements Φ δη in a mode (its axes, the mode's scale):
+    ``translations`` (nodes × 3 complex), ``rotations`` (nodes × 3 complex; None for 3-DOF
+    nodes)."""
+
+    translations: np.ndarray
+    rotations: np.ndarray = None
+
+    def largest(self, which="translations"):
+        """(node, its displacement vector) of the largest translation (or rotation) by magnitude."""
+        values = getattr(self, which)
+        node = int(np.argmax(np.linalg.norm(values, axis=1)))
+        return node, values[node]
 
 
 @dataclass(frozen=True)
@@ -150,7 +172,7 @@ def _mode(system, t, q, lin, s, x, scale):
     shape = lin.basis @ x
     shape = shape / shape[np.argmax(np.abs(shape))]
     return Mode(complex(s), float(abs(s) / (2 * np.pi)), _damping(s, scale), _kind(s, scale), shape,
-                _joint_shape(system, t, q, shape))
+                _joint_shape(system, t, q, shape), _node_shapes(system, shape))
 
 
 def _damping(s, scale):
@@ -173,6 +195,22 @@ def _joint_shape(system, t, q, shape):
     real = system.joint_values(t, q, shape.real)
     imag = system.joint_values(t, q, shape.imag)
     return {name: real[name].rate + 1j * imag[name].rate for name in real}
+
+
+def _node_shapes(system, shape):
+    """{flexible body: NodeShape} of the flexible bodies whose elastic coordinates ``shape``
+    moves (by more than NODE_SHAPE_RTOL of its largest component)."""
+    found, start = {}, 0
+    for part in system.parts:
+        n = len(part.coordinates)
+        if part.kind == "flexible_body":
+            reduction = part.reduction
+            eta = shape[start + n - reduction.size:start + n]
+            if np.abs(eta).max(initial=0.0) > NODE_SHAPE_RTOL * np.abs(shape).max():
+                u = (reduction.basis @ eta).reshape(len(reduction.fe.nodes), -1)
+                found[part.name] = NodeShape(u[:, :3], u[:, 3:6] if u.shape[1] == 6 else None)
+        start += n
+    return found
 
 
 def mode_motion(system, result, index, amplitude=0.05, periods=2, frames=60):
@@ -206,6 +244,7 @@ def format_modes(result, digits=6):
         s = mode.eigenvalue
         lines.append(f"{i:>3}  {mode.frequency:>15.{digits}g}  {mode.damping_ratio:>13.4g}  {mode.kind:<10}  "
                      f"{f'{s.real:.{digits}g}{s.imag:+.{digits}g}j':<26}  {_largest(result, mode)}")
+        lines += [f"{'':>5}{_nodes(name, nodes)}" for name, nodes in (mode.node_shape or {}).items()]
     if result.zeros:
         named = f" (cyclic coordinates and conserved speeds: {', '.join(result.cyclic)})" if result.cyclic else ""
         lines.append(f"zero eigenvalues: {result.zeros}{named}")
@@ -230,6 +269,24 @@ def _largest(result, mode):
     return ", ".join(f"{names[j]} {_short(values[j])}" for j in order if abs(values[j]) > 1e-6)
 
 
+def _nodes(name, nodes):
+    """A flexible body's line under its mode: the node that moves most and its translation
+    (real parts, the part's axes), and the node that turns most."""
+    node, t = nodes.largest()
+    text = f"{name}: node {node} moves most, {_vector(t)} in its axes"
+    if nodes.rotations is not None:
+        node, r = nodes.largest("rotations")
+        text += f"; node {node} turns most, {_vector(r)} rad"
+    return text
+
+
+def _vector(v):
+    """(x, y, z) short, real and imaginary parts below 1e-6 of the vector's size shown as 0."""
+    small = 1e-6 * np.linalg.norm(v)
+    v = np.where(np.abs(v.real) > small, v.real, 0.0) + 1j * np.where(np.abs(v.imag) > small, v.imag, 0.0)
+    return f"({', '.join(_short(x) for x in v)})"
+
+
 def _short(z):
     return f"{z.real:.3g}" if abs(z.imag) <= 1e-9 * max(abs(z), 1e-300) else f"{z.real:.3g}{z.imag:+.3g}j"
 
@@ -250,8 +307,23 @@ def to_dict(result):
                  "damping_ratio": None if np.isnan(mode.damping_ratio) else mode.damping_ratio, "kind": mode.kind,
                  "shape": {c: float(x.real) for c, x in zip(result.coordinates, mode.shape) if abs(x) > 1e-12},
                  "joint_shape": {j: [float(x) for x in v.real] for j, v in mode.joint_shape.items()}}
+        if mode.node_shape:
+            entry["node_shape"] = {name: _node_entry(nodes, np.real) for name, nodes in mode.node_shape.items()}
         if np.abs(mode.shape.imag).max(initial=0.0) > 1e-9:
             entry["shape_imag"] = {c: float(x.imag) for c, x in zip(result.coordinates, mode.shape) if abs(x) > 1e-12}
             entry["joint_shape_imag"] = {j: [float(x) for x in v.imag] for j, v in mode.joint_shape.items()}
+            if mode.node_shape:
+                entry["node_shape_imag"] = {name: _node_entry(nodes, np.imag) for name, nodes in mode.node_shape.items()}
         out["modes"].append(entry)
     return out
+
+
+def _node_entry(nodes, part):
+    """A NodeShape as JSON-ready data: the ``part`` (np.real or np.imag) of each node's
+    translation (and rotation), the largest translation's node and size."""
+    node, t = nodes.largest()
+    entry = {"translations": part(nodes.translations).tolist(), "largest_translation_node": node,
+             "largest_translation": float(np.linalg.norm(t))}
+    if nodes.rotations is not None:
+        entry["rotations"] = part(nodes.rotations).tolist()
+    return entry
