@@ -12,7 +12,7 @@ and run 1 s under gravity.
 The rod bends under its weight and its inertia: its middle node's distance from the chord
 B–C (the model's outputs ``rod_B``, ``rod_middle``, ``rod_C``) is a few tenths of a
 millimetre. Its quasi-static value is the simply supported beam's under the rod's mean
-transverse load, δ = 5 w L⁴ / (384 EI) with w = ρA |(g − a)⊥|, a the acceleration of the
+transverse load, δ = 5 w L⁴ / (384 EI) with w = ρA ‖(g − a)⊥‖, a the acceleration of the
 chord's middle (the mean of B's and C's: the crank's and the slider's accelerations; the
 rest of a rigid rod's acceleration varies linearly along it and does not move its middle).
 Where the load changes slowly the rod rings about that value at its first bending
