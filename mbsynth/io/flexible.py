@@ -1,6 +1,7 @@
 """Reading a flexible body (``type: flexible_body``, issue 46): its FE model from the beam
 generator (``beam:``) or from files (``fe:``, relative to the model file), its reduction,
-damping, frames at FE nodes and initial state (sections in schema.py). Every error of the
+damping, centrifugal stiffening (beams), frames at FE nodes and initial state (sections in
+schema.py). Every error of the
 FE layer is reported at the key that caused it, with the model file and line."""
 
 from ..core.errors import ModelError
@@ -15,21 +16,24 @@ AMPLITUDES = ("amplitudes", "amplitude_rates")
 
 def read_flexible_body(builder, name, spec, path):
     builder.section(spec, path, "flexible_body")
-    fe = _read_fe(builder, spec, path)
+    fe, stress_stiffness = _read_fe(builder, spec, path)
     reduction = _read_reduction(builder, fe, spec.get("reduction"), path + ("reduction",))
     r = reduction.size
     damping = _read_damping(builder, reduction, spec.get("damping"), path + ("damping",))
+    stiffening = _read_stiffening(builder, reduction, stress_stiffness, spec.get("stiffening", False),
+                                  path + ("stiffening",))
     frames = _read_frames(builder, fe, reduction.interface, spec.get("frames"), path + ("frames",))
     initial = _read_initial(builder, spec.get("initial"), path + ("initial",), r)
     q, qd = builder.part_symbols(name, coordinates(r))
     geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
     return _fe_layer(builder, path, FlexibleBody, name, q, qd, reduction, builder.gravity,
-                     builder.param_symbols.values(), frames, damping, geometry, initial)
+                     builder.param_symbols.values(), frames, damping, geometry, initial, stiffening)
 
 
 def _read_fe(builder, spec, path):
-    """The FE model of ``beam:`` or ``fe:`` (exactly one)."""
-    from ..model.flexible.beam import beam  # scipy: loaded only by models with flexible bodies
+    """(the FE model of ``beam:`` or ``fe:`` (exactly one), its stress stiffness u ↦ K_G or
+    None: files carry no element data)."""
+    from ..model.flexible.beam import beam, stress_stiffness  # scipy: loaded only by models with flexible bodies
     from ..model.flexible.files import read_fe
 
     given = [k for k in ("beam", "fe") if k in spec]
@@ -45,16 +49,18 @@ def _read_fe(builder, spec, path):
         if not isinstance(elements, int) or isinstance(elements, bool):
             builder.fail(where + ("elements",), f"elements must be a positive integer, got {elements!r}")
         vectors = {k: builder.numbers(node[k], where + (k,), 3) for k in ("axis", "up") if k in node}
-        return _fe_layer(builder, where, beam, numbers.pop("length"), elements, **numbers, **vectors,
-                         theory=node.get("theory", "euler_bernoulli"), mass=node.get("mass", "consistent"))
+        length = numbers.pop("length")
+        fe = _fe_layer(builder, where, beam, length, elements, **numbers, **vectors,
+                       theory=node.get("theory", "euler_bernoulli"), mass=node.get("mass", "consistent"))
+        return fe, stress_stiffness(length, elements, **numbers, **vectors)
     files = {k: str(_file(builder, node[k], where + (k,))) for k in ("bundle", "mass", "stiffness", "nodes") if k in node}
     if ("bundle" in files) == any(k in files for k in ("mass", "stiffness", "nodes")) or \
             ("bundle" not in files and len(files) != 3):
         builder.fail(where, "give either bundle (one .npz) or all three of mass, stiffness and nodes")
     dofs = node.get("dofs_per_node")
     if "bundle" in files:
-        return _fe_layer(builder, where, read_fe, files["bundle"], dofs_per_node=dofs)
-    return _fe_layer(builder, where, read_fe, **files, dofs_per_node=dofs)
+        return _fe_layer(builder, where, read_fe, files["bundle"], dofs_per_node=dofs), None
+    return _fe_layer(builder, where, read_fe, **files, dofs_per_node=dofs), None
 
 
 def _fe_layer(builder, path, function, *args, **kwargs):
@@ -106,6 +112,20 @@ def _read_reduction(builder, fe, node, path):
                                                 "for craig_bampton")
         return _fe_layer(builder, path, free_interface, fe, interface, count=count, max_frequency=limit, rigid=False)
     builder.fail(path + ("method",), f"method must be craig_bampton or free_interface, got {method!r}")
+
+
+def _read_stiffening(builder, reduction, stress_stiffness, value, path):
+    """``stiffening: true``: the centrifugal stiffening of a spinning beam (stiffening.py)."""
+    from ..model.flexible.stiffening import centrifugal_stiffening
+
+    if not isinstance(value, bool):
+        builder.fail(path, f"stiffening must be true or false, got {value!r}")
+    if not value:
+        return None
+    if stress_stiffness is None:
+        builder.fail(path, "centrifugal stiffening needs the FE model's member forces: it is available for "
+                           "beam: parts (FE files carry no element data)")
+    return _fe_layer(builder, path, centrifugal_stiffening, reduction, stress_stiffness)
 
 
 def _read_damping(builder, reduction, node, path):

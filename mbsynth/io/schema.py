@@ -200,6 +200,8 @@ SECTIONS = {section.name: section for section in (
                        "{method: craig_bampton, interface: [0, 20], modes: 4}"),
              Key("damping", "mapping (section *flexible_damping*)", "structural damping of the reduced "
                  "coordinates", "{modal: 0.02}", default="none"),
+             Key("stiffening", "true or false", "centrifugal stiffening of a spinning part: the geometric "
+                 "stiffness of the spin's member forces (beam parts; docs/flexible.md)", "true", default="false"),
              Key("frames", "mapping name → node frame (section *flexible_frame*)", "named frames at FE nodes, "
                  "besides the interface nodes' ``node_<index>``", "{tip: {node: 20}}", default="{}"),
              _GEOMETRY,

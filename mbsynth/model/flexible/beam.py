@@ -91,6 +91,21 @@ def _assemble(local, frame, scales):
     return (A + A.T) / 2  # rounding of the rotation products
 
 
+def stress_stiffness(length, elements, *, area, E, axis=(1.0, 0.0, 0.0), **_section):
+    """The map u ↦ K_G(N(u)) of the beam of ``beam(length, elements, area=area, E=E,
+    axis=axis, ...)`` (the other section keys are accepted and unused): N_e = EA (u_e+1 −
+    u_e)·x / h, each element's axial force of the nodal displacements u, and K_G
+    ``geometric_stiffness`` under those forces."""
+    x = _section_axes(axis, np.eye(3)[np.argmin(np.abs(axis))], "beam stress stiffness")[0]
+    h = length / elements
+    translation = 6 * np.arange(elements + 1)[:, None] + np.arange(3)
+
+    def stiffness(u):
+        along = np.asarray(u, float)[translation] @ x
+        return geometric_stiffness(length, elements, area * E * np.diff(along) / h, axis=axis)
+    return stiffness
+
+
 def _section_axes(axis, up, where):
     """Rows x, y, z of the section frame in world components."""
     x = np.asarray(axis, float)

@@ -13,6 +13,8 @@ B = blockdiag(Aᵀ, 2E(u), I), the invariants' M(η) ν̇ = h + F gives
 −K_r η and −D η̇ on η. M_q keeps the rigid body's null direction u (closed by the unit-norm
 row). Being ordinary sympy M and Q, the part is evaluated, linearized (complex step) and
 compiled as any other part; its size grows as r², so it is meant for few modes (tens).
+With ``stiffening`` S (model/flexible/stiffening.py), M(η)'s ω–ω block loses Σ ω_a ω_b ηᵀ
+S_ab η: the centrifugal stiffening of a spinning part, as a term of its kinetic energy.
 
 Frames sit at FE nodes: node j at x_j + u_j(η) in the part's axes, turned by the node's
 elastic rotation θ_j(η) (its rotation DOFs; none for 3-DOF nodes) through the Cayley map
@@ -42,14 +44,15 @@ class FlexibleBody(Part):
     modes without rigid ones) on a floating frame. ``frames``: {name: node} or {name: (node,
     rotation 3 × 3[, drawing geometry])}; every interface node also gets a frame ``node_<j>``. ``damping``: an
     r × r matrix D (``rayleigh_damping``, ``modal_damping``), default none. ``gravity``:
-    sympy 3-vector of parameters. ``frame_nodes``: {frame name: FE node}."""
+    sympy 3-vector of parameters. ``stiffening``: the 3 × 3 × r × r S of
+    ``centrifugal_stiffening``, default none. ``frame_nodes``: {frame name: FE node}."""
 
     kind = "flexible_body"
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}
 
     def __init__(self, name, q, qd, reduction, gravity, params, frames=None, damping=None, geometry=(),
-                 initial=None):
+                 initial=None, stiffening=None):
         r = reduction.size
         if len(q) != 7 + r:
             raise ModelError(f"flexible body '{name}': {len(q)} coordinate symbols, its reduction needs {7 + r}")
@@ -58,12 +61,16 @@ class FlexibleBody(Part):
         self.damping = np.zeros((r, r)) if damping is None else np.asarray(damping, float)
         if self.damping.shape != (r, r):
             raise ModelError(f"flexible body '{name}': damping is {self.damping.shape}, the reduction has {r} coordinates")
+        self.stiffening = np.zeros((3, 3, r, r)) if stiffening is None else np.asarray(stiffening, float)
+        if self.stiffening.shape != (3, 3, r, r):
+            raise ModelError(f"flexible body '{name}': stiffening is {self.stiffening.shape}, expected {(3, 3, r, r)}")
         named = {f"node_{j}": j for j in reduction.interface}
         named.update(frames or {})
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
         self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
         made = [self._node_frame(name, label, spec, q[7:], qd[7:]) for label, spec in named.items()]
-        M, Q, T, V = _equations(self.invariants, reduction.stiffness, self.damping, q, qd, self.gravity)
+        M, Q, T, V = _equations(self.invariants, reduction.stiffness, self.damping, self.stiffening, q, qd,
+                                self.gravity)
         super().__init__(name, coordinates(r), q, qd, M, Q, T, V, params, made, geometry, initial)
 
     def _node_frame(self, part, label, spec, eta, eta_dot):
@@ -156,7 +163,7 @@ def _product(*factors):
     return out
 
 
-def _equations(inv, K, D, q, qd, gravity):
+def _equations(inv, K, D, S, q, qd, gravity):
     """(M, Q, T, V) of the part in its coordinates q = (R, u, η): the module's formulas."""
     r = inv.modes
     u, eta = sp.Matrix(q[3:7]), sp.Matrix(q[7:])
@@ -172,6 +179,7 @@ def _equations(inv, K, D, q, qd, gravity):
     linear = np.einsum("kai,ab,bj->kij", P, W, P0)
     linear += linear.transpose(0, 2, 1)
     quadratic = np.einsum("kai,ab,lbj->klij", P, W, P)
+    quadratic[:, :, 3:6, 3:6] -= S.transpose(2, 3, 0, 1)  # centrifugal stiffening: T₂ = −½ ωᵀ [ηᵀ S_ab η] ω
     M_nu = _polynomial(P0.T @ W @ P0, linear, quadratic, eta)  # M(η), ν = (V, ω, η̇)
     slopes = [_polynomial(linear[k], quadratic[k] + quadratic[:, k], np.zeros((r, r) + linear.shape[1:]), eta)
               for k in range(r)]  # ∂M/∂η_k
