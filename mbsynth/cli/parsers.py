@@ -66,7 +66,8 @@ def _model_argument(command):
     command.add_argument("model", help="model file (YAML)")
     command.add_argument("--set", action="append", type=_assignment, default=[], metavar="NAME=VALUE",
                          help="a parameter's value instead of the model file's (repeatable; parameters defined "
-                              "by expressions of it, and initial values written with it, follow)")
+                              "by expressions of it, initial values written with it and what the file builds "
+                              "from it, such as a flexible body's FE model, follow)")
 
 
 def _assignment(text):
@@ -82,11 +83,10 @@ def _assignment(text):
 
 
 def model_of(args):
-    """The System of ``args.model`` with the ``--set`` values (ModelError naming an unknown
-    parameter)."""
+    """The System of ``args.model`` built with the ``--set`` values (ModelError naming an
+    unknown parameter)."""
     from ..io import load
-    system = load(args.model)
-    return system.with_parameters(**dict(args.set)) if args.set else system
+    return load(args.model, parameters=dict(args.set))
 
 
 def _check(commands):

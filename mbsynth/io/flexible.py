@@ -44,11 +44,12 @@ def _read_fe(builder, spec, path):
     node = builder.section(spec[key], path + (key,), f"flexible_{key}")
     where = path + (key,)
     if key == "beam":
-        numbers = {k: builder.value(builder.constant(node[k], where + (k,))) for k in BEAM_NUMBERS if k in node}
+        numbers = {k: builder.fixed_value(builder.constant(node[k], where + (k,)), where + (k,)) for k in BEAM_NUMBERS
+                   if k in node}
         elements = node["elements"]
         if not isinstance(elements, int) or isinstance(elements, bool):
             builder.fail(where + ("elements",), f"elements must be a positive integer, got {elements!r}")
-        vectors = {k: builder.numbers(node[k], where + (k,), 3) for k in ("axis", "up") if k in node}
+        vectors = {k: builder.numbers(node[k], where + (k,), 3, fixed=True) for k in ("axis", "up") if k in node}
         length = numbers.pop("length")
         fe = _fe_layer(builder, where, beam, length, elements, **numbers, **vectors,
                        theory=node.get("theory", "euler_bernoulli"), mass=node.get("mass", "consistent"))
@@ -95,8 +96,8 @@ def _read_reduction(builder, fe, node, path):
         builder.fail(path, f"choose the modes by exactly one of modes (a count) and max_frequency (Hz); got "
                            f"{', '.join(chosen) or 'neither'}")
     count = node.get("modes")
-    limit = builder.value(builder.constant(node["max_frequency"], path + ("max_frequency",))) \
-        if "max_frequency" in node else None
+    where = path + ("max_frequency",)
+    limit = builder.fixed_value(builder.constant(node["max_frequency"], where), where) if "max_frequency" in node else None
     if method == "craig_bampton":
         if not interface:
             builder.fail(path + ("interface",), "Craig–Bampton needs at least one interface node")
@@ -135,11 +136,11 @@ def _read_damping(builder, reduction, node, path):
     if len(node) != 1:
         builder.fail(path, f"give exactly one of rayleigh and modal; got {', '.join(node) or 'neither'}")
     if "rayleigh" in node:
-        alpha, beta = builder.numbers(node["rayleigh"], path + ("rayleigh",), 2)
+        alpha, beta = builder.numbers(node["rayleigh"], path + ("rayleigh",), 2, fixed=True)
         if alpha < 0 or beta < 0:
             builder.fail(path + ("rayleigh",), f"α and β must be ≥ 0, got {alpha}, {beta}")
         return rayleigh_damping(reduction, alpha, beta)
-    ratio = builder.value(builder.constant(node["modal"], path + ("modal",)))
+    ratio = builder.fixed_value(builder.constant(node["modal"], path + ("modal",)), path + ("modal",))
     if ratio < 0:
         builder.fail(path + ("modal",), f"the damping ratio must be ≥ 0, got {ratio}")
     return modal_damping(reduction, ratio)

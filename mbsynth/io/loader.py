@@ -17,6 +17,7 @@ from ..model.connectors.joints import Joint
 from ..model.connectors.base import Connector
 from ..model.joint_values import constraint_symbols, value_expressions, value_names
 from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
+from ..core.errors import ModelError
 from ..model.parts import LagrangianPart
 from ..symbolic.derive import T_SYMBOL, joint_values_in
 from ..model.system import System
@@ -33,9 +34,11 @@ RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
 
-def load(path):
-    """Read the model file at ``path`` and return its ``System``."""
-    return build(read_document(path))
+def load(path, parameters=None):
+    """Read the model file at ``path`` and return its ``System``; ``parameters`` ({name:
+    value}): values instead of the file's (what the file builds from them, e.g. a flexible
+    body's FE model, is built with them)."""
+    return build(read_document(path), parameters)
 
 
 def loads(text, name="<string>", folder=None):
@@ -44,15 +47,17 @@ def loads(text, name="<string>", folder=None):
     return build(Document(name, text, folder))
 
 
-def build(doc):
-    """Build the System described by a parsed Document."""
-    return _Builder(doc).system()
+def build(doc, parameters=None):
+    """Build the System described by a parsed Document (``parameters``: as in ``load``)."""
+    return _Builder(doc, parameters).system()
 
 
 class _Builder:
-    def __init__(self, doc):
+    def __init__(self, doc, parameters=None):
         self.doc = doc
         self.root = doc.root
+        self.overrides = dict(parameters or {})
+        self.fixed = {}  # parameter name -> where the file builds something from its value at load
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
@@ -119,6 +124,14 @@ class _Builder:
         """The float value of an expression of parameters."""
         return float(sp.sympify(expr).subs(self.param_values))
 
+    def fixed_value(self, expr, path):
+        """``value(expr)`` for something built once at load (an FE model): its parameters
+        are recorded as fixed there (``System.fixed_parameters``)."""
+        where = f"{self.doc.name}:{self.doc.line_of(path)}, key {'.'.join(map(str, path))}"
+        for symbol in sp.sympify(expr).free_symbols:
+            self.fixed.setdefault(str(symbol), where)
+        return self.value(expr)
+
     def sized_list(self, node, path, size):
         if not isinstance(node, list) or len(node) != size:
             self.fail(path, f"expected a list of {size} numbers or expressions, got {_kind(node)}"
@@ -130,9 +143,10 @@ class _Builder:
         node = self.sized_list(node, path, size)
         return sp.Matrix([self.expression(x, path + (i,), symbols) for i, x in enumerate(node)])
 
-    def numbers(self, node, path, size):
-        """A list of ``size`` floats (expressions of parameters allowed)."""
-        return [self.value(x) for x in self.constants(node, path, size)]
+    def numbers(self, node, path, size, fixed=False):
+        """A list of ``size`` floats (expressions of parameters allowed; ``fixed``: built
+        from at load, as ``fixed_value``)."""
+        return [self.fixed_value(x, path) if fixed else self.value(x) for x in self.constants(node, path, size)]
 
     def constants(self, node, path, size):
         """A sympy column of ``size`` expressions of parameters, each finite and real."""
@@ -180,7 +194,7 @@ class _Builder:
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
                          source=self.doc.text, source_folder=str(self.doc.folder),
                          robots=tuple(entry.robot for entry in self.robots.values()),
-                         outputs=read_outputs(self, constraints))
+                         outputs=read_outputs(self, constraints), fixed_parameters=dict(self.fixed))
         self.check_parts(system)
         self.check_branches(system)
         closure = root.get("closure", "none")
@@ -193,11 +207,14 @@ class _Builder:
         self.definitions = {}
         node = self.root.get("parameters", LineDict())
         node = self.mapping(node, ("parameters",), set(node) if isinstance(node, dict) else set())
+        unknown = sorted(set(self.overrides) - set(node))
+        if unknown:
+            raise ModelError(f"{self.doc.name}: the model has no parameter(s) {unknown}; it has {sorted(node)}")
         values, symbols = {}, {}
         for key, text in node.items():
             path = ("parameters", key)
             self.identifier(key, path, "parameter")
-            expr = self.expression(text, path, symbols)
+            expr = sp.Float(self.overrides[key]) if key in self.overrides else self.expression(text, path, symbols)
             value = _real(expr, values)
             if value is None:
                 self.fail(path, f"parameter '{key}' = {text!r} is not a finite real number")

@@ -58,6 +58,7 @@ class System:
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
+    fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load
     # what Systems of this structure share (data.Shared: the compiled Template, evaluators): a
     # cache of derived values, handed on by ``with_parameters``, no part of the System's value
     shared: Shared = field(default=None, compare=False, repr=False)
@@ -147,7 +148,9 @@ class System:
         Parameters defined by expressions of others, and initial values written as
         expressions of parameters, follow the new values. Closure balances appended at
         load time are kept as derived; they stay valid while the masses that were zero
-        stay zero. The new System shares this one's compiled path (``mbsynth.compiled``:
+        stay zero. A parameter the file built something from at load (``fixed_parameters``:
+        a flexible body's FE model) cannot change here: ModelError naming where (load the
+        file again with ``parameters=``). The new System shares this one's compiled path (``mbsynth.compiled``:
         parameters are arguments of its code), so a sweep compiles once."""
         p = self.resolved_parameters(values, check_parts=False)
         new = dict(zip(self.parameters, p.tolist()))
@@ -193,6 +196,12 @@ class System:
                 if name in self.definitions and name not in values:
                     new[i] = float(self.definitions[name].xreplace(subs))
                 subs[sp.Symbol(name)] = sp.Float(new[i])
+        changed = {list(self.parameters)[i] for i in np.flatnonzero(old != new)}
+        fixed = sorted(set(self.fixed_parameters or ()) & changed)
+        if fixed:
+            raise ModelError(f"model '{self.name}': parameter '{fixed[0]}' was built into the model when it was loaded "
+                             f"(at {self.fixed_parameters[fixed[0]]}): load the file again with the new value, "
+                             f"mb.load(path, parameters={{'{fixed[0]}': ...}}) (the CLI's --set does)")
         if check_parts:
             moved = {self.parameter_symbols[i] for i in np.flatnonzero(old != new)}
             problems = self.part_problems(moved, new) if moved else []
