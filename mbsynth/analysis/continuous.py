@@ -85,7 +85,7 @@ class ContinuousIntegration(CutIntegration):
         self.steps += 1
         taken = solver.t - start[0]
         if solver.t != solver.t_bound or self.next_step is None:  # a step cut at the bound proposes less
-            self.next_step = solver.h_abs
+            self.next_step = stepper.proposed_step(solver)
         q, qd = self.form.to_state(solver.y)
         self.f.check(solver.t, q, qd)
         redo, cap = next_cap(self.correction.drift(q, qd), taken, solver.max_step, solver.t_bound - solver.t,

@@ -24,6 +24,7 @@ from .derivative import Crawl
 from .drift import next_cap
 from .integration import Integration
 from .projection import project, relative_drift
+from . import stepper
 
 log = logging.getLogger(__name__)
 
@@ -98,7 +99,7 @@ class CutIntegration(Integration):
                 raise self.failed_step(solver, message)
             self.steps += 1
             if solver.t != t_next:
-                self.next_step = solver.h_abs
+                self.next_step = stepper.proposed_step(solver)
         return solver.y.copy()
 
 

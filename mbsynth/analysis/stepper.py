@@ -25,6 +25,12 @@ METHODS = {kind.__name__: kind for kind in (scipy.integrate.RK23, scipy.integrat
 RESUMABLE = (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853)
 
 
+def proposed_step(solver):
+    """The step the solver would take next: its own proposal (h_abs), or for LSODA, which
+    keeps it inside its Fortran state, its last step's size."""
+    return getattr(solver, "h_abs", None) or solver.step_size
+
+
 def saved(solver):
     """What ``rewind`` needs to take the solver's last step again."""
     return solver.t, solver.y, solver.f, solver.h_abs

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import scipy.integrate
 
+import mbsynth as mb
 from mbsynth.analysis import stepper
 
 
@@ -66,3 +67,24 @@ def test_a_rewound_step_is_taken_again_shorter():
     fresh = scipy.integrate.DOP853(damped, state[0], state[1], 10.0, rtol=1e-9, atol=1e-9, first_step=taken / 4)
     fresh.step()
     assert np.array_equal(solver.y, fresh.y)
+
+
+@pytest.mark.parametrize("method", sorted(stepper.METHODS))
+def test_every_method_runs_a_pendulum_to_its_exact_motion(method):
+    """mb.simulate with each integrator it accepts (the implicit ones restart at each output,
+    LSODA keeping its step inside its own state): a pendulum from 1 rad for 2 s ends within 1e-5
+    rad of θ̈ = −(g/L) sin θ solved by solve_ivp at rtol 1e-12."""
+    model = mb.loads("""
+parameters: {g: 9.81, L: 0.5}
+subsystems:
+  bob:
+    type: lagrangian
+    coordinates: [theta]
+    T: 0.5*L**2*theta_dot**2
+    V: -g*L*cos(theta)
+initial: {bob.theta: 1.0}
+""")
+    run = mb.simulate(model, 2.0, dt=0.5, method=method, rtol=1e-9, atol=1e-9)
+    exact = scipy.integrate.solve_ivp(lambda t, y: (y[1], -9.81 / 0.5 * np.sin(y[0])), (0.0, 2.0), (1.0, 0.0),
+                                      method="DOP853", rtol=1e-12, atol=1e-12).y[0, -1]
+    assert abs(run.q[-1, 0] - exact) < 1e-5
