@@ -205,7 +205,7 @@ def _node_shapes(system, shape):
         n = len(part.coordinates)
         if part.kind == "flexible_body":
             reduction = part.reduction
-            eta = shape[start + n - reduction.size:start + n]
+            eta = shape[start:start + n][part.elastic]
             if np.abs(eta).max(initial=0.0) > NODE_SHAPE_RTOL * np.abs(shape).max():
                 u = (reduction.basis @ eta).reshape(len(reduction.fe.nodes), -1)
                 found[part.name] = NodeShape(u[:, :3], u[:, 3:6] if u.shape[1] == 6 else None)

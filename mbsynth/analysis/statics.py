@@ -226,13 +226,11 @@ def _step(system, t, q, lin, model, merit, radius, limit, elastic):
 
 
 def _elastic_coordinates(system):
-    """Indices of the flexible bodies' elastic coordinates (their own, past the floating
-    frame's position and quaternion)."""
+    """Indices of the flexible bodies' elastic coordinates (``FlexibleBody.elastic``)."""
     found, start = [], 0
     for part in system.parts:
         if part.kind == "flexible_body":
-            frame = sum(len(group) for group in part.groups)
-            found += range(start + frame, start + len(part.coordinates))
+            found += range(start + part.elastic.start, start + part.elastic.stop)
         start += len(part.coordinates)
     return found
 

@@ -166,6 +166,7 @@ class _Builder:
             self.fail(("name",), f"expected a string, got {_kind(name)}")
         self.parameters = self.read_parameters()
         self.robots = read_robots(self)  # before any part is built: their torque parameters join the model's
+        self.override_robot_parameters()
         self.param_symbols = {p: sp.Symbol(p) for p in self.parameters}
         self.param_values = {sp.Symbol(k): v for k, v in self.parameters.items()}
         self.gravity = self.constants(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3)
@@ -202,14 +203,20 @@ class _Builder:
             self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
         return close(system) if closure == "auto" else system
 
+    def override_robot_parameters(self):
+        """The given ``parameters`` of load() over the robots' torque parameters (the file's
+        own took theirs in read_parameters); a name the model lacks is a ModelError."""
+        unknown = sorted(set(self.overrides) - set(self.parameters))
+        if unknown:
+            raise ModelError(f"{self.doc.name}: the model has no parameter(s) {unknown}; "
+                             f"it has {sorted(self.parameters)}")
+        self.parameters.update(self.overrides)
+
     def read_parameters(self):
         """Parameter values in order; ``self.definitions`` keeps each one's expression."""
         self.definitions = {}
         node = self.root.get("parameters", LineDict())
         node = self.mapping(node, ("parameters",), set(node) if isinstance(node, dict) else set())
-        unknown = sorted(set(self.overrides) - set(node))
-        if unknown:
-            raise ModelError(f"{self.doc.name}: the model has no parameter(s) {unknown}; it has {sorted(node)}")
         values, symbols = {}, {}
         for key, text in node.items():
             path = ("parameters", key)
@@ -217,7 +224,8 @@ class _Builder:
             expr = sp.Float(self.overrides[key]) if key in self.overrides else self.expression(text, path, symbols)
             value = _real(expr, values)
             if value is None:
-                self.fail(path, f"parameter '{key}' = {text!r} is not a finite real number")
+                given = self.overrides.get(key, text)
+                self.fail(path, f"parameter '{key}' = {given!r} is not a finite real number")
             values[sp.Symbol(key)] = value
             symbols[key] = sp.Symbol(key)
             self.definitions[key] = expr

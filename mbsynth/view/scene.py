@@ -299,7 +299,7 @@ def _mesh_lines(part, poses, color):
     if part.kind != "flexible_body" or part.geometry:
         return []
     reduction = part.reduction
-    eta = sp.Matrix(part.q[len(part.coordinates) - reduction.size:])
+    eta = sp.Matrix(part.q[part.elastic])
     ends = []
     for j, place in enumerate(reduction.fe.nodes):
         shift = sp.Matrix(reduction.basis[reduction.node_rows(j)[:3]].tolist()) * eta
@@ -376,7 +376,7 @@ class _Poses:
         if key not in self.index:
             p, R = (sp.Matrix(frame.position), sp.Matrix(frame.rotation)) if part is None else part.pose(frame)
             if part is not None and part.kind == "flexible_body" and self.scale != 1:
-                scaled = {x: self.scale * x for x in part.q[len(part.coordinates) - part.reduction.size:]}
+                scaled = {x: self.scale * x for x in part.q[part.elastic]}
                 p, R = p.xreplace(scaled), R.xreplace(scaled)
             self.index[key] = self._append(p, R)
         return self.index[key]

@@ -61,3 +61,18 @@ def test_set_rebuilds_what_the_file_builds_from_a_parameter(capsys):
                                          r", key subsystems\.strip\.beam\.I[yz]"):
         mb.load(CANTILEVER).with_parameters(Iz=4e-9)
     assert mb.load(CANTILEVER).with_parameters(L=2.0).parameters["L"] == 2.0  # an unchanged value is no change
+
+
+def test_a_robots_torque_parameter_is_set_at_load_as_by_with_parameters():
+    """A robot's torque parameters join the model after the file's own: loading with one of
+    them set gives the motion that with_parameters gives (q̈ to 1e-12), and an unknown name is
+    refused naming it."""
+    path = MODELS / "robots" / "ur5_holding_bar.yaml"
+    loaded = mb.load(path, parameters={"tau_arm_shoulder_lift_joint": 5.0})
+    changed = mb.load(path).with_parameters(tau_arm_shoulder_lift_joint=5.0)
+    q, qd = loaded.initial_state()
+    expected = changed.motion(0.0, q, qd).qdd
+    assert np.abs(expected - mb.load(path).motion(0.0, q, qd).qdd).max() > 1e-3  # the torque moves something
+    np.testing.assert_allclose(loaded.motion(0.0, q, qd).qdd, expected, atol=1e-12 * np.abs(expected).max())
+    with pytest.raises(ModelError, match=r"has no parameter\(s\) \['tau_nothing'\]"):
+        mb.load(path, parameters={"tau_nothing": 1.0})

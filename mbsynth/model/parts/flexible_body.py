@@ -45,7 +45,8 @@ class FlexibleBody(Part):
     rotation 3 × 3[, drawing geometry])}; every interface node also gets a frame ``node_<j>``. ``damping``: an
     r × r matrix D (``rayleigh_damping``, ``modal_damping``), default none. ``gravity``:
     sympy 3-vector of parameters. ``stiffening``: the 3 × 3 × r × r S of
-    ``centrifugal_stiffening``, default none. ``frame_nodes``: {frame name: FE node}."""
+    ``centrifugal_stiffening``, default none. ``frame_nodes``: {frame name: FE node};
+    ``elastic``: the slice of the part's coordinates that are η."""
 
     kind = "flexible_body"
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
@@ -57,6 +58,7 @@ class FlexibleBody(Part):
         if len(q) != 7 + r:
             raise ModelError(f"flexible body '{name}': {len(q)} coordinate symbols, its reduction needs {7 + r}")
         self.reduction, self.gravity = reduction, sp.Matrix(gravity)
+        self.elastic = slice(len(FRAME_COORDINATES), len(FRAME_COORDINATES) + r)
         self.invariants = invariants(reduction)
         self.damping = np.zeros((r, r)) if damping is None else np.asarray(damping, float)
         if self.damping.shape != (r, r):
@@ -68,7 +70,7 @@ class FlexibleBody(Part):
         named.update(frames or {})
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
         self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
-        made = [self._node_frame(name, label, spec, q[7:], qd[7:]) for label, spec in named.items()]
+        made = [self._node_frame(name, label, spec, q[self.elastic], qd[self.elastic]) for label, spec in named.items()]
         M, Q, T, V = _equations(self.invariants, reduction.stiffness, self.damping, self.stiffening, q, qd,
                                 self.gravity)
         super().__init__(name, coordinates(r), q, qd, M, Q, T, V, params, made, geometry, initial)
