@@ -44,7 +44,8 @@ from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve, spd_inverse
 from ..core.tolerances import (DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL,
-                               SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
+                               NEAR_SINGULAR as NEAR_SINGULAR_RTOL, SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL,
+                               SPLIT_MOVES)
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE, NEAR_SINGULAR = range(7)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
@@ -115,8 +116,10 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         for x in range(nx):
             largest = max(largest, Mx[x, x])
         if spd_inverse(inverse, nx, np.full(nx, largest), work):
-            return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors,
-                                  rhs, lam, multipliers)
+            return _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, z0, y, w, z, S,
+                                  vectors, rhs, lam, multipliers, drift)
+        if drift >= 0.0:
+            return NEAR_SINGULAR  # a singular mass: the exact drift rule's to judge
     S[:, :] = 0.0
     for x in range(nx):
         rhs[x] = Fx[x]
@@ -179,14 +182,16 @@ def _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multiplie
 
 
 @njit(**OPTIONS)
-def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
-                   multipliers):
+def _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
+                   multipliers, drift):
     """``_close`` where the extra coordinates' mass Mx is positive definite (``inverse``: Mx⁻¹,
     tree.spd_inverse): their accelerations q̈_x = Mx⁻¹ (F_x − A_xᵀ λ) are eliminated,
     leaving the rows' Schur matrix A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ (positive semi-definite,
     m_x × m_x) for λ. The motion is unique (the masses are), so dropped directions are
-    dependent rows, judged for consistency. On the manifold only: off it, ``motion`` hands
-    a model with extra coordinates to the exact drift rule."""
+    dependent rows, judged for consistency. Off the manifold (``drift`` ≥ 0; ``motion``
+    lets only a model without kernel nodes come here, G = 0) the answer is the drift rule's
+    only where no direction of the rows is nearly dependent: ``_rows_certified``, else
+    NEAR_SINGULAR."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     Sc, Vc = S[:mx, :mx], vectors[:mx, :mx]
     qx, W = np.zeros(nx), np.zeros((mx, nx))  # Mx⁻¹ F_x; Mx⁻¹ A_xᵀ, a row per extra row
@@ -210,6 +215,8 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
         rhs[x] = total
     values = np.zeros(mx)
     symmetric_eigen(Sc, Vc, values)
+    if drift >= 0.0 and not _rows_certified(values, Mx, inverse):
+        return NEAR_SINGULAR
     top = max(np.abs(values).max(), 1.0) if mx else 1.0
     lam[:] = 0.0
     dropped = size = 0.0
@@ -233,6 +240,33 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
         lam[c] = total
     _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
     return OK
+
+
+@njit(**OPTIONS)
+def _rows_certified(values, Mx, inverse):
+    """Whether the equilibrated rows A_e of a Schur matrix S = A_e Mx⁻¹ A_eᵀ (eigenvalues
+    ``values``) certainly have no nearly dependent direction, σ_min ≥ NEAR_SINGULAR σ₁, so
+    that the drift rule of core/equations.py keeps every direction and its answer is the
+    plain solution of (2.12) this kernel gives. From xᵀSx = ‖Mx^-½ A_eᵀx‖²,
+    σ_min² / σ₁² ≥ (λ_min(S) / λ_max(S)) / κ(Mx), and κ₂(Mx) ≤ ‖Mx‖∞ ‖Mx⁻¹‖∞ (symmetric)."""
+    least, top = np.inf, 0.0
+    for e in range(values.shape[0]):
+        least, top = min(least, values[e]), max(top, values[e])
+    if not top > 0.0:
+        return False
+    return least / top >= NEAR_SINGULAR_RTOL ** 2 * _row_sum_norm(Mx) * _row_sum_norm(inverse)
+
+
+@njit(**OPTIONS)
+def _row_sum_norm(X):
+    """‖X‖∞, the largest row sum of |X|."""
+    top = 0.0
+    for r in range(X.shape[0]):
+        total = 0.0
+        for c in range(X.shape[1]):
+            total += abs(X[r, c])
+        top = max(top, total)
+    return top
 
 
 @njit(**OPTIONS)
@@ -438,10 +472,13 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     largest is rows dependent on the manifold that the drift split, dropped with its part
     of the right side (least squares: no INCONSISTENT); one between that and
     SCHUR_ZERO_RTOL (a singular position near) is the exact rule's to judge
-    (NEAR_SINGULAR), as is every stage of a model with extra rows whose masses are uneven
-    (``_uneven_masses``: a millimetre four-bar's bar inertias) or that has extra coordinates
-    (planar bodies, energy-defined parts: the kernel's rule measured worse than the exact one
-    through their singular positions). ``general``: RIGID_TREE for
+    (NEAR_SINGULAR), as is every stage of a model with kernel nodes and extra rows whose
+    masses are uneven (``_uneven_masses``: a millimetre four-bar's bar inertias) or that has
+    extra coordinates too: there the Schur eigenvalues, in the mass metric, do not stand for
+    the rows' singular values that the drift rule judges. A model of extra coordinates alone
+    (planar bodies, energy-defined parts) keeps a stage only where the eigenvalues certify
+    that no direction is nearly dependent (``_rows_certified``), and so the drift rule would
+    keep every one. ``general``: RIGID_TREE for
     a Layout of rigid bodies on tree joints only (compiled without the rest), else GENERAL."""
     q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
@@ -491,8 +528,8 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
             mu = max(mu, abs(Mx[x, c]))
     mu = mu if mu > 0 else 1.0
     divide_masses(mu, H, F, Mx, Fx)
-    if drift >= 0.0 and xb.shape[0] and (x_coord.shape[0] or _uneven_masses(v, H, Mx)):
-        return NEAR_SINGULAR, 0.0  # the drift rule's to judge (``drift``)
+    if drift >= 0.0 and xb.shape[0] and v.shape[0] and (x_coord.shape[0] or _uneven_masses(v, H, Mx)):
+        return NEAR_SINGULAR, 0.0  # the drift rule's to judge (``drift``); without nodes: ``_close``
     tree_rows(q, qd, bshift, kind, start, node_joint, view1(LI, LX, LAYOUT.node_end), parent,
               rows, nu, s, Rs, joints, joint_row, scratch, J, P, rb, rscale, general)
     if general is not None and xb.shape[0]:

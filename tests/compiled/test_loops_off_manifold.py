@@ -175,3 +175,48 @@ def test_bricard_at_loose_tolerances_completes_unique_and_conserves_energy(rtol)
     assert trajectory.status == "completed" and not trajectory.stats["non_unique"]
     assert trajectory.energy_drift < 1e-6
     assert trajectory.max_residual < 1e-12
+
+
+def test_a_model_of_extra_coordinates_keeps_its_stages_where_no_direction_is_nearly_dependent():
+    """Andrews' squeezer (one energy-defined part, seven angles, six loop rows: extra
+    coordinates and rows only) 1e-9 off the manifold: the Schur eigenvalues and the mass's
+    condition certify that every direction of the rows is far from dependent, so the drift
+    rule keeps them all and the kernel serves the stage, with the KKT path's motion (the same
+    equations, solved another way: to rounding, 1e-9 relative)."""
+    system = mb.load(ROOT / "models" / "mechanisms" / "andrews.yaml")
+    data = system.data()
+    engine = data.engine
+    rng = np.random.default_rng(11)
+    q0, qd0 = system.initial_state()
+    for _ in range(5):
+        q = q0 + 1e-9 * rng.standard_normal(q0.size)
+        qd = qd0 + 1e-9 * rng.standard_normal(q0.size)
+        compiled = engine.motion(0.0, q, qd, None, True)
+        assert compiled is not None
+        exact = data._kkt_motion(0.0, q, qd, "fast", None, True)
+        assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-9 * np.abs(exact.qdd).max()
+
+
+def test_near_a_singular_position_a_planar_loop_leaves_the_stage_to_the_exact_drift_rule(tmp_path):
+    """The planar N-four-bar (N = 2: planar bodies, extra coordinates only) 1e-3 rad from its
+    horizontal position is served by the kernel off the manifold; 1e-7 rad from it, where a
+    direction of the rows is nearly dependent, the certificate fails and
+    the stage goes to the exact drift rule, which names the rows and gives the exact
+    one-degree-of-freedom acceleration."""
+    path = tmp_path / "n_four_bar.yaml"
+    path.write_text(ref.n_four_bar_yaml(2))
+    system = mb.load(path)
+    data = system.data()
+    engine = data.engine
+    J, K = ref.n_four_bar_constants(2)
+    rng = np.random.default_rng(3)
+    for gap, served in ((1e-3, True), (1e-7, False)):
+        psi, psi_dot = np.pi / 2 - gap, 2.0
+        q, qd = ref.n_four_bar_state(system.coordinates, 2, psi, psi_dot)
+        q, qd = q + 1e-13 * rng.standard_normal(q.size), qd + 1e-13 * rng.standard_normal(q.size)
+        assert (engine.motion(0.0, q, qd, None, True) is not None) == served
+        motion = data.motion(0.0, q, qd, drift=True)
+        assert bool(motion.singular) != served
+        psi_ddot = K / J * np.sin(psi)
+        x_ddot = 0.5 * (np.cos(psi) * psi_ddot - np.sin(psi) * psi_dot**2)
+        assert motion.qdd[system.coordinates.index("v0.x")] == pytest.approx(x_ddot, rel=1e-6)
