@@ -41,10 +41,11 @@ def load(path, parameters=None):
     return build(read_document(path), parameters)
 
 
-def loads(text, name="<string>", folder=None):
+def loads(text, name="<string>", folder=None, parameters=None):
     """Build a ``System`` from model text (``name`` is used in error messages); file names
-    in it (meshes, URDFs) are relative to ``folder`` (default: the working folder)."""
-    return build(Document(name, text, folder))
+    in it (meshes, URDFs) are relative to ``folder`` (default: the working folder);
+    ``parameters``: as in ``load``."""
+    return build(Document(name, text, folder), parameters)
 
 
 def build(doc, parameters=None):
@@ -195,7 +196,8 @@ class _Builder:
         system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
                          source=self.doc.text, source_folder=str(self.doc.folder),
                          robots=tuple(entry.robot for entry in self.robots.values()),
-                         outputs=read_outputs(self, constraints), fixed_parameters=dict(self.fixed))
+                         outputs=read_outputs(self, constraints), fixed_parameters=dict(self.fixed),
+                         load_parameters=dict(self.overrides), built_parameters=dict(system.parameters))
         self.check_parts(system)
         self.check_branches(system)
         closure = root.get("closure", "none")
@@ -213,7 +215,9 @@ class _Builder:
         self.parameters.update(self.overrides)
 
     def read_parameters(self):
-        """Parameter values in order; ``self.definitions`` keeps each one's expression."""
+        """Parameter values in order; ``self.definitions`` keeps the expression of each one
+        defined by earlier ones (which follows them in ``System.with_parameters``); a number
+        is no definition: its value stays until changed itself."""
         self.definitions = {}
         node = self.root.get("parameters", LineDict())
         node = self.mapping(node, ("parameters",), set(node) if isinstance(node, dict) else set())
@@ -228,7 +232,8 @@ class _Builder:
                 self.fail(path, f"parameter '{key}' = {given!r} is not a finite real number")
             values[sp.Symbol(key)] = value
             symbols[key] = sp.Symbol(key)
-            self.definitions[key] = expr
+            if expr.free_symbols:
+                self.definitions[key] = expr
         return {str(k): v for k, v in values.items()}
 
     def read_subsystems(self):

@@ -59,6 +59,8 @@ class System:
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
     fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load
+    load_parameters: dict = None  # the values given to ``load`` (``parameters=``), built in at load
+    built_parameters: dict = None  # every parameter's value as the model was built at load
     # what Systems of this structure share (data.Shared: the compiled Template, evaluators): a
     # cache of derived values, handed on by ``with_parameters``, no part of the System's value
     shared: Shared = field(default=None, compare=False, repr=False)

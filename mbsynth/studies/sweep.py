@@ -5,15 +5,17 @@ run: the model with those parameter values simulated to ``t_end``, reduced to th
 metrics asked for. Runs go to a Dask cluster — a local one that mbsynth starts
 (one single-threaded worker process per core, everything bound to 127.0.0.1) or the
 user's (``scheduler``). Each worker builds the model from its text once (file names in
-it relative to the model file's folder) and reuses it for every run it gets
-(``System.with_parameters`` only changes numbers). Results are one table row per
+it relative to the model file's folder), with the values it was loaded with and changed
+to since (``load(path, parameters=)``, ``with_parameters``: the System the sweep was
+given), and reuses it for every run it gets (``System.with_parameters`` only changes
+numbers). Results are one table row per
 run, failures included with their error; the table is written to ``out`` (.parquet or
 .csv) atomically as runs finish and, with every row gathered, when the sweep stops for
 any reason (an interruption, a failure), and a sweep restarted with the same ``out``
 skips the runs that finished in it (failed ones run again). Runs are keyed by a hash
 of their parameter values, so a run that Dask repeats (a worker lost mid-run) still
-appears exactly once; every row records the sweep's settings (model, t_end, simulation
-options, metrics, the swept parameters and their grid), and a restart with other
+appears exactly once; every row records the sweep's settings (model and its values,
+t_end, simulation options, metrics, the swept parameters and their grid), and a restart with other
 settings is refused, naming what changed, rather than mixing the two or dropping rows
 (a file that is no sweep's table is refused too). Trajectories come back from the
 workers and are written by the client, so ``trajectories`` is a folder on this machine.
@@ -154,25 +156,40 @@ def _digest(text):
 @dataclass(frozen=True)
 class ModelText:
     """What a worker needs to rebuild a System: its file's text, the name errors give,
-    and the folder its file names (meshes, URDFs) are relative to."""
+    the folder its file names (meshes, URDFs) are relative to, the values it was loaded
+    with (``load(path, parameters=)``) and the values of its parameters changed since
+    (``with_parameters``; those defined by expressions of others follow them), as
+    (name, value) pairs."""
 
     source: str
     name: str
     folder: str
+    load_parameters: tuple = ()
+    changed: tuple = ()
 
     @classmethod
     def of(cls, system):
-        return cls(system.source, system.name, system.source_folder)
+        return cls(system.source, system.name, system.source_folder, tuple(sorted((system.load_parameters or {}).items())),
+                   tuple(sorted(changed_parameters(system).items())))
 
     def system(self):
-        """The System, built once per process."""
-        key = (self.source, self.folder)
+        """The System as the sweep was given it, the file built once per process."""
+        key = (self.source, self.folder, self.load_parameters, self.changed)
         if key not in _SYSTEMS:
-            _SYSTEMS[key] = loads(self.source, name=self.name, folder=self.folder or None)
+            system = loads(self.source, name=self.name, folder=self.folder or None, parameters=dict(self.load_parameters))
+            _SYSTEMS[key] = system.with_parameters(**dict(self.changed))
         return _SYSTEMS[key]
 
 
-_SYSTEMS = {}  # per worker process: (model text, folder) -> System
+_SYSTEMS = {}  # per worker process: (model text, folder, load values, changed values) -> System
+
+
+def changed_parameters(system):
+    """{name: value} of the parameters not defined by expressions of others (``definitions``)
+    whose values differ from those ``system`` was built with at load (``with_parameters``)."""
+    built, defined = system.built_parameters or {}, system.definitions or {}
+    return {name: value for name, value in system.parameters.items()
+            if name not in defined and name in built and value != built[name]}
 
 
 def run_one(model, values, t_end, metrics, options, keep_trajectory=False):
@@ -182,7 +199,7 @@ def run_one(model, values, t_end, metrics, options, keep_trajectory=False):
     started = time.perf_counter()
     traj = None
     try:
-        system = model.system().with_parameters(**values)
+        system = model.system().with_parameters(**values)  # the sweep's values over the model's
         traj = simulate(system, t_end, **options)
         for metric in metrics:
             row[metric.name] = metric.evaluate(system, traj)
@@ -323,12 +340,17 @@ def _outcome(future, values):
 
 def sweep_settings(system, t_end, metrics, options, params, runs):
     """What a sweep's table holds, as JSON text recorded in every row: the model (its text's
-    hash and folder), t_end, the simulation options, the metrics, the swept parameters'
-    names and their grid (``grid_text``). A sweep resumed into the table must have the same."""
-    return json.dumps({"model_sha1": _digest(system.source), "folder": system.source_folder, "t_end": float(t_end),
-                       "options": options, "metrics": [m.spec for m in metrics],
-                       "parameters": sorted({name for values in runs for name in values}),
-                       "grid": grid_text(params, runs)}, sort_keys=True, default=list)
+    hash and folder, and where it was loaded with other values or changed since, those:
+    ``base``), t_end, the simulation options, the metrics, the swept parameters' names and
+    their grid (``grid_text``). A sweep resumed into the table must have the same."""
+    settings = {"model_sha1": _digest(system.source), "folder": system.source_folder, "t_end": float(t_end),
+                "options": options, "metrics": [m.spec for m in metrics],
+                "parameters": sorted({name for values in runs for name in values}),
+                "grid": grid_text(params, runs)}
+    base = {**(system.load_parameters or {}), **changed_parameters(system)}
+    if base:
+        settings["base"] = base
+    return json.dumps(settings, sort_keys=True, default=list)
 
 
 def grid_text(params, runs):
@@ -374,8 +396,8 @@ def _check_settings(out, found, settings):
     now = json.loads(settings)
     other = sorted(found - {settings})[0]
     before = json.loads(other) if other else {}  # "": a table written before settings were recorded
-    changes = [f"{key} {before.get(key, 'not recorded')!r} there, {now[key]!r} now" for key in sorted(now)
-               if before.get(key) != now[key]]
+    changes = [f"{key} {before.get(key, 'not recorded')!r} there, {now.get(key, 'not recorded')!r} now"
+               for key in sorted(set(now) | (set(before) if before else set())) if before.get(key) != now.get(key)]
     raise ModelError(f"{out}: holds runs of another sweep ({'; '.join(changes)}); resuming would mix them. "
                      f"Give another --out, or remove {out} to start over")
 

@@ -73,6 +73,28 @@ def test_200_runs_recover_the_natural_frequencies(cluster, tmp_path):
     assert set(saved["run_id"]) == set(table["run_id"])
 
 
+def test_a_sweep_runs_the_system_it_was_given_with_its_loaded_and_changed_values(cluster, tmp_path):
+    """A System loaded with other values (``load(parameters=)``: m2) and changed since
+    (``with_parameters``: m1) is swept with them: every run's frequencies are those of its
+    own k1, k2 with those masses (not the file's), and the table's settings record them, so
+    a sweep of the file as written is not resumed into it."""
+    system = mb.load(MODEL, parameters={"m2": 3.0}).with_parameters(m1=0.5)
+    out = tmp_path / "runs.csv"
+    table = sweep(system, {"k1": [50.0, 120.0]}, 2.0, out=out, scheduler=cluster.scheduler_address,
+                  trajectories=tmp_path / "traj", **FAST)
+    assert list(table["status"]) == ["ok", "ok"], list(table["error"])
+    for row in table.to_dict("records"):
+        with np.load(tmp_path / "traj" / f"{row['run_id']}.npz") as data:
+            x1bar = data["q"][:, 0] - system.parameters["l10"]
+        k2 = system.parameters["k2"]
+        K = np.array([[row["k1"] + k2, -k2], [-k2, k2]])
+        exact = np.sqrt(scipy.linalg.eigh(K, np.diag([0.5, 3.0]), eigvals_only=True))
+        assert np.abs(frequencies_from_samples(x1bar, FAST["dt"], 2) / exact - 1).max() < 1e-6
+    assert json.loads(pd.read_csv(out)["settings"][0])["base"] == {"m1": 0.5, "m2": 3.0}
+    with pytest.raises(mb.ModelError, match="holds runs of another sweep.*base"):
+        sweep(MODEL, {"k1": [50.0, 120.0]}, 2.0, out=out, scheduler=cluster.scheduler_address, **FAST)
+
+
 def test_a_killed_worker_loses_no_run_and_repeats_none(cluster):
     killed = []
 
