@@ -62,7 +62,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import SolveError
-from .tolerances import CONSISTENCY_RTOL, DRIFT_RANK, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL, SYMMETRY_RTOL
+from .tolerances import (CONSISTENCY_RTOL, DRIFT_RANK, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL, SYMMETRY_RTOL,
+                         VERDICT_MARGIN)
 
 TERM_FLOOR = 1e-3  # term_scales: the share of ‖A_i‖₁ ‖x‖∞ that a row with coordinates near zero keeps
 DRIFT_GAIN = 10.0  # a nearly dependent direction asking more than this times the rest's acceleration is drift
@@ -229,6 +230,9 @@ def constrained_acceleration(M, Q, A, b, C=None, *, rtol=RANK_RTOL,
     singular, row_space = (), None
     if drift is not None and d.m:
         d, row_space, singular = _trusted(d, rtol, drift)
+        qdd = _definite_solution(d, row_space, rtol)
+        if qdd is not None:  # unique, and (b) holds with no null space
+            return _motion(d, qdd, row_space[2], "pseudoinverse (2.14)", np.zeros((d.n, 0)), singular)
     report, s_hat, Ua, sa, Vk, qdd = _solve(d, row_space, rtol=rtol)
     if drift is None:
         _check_constraints(d, Ua, sa, Vk.shape[1], qdd)
@@ -261,7 +265,7 @@ def _trusted(d: "_Data", rtol, drift):
         dependent = near & (s <= DRIFT_RANK * _relative_drift(d, drift) * s[0])  # (1): the drift's own
         keep &= ~dependent
         near &= ~dependent
-        rest = _solve(*_restricted(d, U, s, Vt, c, keep & ~near), rtol=rtol)[-1]
+        rest = _trusted_solution(*_restricted(d, U, s, Vt, c, keep & ~near), rtol)
         asks = np.abs(c[near]) / s[near]
         drifted = np.flatnonzero(near)[asks > DRIFT_GAIN * np.linalg.norm(rest)]
         keep[drifted] = False
@@ -269,6 +273,39 @@ def _trusted(d: "_Data", rtol, drift):
             singular = tuple(d.constraints[i] for i in _named(np.abs(U[:, near]).max(axis=1)))
     kept, row_space = _restricted(d, U, s, Vt, c, keep)
     return kept, row_space, singular
+
+
+def _trusted_solution(d: "_Data", row_space, rtol):
+    """q̈ of (2.14) on data whose rows are consistent by construction (``_restricted``)."""
+    qdd = _definite_solution(d, row_space, rtol)
+    return _solve(d, row_space, rtol=rtol)[-1] if qdd is None else qdd
+
+
+def _definite_solution(d: "_Data", row_space, rtol):
+    """q̈ of (2.14) where M is certainly positive definite by the rank rule, else None.
+
+    With the row space (U_k, σ_k, V_k) of rows consistent by construction (the drift rule's
+    trusted part, ``_restricted``), A_e q̈ = b_e reads V_kᵀ q̈ = σ_k⁻¹ U_kᵀ b_e, and (2.12)'s
+    unique solution is the KKT one, q̈ = W (F/μ − V_k ν) with W = (M/μ)⁻¹ and
+    (V_kᵀ W V_k) ν = V_kᵀ W F/μ − σ_k⁻¹ U_kᵀ b_e: M̄⁺ gives it when M̂ has full column rank,
+    with no SVD of M̂ or M̄. Certain: σ_min(M̂) ≥ λ_min(M/μ) and σ₁(M̂) ≤ (‖M/μ‖∞² + σ₁(A_e)²)^½,
+    so λ_min(M/μ) above VERDICT_MARGIN · rtol times that bound is full rank beyond doubt.
+    λ_min is read off a diagonal M (planar bodies, particles); a full one is left to the SVDs."""
+    M = d.M / d.mu
+    diagonal = np.diag(M)
+    if np.count_nonzero(M) != np.count_nonzero(diagonal):
+        return None
+    Ua, sa, Vk = row_space
+    top = np.sqrt(np.abs(diagonal).max() ** 2 + (sa[0] ** 2 if sa.size else 0.0))
+    if not diagonal.min() > VERDICT_MARGIN * rtol * top:
+        return None
+    W = 1.0 / diagonal
+    WF = W * d.F / d.mu
+    if Vk.shape[1] == 0:
+        return WF
+    WV = W[:, None] * Vk
+    nu = np.linalg.solve(Vk.T @ WV, Vk.T @ WF - (Ua.T @ d.be) / sa)
+    return WF - WV @ nu
 
 
 def _relative_drift(d: "_Data", drift):

@@ -436,3 +436,19 @@ def test_drift_rule_sets_aside_a_nearly_dependent_direction_that_amplifies_drift
     U, s, Vt = np.linalg.svd(A / np.linalg.norm(A, axis=1)[:, None])
     kept = Vt[:1]  # the well-conditioned direction: x₁ held, x₂ free under its load
     np.testing.assert_allclose(motion.qdd, Q - kept.T @ (kept @ Q), atol=1e-6)
+
+
+@pytest.mark.parametrize("masses", [[1.0, 1e-6, 3.0, 0.5, 2.0], [1.0, 0.0, 3.0, 0.5, 2.0]])
+def test_drift_rule_with_full_row_rank_gives_the_kkt_motion(masses):
+    """Off the manifold, rows of full rank far from dependent: the drift rule keeps every
+    direction and (2.14) is the solution of the KKT equations M q̈ + Aᵀλ = Q, A q̈ = b
+    (numpy's solve), for a diagonal M of masses spanning 1e6 (solved without the SVDs of M̂
+    and M̄) and for one with a massless coordinate that the rows fix (solved with them)."""
+    rng = np.random.default_rng(4)
+    M, Q = np.diag(masses), rng.standard_normal(5)
+    A, b = rng.standard_normal((3, 5)), rng.standard_normal(3)
+    K = np.block([[M, A.T], [A, np.zeros((3, 3))]])
+    expected = np.linalg.solve(K, np.concatenate([Q, b]))[:5]
+    motion = constrained_acceleration(M, Q, A, b, drift=lambda: (np.full(3, 1e-12), np.ones(5)))
+    assert motion.unique and motion.singular == ()
+    np.testing.assert_allclose(motion.qdd, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
