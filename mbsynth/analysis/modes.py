@@ -26,6 +26,7 @@ from .trajectory import Trajectory
 from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL
 
 SHOWN = 3  # coordinates named per mode in the table
+DEGENERATE_RTOL = 1e-6  # eigenvalues this close (relative) are one repeated mode, split by rounding
 NODE_SHAPE_RTOL = 1e-9  # a flexible body's elastic coordinates below this share of a shape's largest: it does not bend
 
 
@@ -125,9 +126,10 @@ def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, 
     found = []
     if _holonomic_rest(lin):  # zeros in pairs: a free direction and its rate
         found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
-    for s in values[~free]:
-        if s.imag >= -MODE_ZERO_RTOL * scale:  # one of each conjugate pair
-            found.append(_mode(system, t, q, lin, s, _eigenvector(lin.A, s)[:k], scale))
+    upper = [s for s in values[~free] if s.imag >= -MODE_ZERO_RTOL * scale]  # one of each conjugate pair
+    for group in _degenerate_groups(upper):
+        for s, x in zip(group, _eigenspace(lin.A, group, k)):
+            found.append(_mode(system, t, q, lin, s, x, scale))
     found.sort(key=lambda m: (m.frequency, m.eigenvalue.real))
     cyclic = () if _holonomic_rest(lin) else lin.cyclic
     return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin, qd, cyclic,
@@ -153,10 +155,37 @@ def _check_rest_or_steady(system, lin, tolerance, steady):
                             "(mbsynth.equilibrium, or equilibrium=True)", coordinates=[system.coordinates[worst]])
 
 
-def _eigenvector(A, s):
-    """A unit eigenvector of A for its eigenvalue s: the right singular vector of A − sI of
-    the smallest singular value."""
-    return np.linalg.svd(A - s * np.eye(A.shape[0]))[2][-1].conj()
+def _degenerate_groups(values):
+    """The eigenvalues grouped where they repeat (within DEGENERATE_RTOL of their size: a
+    round beam's two bending planes, split by rounding only)."""
+    groups = []
+    for s in sorted(values, key=lambda z: (z.imag, z.real)):
+        if groups and abs(s - groups[-1][0]) <= DEGENERATE_RTOL * max(abs(s), abs(groups[-1][0])):
+            groups[-1].append(s)
+        else:
+            groups.append([s])
+    return groups
+
+
+def _eigenspace(A, group, k):
+    """One position part (the first k components) of an eigenvector of A per eigenvalue of
+    ``group`` (equal but for rounding), spanning their eigenspace: the right singular
+    vectors of A − s̄I of the smallest singular values. Where those positions span a real
+    space (an undamped or proportionally damped repeated mode), a real orthonormal basis of
+    it, so that each shape is one real motion rather than a complex mixture of the others,
+    each moving one of the basis's pivot coordinates (QR with column pivoting) and not the
+    others' (a beam's bending in each of its axes' planes, where its coordinates are those)."""
+    mean = np.mean(group)
+    vectors = np.linalg.svd(A - mean * np.eye(A.shape[0]))[2][-len(group):].conj()[:, :k]
+    if len(group) == 1:
+        return list(vectors)
+    parts = np.vstack([vectors.real, vectors.imag])
+    _, sigma, Vt = np.linalg.svd(parts)
+    if sigma.size > len(group) and sigma[len(group)] > DEGENERATE_RTOL * sigma[0]:
+        return list(vectors)  # a complex eigenspace (gyroscopic, non-proportional damping)
+    basis = Vt[:len(group)]
+    pivots = scipy.linalg.qr(basis, pivoting=True)[2][:len(group)]
+    return list(np.linalg.solve(basis[:, pivots], basis).astype(complex))
 
 
 def _free_directions(lin, count):

@@ -32,6 +32,34 @@ joints:
     np.testing.assert_allclose(found[:5], expected, rtol=1e-6)
 
 
+def test_a_round_beams_repeated_modes_are_real_and_independent():
+    """A round strip (Iy = Iz): each bending frequency is a repeated eigenvalue (both planes),
+    split by rounding only. mb.modes lists it twice at the Euler–Bernoulli frequency (1e-6)
+    with two real shapes (no imaginary part) that are independent: orthogonal in the elastic
+    coordinates, and at the tip one bends the beam in the xy plane, the other in xz, as a
+    repeated mode's basis may be chosen (nodal tip translations orthogonal to 1e-6)."""
+    round_strip = ", ".join(f"{k}: {v}" for k, v in {**STRIP, "Iy": STRIP["Iz"]}.items())
+    model = mb.loads(f"""
+subsystems:
+  beam:
+    type: flexible_body
+    beam: {{length: {LENGTH}, elements: 40, {round_strip}}}
+    reduction: {{method: craig_bampton, interface: [0], modes: 4}}
+joints:
+  - {{name: clamp, type: fixed, parent: world, child: beam.node_0}}
+""")
+    modes = mb.modes(model).modes
+    expected = euler_bernoulli(CLAMPED_FREE[:2], STRIP["Iz"]) / (2 * np.pi)
+    np.testing.assert_allclose([m.frequency for m in modes], np.repeat(expected, 2), rtol=1e-6)
+    for first, second in (modes[0:2], modes[2:4]):
+        for mode in (first, second):
+            assert np.abs(mode.shape.imag).max() == 0.0
+        eta = [model.coordinates.index(f"beam.eta{i}") for i in range(1, 5)]
+        assert abs(np.dot(first.shape[eta].real, second.shape[eta].real)) <= 1e-9
+        tips = [mode.node_shape["beam"].translations[-1].real for mode in (first, second)]
+        assert abs(np.dot(*tips)) <= 1e-6 * np.linalg.norm(tips[0]) * np.linalg.norm(tips[1])
+
+
 def test_a_free_beams_modes_are_the_analytic_free_free_ones():
     """The same strip alone in space, six free-interface modes: mb.modes finds six free
     (rigid-body) modes of the frame and vibrations whose five lowest are the free–free
