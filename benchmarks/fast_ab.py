@@ -52,7 +52,8 @@ def package_at(rev):
         (home / "partial" / "mbsynth").rename(home / name)
         (home / "partial").rmdir()
     sys.path.insert(0, str(home))
-    return commit, importlib.import_module(f"{name}.fast.kernel")
+    folder = "compiled" if (home / name / "compiled").is_dir() else "fast"  # the compiled path's folder then
+    return commit, importlib.import_module(f"{name}.{folder}.kernel")
 
 
 def same_packing(old):
@@ -62,10 +63,12 @@ def same_packing(old):
 
 
 def _checked(module, engine):
-    """The mode argument of a kernel whose ``motion`` takes one (its checked call), then its
-    ``general`` where it takes that, else none."""
+    """The mode argument of a kernel whose ``motion`` takes one (its checked call), its
+    ``drift`` where it takes that (−1: on the manifold), then its ``general`` where it takes
+    that, else none."""
     mode = (module.CHECKED,) if hasattr(module, "CHECKED") else ()
-    return mode + ((engine.general,) if hasattr(module, "GENERAL") else ())
+    drift = (-1.0,) if hasattr(module, "NEAR_SINGULAR") else ()
+    return mode + drift + ((engine.general,) if hasattr(module, "GENERAL") else ())
 
 
 def compare(label, old, new):
