@@ -149,9 +149,13 @@ def test_ctrl_c_keeps_the_output_and_exits_130(capsys, tmp_path, monkeypatch):
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL], ids=lambda s: s.name)
 def test_the_live_viewer_and_its_meshcat_server_end_together(signum):
     """``mbsynth view`` serving a model: SIGINT (Ctrl-C) or SIGTERM stops it, exit 130, one
-    line; after any of them, SIGKILL of the viewer included, its meshcat server ends too."""
+    line; after any of them, SIGKILL of the viewer included, its meshcat server ends too.
+    The viewer starts with SIGINT at its default, as a terminal's foreground command does: a
+    test run started in the background of a shell (``make test &``) ignores SIGINT, and a
+    Python child keeps an inherited SIG_IGN."""
     process = subprocess.Popen([sys.executable, "-m", "mbsynth.cli", "view", MODEL, "--t-end", "0.2"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     servers = []
     try:
         line = readline_within(process.stdout, HANG)
