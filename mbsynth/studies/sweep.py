@@ -226,9 +226,10 @@ def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift
     """Run every combination of ``params`` ({name: (start, stop, count) or values}) or every
     row of ``samples`` (a CSV path or a list of dicts); return the results as a DataFrame.
 
-    model: a model path or a System loaded from a file. options: passed to ``simulate``
-    (dt, method, rtol, atol, stabilization). workers: the size of the local cluster (not
-    with ``scheduler``). trajectories: a folder here, where each run's trajectory is saved
+    model: a model path or a System loaded from a file (its values as loaded, ``parameters=``,
+    or changed by ``with_parameters`` kept in every run, the swept ones set over them).
+    options: passed to ``simulate`` (dt, method, rtol, atol, stabilization). workers: the
+    size of the local cluster (not with ``scheduler``). trajectories: a folder here, where each run's trajectory is saved
     as <run_id>.npz. progress: callable(done, failed, total, eta_s).
     """
     system = model if hasattr(model, "with_parameters") else load(model)
