@@ -1,17 +1,19 @@
-"""The continuous strategy of the run loop: where the compiled kernel puts a state back on
-the constraints itself (compiled/correction.py: kernel joints and bodies, in a tree or
-closing loops), with ``stabilization="projection"`` and an explicit Runge–Kutta pair (RK23, RK45,
-DOP853).
+"""The continuous strategy of the run loop: every run with ``stabilization="projection"``
+and an explicit Runge–Kutta pair (RK23, RK45, DOP853).
 
 The steps are chosen by the error control alone, up to the next control sample or the end;
-each accepted step is corrected and the integrator goes on from there, given the corrected
-state's derivative, its steps capped (``max_step``) to keep the drift between corrections
-below DRIFT_TARGET (drift.py). Each output row is read from the step's dense output (the
-interpolant ``solve_ivp`` gives at ``t_eval``) and corrected (a copy: the integrator goes
-on from its own state), the rows a step passed in one block with its end
-(correction.Correction.block, on all cores). An output interval in which the integrator
-crawls near a singular position, or fails, is integrated again, cut (cut.py), from the last
-output: a failure is then reported in the interval it happens in, the rows before it kept.
+each accepted step is put back on the constraints and the integrator goes on from there,
+given that state's derivative, its steps capped (``max_step``) to keep the drift between
+corrections below DRIFT_TARGET (drift.py). Each output row is read from the step's dense
+output (the interpolant ``solve_ivp`` gives at ``t_eval``) and put back on the constraints
+too (a copy: the integrator goes on from its own state). Where the compiled kernel covers
+the model (compiled/correction.py: kernel joints and bodies, in a tree or closing loops) it
+corrects the rows a step passed in one block with its end (correction.Correction.block, on
+all cores); elsewhere each state is projected (projection.py) and judged strictly there
+(Integration.arrived), and a model with no rows has nothing to correct. An output interval
+in which the integrator crawls near a singular position, or fails, is integrated again,
+cut (cut.py), from the last output: a failure is then reported in the interval it happens
+in, the rows before it kept.
 """
 
 import numpy as np
@@ -21,7 +23,8 @@ from ..core.errors import SolveError
 from .cut import RELAXED_MAX, CutIntegration
 from .derivative import MAX_STATE, Crawl
 from .drift import next_cap
-from .projection import project
+from .projection import project, relative_drift
+from .singular_watch import SingularWatch
 
 
 class ContinuousIntegration(CutIntegration):
@@ -29,16 +32,16 @@ class ContinuousIntegration(CutIntegration):
     interval it cannot do is done cut (CutIntegration.advance)."""
 
     @staticmethod
-    def fits(data, method, stabilization):
-        """Whether a run on ``data`` (its Data) with the OdeSolver class ``method`` and
-        ``stabilization`` can be integrated continuously."""
-        engine = data.engine
-        return engine is not None and engine.correction() is not None \
-            and issubclass(method, stepper.RESUMABLE) and stabilization == "projection"
+    def fits(method, stabilization):
+        """Whether a run with the OdeSolver class ``method`` and ``stabilization`` can be
+        integrated continuously."""
+        return issubclass(method, stepper.RESUMABLE) and stabilization == "projection"
 
     def __init__(self, *args):
-        self.passed = {}  # the states at the times the last step passed ({t: (y, Corrected, bounded)})
+        self.passed = {}  # the states at the times the last step passed ({t: (y, Corrected or None, bounded)})
         super().__init__(*args)
+        self.has_rows = len(self.data.system.constraint_names) > 0
+        self.watch = None  # the singular positions passed between stages (singular_watch.py), on projected runs
 
     def advance(self, t_next, q, qd, t_stop):
         try:
@@ -62,6 +65,8 @@ class ContinuousIntegration(CutIntegration):
         self.f.begin(self.t_now, t_next, may_crawl=self.rtol < RELAXED_MAX)
         solver = self.solver
         if solver is None or self.forces_jumped:
+            if solver is None:
+                self._watch_from(self.t_now, q, qd)
             solver = self.resumed(self.t_now, q, qd, t_stop, self.rtol, self.atol)
             self.passed = {}
         while solver.t < t_next:
@@ -88,8 +93,8 @@ class ContinuousIntegration(CutIntegration):
             self.next_step = stepper.proposed_step(solver)
         q, qd = self.form.to_state(solver.y)
         self.f.check(solver.t, q, qd)
-        redo, cap = next_cap(self.correction.drift(q, qd), taken, solver.max_step, solver.t_bound - solver.t,
-                             self.f.span)
+        drift, arrays = self._drift(solver.t, q, qd)
+        redo, cap = next_cap(drift, taken, solver.max_step, solver.t_bound - solver.t, self.f.span)
         if redo:
             stepper.rewind(solver, start, cap)
             self.steps -= 1
@@ -100,15 +105,42 @@ class ContinuousIntegration(CutIntegration):
         if times:
             stepper.interpolate(solver, times, states[:-1])
         states[-1] = solver.y
-        corrected = self.correction.block(*self.form.states(states))
+        corrected = self.correction.block(*self.form.states(states)) if self.correction is not None \
+            else [None] * len(states)
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
-        q_on, qd_on = self._on_constraints(solver.t, q, qd, corrected[-1])
+        q_on, qd_on = self._on_constraints(solver.t, q, qd, corrected[-1], arrays)
+        if self.watch is not None and self.correction is None:
+            for t_star, rows, width in self.watch.passed(solver.t, q_on, qd_on):
+                self.f.add_singular(t_star, rows, width)
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
             y = self.form.to_integrator(q_on, qd_on)
             stepper.move(solver, y, None if solver.status == "finished" else self.f(solver.t, y))
 
-    def _on_constraints(self, t, q, qd, corrected):
+    def _watch_from(self, t, q, qd):
+        """Watch for the singular positions passed between stages from the state (t, q, q̇)
+        on (singular_watch.py): on projected runs (the kernel's corrections keep no rows at
+        hand) of models whose A is small enough."""
+        if self.correction is None and SingularWatch.fits(self.data):
+            if self.watch is None:
+                self.watch = SingularWatch(self.data, t, q, qd)
+            self.watch.restart()
+            self.watch.passed(t, q, qd)
+
+    def _drift(self, t, q, qd):
+        """(the state's relative drift off the constraints, its ConstraintArrays or None):
+        the kernel's rows where it corrects the model, else projection.py's."""
+        if self.correction is not None:
+            return self.correction.drift(q, qd), None
+        if not self.has_rows:
+            return 0.0, None
+        arrays = self.data.constraint_arrays(t, q, qd, sparse=None)
+        return relative_drift(self.data, t, q, qd, arrays), arrays
+
+    def _on_constraints(self, t, q, qd, corrected, arrays=None):
         """The state (q, q̇) on the constraints: ``corrected``'s where the kernel's correction
-        put it there (correction.Corrected), else projected (projection.py)."""
-        return project(self.data, t, q, qd) if corrected is None else corrected[:2]
+        put it there (correction.Corrected), else projected (projection.py; ``arrays``: the
+        ConstraintArrays at the state, if at hand), as it is in a model with no rows."""
+        if corrected is not None:
+            return corrected[:2]
+        return project(self.data, t, q, qd, arrays=arrays) if self.has_rows else (q, qd)

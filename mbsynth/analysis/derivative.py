@@ -91,14 +91,29 @@ class StateDerivative:
             raise Crawl
         return self.form.rates(y, found if found is not None else np.concatenate([qd, motion.qdd]))
 
+    def add_singular(self, t, rows, within):
+        """A singular position passed at t (``rows``: its nearly dependent rows) found between
+        the stages (singular_watch.py), unless a stage came near one within ``within`` of t."""
+        listed = [(e["t_from"], e["t_to"]) for e in self.singular_positions] + [(u, u) for u, _ in self.singular]
+        if not any(t_from - within <= t <= t_to + within for t_from, t_to in listed):
+            self.singular.append((t, rows))
+
     def note_singular(self):
-        """One entry of ``singular_positions`` for the stages of the interval just done."""
+        """One entry of ``singular_positions`` for the stages of the interval just done (an
+        entry it overlaps, a crossing found between the stages and then integrated again,
+        takes it in)."""
         if self.singular:
             times = [t for t, _ in self.singular]
-            rows = sorted({r for _, names in self.singular for r in names})
-            self.singular_positions.append(dict(t_from=min(times), t_to=max(times), rows=rows))
-            log.info("singular position near t = %.6g (nearly dependent rows %s)", min(times), ", ".join(rows))
+            rows = {r for _, names in self.singular for r in names}
+            t_from, t_to = min(times), max(times)
             self.singular = []
+            for entry in self.singular_positions:
+                if entry["t_from"] <= t_to and t_from <= entry["t_to"]:
+                    entry.update(t_from=min(t_from, entry["t_from"]), t_to=max(t_to, entry["t_to"]),
+                                 rows=sorted(rows | set(entry["rows"])))
+                    return
+            self.singular_positions.append(dict(t_from=t_from, t_to=t_to, rows=sorted(rows)))
+            log.info("singular position near t = %.6g (nearly dependent rows %s)", t_from, ", ".join(sorted(rows)))
 
     def collapse(self, t, y, why):
         """The SolveError of a step-size collapse at (t, y), naming the coordinates of the

@@ -8,11 +8,12 @@ compiled/correction.py) and has been judged strictly there: a real contradiction
 SolveError. ``restart`` follows a jump of the forces (new parameter values in the Data, at a
 control sample): the integrator's f is computed afresh there.
 
-- ContinuousIntegration (continuous.py): where the kernel corrects states itself (a tree of
-  kernel joints and bodies) and the integrator is an explicit pair, the steps are chosen by
-  the error control alone, up to the next control sample or the end, each corrected.
-- CutIntegration (cut.py): otherwise, each interval integrated on its own, the last step
-  cut short at its end, the state projected there and between as the drift asks.
+- ContinuousIntegration (continuous.py): with an explicit pair and projection, the steps
+  are chosen by the error control alone, up to the next control sample or the end, each
+  corrected (by the kernel where it covers the model, else projected).
+- CutIntegration (cut.py): otherwise, and for an interval the continuous integrator cannot
+  do, each interval integrated on its own, the last step cut short at its end, the state
+  projected there and between as the drift asks.
 
 ``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share
 how an integrator goes on from a state: the same explicit pair where it can

@@ -16,8 +16,10 @@ dependent rows whose dependency changes with the configuration — Bricard's mec
 and nearly dependent directions near a singular position set aside). At each output state
 the constraints are judged strictly: a real contradiction raises SolveError there.
 ``stats["singular_positions"]`` lists the output intervals in which a stage came near a
-singular position (σ < 1e-5 σ₁ of the equilibrated A: the drift rule's zone); a crossing
-whose stages all stay farther from it needs no special treatment and may go unlisted.
+singular position (σ < 1e-5 σ₁ of the equilibrated A: the drift rule's zone), and, on a
+continuous projected run of a small model, each crossing found between the steps' ends
+(singular_watch.py); a crossing whose stages all stay farther from it needs no special
+treatment, and on other runs may go unlisted.
 There a tolerance tighter than the stages' noise makes the integrator crawl: such a span is
 integrated again more loosely (cut.py) and listed in ``stats["relaxed_spans"]``.
 """
@@ -82,7 +84,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     control = None if controller is None else \
         SampledControl(controller, times[1] - times[0] if control_dt is None else control_dt)
     schedule = Schedule(times, None if control is None else control.dt)
-    strategy = ContinuousIntegration if ContinuousIntegration.fits(data, method, stabilization) else CutIntegration
+    strategy = ContinuousIntegration if ContinuousIntegration.fits(method, stabilization) else CutIntegration
     run = strategy(data, method, rtol, atol, stabilization, baumgarte, schedule)
     recorder.open()
     started = time.perf_counter()

@@ -46,12 +46,13 @@ def test_a_state_that_blows_up_in_finite_time(tmp_path):
 
 
 def test_a_step_size_collapse_at_a_singular_force(tmp_path):
-    """ẍ = 1/(1 − t)³ from rest: x = ½ (1/(1 − t) − 1 − t), singular at t = 1."""
+    """ẍ = 1/(1 − t)³ from rest: x = ½ (1/(1 − t) − 1 − t), singular at t = 1. The rows
+    within the run's tolerances (rtol = atol = 1e-10 per step) of the exact x."""
     error, saved = stop(one_coordinate("1/(1 - t)**3"), 2.0, tmp_path / "run.csv", 0.01)
     assert 0.99 < error.time <= 1.0 and error.coordinates == ("p.x",)
     assert "step-size collapse" in str(error) and "last good state saved at t = 0.99" in str(error)
     assert saved.t[-1] == pytest.approx(0.99)
-    np.testing.assert_allclose(saved.q[:, 0], 0.5 * (1 / (1 - saved.t) - 1 - saved.t), rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(saved.q[:, 0], 0.5 * (1 / (1 - saved.t) - 1 - saved.t), rtol=1e-8, atol=1e-10)
 
 
 def test_a_state_beyond_max_state_stops_at_the_first_output_past_it(tmp_path):

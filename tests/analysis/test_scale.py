@@ -40,8 +40,12 @@ def test_pendulum_at_any_scale(length, mass):
 def test_n_four_bar_through_its_singular_position_at_any_scale(length, mass):
     unit = math.sqrt(length)
     system = mb.loads(ref.n_four_bar_yaml(1, L=length, m=mass, v0=unit), name="n_four_bar_1")
-    traj = mb.simulate(system, 1.5 * unit)  # the first singular position is near t = 0.7 √L
-    assert traj.status == "completed" and traj.stats["singular_positions"]
+    traj = mb.simulate(system, 1.5 * unit)  # the singular positions are near t = 0.71 √L and 1.22 √L
+    crossings = ref.n_four_bar_singular_times(1, 1.5) * unit
+    listed = traj.stats["singular_positions"]
+    assert traj.status == "completed" and len(listed) == len(crossings) == 2
+    for entry, t in zip(listed, crossings):
+        assert entry["t_from"] - 1e-5 * unit <= t <= entry["t_to"] + 1e-5 * unit, (entry, t)
     theta = traj.column("v0.theta")
     bx = (traj.column("v0.x") - 0.5 * length * np.sin(theta)) / length
     by = (traj.column("v0.y") + 0.5 * length * np.cos(theta)) / length

@@ -1,0 +1,100 @@
+"""The singular positions a continuous run passes between its stages.
+
+At a singular position the rows of A are dependent for an instant (a parallelogram's change
+points): σ_r, the r-th singular value of the equilibrated A (r its rank where the watch
+starts: rows dependent throughout stay out), dips to about zero and rises again, like
+|t − t*|. A's rows and then its columns are scaled to unit norm, so that metres, kilometres
+and radians weigh alike and σ_r/σ₁ means the same at every scale. The stages of a
+continuous run rarely come within NEAR_SINGULAR σ₁ of it, where derivative.py lists them,
+so the run also reads σ_r/σ₁ at each accepted step's end (on the constraints). Where one
+end's ratio lies below both its neighbours', the dip lies between them: a golden-section
+search on the positions' cubic Hermite interpolant between the ends (q and q̇ at each)
+finds its bottom, listed as a singular position where the ratio falls below NEAR_SINGULAR
+there, with the rows of its nearly dependent direction. For models whose A is small enough
+to decompose at every step (WATCH_ENTRIES).
+"""
+
+import numpy as np
+
+from ..core.equations import equilibrate_rows
+from ..core.tolerances import NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
+
+WATCH_ENTRIES = 4096  # the largest A (rows × coordinates) watched: an SVD per step costs little beside the step
+SEARCH_STEPS = 60  # golden-section steps: the bracket shrinks to 0.618^60 ≈ 3e-13 of its width
+GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+
+
+class SingularWatch:
+    """The watch of a run on ``data`` (a run's Data) from the state (t, q, q̇)."""
+
+    @staticmethod
+    def fits(data):
+        """Whether the model's A is worth watching: some rows, at most WATCH_ENTRIES entries."""
+        entries = len(data.system.constraint_names) * data.n
+        return 0 < entries <= WATCH_ENTRIES
+
+    def __init__(self, data, t, q, qd):
+        self.data = data
+        s = np.linalg.svd(self._equilibrated(t, q, qd), compute_uv=False)
+        self.rank = int(np.count_nonzero(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+        self.ends = []  # the last three step ends: (t, q, q̇, σ_r/σ₁)
+
+    def restart(self):
+        """Forget the ends: the run goes on from a state not reached by a watched step."""
+        self.ends = []
+
+    def passed(self, t, q, qd):
+        """After a step ending at the state (t, q, q̇) on the constraints: [(t*, row names,
+        the bracket's width)] of the singular position whose dip the last three ends
+        bracket, if it reaches NEAR_SINGULAR; [] otherwise."""
+        if not self.rank:
+            return []
+        self.ends = self.ends[-2:] + [(t, q.copy(), qd.copy(), self._measure(t, q, qd))]
+        if len(self.ends) < 3 or not self.ends[1][3] < min(self.ends[0][3], self.ends[2][3]):
+            return []
+        t_star = self._bottom()
+        q_star, qd_star = self._state(t_star)
+        U, s, _ = np.linalg.svd(self._equilibrated(t_star, q_star, qd_star), full_matrices=False)
+        if not s[self.rank - 1] < NEAR_SINGULAR * s[0]:
+            return []
+        weights = np.abs(U[:, self.rank - 1])
+        names = self.data.system.constraint_names
+        rows = tuple(names[i] for i in np.flatnonzero(weights > NAME_RTOL * weights.max()))
+        return [(t_star, rows, self.ends[2][0] - self.ends[0][0])]
+
+    def _equilibrated(self, t, q, qd):
+        """A at (t, q, q̇), its rows and then its columns scaled to unit norm."""
+        A = equilibrate_rows(np.asarray(self.data.constraint_arrays(t, q, qd, sparse=False).A, dtype=float))[0]
+        return equilibrate_rows(A.T)[0].T
+
+    def _measure(self, t, q, qd):
+        """σ_r/σ₁ of the equilibrated A at (t, q, q̇)."""
+        s = np.linalg.svd(self._equilibrated(t, q, qd), compute_uv=False)
+        return s[self.rank - 1] / s[0] if s[0] > 0 else 0.0
+
+    def _bottom(self):
+        """The time of the smallest ratio between the first and the last end (golden section)."""
+        a, b = self.ends[0][0], self.ends[2][0]
+        c, d = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
+        fc, fd = self._measure(c, *self._state(c)), self._measure(d, *self._state(d))
+        for _ in range(SEARCH_STEPS):
+            if fc < fd:
+                b, d, fd = d, c, fc
+                c = b - GOLDEN * (b - a)
+                fc = self._measure(c, *self._state(c))
+            else:
+                a, c, fc = c, d, fd
+                d = a + GOLDEN * (b - a)
+                fd = self._measure(d, *self._state(d))
+        return (a + b) / 2
+
+    def _state(self, t):
+        """(q, q̇) at t on the cubic Hermite interpolant of the step ends around it."""
+        (t0, q0, v0, _), (t1, q1, v1, _) = self.ends[:2] if t <= self.ends[1][0] else self.ends[1:]
+        h = t1 - t0
+        s = (t - t0) / h
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+        d00, d10, d01, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, -6 * s**2 + 6 * s, 3 * s**2 - 2 * s
+        q = h00 * q0 + h10 * h * v0 + h01 * q1 + h11 * h * v1
+        qd = (d00 * q0 + d01 * q1) / h + d10 * v0 + d11 * v1
+        return q, qd
