@@ -51,6 +51,8 @@ class ContinuousIntegration(CutIntegration):
             q, qd = super().advance(t_next, q, qd, loosen=isinstance(stop, Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
+        if bounded and corrected is not None:  # the kernel's correction holds the state on the constraints
+            return self.arrived(t_next, corrected.q, corrected.qd, None, corrected)
         q, qd = self.form.to_state(y)
         if not bounded:
             self.f.check(t_next, q, qd)

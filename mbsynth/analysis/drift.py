@@ -1,6 +1,6 @@
 """The run loop's drift control: how long a span of integration may be before the state is
-put back on the constraints (corrected by the kernel after each step of a continuous run,
-projected between the output times of a cut one).
+put back on the constraints (after each step of a continuous run, corrected by the kernel or
+projected; between the output times of a cut one, projected).
 
 The accelerations (2.14) satisfy the constraints at the acceleration level only, so positions
 and velocities drift off them by the integration error. The stages of a span are only as good
