@@ -112,9 +112,10 @@ class ContinuousIntegration(CutIntegration):
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
         q_on, qd_on = self._on_constraints(solver.t, q, qd, corrected[-1], arrays)
-        if self.watch is not None and self.correction is None:
-            for t_star, rows, width in self.watch.passed(solver.t, q_on, qd_on):
-                self.f.add_singular(t_star, rows, width)
+        if self.watch is not None and self.correction is None:  # A before the projection: it moved q by the drift alone
+            found = self.watch.passed(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
+            if found is not None:
+                self.f.add_singular(*found)
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
             y = self.form.to_integrator(q_on, qd_on)
             stepper.move(solver, y, None if solver.status == "finished" else self.f(solver.t, y))

@@ -43,33 +43,34 @@ class SingularWatch:
         """Forget the ends: the run goes on from a state not reached by a watched step."""
         self.ends = []
 
-    def passed(self, t, q, qd):
-        """After a step ending at the state (t, q, q̇) on the constraints: [(t*, row names,
-        the bracket's width)] of the singular position whose dip the last three ends
-        bracket, if it reaches NEAR_SINGULAR; [] otherwise."""
+    def passed(self, t, q, qd, A=None):
+        """After a step ending at the state (t, q, q̇) on the constraints (``A``: its rows,
+        if at hand): (t*, row names, the bracket's width) of the singular position whose dip
+        the last three ends bracket, if it reaches NEAR_SINGULAR; None otherwise."""
         if not self.rank:
-            return []
-        self.ends = self.ends[-2:] + [(t, q.copy(), qd.copy(), self._measure(t, q, qd))]
+            return None
+        self.ends = self.ends[-2:] + [(t, q.copy(), qd.copy(), self._measure(t, q, qd, A))]
         if len(self.ends) < 3 or not self.ends[1][3] < min(self.ends[0][3], self.ends[2][3]):
-            return []
+            return None
         t_star = self._bottom()
         q_star, qd_star = self._state(t_star)
         U, s, _ = np.linalg.svd(self._equilibrated(t_star, q_star, qd_star), full_matrices=False)
         if not s[self.rank - 1] < NEAR_SINGULAR * s[0]:
-            return []
+            return None
         weights = np.abs(U[:, self.rank - 1])
         names = self.data.system.constraint_names
         rows = tuple(names[i] for i in np.flatnonzero(weights > NAME_RTOL * weights.max()))
-        return [(t_star, rows, self.ends[2][0] - self.ends[0][0])]
+        return t_star, rows, self.ends[2][0] - self.ends[0][0]
 
-    def _equilibrated(self, t, q, qd):
-        """A at (t, q, q̇), its rows and then its columns scaled to unit norm."""
-        A = equilibrate_rows(np.asarray(self.data.constraint_arrays(t, q, qd, sparse=False).A, dtype=float))[0]
+    def _equilibrated(self, t, q, qd, A=None):
+        """A at (t, q, q̇) (``A``, if given), its rows and then its columns scaled to unit norm."""
+        A = self.data.constraint_arrays(t, q, qd, sparse=False).A if A is None else A
+        A = equilibrate_rows(np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float))[0]
         return equilibrate_rows(A.T)[0].T
 
-    def _measure(self, t, q, qd):
-        """σ_r/σ₁ of the equilibrated A at (t, q, q̇)."""
-        s = np.linalg.svd(self._equilibrated(t, q, qd), compute_uv=False)
+    def _measure(self, t, q, qd, A=None):
+        """σ_r/σ₁ of the equilibrated A at (t, q, q̇) (``A``: the rows there, if at hand)."""
+        s = np.linalg.svd(self._equilibrated(t, q, qd, A), compute_uv=False)
         return s[self.rank - 1] / s[0] if s[0] > 0 else 0.0
 
     def _bottom(self):
