@@ -57,9 +57,10 @@ class StateDerivative:
     def use(self, engine):
         """Its motion from the Data's parameter values as they are now (new at a control
         sample), ``engine`` the compiled Engine serving the stages (Data.engine) or None."""
-        self.stage_motion = self.data.stage_motion(self.baumgarte, drift=True)
         # the compiled engine's (q̇, q̈) where stage_motion would call it anyway: no Motion per stage
         self.fast = None if engine is None or self.baumgarte is not None else engine.derivative
+        # a stage the engine declined goes to the KKT path at once
+        self.stage_motion = self.data.stage_motion(self.baumgarte, drift=True, compiled=self.fast is None)
 
     def begin(self, t, t_next, relaxed=False, may_crawl=True):
         """Count the evaluations from here: an interval from t to t_next; ``relaxed``: it is

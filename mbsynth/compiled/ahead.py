@@ -33,8 +33,9 @@ TOPOLOGY = "(i1 i1 i1 i1 i1 i1 i1)"
 FACTORED = "(f3 f3 f3 f3 f3 f3 f2 f2 f2)"
 GROUPS = (
     (("tree", "factor", f"{TOPOLOGY} f3 f2 f2 {FACTORED} f2 i1"),
-     ("kernel", "_residual", f"{TOPOLOGY} i1 (i1 i1 i1 i1) f2 f3 f2 f2 f2 f1 f1 f1 f1 f1 f2 f2 f1 f2"),
-     ("kernel", "_recover", "f1 i1 i1 f1 f3 i1 i1 f1 f1 f4 f1 f1 f2 f1 float64 f1 f1")),
+     ("kernel", "_residual", f"{TOPOLOGY} i1 (i1 i1 i1 i1) f2 f3 f2 f2 f2 f1 f1 f1 f1 f1 f2 f2 f1 "
+                             "(i1 i1 i1 i1 i1 i1) f2 f1"),
+     ("kernel", "_recover", "f1 i1 i1 f1 f3 i1 i1 f1 f1 f4 f1 f1 f2 i1 i1 f1 float64 f1 f1")),
     (("tree", "solve", f"{TOPOLOGY} {FACTORED} f1 f1 boolean"),
      ("assembly", "tree_rows", "f1 f1 f1 i1 i1 i1 i1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 (f3 f3 f2 f2 f1) "
                                "f2 f2 f1 f1 general"),
@@ -45,7 +46,7 @@ SEGMENTS = "(i1 i1 i1 i1)"
 GENERAL_ONLY = (  # what a rigid tree's motion leaves out, per group
     (("kernel", "_close", f"{TOPOLOGY} {SEGMENTS} f2 {FACTORED} f2 f2 f1 f1 f1 f1 f1 f1 f1 f2 f2 f1 f1 boolean float64"),),
     (("assembly", "extra_rows", "f1 f1 f1 f1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 i2 i1 i1 i1 "
-                                f"{SEGMENTS} (f3 f3 f2 f2 f1) f2 f2 f1 f2"),),
+                                f"{SEGMENTS} i1 i1 (f3 f3 f2 f2 f1) f2 f2 f1 f2"),),
 )
 VARIANTS = {"rigid_tree": None, "general": True}  # kernel.RIGID_TREE, kernel.GENERAL
 TIMEOUT = 600  # seconds a helper may take before it is stopped

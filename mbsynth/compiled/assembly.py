@@ -71,6 +71,8 @@ class Work(NamedTuple):
     rhs: np.ndarray    # (n_x + m_x,)
     lam: np.ndarray    # (n_x + m_x,) extra accelerations, then extra multipliers
     vectors: np.ndarray  # (n_x + m_x,)² eigenvectors of S
+    band: np.ndarray   # (2, m_x, w + 1) the banded Schur matrix and A_x A_xᵀ, then their Cholesky factors (banded.py); empty: dense S
+    bandv: np.ndarray  # (2, m_x) work of banded.py
     dyn: np.ndarray    # (N, 6) residual work
     qdd: np.ndarray    # (n,) result: q̈
     Qc: np.ndarray     # (n,) result: M q̈ − Q (2.5)
@@ -82,9 +84,11 @@ def make_work(L):
     N, S = L.node_kind.shape[0], L.xseg_node.shape[0]
     mx, nx = L.xrow_row.shape[0], L.x_coord.shape[0]
     p = nx + mx
+    width = int(L.band_width[0]) if L.band_width.size else -1
+    dense, banded = (0 if width >= 0 else p), (mx if width >= 0 else 0)  # S is dense or banded
     shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N + 1, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
-                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, rscale=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(p, p),
-                  rhs=p, lam=p, vectors=(p, p), dyn=(N, 6), qdd=n, Qc=n)
+                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, rscale=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(dense, dense),
+                  rhs=p, lam=p, vectors=(dense, dense), band=(2, banded, width + 1), bandv=(2, banded), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
     arrays["Rs"][N, 0] = np.eye(3)  # the world, as a body at rest in its own frame (rate_rows.py)
     V, R, Jt = vector_work()
@@ -213,13 +217,16 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
 
 @njit(**OPTIONS)
 def extra_rows(q, qd, gen, bshift, kind, start, nu, s, Rs, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
-                xseg_node, gen_rows, scratch, seg7, seg6, xb, Ax):
+                xseg_node, gen_rows, xa_ptr, xa_col, scratch, seg7, seg6, xb, Ax):
     """Loop-joint rows and the generated rows (gen: their entries, then their b), as
-    segments and Ax entries; equilibrated."""
+    segments and Ax entries; equilibrated. Only the entries of Ax's pattern (xa_ptr,
+    xa_col: layout.py) are written; the others stay zero."""
     arow, aseg, acol, brow = gen_rows
     A, b = scratch[3], scratch[4]
     seg7[:, :] = 0.0
-    Ax[:, :] = 0.0
+    for e in range(arow.shape[0]):
+        if aseg[e] < 0:
+            Ax[arow[e], acol[e]] = 0.0
     xb[:] = 0.0
     for j in range(joint_xrow.shape[0]):
         x0 = joint_xrow[j]
@@ -240,14 +247,13 @@ def extra_rows(q, qd, gen, bshift, kind, start, nu, s, Rs, joints, joint_xrow, j
             Ax[arow[e], acol[e]] += gen[e]
     for e in range(brow.shape[0]):
         xb[brow[e]] += gen[arow.shape[0] + e]
-    nx = Ax.shape[1]
     for x in range(xrow_row.shape[0]):
         total = 0.0
         for seg in range(xseg_ptr[x], xseg_ptr[x + 1]):
             for a in range(7):
                 total += seg7[seg, a] * seg7[seg, a]
-        for c in range(nx):
-            total += Ax[x, c] * Ax[x, c]
+        for e in range(xa_ptr[x], xa_ptr[x + 1]):
+            total += Ax[x, xa_col[e]] ** 2
         scale = 1.0 / math.sqrt(total) if total > 0 else 1.0
         rhs = xb[x] + (bshift[xrow_row[x]] if bshift.shape[0] else 0.0)
         for seg in range(xseg_ptr[x], xseg_ptr[x + 1]):
@@ -255,18 +261,20 @@ def extra_rows(q, qd, gen, bshift, kind, start, nu, s, Rs, joints, joint_xrow, j
             rhs += _reduce(seg7[seg], kind[i] == RIGID, q, start[i], nu[i], s[i], Rs[i, 3], seg6[seg])
             for a in range(6):
                 seg6[seg, a] *= scale
-        for c in range(nx):
-            Ax[x, c] *= scale
+        for e in range(xa_ptr[x], xa_ptr[x + 1]):
+            Ax[x, xa_col[e]] *= scale
         xb[x] = rhs * scale
 
 
 @njit(**OPTIONS)
 def generated(gen, gen_q, gen_c, gen_mi, gen_mj, Qf, Cf, Mx):
     """Q additions, C and the extra coordinates' M from the generated outputs; returns
-    the offset of the row entries that follow."""
+    the offset of the row entries that follow. Only the entries of Mx's pattern (gen_mi,
+    gen_mj: each pair once) are written; the others stay zero."""
     Qf[:] = 0.0
     Cf[:] = 0.0
-    Mx[:, :] = 0.0
+    for e in range(gen_mi.shape[0]):
+        Mx[gen_mi[e], gen_mj[e]] = 0.0
     o = 0
     for e in range(gen_q.shape[0]):
         Qf[gen_q[e]] += gen[o + e]
@@ -280,8 +288,8 @@ def generated(gen, gen_q, gen_c, gen_mi, gen_mj, Qf, Cf, Mx):
 
 
 @njit(**OPTIONS)
-def divide_masses(mu, H, F, Mx, Fx):
-    """Divide the masses and forces by μ."""
+def divide_masses(mu, H, F, Mx, Fx, gen_mi, gen_mj):
+    """Divide the masses and forces by μ (of Mx, the entries of its pattern: ``generated``)."""
     inv = 1.0 / mu
     for i in range(H.shape[0]):
         for a in range(6):
@@ -290,8 +298,8 @@ def divide_masses(mu, H, F, Mx, Fx):
                 H[i, a, b] *= inv
     for x in range(Fx.shape[0]):
         Fx[x] *= inv
-        for c in range(Fx.shape[0]):
-            Mx[x, c] *= inv
+    for e in range(gen_mi.shape[0]):
+        Mx[gen_mi[e], gen_mj[e]] *= inv
 
 
 @njit(**OPTIONS)

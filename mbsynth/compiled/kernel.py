@@ -36,6 +36,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import banded
 from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
 from .bodies import INLINE, OPTIONS, rate_transpose
 from .eigen import symmetric_eigen
@@ -53,6 +54,7 @@ CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motio
 RIGID_TREE, GENERAL = None, True  # ``motion``'s ``general``: numba prunes the branches on ``general is None``, so
 # a rigid tree's motion compiles without particle joints, extra rows and extra coordinates (Layout.general)
 RESIDUAL_MAX = 1e-9
+ESTIMATE_MARGIN = 10.0  # banded.inverse_norm1 is a lower bound of ‖S⁻¹‖₁: certified with this much to spare
 LAYOUT, WORK = fields(Layout), fields(Work)
 
 
@@ -258,6 +260,57 @@ def _rows_certified(values, Mx, inverse):
 
 
 @njit(**OPTIONS)
+def _close_banded(Mx, Ax, xb, Fx, lam, patterns, position, width, bands, work, rhs):
+    """``_close_reduced`` for a model of extra coordinates alone whose mass Mx is diagonal and
+    whose rows' Schur matrix S = A_x Mx⁻¹ A_xᵀ is banded in the order ``position`` (layout.py,
+    banded.py): S assembled coordinate by coordinate from the entries of A_x, factored by
+    Cholesky, λ = S⁻¹ (A_x Mx⁻¹ F_x − b_x), q̈_x = Mx⁻¹ (F_x − A_xᵀ λ). On the manifold and
+    off it alike the answer is kept only where the equilibrated rows are certainly
+    independent, σ_min ≥ NEAR_SINGULAR σ₁, so that the drift rule of core/equations.py keeps
+    every direction and its answer is this plain one: with T = A_x A_xᵀ (banded alike),
+    σ_min² = λ_min(T) ≥ 1 / ‖T⁻¹‖₁ ≥ 1 / (ESTIMATE_MARGIN · banded.inverse_norm1) and
+    σ₁² = λ_max(T) ≤ ‖T‖₁. Else (dependent or nearly dependent rows, a singular position
+    near, a mass not positive) NEAR_SINGULAR: the exact treatment's. ``bands``: (S, T)."""
+    xa_ptr, xa_col, xc_ptr, xc_row = patterns[0], patterns[1], patterns[2], patterns[3]
+    mx, nx = Ax.shape[0], Ax.shape[1]
+    S, T = bands[0], bands[1]
+    for c in range(nx):
+        if not Mx[c, c] > 0.0:
+            return NEAR_SINGULAR
+    S[:, :] = 0.0
+    T[:, :] = 0.0
+    for c in range(nx):
+        inverse = 1.0 / Mx[c, c]
+        for e in range(xc_ptr[c], xc_ptr[c + 1]):
+            r = xc_row[e]
+            for f in range(xc_ptr[c], xc_ptr[c + 1]):
+                d = position[r] - position[xc_row[f]]
+                if d >= 0:
+                    product = Ax[r, c] * Ax[xc_row[f], c]
+                    S[position[r], d] += product * inverse
+                    T[position[r], d] += product
+    size = banded.norm1(T, width, work[0])
+    if not (banded.cholesky(T, width) and banded.cholesky(S, width)):
+        return NEAR_SINGULAR
+    if not 1.0 >= ESTIMATE_MARGIN * banded.inverse_norm1(T, width, work[0], work[1]) * size * NEAR_SINGULAR_RTOL ** 2:
+        return NEAR_SINGULAR
+    for x in range(mx):
+        total = -xb[x]
+        for e in range(xa_ptr[x], xa_ptr[x + 1]):
+            total += Ax[x, xa_col[e]] * Fx[xa_col[e]] / Mx[xa_col[e], xa_col[e]]
+        rhs[position[x]] = total
+    banded.solve(S, width, rhs)
+    for x in range(mx):
+        lam[nx + x] = rhs[position[x]]
+    for c in range(nx):
+        total = Fx[c]
+        for e in range(xc_ptr[c], xc_ptr[c + 1]):
+            total -= Ax[xc_row[e], c] * lam[nx + xc_row[e]]
+        lam[c] = total / Mx[c, c]
+    return OK
+
+
+@njit(**OPTIONS)
 def _row_sum_norm(X):
     """‖X‖∞, the largest row sum of |X|."""
     top = 0.0
@@ -285,7 +338,7 @@ def _uneven_masses(v, H, Mx):
 
 
 @njit(**OPTIONS)
-def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc):
+def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, gen_mi, gen_mj, lam, mu, qdd, Qc):
     """q̈ (bodies.py: ü = (u s + Eᵀa)/ν, a = Bᵀα) and Qc = M q̈ − Q from the solution."""
     for i in range(kind.shape[0]):
         c, o, m = start[i], yoff[i], mass[i]
@@ -305,13 +358,11 @@ def _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx,
         for a in range(4):
             qdd[c + 3 + a] = (u[a] * s[i] + et[a]) / nu[i]
             Qc[c + 3 + a] = 4 * nu[i] * f[a] - Qf[c + 3 + a]
-    nx = x_coord.shape[0]
-    for x in range(nx):
-        total = 0.0
-        for c in range(nx):
-            total += Mx[x, c] * lam[c]
+    for x in range(x_coord.shape[0]):
         qdd[x_coord[x]] = lam[x]
-        Qc[x_coord[x]] = mu * total - Qf[x_coord[x]]
+        Qc[x_coord[x]] = -Qf[x_coord[x]]
+    for e in range(gen_mi.shape[0]):  # the entries of Mx (assembly.generated)
+        Qc[x_coord[gen_mi[e]]] += mu * Mx[gen_mi[e], gen_mj[e]] * lam[gen_mj[e]]
 
 
 @njit(**OPTIONS)
@@ -393,9 +444,12 @@ def _node_rows(i, vi, ki, vp, p, yoff, rows, J, P, rb, z, dyn):
 
 
 @njit(**OPTIONS)
-def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn):
+def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, patterns, dyn, t_x):
     """Relative residual of the equilibrated KKT equations at the solution (module docstring).
-    Rigid nodes on revolute or fixed joints run with constant sizes (numba unrolls them)."""
+    Rigid nodes on revolute or fixed joints run with constant sizes (numba unrolls them).
+    patterns: (xa_ptr, xa_col, xc_ptr, xc_row, gen_mi, gen_mj), the entries of Ax and Mx
+    (layout.py); t_x: work (n_x)."""
+    xa_ptr, xa_col, xc_ptr, xc_row, mi, mj = patterns
     _, parent, v, k, yoff, rows, _ = topology
     ptr, node = segs[0], segs[1]
     mx, nx = Ax.shape[0], Ax.shape[1]
@@ -432,21 +486,23 @@ def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx,
             for a in range(6):
                 dyn[node[seg], a] += seg6[seg, a] * lam[nx + x]
                 norm_A += seg6[seg, a] ** 2
-        for c in range(nx):
-            t += Ax[x, c] * lam[c]
-            norm_A += Ax[x, c] ** 2
+        for e in range(xa_ptr[x], xa_ptr[x + 1]):
+            t += Ax[x, xa_col[e]] * lam[xa_col[e]]
+            norm_A += Ax[x, xa_col[e]] ** 2
         res += t * t
         norm_r += xb[x] ** 2
     for i in range(kind.shape[0]):
         for a in range(v[i]):
             res += dyn[i, a] ** 2
     for c in range(nx):
-        t = -Fx[c]
-        for e in range(nx):
-            t += Mx[c, e] * lam[e]
-            norm_M += Mx[c, e] ** 2
-        for x in range(mx):
-            t += Ax[x, c] * lam[nx + x]
+        t_x[c] = -Fx[c]
+    for e in range(mi.shape[0]):
+        t_x[mi[e]] += Mx[mi[e], mj[e]] * lam[mj[e]]
+        norm_M += Mx[mi[e], mj[e]] ** 2
+    for c in range(nx):
+        t = t_x[c]
+        for e in range(xc_ptr[c], xc_ptr[c + 1]):
+            t += Ax[xc_row[e], c] * lam[nx + xc_row[e]]
         res += t * t
         norm_x += lam[c] ** 2
         norm_r += Fx[c] ** 2
@@ -510,24 +566,29 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     Mx, Fx, lam = view2(WF, WX, WORK.Mx), view1(WF, WX, WORK.Fx), view1(WF, WX, WORK.lam)
     node_joint, joint_row, quat_row = (view1(LI, LX, LAYOUT.node_joint), view1(LI, LX, LAYOUT.joint_row),
                                        view1(LI, LX, LAYOUT.quat_row))
+    patterns = (view1(LI, LX, LAYOUT.xa_ptr), view1(LI, LX, LAYOUT.xa_col), view1(LI, LX, LAYOUT.xc_ptr),
+                view1(LI, LX, LAYOUT.xc_row), view1(LI, LX, LAYOUT.gen_mi), view1(LI, LX, LAYOUT.gen_mj))
+    band_width = view1(LI, LX, LAYOUT.band_width)
 
     if mode == REUSED and x_coord.shape[0] + xb.shape[0] == 0 and _shifts_only(qd, bshift, kind, quat_row):
         _shifted_rows(kind, node_joint, k, rows, joint_row, bshift, rscale, rb, s)
         tree_rhs(v, k, yoff, rows, F, rb, ry)
         _copy(ry, y)
         solve(topology, factored, y, z, False)
-        _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, 1.0, qdd, Qc)
+        _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, patterns[4], patterns[5], lam, 1.0,
+                 qdd, Qc)
         return (OK if _finite(qdd, Qc) else NOT_FINITE), 0.0
     o = generated(gen, view1(LI, LX, LAYOUT.gen_q), view1(LI, LX, LAYOUT.gen_c), view1(LI, LX, LAYOUT.gen_mi),
                   view1(LI, LX, LAYOUT.gen_mj), Qf, Cf, Mx)
     mu = nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F, s, nu,
                view1(WF, WX, WORK.q7), Rs)
+    gen_mi, gen_mj = view1(LI, LX, LAYOUT.gen_mi), view1(LI, LX, LAYOUT.gen_mj)
     for x in range(x_coord.shape[0]):
         Fx[x] = Qf[x_coord[x]] + Cf[x_coord[x]]
-        for c in range(x_coord.shape[0]):
-            mu = max(mu, abs(Mx[x, c]))
+    for e in range(gen_mi.shape[0]):
+        mu = max(mu, abs(Mx[gen_mi[e], gen_mj[e]]))
     mu = mu if mu > 0 else 1.0
-    divide_masses(mu, H, F, Mx, Fx)
+    divide_masses(mu, H, F, Mx, Fx, gen_mi, gen_mj)
     if drift >= 0.0 and xb.shape[0] and v.shape[0] and (x_coord.shape[0] or _uneven_masses(v, H, Mx)):
         return NEAR_SINGULAR, 0.0  # the drift rule's to judge (``drift``); without nodes: ``_close``
     tree_rows(q, qd, bshift, kind, start, node_joint, view1(LI, LX, LAYOUT.node_end), parent,
@@ -535,7 +596,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     if general is not None and xb.shape[0]:
         extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_xrow),
                    view2(LI, LX, LAYOUT.joint_xseg), view1(LI, LX, LAYOUT.xrow_row), xseg_ptr, xseg_node, gen_rows,
-                   scratch, seg7, seg6, xb, Ax)
+                   patterns[0], patterns[1], scratch, seg7, seg6, xb, Ax)
     transports(q, start, parent, node_joint, view1(LI, LX, LAYOUT.node_end), transport,
                joints[4], Rs, factored[8])
     tree_rhs(v, k, yoff, rows, F, rb, ry)
@@ -545,16 +606,21 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     _copy(ry, y)
     if general is not None and x_coord.shape[0] + xb.shape[0] > 0:
         solve(topology, factored, y, z0, False)  # _close solves again into z
-        status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
-                        view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED, drift)
+        if band_width.shape[0]:
+            status = _close_banded(Mx, Ax, xb, Fx, lam, patterns, view1(LI, LX, LAYOUT.band_pos), band_width[0],
+                                   view3(WF, WX, WORK.band), view2(WF, WX, WORK.bandv), view1(WF, WX, WORK.rhs))
+        else:
+            status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
+                            view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED, drift)
         if status != OK:
             return status, 0.0
     else:
         solve(topology, factored, y, z, mode == CHECKED)
-    _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, lam, mu, qdd, Qc)
+    _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, gen_mi, gen_mj, lam, mu, qdd, Qc)
     residual = 0.0
     if mode == CHECKED:
-        residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, dyn)
+        residual = _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx, Fx, patterns, dyn,
+                             view1(WF, WX, WORK.rhs))
     if not _finite(qdd, Qc):
         return NOT_FINITE, residual
     if not residual <= RESIDUAL_MAX:

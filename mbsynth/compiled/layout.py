@@ -29,11 +29,13 @@ import numpy as np
 import sympy as sp
 
 from ..core.joint_kinds import COMPONENT, JOINT_KINDS, KINDS, MAX_ROWS
+from .banded import band_order
 from .joints import PARTICLE, RIGID, WORLD
 from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
 
-# a System with no kernel node is one dense Schur system (kernel.py), its extra coordinates and rows: up to this
-# size (Jacobi's eigendecomposition, O(p³)) it costs less than the KKT path
+# a System with no kernel node is one Schur system (kernel.py), its extra coordinates and rows: up to this size it
+# is dense (Jacobi's eigendecomposition, O(p³)); beyond it, where the extra coordinates' mass is diagonal, the
+# rows' Schur matrix is banded (banded.py), else the System is left to the KKT path
 DENSE_SCHUR_MAX = 64
 # the parts' ``kind`` of the kernel's nodes: the model is read through its parts' and joints'
 # attributes (``kind``, ``joint_kind``, masses, frames), not their classes
@@ -85,8 +87,31 @@ class Layout(NamedTuple):
     gen_aseg: np.ndarray     # its flat place in the segments (7 per segment), or −1
     gen_acol: np.ndarray     # its extra coordinate, or −1
     gen_brow: np.ndarray     # extra row of each b
+    xa_ptr: np.ndarray       # (m_x + 1,) the extra coordinates each extra row touches (CSR: xa_col)
+    xa_col: np.ndarray
+    xc_ptr: np.ndarray       # (n_x + 1,) the extra rows that touch each extra coordinate (CSC: xc_row)
+    xc_row: np.ndarray
+    band_pos: np.ndarray     # (m_x,) each extra row's place in the banded Schur matrix (banded.py), or empty: dense
+    band_width: np.ndarray   # (1,) that matrix's band width, or empty: dense
     quat_row: np.ndarray     # (N,) the System's row of a body's unit-norm row (−1 for particles)
     sizes: np.ndarray        # n, m, tree unknowns, tree rows
+
+
+def _patterns(gen, rows, columns):
+    """The entries of the extra rows on the extra coordinates (``gen_arow``, ``gen_acol``)
+    as CSR by row (xa_ptr, xa_col) and CSC by coordinate (xc_ptr, xc_row), each index once."""
+    pairs = sorted({(int(r), int(c)) for r, c in zip(gen["gen_arow"], gen["gen_acol"]) if c >= 0})
+    by_column = sorted((c, r) for r, c in pairs)
+    return dict(xa_ptr=_ints(np.searchsorted([r for r, _ in pairs], np.arange(rows + 1))),
+                xa_col=_ints([c for _, c in pairs]),
+                xc_ptr=_ints(np.searchsorted([c for c, _ in by_column], np.arange(columns + 1))),
+                xc_row=_ints([r for _, r in by_column]))
+
+
+def _diagonal(gen, columns):
+    """Whether the extra coordinates' mass has an entry on each diagonal place and no other."""
+    mi, mj = gen["gen_mi"], gen["gen_mj"]
+    return bool((mi == mj).all()) and set(mi.tolist()) == set(range(columns))
 
 
 def _ints(values, shape=None):
@@ -136,8 +161,8 @@ def build(system):
     quat = {c.name: r for c, r in zip(system.connectors, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.parts, starts)
              if (_kind(part) == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or _kind(part) == PARTICLE_PART]
-    if not nodes and system.n > DENSE_SCHUR_MAX:  # its Schur system has at least its n coordinates
-        return None
+    if not nodes and system.n > DENSE_SCHUR_MAX and not all(part.M.is_diagonal() for part in system.parts):
+        return None  # its Schur system has at least its n coordinates, and cannot be banded
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
     quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _kind(part) == RIGID_BODY}
     joints, others = [], []
@@ -147,7 +172,7 @@ def build(system):
         (joints if _kernel_joint(con, node_of, number) else others).append((con, int(row)))
     parent, pjoint, order = _tree(len(nodes), joints, node_of)
     found = _Builder(system, number, starts, nodes, node_of, quat, joints, others, parent, pjoint, order).layout()
-    if not nodes and found[0].x_coord.size + found[0].xrow_row.size > DENSE_SCHUR_MAX:
+    if not nodes and found[0].x_coord.size + found[0].xrow_row.size > DENSE_SCHUR_MAX and not found[0].band_width.size:
         return None
     return found
 
@@ -292,6 +317,11 @@ class _Builder:
                 segs.append(ends)
         exprs, gen, phi_outputs = self._generated(xrow_row, segs)
         seg_ptr = np.cumsum([0] + [len(s) for s in segs])
+        patterns = _patterns(gen, len(xrow_row), len(self.x_coord))
+        band = dict(band_pos=_ints([]), band_width=_ints([]))
+        if not nodes and len(xrow_row) + len(self.x_coord) > DENSE_SCHUR_MAX and _diagonal(gen, len(self.x_coord)):
+            position, width = band_order(patterns["xa_ptr"], patterns["xa_col"], len(xrow_row))
+            band = dict(band_pos=position, band_width=_ints([width]))
         kernel = [self._joint(con) for con, _ in joints]
         numbers = _numbers([part for part, _ in nodes], [con for con, _ in joints], self.number)
         sizes = [self.system.n, sum(c.size for c in self.system.connectors), int(yoff[-1]),
@@ -312,7 +342,7 @@ class _Builder:
             xseg_node=_ints([i for s in segs for i in s]),
             quat_row=_ints([self.quat[f"{part.name}.unit_quaternion"] if r else -1
                             for (part, _), r in zip(nodes, rigid)]),
-            sizes=_ints(sizes), **numbers, **gen)
+            sizes=_ints(sizes), **numbers, **gen, **patterns, **band)
         return layout, exprs, phi_outputs
 
     def _end_of(self, i, j):

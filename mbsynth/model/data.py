@@ -216,11 +216,14 @@ class Data:
             return friction.coulomb_motion(system.connectors, arrays, solve, t, q, qd, self.p)
         return solve(arrays.C)
 
-    def stage_motion(self, baumgarte=None, drift=False):
+    def stage_motion(self, baumgarte=None, drift=False, compiled=True):
         """``motion(t, q, q̇, baumgarte=, drift=)`` as a callable for an integrator's stages,
         without ``lam``: the compiled engine's own call where ``motion`` would make it anyway
-        (no Baumgarte shift), skipping the checks and bookkeeping of each call."""
+        (no Baumgarte shift), skipping the checks and bookkeeping of each call. ``compiled``
+        False: the KKT path alone (for stages the engine has declined already)."""
         engine = self.engine
+        if not compiled:
+            return lambda t, q, qd: self._kkt_motion(t, *self._state(q, qd), "fast", baumgarte, drift)
         if engine is None or baumgarte is not None:
             return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
 

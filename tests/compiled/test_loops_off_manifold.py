@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.compiled import kernel
+from mbsynth.compiled import kernel, layout
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -220,3 +220,40 @@ def test_near_a_singular_position_a_planar_loop_leaves_the_stage_to_the_exact_dr
         psi_ddot = K / J * np.sin(psi)
         x_ddot = 0.5 * (np.cos(psi) * psi_ddot - np.sin(psi) * psi_dot**2)
         assert motion.qdd[system.coordinates.index("v0.x")] == pytest.approx(x_ddot, rel=1e-6)
+
+
+def test_a_large_planar_loop_is_served_by_the_banded_schur_step(tmp_path):
+    """The planar N-four-bar with N = 12 (25 planar bodies: 75 extra coordinates, 74 rows, a
+    Schur system beyond layout.DENSE_SCHUR_MAX) gets a banded Schur matrix (banded.py). On the
+    manifold the kernel's acceleration is the exact one-degree-of-freedom motion's, 1 rad and
+    1e-3 rad from the horizontal position alike (the KKT path's SVD loses digits near it: its
+    q̈ there is held to 1e-6 only); 1e-9 off the manifold 1 rad from it the kernel serves the
+    stage with the KKT drift rule's motion; 1e-7 rad from it, where a direction of the rows is
+    nearly dependent, the certificate fails and the stage goes to the exact drift rule."""
+    N = 12
+    path = tmp_path / "n_four_bar.yaml"
+    path.write_text(ref.n_four_bar_yaml(N))
+    system = mb.load(path)
+    data = system.data()
+    engine = data.engine
+    assert engine is not None and engine.L.band_width.size == 1
+    assert engine.L.x_coord.size + engine.L.xrow_row.size > layout.DENSE_SCHUR_MAX
+    J, K = ref.n_four_bar_constants(N)
+    rng = np.random.default_rng(5)
+    for gap, served, agree in ((1.0, True, 1e-9), (1e-3, True, 1e-6), (1e-7, False, None)):
+        psi, psi_dot = np.pi / 2 - gap, 2.0
+        q, qd = ref.n_four_bar_state(system.coordinates, N, psi, psi_dot)
+        if served:
+            on = engine.motion(0.0, q, qd)
+            assert on is not None
+            psi_ddot = K / J * np.sin(psi)
+            x_ddot = 0.5 * (np.cos(psi) * psi_ddot - np.sin(psi) * psi_dot**2)
+            assert on.qdd[system.coordinates.index("v0.x")] == pytest.approx(x_ddot, rel=1e-9)
+            exact = data._kkt_motion(0.0, q, qd, "reference", None, False)
+            assert np.abs(on.qdd - exact.qdd).max() <= agree * np.abs(exact.qdd).max()
+        q, qd = q + 1e-9 * rng.standard_normal(q.size), qd + 1e-9 * rng.standard_normal(q.size)
+        stage = engine.motion(0.0, q, qd, None, True)
+        assert (stage is not None) == served
+        if served:
+            exact = data._kkt_motion(0.0, q, qd, "reference", None, True)
+            assert np.abs(stage.qdd - exact.qdd).max() <= agree * np.abs(exact.qdd).max()
