@@ -7,9 +7,10 @@ given that state's derivative, its steps capped (``max_step``) to keep the drift
 corrections below DRIFT_TARGET (drift.py). Each output row is read from the step's dense
 output (the interpolant ``solve_ivp`` gives at ``t_eval``) and put back on the constraints
 too (a copy: the integrator goes on from its own state). Where the compiled kernel covers
-the model (compiled/correction.py: kernel joints and bodies, in a tree or closing loops) it
-corrects the rows a step passed in one block with its end (correction.Correction.block, on
-all cores); elsewhere each state is projected (projection.py) and judged strictly there
+the model (compiled/correction.py: kernel joints and bodies, in a tree or closing loops; or
+compiled/extra_correction.py: a small model of extra coordinates alone) it corrects the rows
+a step passed in one block with its end (``block``, on all cores where it threads);
+elsewhere each state is projected (projection.py) and judged strictly there
 (Integration.arrived), and a model with no rows has nothing to correct. An output interval
 in which the integrator crawls near a singular position, or fails, is integrated again,
 cut (cut.py), from the last output: a failure is then reported in the interval it happens
@@ -112,7 +113,7 @@ class ContinuousIntegration(CutIntegration):
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
         q_on, qd_on = self._on_constraints(solver.t, q, qd, corrected[-1], arrays)
-        if self.watch is not None and self.correction is None:  # A before the projection: it moved q by the drift alone
+        if self.watch is not None:  # A before the projection: it moved q by the drift alone
             found = self.watch.passed(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
             if found is not None:
                 self.f.add_singular(*found)
@@ -122,9 +123,9 @@ class ContinuousIntegration(CutIntegration):
 
     def _watch_from(self, t, q, qd):
         """Watch for the singular positions passed between stages from the state (t, q, q̇)
-        on (singular_watch.py): on projected runs (the kernel's corrections keep no rows at
-        hand) of models whose A is small enough."""
-        if self.correction is None and SingularWatch.fits(self.data):
+        on (singular_watch.py): on runs projected or corrected by extra_correction.py
+        (``watched``) of models whose A is small enough."""
+        if (self.correction is None or self.correction.watched) and SingularWatch.fits(self.data):
             if self.watch is None:
                 self.watch = SingularWatch(self.data, t, q, qd)
             self.watch.restart()

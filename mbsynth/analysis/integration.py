@@ -63,7 +63,8 @@ class Integration:
         engine = self.data.engine
         self.f.use(engine)
         self.correction = None if engine is None else engine.correction()
-        self.compiled_energy = self.correction is not None and all(f.V == 0 for f in self.data.forces)
+        self.compiled_energy = self.correction is not None and self.correction.energies and \
+            all(f.V == 0 for f in self.data.forces)
 
     def advance(self, t_next, q, qd, t_stop):
         """The state (q, q̇) at t_next from (q, q̇) at ``t_now``; t_stop: the next control

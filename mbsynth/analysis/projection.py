@@ -24,7 +24,7 @@ import scipy.sparse.linalg
 from ..core.equations import term_scales
 from ..model.evaluation import DENSE_ENTRIES
 from ..core.errors import SolveError
-from ..core.tolerances import NEAR_SINGULAR, PROJECTION_RTOL
+from ..core.tolerances import DRIFT_FLOOR, NEAR_SINGULAR, PROJECTION_RTOL
 
 MAX_ITERATIONS = 50
 DIVERGED = 1e6  # a last pass stops where its largest residual exceeds this times its smallest so far
@@ -202,12 +202,6 @@ def project_velocities(system, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, 
     return qd
 
 
-# relative_drift: a row's scale is at least this share of ‖A_i‖₁ ‖x‖∞. At a singular position
-# some rows' terms vanish (the N-four-bar's horizontal velocity rows when the bars lie flat)
-# down to term_scales' default floor of 1e-3 of that, and the same absolute drift read up to a
-# thousand times larger there: simulate's spans between projections then shrank to 5e-10 s
-# and stayed there (N = 2 at dt = 0.001, its second crossing)
-DRIFT_FLOOR = 0.1
 
 
 def relative_drift(system, t, q, qd, arrays=None):

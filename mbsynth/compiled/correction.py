@@ -148,6 +148,9 @@ class Correction:
     """The kernel's projection: ``rows`` (rows.py) on an Engine's Layout, and ``at_rest``,
     that Engine with no gravity (Engine.at_rest)."""
 
+    energies = True  # Corrected holds the kinetic and potential energy of the corrected state
+    watched = False  # the run's singular watch (analysis/singular_watch.py) does not look at its states
+
     def __init__(self, rows, at_rest):
         self.rows, self.at_rest = rows, at_rest
         self.gen = np.zeros(at_rest.outputs)

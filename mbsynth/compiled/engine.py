@@ -19,11 +19,14 @@ import copy
 import threading
 
 import numpy as np
+import sympy as sp
 
 from ..core.equations import Motion
+from ..symbolic.derive import T_SYMBOL
 from . import ahead, codegen, kernel, layout
 from .assembly import Work, make_work
 from .correction import Correction
+from .extra_correction import ExtraCorrection
 from .rows import Rows
 from .packing import pack, views
 from .threads import THREADS, pool
@@ -45,6 +48,9 @@ class Template:
         self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
                                                   system.parameter_symbols) if exprs else None
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
+        # the generated masses, rows and φ (all but the Q additions and C) depend on t: no correction without t
+        self.rows_depend_on_time = any(T_SYMBOL in sp.sympify(expr).free_symbols
+                                       for expr in exprs[L.gen_q.size + L.gen_c.size:])
         self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
         used = layout.number_parameters(L, self.sources, system.parameters)
         # the parameters the Layout's numbers use: values that differ only in others share L as it is
@@ -106,10 +112,10 @@ class Engine:
         return Engine(self.template, self.L._replace(node_mg=np.zeros_like(self.L.node_mg)), self.p)
 
     def correction(self):
-        """The kernel's projection on this Engine's Layout (correction.py), or None where the
-        kernel does not cover the System."""
+        """The kernel's projection on this Engine's Layout (correction.py; extra_correction.py
+        for a model of extra coordinates alone), or None where neither covers the System."""
         if not self.corrections:
-            self.corrections.append(Correction.build(self))
+            self.corrections.append(Correction.build(self) or ExtraCorrection.build(self))
         return self.corrections[0]
 
     def new_work(self):

@@ -268,9 +268,11 @@ def _close_banded(Mx, Ax, xb, Fx, lam, patterns, position, width, bands, work, r
     off it alike the answer is kept only where the equilibrated rows are certainly
     independent, σ_min ≥ NEAR_SINGULAR σ₁, so that the drift rule of core/equations.py keeps
     every direction and its answer is this plain one: with T = A_x A_xᵀ (banded alike),
-    σ_min² = λ_min(T) ≥ 1 / ‖T⁻¹‖₁ ≥ 1 / (ESTIMATE_MARGIN · banded.inverse_norm1) and
-    σ₁² = λ_max(T) ≤ ‖T‖₁. Else (dependent or nearly dependent rows, a singular position
-    near, a mass not positive) NEAR_SINGULAR: the exact treatment's. ``bands``: (S, T)."""
+    σ_min² = λ_min(T) ≥ 1 / ‖T⁻¹‖₁ and σ₁² = λ_max(T) ≤ ‖T‖₁, ‖T⁻¹‖₁ taken as
+    ESTIMATE_MARGIN times its estimate (banded.inverse_norm1, a lower bound) where that
+    certifies, else computed (banded.inverse_norm1_exact: near a singular position only).
+    Else (dependent or nearly dependent rows, a singular position near, a mass not positive)
+    NEAR_SINGULAR: the exact treatment's. ``bands``: (S, T)."""
     xa_ptr, xa_col, xc_ptr, xc_row = patterns[0], patterns[1], patterns[2], patterns[3]
     mx, nx = Ax.shape[0], Ax.shape[1]
     S, T = bands[0], bands[1]
@@ -292,7 +294,12 @@ def _close_banded(Mx, Ax, xb, Fx, lam, patterns, position, width, bands, work, r
     size = banded.norm1(T, width, work[0])
     if not (banded.cholesky(T, width) and banded.cholesky(S, width)):
         return NEAR_SINGULAR
-    if not 1.0 >= ESTIMATE_MARGIN * banded.inverse_norm1(T, width, work[0], work[1]) * size * NEAR_SINGULAR_RTOL ** 2:
+    needed = NEAR_SINGULAR_RTOL ** 2 * size  # 1 / ‖T⁻¹‖₁ must reach this
+    estimate = banded.inverse_norm1(T, width, work[0], work[1])  # ≤ ‖T⁻¹‖₁
+    if not 1.0 >= estimate * needed:
+        return NEAR_SINGULAR  # ‖T⁻¹‖₁ is larger still
+    if not 1.0 >= ESTIMATE_MARGIN * estimate * needed and \
+            not 1.0 >= banded.inverse_norm1_exact(T, width, work[0]) * needed:
         return NEAR_SINGULAR
     for x in range(mx):
         total = -xb[x]

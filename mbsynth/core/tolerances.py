@@ -28,9 +28,16 @@ DRIFT_MASS_SPREAD = 1e-4  # kernel.py, off the manifold: masses (diagonal, over 
 # send a model's stages to the exact drift rule (the Schur eigenvalues mix masses with the rows' geometry)
 SPLIT_MOVES = 1e4  # kernel.py, off the manifold: a dropped direction of Schur eigenvalue λ may move accelerations
 # up to this times √(λ / the largest) (the drift splits dependent rows by about that much)
-CORRECTION_RTOL = 1e-14  # correction.py: largest |φ| left, relative to the largest coordinate (at least 1): ~50 ε
+CORRECTION_RTOL = 1e-14  # correction.py: largest |φ| left, relative to the largest coordinate (at least 1): ~50 ε;
+# extra_correction.py: relative to each row's terms
 CORRECTION_RATE_RTOL = 1e-12  # correction.py: a velocity step must leave φ̇ below this, relative to the
 # largest coordinate (at least 1) times the largest rate (or cut it by SHRINK)
+# projection.relative_drift, extra_correction.py: a row's scale is at least this share of ‖A_i‖₁ ‖x‖∞. At a
+# singular position some rows' terms vanish (the N-four-bar's horizontal velocity rows when the bars lie flat)
+# down to term_scales' default floor of 1e-3 of that, and the same absolute drift read up to a thousand times
+# larger there: simulate's spans between projections then shrank to 5e-10 s and stayed there (N = 2 at
+# dt = 0.001, its second crossing)
+DRIFT_FLOOR = 0.1
 STACKED_CHECK_RTOL = 1e-12  # grouped.py: a stacked call must agree with the single calls to this,
 # relative to the group's largest value (checked once, at the first state)
 

@@ -105,7 +105,7 @@ def test_short_output_intervals_pass_the_crossings_without_a_crawl():
     """N = 2 at 1 ms outputs through its first two singular positions (t = 0.714, 1.228 s).
     Near the second, the rows whose velocity terms vanish with the bars flat made the
     relative drift read up to a thousand times its size; the spans between projections
-    shrank to 5e-10 s and stayed there (projection.DRIFT_FLOOR). B0 follows the exact
+    shrank to 5e-10 s and stayed there (tolerances.DRIFT_FLOOR). B0 follows the exact
     one-degree-of-freedom motion (benchmarks/iftomm_reference.py)."""
     crossings = ref.n_four_bar_singular_times(2, 1.3)
     traj = mb.simulate(mb.loads(ref.n_four_bar_yaml(2), name="n_four_bar_2"), 1.3, dt=0.001)

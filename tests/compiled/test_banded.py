@@ -38,6 +38,7 @@ def test_the_band_solver_gives_numpys_answers(m, half, shift):
     exact = np.abs(np.linalg.inv(S)).sum(axis=0).max()
     estimate = banded.inverse_norm1(band, width, np.zeros(m), np.zeros(m))
     assert exact / 3 <= estimate <= exact * (1 + 1e-9)  # a lower bound, within Hager's usual factor
+    assert banded.inverse_norm1_exact(band, width, np.zeros(m)) == pytest.approx(exact, rel=1e-8)
 
 
 def test_an_indefinite_matrix_is_refused():

@@ -238,6 +238,7 @@ def test_a_large_planar_loop_is_served_by_the_banded_schur_step(tmp_path):
     engine = data.engine
     assert engine is not None and engine.L.band_width.size == 1
     assert engine.L.x_coord.size + engine.L.xrow_row.size > layout.DENSE_SCHUR_MAX
+    assert engine.correction() is None  # its states are projected by projection.py (extra_correction.py)
     J, K = ref.n_four_bar_constants(N)
     rng = np.random.default_rng(5)
     for gap, served, agree in ((1.0, True, 1e-9), (1e-3, True, 1e-6), (1e-7, False, None)):
