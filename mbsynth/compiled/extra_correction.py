@@ -29,7 +29,7 @@ import numpy as np
 
 from . import kernel
 from .correction import MAX_STEPS, SHRINK, TINY, Corrected
-from ..core.equations import TERM_FLOOR
+from ..core.equations import TERM_FLOOR, entry_term_scales
 from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR
 
 
@@ -78,14 +78,10 @@ class ExtraCorrection:
         return np.bincount(self.rows, weights=self.gen[self.entries] * qd[self.columns], minlength=self.xrow_row.size)
 
     def _terms(self, x, floor):
-        """The size of each row's terms at x (core/equations.term_scales: Σ_j |A_ij x_j| plus
-        ``floor`` ‖A_i‖₁ ‖x‖∞), from the rows' entries as evaluated last: residuals are judged
-        against them, alike at every scale."""
-        weights = np.abs(self.gen[self.entries])
-        count = self.xrow_row.size
-        terms = np.bincount(self.rows, weights=weights * np.abs(x[self.columns]), minlength=count)
-        norms = np.bincount(self.rows, weights=weights, minlength=count)
-        return np.maximum(terms + floor * norms * np.abs(x).max(initial=0.0), TINY)
+        """The size of each row's terms at x (core/equations.term_scales), from the rows'
+        entries as evaluated last: residuals are judged against them, alike at every scale."""
+        scales = entry_term_scales(self.rows, self.columns, self.gen[self.entries], self.xrow_row.size, x, floor)
+        return np.maximum(scales, TINY)
 
     def _step(self, q, residual):
         """The least-M-norm Δ with A Δ = −residual (rows as evaluated last at q), or None

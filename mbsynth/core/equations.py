@@ -316,6 +316,14 @@ def _relative_drift(d: "_Data", drift):
     return float(finite.max(initial=0.0))
 
 
+def entry_term_scales(rows, columns, values, count, x, floor=TERM_FLOOR):
+    """``term_scales`` of the ``count`` rows of A given by its entries (row, column, value)."""
+    weights, x = np.abs(values), np.abs(x)
+    terms = np.bincount(rows, weights=weights * x[columns], minlength=count)
+    norms = np.bincount(rows, weights=weights, minlength=count)
+    return terms + floor * norms * x.max(initial=0.0)
+
+
 def term_scales(A, x, floor=TERM_FLOOR):
     """The size of the terms of each row's residual at x, estimated from its row of A:
     Σ_j |A_ij x_j| (x² + y² − L² at x, y ≈ L: 2L², where rounding is ε L²; each
@@ -325,9 +333,8 @@ def term_scales(A, x, floor=TERM_FLOOR):
     x = np.abs(np.asarray(x, dtype=float))
     if hasattr(A, "tocsr"):  # scipy.sparse, from the CSR arrays (scipy's abs and sum build matrices: 10× slower)
         A = A.tocsr()
-        weights, row = np.abs(A.data), np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
-        terms = np.bincount(row, weights=weights * x[A.indices], minlength=A.shape[0])
-        norms = np.bincount(row, weights=weights, minlength=A.shape[0])
+        return entry_term_scales(np.repeat(np.arange(A.shape[0]), np.diff(A.indptr)), A.indices, A.data, A.shape[0],
+                                 x, floor)
     else:
         weights = np.abs(A)
         terms, norms = weights @ x, weights.sum(axis=1)
