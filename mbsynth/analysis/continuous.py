@@ -17,6 +17,9 @@ cut (cut.py), from the last output: a failure is then reported in the interval i
 in, the rows before it kept.
 """
 
+import bisect
+from typing import NamedTuple
+
 import numpy as np
 
 from . import stepper
@@ -26,6 +29,28 @@ from .derivative import MAX_STATE, Crawl
 from .drift import next_cap
 from .projection import project, relative_drift
 from .singular_watch import SingularWatch
+
+
+class Passed(NamedTuple):
+    """The states a step passed: at ``times`` (the output times and control samples it
+    passed, then its end) the integrator's ``states`` (rows of y), their corrections
+    (CorrectedRows, or None where the kernel corrects nothing) and whether each is within
+    MAX_STATE (``bounded``)."""
+
+    times: list
+    states: np.ndarray
+    corrected: object
+    bounded: np.ndarray
+
+    def index(self, t):
+        """The row at the time t, or None where the step passed no such time."""
+        i = bisect.bisect_left(self.times, t)
+        return i if i < len(self.times) and self.times[i] == t else None
+
+    def at(self, t):
+        """(y, Corrected or None, bounded) at the time t (one the step passed)."""
+        i = self.index(t)
+        return self.states[i], None if self.corrected is None else self.corrected.row(i), self.bounded[i]
 
 
 class ContinuousIntegration(CutIntegration):
@@ -39,7 +64,7 @@ class ContinuousIntegration(CutIntegration):
         return issubclass(method, stepper.RESUMABLE) and stabilization == "projection"
 
     def __init__(self, *args):
-        self.passed = {}  # the states at the times the last step passed ({t: (y, Corrected or None, bounded)})
+        self.passed = None  # the states at the times the last step passed (Passed)
         super().__init__(*args)
         self.has_rows = len(self.data.system.constraint_names) > 0
         self.watch = None  # the singular positions passed between stages (singular_watch.py), on projected runs
@@ -71,10 +96,29 @@ class ContinuousIntegration(CutIntegration):
             if solver is None:
                 self._watch_from(self.t_now, q, qd)
             solver = self.resumed(self.t_now, q, qd, t_stop, self.rtol, self.atol)
-            self.passed = {}
+            self.passed = None
         while solver.t < t_next:
             self._step(solver, t_next)
-        return self.passed[t_next]
+        return self.passed.at(t_next)
+
+    def ready(self):
+        """(times, CorrectedRows) of the output rows after ``t_now`` that the last step passed
+        and corrected, up to the first one that needs more (a state not corrected or beyond
+        MAX_STATE, the step's end, a control sample), taken as arrived; None where there are
+        none. For a run without control samples: ``simulate`` records them at once."""
+        passed = self.passed
+        start = None if passed is None else passed.index(self.t_now)
+        if start is None or passed.corrected is None:
+            return None
+        start += 1
+        ok = passed.corrected.done[start:-1] & passed.bounded[start:-1]  # the step's end is not a row here
+        stop = start + (int(np.argmin(ok)) if not ok.all() else ok.size)
+        if stop == start:
+            return None
+        rows = passed.corrected
+        self.f.note_singular()
+        self.t_now, self.arrays, self.corrected = passed.times[stop - 1], None, rows.row(stop - 1)
+        return passed.times[start:stop], rows.part(start, stop)
 
     def _step(self, solver, t_next):
         """One accepted step, its state then corrected, and with it, in one block
@@ -108,11 +152,12 @@ class ContinuousIntegration(CutIntegration):
         if times:
             stepper.interpolate(solver, times, states[:-1])
         states[-1] = solver.y
-        corrected = self.correction.block(*self.form.states(states)) if self.correction is not None \
-            else [None] * len(states)
+        times.append(solver.t)
+        corrected = None if self.correction is None else \
+            self.correction.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
-        self.passed = dict(zip([*times, solver.t], zip(states, corrected, bounded)))
-        q_on, qd_on = self._on_constraints(solver.t, q, qd, corrected[-1], arrays)
+        self.passed = Passed(times, states, corrected, bounded)
+        q_on, qd_on = self._on_constraints(solver.t, q, qd, None if corrected is None else corrected.row(-1), arrays)
         if self.watch is not None:  # A before the projection: it moved q by the drift alone
             found = self.watch.passed(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
             if found is not None:

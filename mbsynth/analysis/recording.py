@@ -67,6 +67,25 @@ class Recorder:
         if self.writer is not None:
             self.writer.append(self.trajectory("running", rows=slice(self.count - 1, self.count)))
 
+    def record_rows(self, times, rows, compiled_energy):
+        """A row at each of ``times`` from their corrected states ``rows``
+        (correction.CorrectedRows, with their residuals and, where ``compiled_energy``,
+        energies; else the energies are evaluated here), as ``record`` would one by one."""
+        data, k = self.data, len(times)
+        rows_at = slice(self.count, self.count + k)
+        c = self.columns
+        c["t"][rows_at], c["q"][rows_at], c["qd"][rows_at] = times, rows.q, rows.qd
+        kinetic, potential, c["residual_position"][rows_at], c["residual_velocity"][rows_at] = rows.found[:, :4].T
+        if not compiled_energy:
+            kinetic, potential = np.array([data.energy(t, q, qd) for t, q, qd in zip(times, rows.q, rows.qd)]).T
+        c["kinetic"][rows_at], c["energy"][rows_at] = kinetic, kinetic + potential
+        if self.outputs:
+            for i, (t, q, qd) in enumerate(zip(times, rows.q, rows.qd)):
+                c["outputs"][self.count + i] = self.outputs.evaluate(t, q, qd)
+        self.count += k
+        if self.writer is not None:
+            self.writer.append(self.trajectory("running", rows=rows_at))
+
     def close(self, status):
         """Finish the file, if any, with the run's ``status``."""
         if self.writer is not None:

@@ -19,6 +19,7 @@ class Schedule:
         self.h = None if sample_dt is None else float(sample_dt)
         span = self.t_end - self.t0
         self.count = 0 if self.h is None else int(np.ceil(span / self.h - 1e-9))  # samples in [t0, t_end)
+        self.skipped = None  # ``skip_through``'s time, for the iteration to go on after
 
     def sample(self, j):
         """The time of sample j."""
@@ -46,6 +47,15 @@ class Schedule:
             yield float(t), t == t_out, t == t_sample
             i += t == t_out
             j += t == t_sample
+            if self.skipped is not None:
+                i = max(i, int(np.searchsorted(outputs, self.skipped, side="right")))
+                j = max(j, self._first_sample_from(np.nextafter(self.skipped, np.inf)))
+                self.skipped = None
+
+    def skip_through(self, t):
+        """Go on, in the iteration under way, from the first time after t (the times up to t
+        were dealt with at once)."""
+        self.skipped = t
 
     def next_stop(self, t):
         """The first control sample at or after t, or t_end: where a continuous integrator
@@ -56,6 +66,8 @@ class Schedule:
     def between(self, a, b):
         """The output times and samples in [a, b), in order."""
         outputs = self.outputs[np.searchsorted(self.outputs, a):np.searchsorted(self.outputs, b)].tolist()
+        if self.h is None:
+            return outputs
         j, samples = self._first_sample_from(a), []
         while j < self.count and self.sample(j) < b:
             samples.append(self.sample(j))

@@ -110,6 +110,8 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
                 recorder.record(t_next, q, qd, run.correction, run.compiled_energy, *at_hand)
                 if progress is not None:
                     progress(t_next)
+                if control is None:
+                    q, qd = _record_ready(run, recorder, schedule, progress, q, qd)
         status = COMPLETED
     except SolveError as err:
         status = f"failed at t = {run.t_failed:.9g}: {err}"
@@ -129,6 +131,22 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     traj = _trajectory(recorder, run, status)
     traj.stats.update(wall_time=time.perf_counter() - started, initial_changes=changes)
     return traj
+
+
+def _record_ready(run, recorder, schedule, progress, q, qd):
+    """The rows the integrator has passed and corrected already (ContinuousIntegration.ready),
+    recorded at once and skipped in the ``schedule``; returns the last state recorded."""
+    ready = getattr(run, "ready", None)
+    rows = None if ready is None else ready()
+    if rows is None:
+        return q, qd
+    times, corrected = rows
+    recorder.record_rows(times, corrected, run.compiled_energy)
+    schedule.skip_through(times[-1])
+    if progress is not None:
+        for t in times:
+            progress(t)
+    return corrected.q[-1], corrected.qd[-1]
 
 
 def _trajectory(recorder, run, status):

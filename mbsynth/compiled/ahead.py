@@ -44,9 +44,9 @@ GROUPS = (
 )
 SEGMENTS = "(i1 i1 i1 i1)"
 GENERAL_ONLY = (  # what a rigid tree's motion leaves out, per group
-    (("kernel", "_close", f"{TOPOLOGY} {SEGMENTS} f2 {FACTORED} f2 f2 f1 f1 f1 f1 f1 f1 f1 f2 f2 f1 f1 boolean float64"),),
+    (("kernel", "_close", f"{TOPOLOGY} {SEGMENTS} f2 {FACTORED} f2 f2 f1 f1 f1 f1 f1 f1 f1 f2 f2 f1 f1 f1 boolean float64"),),
     (("assembly", "extra_rows", "f1 f1 f1 f1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 i2 i1 i1 i1 "
-                                f"{SEGMENTS} i1 i1 (f3 f3 f2 f2 f1) f2 f2 f1 f2"),),
+                                f"{SEGMENTS} i1 i1 (f3 f3 f2 f2 f1) f2 f2 f1 f1 f2"),),
 )
 VARIANTS = {"rigid_tree": None, "general": True}  # kernel.RIGID_TREE, kernel.GENERAL
 TIMEOUT = 600  # seconds a helper may take before it is stopped

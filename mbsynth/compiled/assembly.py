@@ -64,6 +64,7 @@ class Work(NamedTuple):
     seg7: np.ndarray   # (S, 7) extra rows' coefficients per node
     seg6: np.ndarray   # (S, 6) the same in reduced unknowns, equilibrated
     xb: np.ndarray     # (m_x,) extra rows' right sides
+    xscale: np.ndarray  # (m_x,) the factors that equilibrated them (1 / the row's 2-norm)
     Ax: np.ndarray     # (m_x, n_x) extra rows on extra coordinates
     Mx: np.ndarray     # (n_x, n_x) extra coordinates' M / μ
     Fx: np.ndarray     # (n_x,) their F / μ
@@ -71,6 +72,7 @@ class Work(NamedTuple):
     rhs: np.ndarray    # (n_x + m_x,)
     lam: np.ndarray    # (n_x + m_x,) extra accelerations, then extra multipliers
     vectors: np.ndarray  # (n_x + m_x,)² eigenvectors of S
+    values: np.ndarray  # (n_x + m_x,) its eigenvalues
     band: np.ndarray   # (2, m_x, w + 1) the banded Schur matrix and A_x A_xᵀ, then their Cholesky factors (banded.py); empty: dense S
     bandv: np.ndarray  # (2, m_x) work of banded.py
     dyn: np.ndarray    # (N, 6) residual work
@@ -87,8 +89,8 @@ def make_work(L):
     width = int(L.band_width[0]) if L.band_width.size else -1
     dense, banded = (0 if width >= 0 else p), (mx if width >= 0 else 0)  # S is dense or banded
     shapes = dict(Qf=n, Cf=n, H=(N, 6, 6), F=(N, 6), s=N, nu=N, Rs=(N + 1, 4, 3, 3), zeta=(N, 3), HA=(N, 6, 6), Sn=(N, 6, 6), Jr=(N, 6, 6), X=(N, 6, 6), U=(N, 6, 6),
-                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, rscale=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(dense, dense),
-                  rhs=p, lam=p, vectors=(dense, dense), band=(2, banded, width + 1), bandv=(2, banded), dyn=(N, 6), qdd=n, Qc=n)
+                  Ninv=(N, 6, 6), c=(N, 12), x0=(N, 6), G=(12, 12), J=(rows, 6), P=(rows, 6), rb=rows, rscale=rows, ry=nz, y=nz, z=nz, z0=nz, w=nz, A=(MAX_ROWS, 14), b=MAX_ROWS, q7=7, seg7=(S, 7), seg6=(S, 6), xb=mx, xscale=mx, Ax=(mx, nx), Mx=(nx, nx), Fx=nx, S=(dense, dense),
+                  rhs=p, lam=p, vectors=(dense, dense), values=dense, band=(2, banded, width + 1), bandv=(2, banded), dyn=(N, 6), qdd=n, Qc=n)
     arrays = {name: np.zeros(shape) for name, shape in shapes.items()}
     arrays["Rs"][N, 0] = np.eye(3)  # the world, as a body at rest in its own frame (rate_rows.py)
     V, R, Jt = vector_work()
@@ -217,9 +219,9 @@ def tree_rows(q, qd, bshift, kind, start, node_joint, node_end, parent, rows, nu
 
 @njit(**OPTIONS)
 def extra_rows(q, qd, gen, bshift, kind, start, nu, s, Rs, joints, joint_xrow, joint_xseg, xrow_row, xseg_ptr,
-                xseg_node, gen_rows, xa_ptr, xa_col, scratch, seg7, seg6, xb, Ax):
+                xseg_node, gen_rows, xa_ptr, xa_col, scratch, seg7, seg6, xb, xscale, Ax):
     """Loop-joint rows and the generated rows (gen: their entries, then their b), as
-    segments and Ax entries; equilibrated. Only the entries of Ax's pattern (xa_ptr,
+    segments and Ax entries; equilibrated (each row's factor into xscale). Only the entries of Ax's pattern (xa_ptr,
     xa_col: layout.py) are written; the others stay zero."""
     arow, aseg, acol, brow = gen_rows
     A, b = scratch[3], scratch[4]
@@ -255,6 +257,7 @@ def extra_rows(q, qd, gen, bshift, kind, start, nu, s, Rs, joints, joint_xrow, j
         for e in range(xa_ptr[x], xa_ptr[x + 1]):
             total += Ax[x, xa_col[e]] ** 2
         scale = 1.0 / math.sqrt(total) if total > 0 else 1.0
+        xscale[x] = scale
         rhs = xb[x] + (bshift[xrow_row[x]] if bshift.shape[0] else 0.0)
         for seg in range(xseg_ptr[x], xseg_ptr[x + 1]):
             i = xseg_node[seg]

@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from .bodies import OPTIONS
-from . import threads
+from . import row_fit, threads
 from .joints import RIGID
 from .kernel import LAYOUT, OK, REUSED, UNCHECKED, WORK, motion
 from .packing import view1
@@ -61,6 +61,39 @@ class Corrected(NamedTuple):
     potential: float
     phi_max: float
     psi_max: float
+
+
+class CorrectedRows(NamedTuple):
+    """States corrected in one block: q, q̇ (a row each) and ``found`` (a row each:
+    KINETIC, POTENTIAL, PHI_MAX, PSI_MAX, DONE = 1 where the row was corrected, else 0 and
+    the row's state is not on the constraints)."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    found: np.ndarray
+
+    @property
+    def done(self):
+        """Whether each row was corrected."""
+        return self.found[:, DONE] == 1.0
+
+    def part(self, a, b):
+        """Rows a to b (views)."""
+        return CorrectedRows(self.q[a:b], self.qd[a:b], self.found[a:b])
+
+    def row(self, i):
+        """Row i as Corrected, or None where it was not corrected."""
+        info = self.found[i]
+        return Corrected(self.q[i], self.qd[i], *info[:DONE]) if info[DONE] else None
+
+    @classmethod
+    def of(cls, corrected, n):
+        """The rows of a list of Corrected or None (a state of n coordinates each)."""
+        q, qd, found = np.zeros((len(corrected), n)), np.zeros((len(corrected), n)), np.zeros((len(corrected), DONE + 1))
+        for i, c in enumerate(corrected):
+            if c is not None:
+                q[i], qd[i], found[i, :DONE], found[i, DONE] = c.q, c.qd, c[2:], 1.0
+        return cls(q, qd, found)
 
 
 @njit(nogil=True, **OPTIONS)
@@ -123,6 +156,20 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             found[b, DONE] = 1.0
 
 
+@njit(nogil=True, **OPTIONS)
+def judge(Q, QD, found, LI, LF, LX, phi, psi, Rs):
+    """found's row for each state (row of Q, Q̇) as ``correct`` leaves it, without moving
+    the state: DONE = 1 where |φ| is within CORRECTION_RTOL of the coordinates' size and
+    |φ̇| within CORRECTION_RATE_RTOL of that times the largest rate (row_fit.py's rows)."""
+    for b in range(Q.shape[0]):
+        kinetic, potential, phi_max, psi_max, q_max, qd_max = residuals_energy(Q[b], QD[b], LI, LF, LX, phi, psi, Rs)
+        size = max(q_max, 1.0)
+        found[b, KINETIC], found[b, POTENTIAL], found[b, PHI_MAX], found[b, PSI_MAX] = \
+            kinetic, potential, phi_max, psi_max
+        found[b, DONE] = 1.0 if phi_max <= CORRECTION_RTOL * size and \
+            psi_max <= CORRECTION_RATE_RTOL * size * max(qd_max, TINY) else 0.0
+
+
 @njit(**OPTIONS)
 def _unit_rates(q, qd, kind, start):
     """Each body's quaternion rate u̇ less its part along u, (u·u̇/uᵀu) u: the velocity step's
@@ -174,12 +221,50 @@ class Correction:
         """``Corrected`` (q, q̇) on the constraints (new arrays) with their rows, or None where
         the kernel declines the state, MAX_STEPS position steps leave φ above CORRECTION_RTOL, or
         the velocity step leaves φ̇ above SHRINK of what it was (and above rounding)."""
-        return self.block(q[None, :], qd[None, :])[0]
+        return self.block(q[None, :], qd[None, :]).row(0)
 
-    def block(self, Q, QD):
-        """``__call__`` of each state (row of Q, Q̇), in compiled calls on up to threads.THREADS
-        threads (states of PER_THREAD coordinates in all at least each): a list."""
+    def block(self, Q, QD, fractions=None):
+        """``__call__`` of each state (row of Q, Q̇), as CorrectedRows. ``fractions``: where
+        the states are the rows a step passed, each one's fraction θ of the step (the last
+        1, its end): where they are at least row_fit.MIN_ROWS, a few of them are corrected
+        and the others get the corrections interpolated through those (row_fit.py), each
+        then judged (``judge``) and corrected on its own where it fails."""
         Q, QD = np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(QD, dtype=float)
+        if fractions is None:
+            return self._exact(Q, QD)
+        rows = CorrectedRows(np.empty(Q.shape), np.empty(QD.shape), np.empty((Q.shape[0], DONE + 1)))
+        self._fitted(Q, QD, np.asarray(fractions, dtype=float), 0.0, rows)
+        return rows
+
+    def _fitted(self, Q, QD, fractions, a, rows):
+        """The states Q, Q̇ at ``fractions``, a span of a step from θ = a (below the first
+        fraction: the step's start, on the constraints), corrected into ``rows`` by
+        row_fit.py: each exactly where they are fewer than row_fit.MIN_ROWS; halved where more
+        than row_fit.NODES fail the fit."""
+        if Q.shape[0] < row_fit.MIN_ROWS:
+            rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
+            return
+        at = row_fit.nodes(fractions, a)
+        exact = self._exact(Q[at], QD[at])
+        if not exact.done.all():  # a node the kernel declined: no interpolant through it
+            rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
+            return
+        row_fit.interpolate(fractions, a, at, Q, QD, exact.q, exact.qd, rows.q, rows.qd)
+        with self.lock:
+            judge(rows.q, rows.qd, rows.found, *self.rows.packed, self.rows.phi, self.rows.psi, self.rows.work[0])
+        rows.found[at] = exact.found
+        failed = np.flatnonzero(rows.found[:, DONE] == 0.0)
+        if failed.size > row_fit.NODES:
+            half = Q.shape[0] // 2
+            self._fitted(Q[:half], QD[:half], fractions[:half], a, rows.part(0, half))
+            self._fitted(Q[half:], QD[half:], fractions[half:], fractions[half], rows.part(half, Q.shape[0]))
+        elif failed.size:
+            again = self._exact(Q[failed], QD[failed])
+            rows.q[failed], rows.qd[failed], rows.found[failed] = again
+
+    def _exact(self, Q, QD):
+        """Each state (row of Q, Q̇) corrected by ``correct``, in compiled calls on up to
+        threads.THREADS threads (states of PER_THREAD coordinates in all at least each)."""
         count = Q.shape[0]
         Q_on, QD_on, found = np.empty(Q.shape), np.empty(QD.shape), np.empty((count, DONE + 1))
         parts = max(1, min(threads.THREADS, count * Q.shape[1] // PER_THREAD))  # read here: a benchmark may lower it
@@ -196,7 +281,7 @@ class Correction:
             part(0)  # on this thread meanwhile
             for other in others:
                 other.result()
-        return [Corrected(q, qd, *info[:DONE]) if info[DONE] else None for q, qd, info in zip(Q_on, QD_on, found)]
+        return CorrectedRows(Q_on, QD_on, found)
 
     def residuals_energy(self, q, qd):
         """(φ, φ̇, T, V) at (q, q̇): the System's residuals and its parts' energies."""

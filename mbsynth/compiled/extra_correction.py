@@ -28,7 +28,7 @@ import threading
 import numpy as np
 
 from . import kernel
-from .correction import MAX_STEPS, SHRINK, TINY, Corrected
+from .correction import MAX_STEPS, SHRINK, TINY, Corrected, CorrectedRows
 from ..core.equations import TERM_FLOOR, entry_term_scales
 from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR
 
@@ -123,9 +123,10 @@ class ExtraCorrection:
             return Corrected(q, qd, np.nan, np.nan, float(np.abs(self.gen[self.phi]).max(initial=0.0)),
                              float(np.abs(psi).max(initial=0.0)))
 
-    def block(self, Q, QD):
-        """``__call__`` of each state (row of Q, Q̇): a list."""
-        return [self(q, qd) for q, qd in zip(Q, QD)]
+    def block(self, Q, QD, fractions=None):
+        """``__call__`` of each state (row of Q, Q̇), as CorrectedRows (``fractions``, the
+        states' fractions of a step, are not used: each state is corrected on its own)."""
+        return CorrectedRows.of([self(q, qd) for q, qd in zip(Q, QD)], self.n)
 
     def residuals_energy(self, q, qd):
         """(φ, φ̇ of the extra rows, NaN, NaN): the energies are the Data's."""

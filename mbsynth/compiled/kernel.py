@@ -105,12 +105,14 @@ def _moves(vec, nx, topology, segs, seg6, factored, y, w):
 
 
 @njit(**OPTIONS)
-def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam, multipliers, drift):
+def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, values, rhs, lam, multipliers,
+           drift):
     """Solve the Schur system of the extra rows and coordinates into lam (extra
     accelerations, then extra multipliers), then the tree into z (its multipliers too
     where ``multipliers``: tree.solve). Returns a status. ``drift``: negative on the
     manifold (the rules of the module docstring), else the state's relative drift δ
-    (``motion``)."""
+    (``motion``). The Schur matrix's eigenvectors and eigenvalues stay in ``vectors`` and
+    ``values`` (``_close_solve`` solves with them again)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     if nx > 0:
         inverse, work = Mx.copy(), np.zeros((nx, nx))
@@ -124,22 +126,32 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
             return NEAR_SINGULAR  # a singular mass: the exact drift rule's to judge
     S[:, :] = 0.0
     for x in range(nx):
-        rhs[x] = Fx[x]
         for c in range(nx):
             S[x, c] = Mx[x, c]
     for x in range(mx):
         for c in range(nx):
             S[c, nx + x] = Ax[x, c]
             S[nx + x, c] = Ax[x, c]
-        rhs[nx + x] = xb[x] - _row_dot(x, segs, seg6, z0)
     for x in range(mx):
         y[:] = 0.0
         _scatter(x, 1.0, segs, seg6, y)
         solve(topology, factored, y, w, False)
         for r in range(mx):
             S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
-    values = np.zeros(mx + nx)
     symmetric_eigen(S, vectors, values)
+    return _close_solve(topology, segs, seg6, factored, Fx, xb, ry, z0, y, w, z, vectors, values, rhs, lam, nx, mx,
+                        multipliers, drift)
+
+
+@njit(**OPTIONS)
+def _close_solve(topology, segs, seg6, factored, Fx, xb, ry, z0, y, w, z, vectors, values, rhs, lam, nx, mx,
+                 multipliers, drift):
+    """``_close``'s solve, from the Schur matrix's eigenvectors and eigenvalues (``vectors``,
+    ``values``) and z0 = K⁻¹ ry: the right side, the dropped directions' rules, lam, z."""
+    for x in range(nx):
+        rhs[x] = Fx[x]
+    for x in range(mx):
+        rhs[nx + x] = xb[x] - _row_dot(x, segs, seg6, z0)
     top = max(np.abs(values).max(), 1.0) if values.shape[0] else 1.0
     dependent = max(SCHUR_DEPENDENT_RTOL, (DRIFT_RANK * drift) ** 2) * top  # off the manifold: the drift's own
     lam[:] = 0.0
@@ -528,7 +540,9 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     left, for a call with the same M and A (the same q) and another right side; when that
     call was at the same state, at rest (q̇ = 0) with the same forces, and this one's shifts
     leave the unit-norm rows alone (``_shifts_only``: a correction's velocity step), only
-    the right side is rebuilt and solved, not the masses and rows. ``drift``: negative for
+    the right side is rebuilt and solved, not the masses and rows (nor, with loop rows, their
+    Schur matrix: ``_close_solve`` with the last call's eigenvectors; not for a model with
+    extra coordinates, generated right sides or a banded Schur step). ``drift``: negative for
     a state on the constraint manifold, else its relative drift δ (Engine.relative_drift),
     by which the Schur step of the extra rows follows the drift rule of core/equations.py:
     a direction whose eigenvalue is below (DRIFT_RANK δ)² (or SCHUR_DEPENDENT_RTOL) of the
@@ -577,11 +591,23 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
                 view1(LI, LX, LAYOUT.xc_row), view1(LI, LX, LAYOUT.gen_mi), view1(LI, LX, LAYOUT.gen_mj))
     band_width = view1(LI, LX, LAYOUT.band_width)
 
-    if mode == REUSED and x_coord.shape[0] + xb.shape[0] == 0 and _shifts_only(qd, bshift, kind, quat_row):
+    xscale, xrow_row = view1(WF, WX, WORK.xscale), view1(LI, LX, LAYOUT.xrow_row)
+    if mode == REUSED and x_coord.shape[0] + band_width.shape[0] + view1(LI, LX, LAYOUT.gen_brow).shape[0] == 0 and \
+            _shifts_only(qd, bshift, kind, quat_row):
         _shifted_rows(kind, node_joint, k, rows, joint_row, bshift, rscale, rb, s)
         tree_rhs(v, k, yoff, rows, F, rb, ry)
         _copy(ry, y)
-        solve(topology, factored, y, z, False)
+        if general is not None and xb.shape[0]:
+            for x in range(xb.shape[0]):  # the loop rows' right sides: their shifts alone, equilibrated
+                xb[x] = xscale[x] * bshift[xrow_row[x]]
+            solve(topology, factored, y, z0, False)
+            status = _close_solve(topology, segs, seg6, factored, Fx, xb, ry, z0, y, w, z, view2(WF, WX, WORK.vectors),
+                                  view1(WF, WX, WORK.values), view1(WF, WX, WORK.rhs), lam, 0, xb.shape[0], False,
+                                  drift)
+            if status != OK:
+                return status, 0.0
+        else:
+            solve(topology, factored, y, z, False)
         _recover(q, kind, start, mass, inertia, yoff, x_coord, nu, s, Rs, z, Qf, Mx, patterns[4], patterns[5], lam, 1.0,
                  qdd, Qc)
         return (OK if _finite(qdd, Qc) else NOT_FINITE), 0.0
@@ -602,8 +628,8 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
               rows, nu, s, Rs, joints, joint_row, scratch, J, P, rb, rscale, general)
     if general is not None and xb.shape[0]:
         extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_xrow),
-                   view2(LI, LX, LAYOUT.joint_xseg), view1(LI, LX, LAYOUT.xrow_row), xseg_ptr, xseg_node, gen_rows,
-                   patterns[0], patterns[1], scratch, seg7, seg6, xb, Ax)
+                   view2(LI, LX, LAYOUT.joint_xseg), xrow_row, xseg_ptr, xseg_node, gen_rows,
+                   patterns[0], patterns[1], scratch, seg7, seg6, xb, xscale, Ax)
     transports(q, start, parent, node_joint, view1(LI, LX, LAYOUT.node_end), transport,
                joints[4], Rs, factored[8])
     tree_rhs(v, k, yoff, rows, F, rb, ry)
@@ -618,7 +644,8 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
                                    view3(WF, WX, WORK.band), view2(WF, WX, WORK.bandv), view1(WF, WX, WORK.rhs))
         else:
             status = _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, view2(WF, WX, WORK.S),
-                            view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.rhs), lam, mode == CHECKED, drift)
+                            view2(WF, WX, WORK.vectors), view1(WF, WX, WORK.values), view1(WF, WX, WORK.rhs), lam,
+                            mode == CHECKED, drift)
         if status != OK:
             return status, 0.0
     else:

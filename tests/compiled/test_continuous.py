@@ -131,9 +131,9 @@ def test_a_block_of_states_is_corrected_as_each_state_alone():
     Q[7] = np.nan
     correction = correction_of(system)
     block = correction.block(Q, QD)
-    assert len(block) == count and block[7] is None
-    for q, qd, together in zip(Q, QD, block):
-        alone = correction(q, qd)
+    assert len(block.q) == count and block.row(7) is None
+    for i, (q, qd) in enumerate(zip(Q, QD)):
+        together, alone = block.row(i), correction(q, qd)
         if alone is None:
             assert together is None
             continue
