@@ -101,6 +101,12 @@ class Integration:
         self.t_now, self.arrays, self.corrected = t_next, arrays, corrected
         return q, qd
 
+    def ready(self):
+        """(times, CorrectedRows) of output rows after ``t_now`` reached already and corrected,
+        taken as arrived, for ``simulate`` to record at once; None: none (continuous.py's
+        integrator has them)."""
+        return None
+
     def failed_step(self, solver, message):
         """The SolveError of the integrator's own failure (its step size too small)."""
         return self.f.collapse(solver.t, solver.y, (message or "the integrator failed").rstrip("."))

@@ -57,32 +57,29 @@ class Recorder:
             kinetic, potential, *residuals = corrected[2:]
         if not compiled_energy:
             kinetic, potential = data.energy(t, q, qd)
-        values = dict(t=t, q=q, qd=qd, energy=kinetic + potential, kinetic=kinetic, residual_position=residuals[0],
-                      residual_velocity=residuals[1])
-        if self.outputs:
-            values["outputs"] = self.outputs.evaluate(t, q, qd)
-        for name, value in values.items():
-            self.columns[name][self.count] = value
-        self.count += 1
-        if self.writer is not None:
-            self.writer.append(self.trajectory("running", rows=slice(self.count - 1, self.count)))
+        self._store([t], q[None, :], qd[None, :], kinetic, potential, *residuals)
 
     def record_rows(self, times, rows, compiled_energy):
         """A row at each of ``times`` from their corrected states ``rows``
         (correction.CorrectedRows, with their residuals and, where ``compiled_energy``,
         energies; else the energies are evaluated here), as ``record`` would one by one."""
-        data, k = self.data, len(times)
-        rows_at = slice(self.count, self.count + k)
-        c = self.columns
-        c["t"][rows_at], c["q"][rows_at], c["qd"][rows_at] = times, rows.q, rows.qd
-        kinetic, potential, c["residual_position"][rows_at], c["residual_velocity"][rows_at] = rows.found[:, :4].T
+        kinetic, potential, residual_position, residual_velocity = rows.found[:, :4].T
         if not compiled_energy:
-            kinetic, potential = np.array([data.energy(t, q, qd) for t, q, qd in zip(times, rows.q, rows.qd)]).T
+            kinetic, potential = np.array([self.data.energy(t, q, qd) for t, q, qd in zip(times, rows.q, rows.qd)]).T
+        self._store(times, rows.q, rows.qd, kinetic, potential, residual_position, residual_velocity)
+
+    def _store(self, times, q, qd, kinetic, potential, residual_position, residual_velocity):
+        """Rows at ``times`` (q, q̇ a row each; the others an entry each, or one value for a
+        single row) into the columns, with the model's declared outputs, and to the file."""
+        rows_at = slice(self.count, self.count + len(times))
+        c = self.columns
+        c["t"][rows_at], c["q"][rows_at], c["qd"][rows_at] = times, q, qd
         c["kinetic"][rows_at], c["energy"][rows_at] = kinetic, kinetic + potential
+        c["residual_position"][rows_at], c["residual_velocity"][rows_at] = residual_position, residual_velocity
         if self.outputs:
-            for i, (t, q, qd) in enumerate(zip(times, rows.q, rows.qd)):
-                c["outputs"][self.count + i] = self.outputs.evaluate(t, q, qd)
-        self.count += k
+            for i, (t, q_row, qd_row) in enumerate(zip(times, q, qd)):
+                c["outputs"][self.count + i] = self.outputs.evaluate(t, q_row, qd_row)
+        self.count += len(times)
         if self.writer is not None:
             self.writer.append(self.trajectory("running", rows=rows_at))
 

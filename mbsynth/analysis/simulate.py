@@ -135,9 +135,9 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
 
 def _record_ready(run, recorder, schedule, progress, q, qd):
     """The rows the integrator has passed and corrected already (ContinuousIntegration.ready),
-    recorded at once and skipped in the ``schedule``; returns the last state recorded."""
-    ready = getattr(run, "ready", None)
-    rows = None if ready is None else ready()
+    recorded at once and skipped in the ``schedule``; returns the last state recorded
+    (q, q̇ as they were where there are none)."""
+    rows = run.ready()
     if rows is None:
         return q, qd
     times, corrected = rows

@@ -542,7 +542,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     leave the unit-norm rows alone (``_shifts_only``: a correction's velocity step), only
     the right side is rebuilt and solved, not the masses and rows (nor, with loop rows, their
     Schur matrix: ``_close_solve`` with the last call's eigenvectors; not for a model with
-    extra coordinates, generated right sides or a banded Schur step). ``drift``: negative for
+    extra coordinates or generated right sides). ``drift``: negative for
     a state on the constraint manifold, else its relative drift δ (Engine.relative_drift),
     by which the Schur step of the extra rows follows the drift rule of core/equations.py:
     a direction whose eigenvalue is below (DRIFT_RANK δ)² (or SCHUR_DEPENDENT_RTOL) of the
@@ -592,7 +592,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     band_width = view1(LI, LX, LAYOUT.band_width)
 
     xscale, xrow_row = view1(WF, WX, WORK.xscale), view1(LI, LX, LAYOUT.xrow_row)
-    if mode == REUSED and x_coord.shape[0] + band_width.shape[0] + view1(LI, LX, LAYOUT.gen_brow).shape[0] == 0 and \
+    if mode == REUSED and x_coord.shape[0] + view1(LI, LX, LAYOUT.gen_brow).shape[0] == 0 and \
             _shifts_only(qd, bshift, kind, quat_row):
         _shifted_rows(kind, node_joint, k, rows, joint_row, bshift, rscale, rb, s)
         tree_rhs(v, k, yoff, rows, F, rb, ry)
