@@ -14,7 +14,10 @@ elsewhere each state is projected (projection.py) and judged strictly there
 (Integration.arrived), and a model with no rows has nothing to correct. An output interval
 in which the integrator crawls near a singular position, or fails, is integrated again,
 cut (cut.py), from the last output: a failure is then reported in the interval it happens
-in, the rows before it kept.
+in, the rows before it kept. Where the kernel corrects the states and the run's singular
+watch or the correction measures how near the rows are to losing rank, a singular position
+seen coming is crossed by one planned step whose stages keep away from it and are put on
+the constraints first (crossing.py): no crawl.
 """
 
 import bisect
@@ -24,6 +27,7 @@ import numpy as np
 
 from . import stepper
 from ..core.errors import SolveError
+from .crossing import NAMED_SHARE, Crossing
 from .cut import RELAXED_MAX, CutIntegration
 from .derivative import MAX_STATE, Crawl
 from .drift import next_cap
@@ -68,6 +72,7 @@ class ContinuousIntegration(CutIntegration):
         super().__init__(*args)
         self.has_rows = len(self.data.system.constraint_names) > 0
         self.watch = None  # the singular positions passed between stages (singular_watch.py), on projected runs
+        self.crossing = None  # the step plan near singular positions (crossing.py)
 
     def advance(self, t_next, q, qd, t_stop):
         try:
@@ -127,11 +132,45 @@ class ContinuousIntegration(CutIntegration):
         whether the state is within MAX_STATE) per time. The step is capped (``max_step``) to
         keep the drift between corrections below DRIFT_TARGET: halved after a larger drift,
         doubled after one below a hundredth of it; a step that drifted more than
-        DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length. A step that
-        reaches the bound (a control sample or the end) leaves f at the corrected state to
-        be computed when the integrator goes on (Integration.resumed)."""
+        DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length. Near a singular
+        position the step is aimed where ``crossing`` plans it, and the step across it
+        evaluates its stages on the constraints (crossing.py). A step that reaches the bound
+        (a control sample or the end) leaves f at the corrected state to be computed when
+        the integrator goes on (Integration.resumed)."""
         start = stepper.saved(solver)
-        message = solver.step()
+        target, across = (None, False) if self.crossing is None else \
+            self.crossing.plan(solver.t, min(stepper.proposed_step(solver), solver.max_step), solver.t_bound)
+        self.f.on_manifold = self.correction if across else None
+        try:
+            self._take(solver, t_next, start, target)
+        finally:
+            self.f.on_manifold = None
+        if across and solver.t == target and self.watch is None:  # crossed: the watch would have found it
+            self._list_crossing(solver, start[0])
+
+    def _list_crossing(self, solver, t_start):
+        """List the singular position the step from t_start just crossed: at t*, where the
+        measure falls to zero on a line through the step's ends on either side of it
+        (Crossing.crossed), with the rows of the least direction of the state there, read
+        from the step's interpolant and put on the constraints (those of weight above
+        NAMED_SHARE of the largest: t* is known to the line's accuracy, and off it the
+        least direction mixes in others)."""
+        t_star = self.crossing.crossed()
+        y = np.empty((1, solver.y.size))
+        self.f.on_manifold = self.correction  # the interpolant's extra stages, as the step's
+        try:
+            stepper.interpolate(solver, [t_star], y)
+        finally:
+            self.f.on_manifold = None
+        q, qd = self.form.to_state(y[0])
+        on = self.correction(q, qd)
+        rows = self.correction.measure(*((q, qd) if on is None else on[:2]), share=NAMED_SHARE)[1]
+        names = self.data.system.constraint_names
+        self.f.add_singular(t_star, tuple(names[r] for r in rows), solver.t - t_start)
+
+    def _take(self, solver, t_next, start, target):
+        """``_step``'s step from ``start`` (stepper.saved), aimed at ``target`` (or None)."""
+        message = solver.step() if target is None else stepper.step_to(solver, target)
         if solver.status == "failed":
             raise self.failed_step(solver, message)
         self.steps += 1
@@ -157,11 +196,10 @@ class ContinuousIntegration(CutIntegration):
             self.correction.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = Passed(times, states, corrected, bounded)
+        self.f.on_manifold = None  # the step's end: on the constraints already
         q_on, qd_on = self._on_constraints(solver.t, q, qd, None if corrected is None else corrected.row(-1), arrays)
-        if self.watch is not None:  # A before the projection: it moved q by the drift alone
-            found = self.watch.passed(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
-            if found is not None:
-                self.f.add_singular(*found)
+        # A before the projection: it moved q by the drift alone
+        self._look(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
             y = self.form.to_integrator(q_on, qd_on)
             stepper.move(solver, y, None if solver.status == "finished" else self.f(solver.t, y))
@@ -169,12 +207,34 @@ class ContinuousIntegration(CutIntegration):
     def _watch_from(self, t, q, qd):
         """Watch for the singular positions passed between stages from the state (t, q, q̇)
         on (singular_watch.py): on runs projected or corrected by extra_correction.py
-        (``watched``) of models whose A is small enough."""
-        if (self.correction is None or self.correction.watched) and SingularWatch.fits(self.data):
-            if self.watch is None:
-                self.watch = SingularWatch(self.data, t, q, qd)
-            self.watch.restart()
-            self.watch.passed(t, q, qd)
+        (``watched``) of models whose A is small enough. Plan the steps across them
+        (crossing.py) where the kernel corrects the states and the watch or the correction
+        (extra_correction.py's ``measure``) measures them."""
+        if self.watch is None and (self.correction is None or self.correction.watched) and \
+                SingularWatch.fits(self.data):
+            self.watch = SingularWatch(self.data, t, q, qd)
+        if self.crossing is None and self.correction is not None and \
+                (self.watch is not None or self.correction.measure is not None):
+            self.crossing = Crossing(self.method)
+        for watching in (self.watch, self.crossing):
+            if watching is not None:
+                watching.restart()
+        self._look(t, q, qd)
+
+    def _look(self, t, q, qd, A=None):
+        """The state (t, q, q̇) reached on the constraints (``A``: its rows, if at hand) shown
+        to the watch, which may list a singular position passed, and its measure to the step
+        plan."""
+        if self.watch is not None:
+            found = self.watch.passed(t, q, qd, A)
+            if found is not None:
+                self.f.add_singular(*found)
+        if self.crossing is not None:
+            if self.watch is not None:
+                m = self.watch.measure
+            else:
+                m = self.correction.measure(q, qd)[0]
+            self.crossing.passed(t, m)
 
     def _drift(self, t, q, qd):
         """(the state's relative drift off the constraints, its ConstraintArrays or None):

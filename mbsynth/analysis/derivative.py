@@ -51,6 +51,7 @@ class StateDerivative:
         self.non_unique = False
         self.singular = []  # (t, rows) of the interval's stages near a singular position
         self.singular_positions = []  # per interval with such stages: {t_from, t_to, rows}
+        self.on_manifold = None  # (q, q̇) -> the state on the constraints or None: a step across a singular position
         self.use(None)
         self.begin(0.0, 0.0)
 
@@ -74,6 +75,8 @@ class StateDerivative:
         self.t_failed = t
         self.calls += 1
         self.evaluations += 1
+        if self.on_manifold is not None:  # a step across a singular position (crossing.py)
+            y = self._on_manifold(y)
         if self.calls % COLLAPSE_CALLS == 0:
             if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
                 raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
@@ -91,6 +94,13 @@ class StateDerivative:
         if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
             raise Crawl
         return self.form.rates(y, found if found is not None else np.concatenate([qd, motion.qdd]))
+
+    def _on_manifold(self, y):
+        """The stage y put on the constraints by ``on_manifold`` (as it is where that declines)."""
+        if not np.abs(y).max(initial=0.0) <= MAX_STATE:
+            return y
+        corrected = self.on_manifold(*self.form.to_state(y))
+        return y if corrected is None else self.form.to_integrator(corrected.q, corrected.qd)
 
     def add_singular(self, t, rows, within):
         """A singular position passed at t (``rows``: its nearly dependent rows) found between

@@ -20,8 +20,10 @@ singular position (σ < 1e-5 σ₁ of the equilibrated A: the drift rule's zone)
 continuous projected run of a small model, each crossing found between the steps' ends
 (singular_watch.py); a crossing whose stages all stay farther from it needs no special
 treatment, and on other runs may go unlisted.
-There a tolerance tighter than the stages' noise makes the integrator crawl: such a span is
-integrated again more loosely (cut.py) and listed in ``stats["relaxed_spans"]``.
+There a tolerance tighter than the stages' noise makes the integrator crawl; a continuous
+run whose watch sees a singular position coming steps across it in one planned step
+(crossing.py), and a span that crawls still is integrated again more loosely (cut.py) and
+listed in ``stats["relaxed_spans"]``.
 """
 
 import logging

@@ -43,6 +43,11 @@ class SingularWatch:
         """Forget the ends: the run goes on from a state not reached by a watched step."""
         self.ends = []
 
+    @property
+    def measure(self):
+        """σ_r/σ₁ at the last end (1 where the rows have no rank to lose)."""
+        return self.ends[-1][3] if self.ends else 1.0
+
     def passed(self, t, q, qd, A=None):
         """After a step ending at the state (t, q, q̇) on the constraints (``A``: its rows,
         if at hand): (t*, row names, the bracket's width) of the singular position whose dip

@@ -62,6 +62,20 @@ def resume(solver, t_bound, first_step=None):
         solver.h_abs = first_step
 
 
+def step_to(solver, t_to):
+    """One step of the solver aimed to end at t_to (between its t and its bound): its step
+    size set to reach t_to, its bound moved there for the step; a rejected trial shortens it
+    as usual (the step then ends before t_to). ``step()``'s message."""
+    bound = solver.t_bound
+    solver.t_bound, solver.h_abs = t_to, abs(t_to - solver.t)
+    try:
+        return solver.step()
+    finally:
+        solver.t_bound = bound
+        if solver.status == "finished" and solver.t != bound:
+            solver.status = "running"
+
+
 def cap(solver, max_step):
     """The solver's steps capped at ``max_step`` (np.inf: uncapped)."""
     solver.max_step = max_step

@@ -197,6 +197,7 @@ class Correction:
 
     energies = True  # Corrected holds the kinetic and potential energy of the corrected state
     watched = False  # the run's singular watch (analysis/singular_watch.py) does not look at its states
+    measure = None  # no measure of how near its rows are to losing rank (extra_correction.py's ``measure``)
 
     def __init__(self, rows, at_rest):
         self.rows, self.at_rest = rows, at_rest

@@ -14,13 +14,14 @@ to projection.py (None), as with correction.py.
 
 Only for Systems whose every coordinate is an extra coordinate, every extra row has a φ
 (holonomic rows: a velocity-level row has no position to correct), whose masses and rows
-do not depend on time (a correction is called without t) and whose Schur step is dense
-(kernel.py; layout.DENSE_SCHUR_MAX). The banded step of a larger model declines states near
-a singular position, and there the mass metric moves the velocity far more than
-projection.py's: measured on the N = 40 four-bar, a velocity 1e-10 off its manifold 1e-4
-rad from a horizontal position is put 1e-6 from the exact one (projection.py: 2e-8), and
-over 20 s six of its twenty crossings crawled (one with projection.py). Its energies are left to the Data
-(``energies`` False); the run's singular watch goes on through its states (``watched``).
+do not depend on time (a correction is called without t). The banded Schur step of a larger
+model (kernel.py; layout.DENSE_SCHUR_MAX) declines states near a singular position, and
+there the mass metric moves the velocity far more than projection.py's (a velocity 1e-10 off
+the N = 40 four-bar's manifold 1e-4 rad from a horizontal position is put 1e-6 from the
+exact one; projection.py: 2e-8): a run steps across such positions with its stages kept
+away from them (analysis/crossing.py), from the rows' ``measure``, which its singular watch
+gives where the model is small. Its energies are left to the Data (``energies`` False); the
+run's singular watch goes on through its states (``watched``).
 """
 
 import threading
@@ -30,7 +31,8 @@ import numpy as np
 from . import kernel
 from .correction import MAX_STEPS, SHRINK, TINY, Corrected, CorrectedRows
 from ..core.equations import TERM_FLOOR, entry_term_scales
-from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR
+from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR, NAME_RTOL
+from .least_direction import LeastDirection
 
 
 class ExtraCorrection:
@@ -56,16 +58,17 @@ class ExtraCorrection:
         packed_work, self.W = engine.new_work()
         self.buffers = (*engine.packed, *packed_work)
         self.lock = threading.Lock()
+        self.least = None  # the rows' LeastDirection, made at the first ``measure``
 
     @classmethod
     def build(cls, engine):
         """The ExtraCorrection of ``engine``, or None where its model is not of extra
-        coordinates alone, has no row or a row without φ, rows or masses that depend on t
-        (Template.rows_depend_on_time) or a banded Schur step."""
+        coordinates alone, has no row or a row without φ, or rows or masses that depend on t
+        (Template.rows_depend_on_time)."""
         L, template = engine.L, engine.template
         if L.node_kind.size or L.x_coord.size != engine.n or not L.xrow_row.size:
             return None
-        if template.phi_outputs != L.xrow_row.size or template.rows_depend_on_time or L.band_width.size:
+        if template.phi_outputs != L.xrow_row.size or template.rows_depend_on_time:
             return None
         return cls(engine)
 
@@ -127,6 +130,20 @@ class ExtraCorrection:
         """``__call__`` of each state (row of Q, Q̇), as CorrectedRows (``fractions``, the
         states' fractions of a step, are not used: each state is corrected on its own)."""
         return CorrectedRows.of([self(q, qd) for q, qd in zip(Q, QD)], self.n)
+
+    def measure(self, q, qd, share=NAME_RTOL):
+        """(m, rows): m = σ_min/σ₁ of the rows' A at (q, q̇), each row scaled to unit norm
+        (least_direction.py), and the System's rows that take part in its least direction
+        (weights above ``share`` of the largest): what a run's step plan near singular
+        positions reads (analysis/crossing.py) where its singular watch does not."""
+        q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+        with self.lock:
+            self._evaluate(q, qd)
+            values = self.gen[self.entries].copy()
+        if self.least is None:
+            self.least = LeastDirection(self.rows, self.columns, self.xrow_row.size)
+        m, weights = self.least(values)
+        return m, tuple(int(r) for r in self.xrow_row[weights > share * weights.max(initial=0.0)])
 
     def residuals_energy(self, q, qd):
         """(φ, φ̇ of the extra rows, NaN, NaN): the energies are the Data's."""

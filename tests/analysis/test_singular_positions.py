@@ -101,6 +101,25 @@ def test_a_span_that_crawls_near_a_singular_position_is_integrated_again_at_a_lo
     assert traj.max_residual < 1e-10
 
 
+def test_crossings_at_a_tight_tolerance_are_stepped_across_on_the_exact_motion(monkeypatch):
+    """N = 2 for 4 s through its first four singular positions at rtol = atol = 1e-12: a
+    tolerance at which stages near a crossing see the drift of rounding amplified (ε/σ³) and
+    the integrator crawled. The run plans one step across each (crossing.py: its stages at
+    least 0.13 of the step from it, put on the constraints first): no span relaxed, and B0
+    within 1e-11 m of the exact one-degree-of-freedom motion, its energy kept to 1e-10 J. The
+    kernel's correction puts the stages on the constraints: its kernels waited for."""
+    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    system = mb.loads(ref.n_four_bar_yaml(2), name="n_four_bar_2")
+    traj = mb.simulate(system, 4.0, dt=0.1, rtol=1e-12, atol=1e-12)
+    assert traj.status == "completed" and not traj.stats["relaxed_spans"]
+    assert len(ref.n_four_bar_singular_times(2, 4.0)) == 4
+    theta = traj.column("v0.theta")
+    bx, by = traj.column("v0.x") - 0.5 * np.sin(theta), traj.column("v0.y") + 0.5 * np.cos(theta)
+    xr, yr = ref.n_four_bar_reference(traj.t, 2)
+    assert np.hypot(bx - xr, by - yr).max() < 1e-11
+    assert np.abs(traj.energy - traj.energy[0]).max() < 1e-10
+
+
 def test_short_output_intervals_pass_the_crossings_without_a_crawl():
     """N = 2 at 1 ms outputs through its first two singular positions (t = 0.714, 1.228 s).
     Near the second, the rows whose velocity terms vanish with the bars flat made the

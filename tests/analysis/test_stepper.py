@@ -69,6 +69,24 @@ def test_a_rewound_step_is_taken_again_shorter():
     assert np.array_equal(solver.y, fresh.y)
 
 
+@pytest.mark.implementation
+@pytest.mark.parametrize("method", stepper.RESUMABLE)
+def test_a_step_aimed_at_a_time_ends_there_as_one_bound_there_would(method):
+    """``step_to`` takes the step scipy takes towards a bound at that time (bit for bit: the
+    same state, the same proposal for the next step) and leaves the solver running towards
+    its own bound."""
+    solver = method(damped, 0.0, np.array([1.0, 0.3, 0.2]), 10.0, rtol=1e-9, atol=1e-9)
+    solver.step()
+    t, y, f = solver.t, solver.y.copy(), solver.f.copy()
+    aim = t + 0.6 * stepper.proposed_step(solver)
+    stepper.step_to(solver, aim)
+    fresh = method(damped, t, y, aim, rtol=1e-9, atol=1e-9, first_step=aim - t)
+    assert np.array_equal(fresh.f, f)
+    fresh.step()
+    assert solver.t == fresh.t == aim and np.array_equal(solver.y, fresh.y)
+    assert solver.h_abs == fresh.h_abs and solver.status == "running" and solver.t_bound == 10.0
+
+
 @pytest.mark.parametrize("method", sorted(stepper.METHODS))
 def test_every_method_runs_a_pendulum_to_its_exact_motion(method):
     """mb.simulate with each integrator it accepts (the implicit ones restart at each output,
