@@ -21,6 +21,7 @@ the constraints first (crossing.py): no crawl.
 """
 
 import bisect
+import contextlib
 from typing import NamedTuple
 
 import numpy as np
@@ -140,11 +141,7 @@ class ContinuousIntegration(CutIntegration):
         start = stepper.saved(solver)
         target, across = (None, False) if self.crossing is None else \
             self.crossing.plan(solver.t, min(stepper.proposed_step(solver), solver.max_step), solver.t_bound)
-        self.f.on_manifold = self.correction if across else None
-        try:
-            self._take(solver, t_next, start, target)
-        finally:
-            self.f.on_manifold = None
+        self._take(solver, t_next, start, target, across)
         if across and solver.t == target and self.watch is None:  # crossed: the watch would have found it
             self._list_crossing(solver, start[0])
 
@@ -157,20 +154,29 @@ class ContinuousIntegration(CutIntegration):
         least direction mixes in others)."""
         t_star = self.crossing.crossed()
         y = np.empty((1, solver.y.size))
-        self.f.on_manifold = self.correction  # the interpolant's extra stages, as the step's
-        try:
+        with self._stages_on_manifold(True):  # the interpolant's extra stages, as the step's
             stepper.interpolate(solver, [t_star], y)
-        finally:
-            self.f.on_manifold = None
         q, qd = self.form.to_state(y[0])
         on = self.correction(q, qd)
-        rows = self.correction.measure(*((q, qd) if on is None else on[:2]), share=NAMED_SHARE)[1]
+        rows = self.correction.least_rows(*((q, qd) if on is None else on[:2]), NAMED_SHARE)
         names = self.data.system.constraint_names
         self.f.add_singular(t_star, tuple(names[r] for r in rows), solver.t - t_start)
 
-    def _take(self, solver, t_next, start, target):
-        """``_step``'s step from ``start`` (stepper.saved), aimed at ``target`` (or None)."""
-        message = solver.step() if target is None else stepper.step_to(solver, target)
+    @contextlib.contextmanager
+    def _stages_on_manifold(self, across):
+        """Within: where ``across`` (a step across a singular position), each stage is put on
+        the constraints by the kernel's correction before its motion is evaluated."""
+        self.f.on_manifold = self.correction if across else None
+        try:
+            yield
+        finally:
+            self.f.on_manifold = None
+
+    def _take(self, solver, t_next, start, target, across):
+        """``_step``'s step from ``start`` (stepper.saved), aimed at ``target`` (or None),
+        across a singular position where ``across``."""
+        with self._stages_on_manifold(across):
+            message = solver.step() if target is None else stepper.step_to(solver, target)
         if solver.status == "failed":
             raise self.failed_step(solver, message)
         self.steps += 1
@@ -189,14 +195,14 @@ class ContinuousIntegration(CutIntegration):
         times = self.schedule.between(t_next, solver.t)
         states = np.empty((len(times) + 1, solver.y.size))
         if times:
-            stepper.interpolate(solver, times, states[:-1])
+            with self._stages_on_manifold(across):
+                stepper.interpolate(solver, times, states[:-1])
         states[-1] = solver.y
         times.append(solver.t)
         corrected = None if self.correction is None else \
             self.correction.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
         bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
         self.passed = Passed(times, states, corrected, bounded)
-        self.f.on_manifold = None  # the step's end: on the constraints already
         q_on, qd_on = self._on_constraints(solver.t, q, qd, None if corrected is None else corrected.row(-1), arrays)
         # A before the projection: it moved q by the drift alone
         self._look(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
@@ -233,7 +239,7 @@ class ContinuousIntegration(CutIntegration):
             if self.watch is not None:
                 m = self.watch.measure
             else:
-                m = self.correction.measure(q, qd)[0]
+                m = self.correction.measure(q, qd)
             self.crossing.passed(t, m)
 
     def _drift(self, t, q, qd):

@@ -31,7 +31,7 @@ import numpy as np
 from . import kernel
 from .correction import MAX_STEPS, SHRINK, TINY, Corrected, CorrectedRows
 from ..core.equations import TERM_FLOOR, entry_term_scales
-from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR, NAME_RTOL
+from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR
 from .least_direction import LeastDirection
 
 
@@ -131,19 +131,27 @@ class ExtraCorrection:
         states' fractions of a step, are not used: each state is corrected on its own)."""
         return CorrectedRows.of([self(q, qd) for q, qd in zip(Q, QD)], self.n)
 
-    def measure(self, q, qd, share=NAME_RTOL):
-        """(m, rows): m = σ_min/σ₁ of the rows' A at (q, q̇), each row scaled to unit norm
-        (least_direction.py), and the System's rows that take part in its least direction
-        (weights above ``share`` of the largest): what a run's step plan near singular
-        positions reads (analysis/crossing.py) where its singular watch does not."""
+    def measure(self, q, qd):
+        """σ_min/σ₁ of the rows' A at (q, q̇), each row scaled to unit norm
+        (least_direction.py): what a run's step plan near singular positions reads
+        (analysis/crossing.py) where its singular watch does not."""
+        return self._least(q, qd)[0]
+
+    def least_rows(self, q, qd, share):
+        """The System's rows that take part in the least direction of the rows' A at (q, q̇):
+        those of weight above ``share`` of the largest."""
+        weights = self._least(q, qd)[1]
+        return tuple(int(r) for r in self.xrow_row[weights > share * weights.max(initial=0.0)])
+
+    def _least(self, q, qd):
+        """(σ_min/σ₁, the rows' weights in the least direction) at (q, q̇)."""
         q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
         with self.lock:
             self._evaluate(q, qd)
             values = self.gen[self.entries].copy()
         if self.least is None:
             self.least = LeastDirection(self.rows, self.columns, self.xrow_row.size)
-        m, weights = self.least(values)
-        return m, tuple(int(r) for r in self.xrow_row[weights > share * weights.max(initial=0.0)])
+        return self.least(values)
 
     def residuals_energy(self, q, qd):
         """(φ, φ̇ of the extra rows, NaN, NaN): the energies are the Data's."""
