@@ -111,7 +111,7 @@ class ContinuousIntegration(CutIntegration):
         """(times, CorrectedRows) of the output rows after ``t_now`` that the last step passed
         and corrected, up to the first one that needs more (a state not corrected or beyond
         MAX_STATE, the step's end, a control sample), taken as arrived; None where there are
-        none. For a run without control samples: ``simulate`` records them at once."""
+        none: ``simulate`` records them at once."""
         passed = self.passed
         start = None if passed is None else passed.index(self.t_now)
         if start is None or passed.corrected is None:

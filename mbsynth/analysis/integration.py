@@ -48,6 +48,7 @@ class Integration:
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
         self.corrected = None  # the kernel's correction.Corrected there, if at hand
         self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
+        self.potential_free = all(f.V == 0 for f in data.forces)  # no force element with a potential
         self.restart()
 
     @property
@@ -63,8 +64,7 @@ class Integration:
         engine = self.data.engine
         self.f.use(engine)
         self.correction = None if engine is None else engine.correction()
-        self.compiled_energy = self.correction is not None and self.correction.energies and \
-            all(f.V == 0 for f in self.data.forces)
+        self.compiled_energy = self.correction is not None and self.correction.energies and self.potential_free
 
     def advance(self, t_next, q, qd, t_stop):
         """The state (q, q̇) at t_next from (q, q̇) at ``t_now``; t_stop: the next control

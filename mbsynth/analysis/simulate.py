@@ -112,8 +112,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
                 recorder.record(t_next, q, qd, run.correction, run.compiled_energy, *at_hand)
                 if progress is not None:
                     progress(t_next)
-                if control is None:
-                    q, qd = _record_ready(run, recorder, schedule, progress, q, qd)
+                q, qd = _record_ready(run, recorder, schedule, progress, q, qd)
         status = COMPLETED
     except SolveError as err:
         status = f"failed at t = {run.t_failed:.9g}: {err}"

@@ -11,6 +11,7 @@ assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
 """
 
 import functools
+import math
 import numbers
 from dataclasses import dataclass, field, replace
 
@@ -136,6 +137,11 @@ class System:
         return np.array(list(self.parameters.values()), dtype=float)
 
     @functools.cached_property
+    def parameter_index(self):
+        """{parameter name: its place in the model's order}."""
+        return {name: i for i, name in enumerate(self.parameters)}
+
+    @functools.cached_property
     def parameter_symbols(self):
         """The parameters' sympy symbols, in the model's order."""
         return tuple(sp.Symbol(p) for p in self.parameters)
@@ -179,34 +185,35 @@ class System:
         number (a string, a complex number, an array of more elements) or not finite, or
         (``check_parts``) a part that reads a changed parameter and
         whose M or Q is then not finite or M not positive semi-definite at the initial state."""
-        unknown = sorted(set(values) - set(self.parameters))
+        index = self.parameter_index
+        unknown = sorted(name for name in values if name not in index)
         if unknown:
             raise ModelError(f"model '{self.name}' has no parameter(s) {unknown}; "
                              f"it has {sorted(self.parameters)}")
         values = {name: self._parameter_value(name, x) for name, x in values.items()}
-        bad = sorted(name for name, x in values.items() if not np.isfinite(x))
+        bad = sorted(name for name, x in values.items() if not math.isfinite(x))
         if bad:
             raise ModelError(f"model '{self.name}': non-finite values for parameter(s) {bad}")
         old = self.parameter_values if p is None else np.asarray(p, dtype=float)
         new = old.copy()
-        for i, name in enumerate(self.parameters):
-            if name in values:
-                new[i] = values[name]
+        for name, x in values.items():
+            new[index[name]] = x
         if self.definitions:  # parameters defined by expressions of earlier ones follow, in order
             subs = {}
             for i, name in enumerate(self.parameters):
                 if name in self.definitions and name not in values:
                     new[i] = float(self.definitions[name].xreplace(subs))
                 subs[sp.Symbol(name)] = sp.Float(new[i])
-        changed = {list(self.parameters)[i] for i in np.flatnonzero(old != new)}
-        fixed = sorted(set(self.fixed_parameters or ()) & changed)
-        if fixed:
-            raise ModelError(f"model '{self.name}': parameter '{fixed[0]}' was built into the model when it was loaded "
-                             f"(at {self.fixed_parameters[fixed[0]]}): load the file again with the new value, "
-                             f"mb.load(path, parameters={{'{fixed[0]}': ...}}) (the CLI's --set does)")
-        if check_parts:
-            moved = {self.parameter_symbols[i] for i in np.flatnonzero(old != new)}
-            problems = self.part_problems(moved, new) if moved else []
+        changed = np.flatnonzero(old != new)
+        if self.fixed_parameters:
+            names = tuple(self.parameters)
+            fixed = sorted(set(self.fixed_parameters) & {names[i] for i in changed})
+            if fixed:
+                raise ModelError(f"model '{self.name}': parameter '{fixed[0]}' was built into the model when it was "
+                                 f"loaded (at {self.fixed_parameters[fixed[0]]}): load the file again with the new "
+                                 f"value, mb.load(path, parameters={{'{fixed[0]}': ...}}) (the CLI's --set does)")
+        if check_parts and changed.size:
+            problems = self.part_problems({self.parameter_symbols[i] for i in changed}, new)
             if problems:
                 raise ModelError(f"model '{self.name}' with {values}: {problems[0][1]}")
         return new
@@ -216,8 +223,8 @@ class System:
         (a joint value is an array, ``-2*jv["hinge"].position`` one of shape (1,)). ModelError
         naming the parameter for a string (even "3"), a complex number, a boolean, an array
         of another size or anything else."""
-        if type(x) is float:  # the common case, at every control sample
-            return x
+        if type(x) is float or type(x) is np.float64:  # the common cases, at every control sample
+            return float(x)
         if isinstance(x, numbers.Real) and not isinstance(x, bool):  # a sympy or fractions number too
             return float(x)
         kind = np.asarray(x).dtype.kind if not isinstance(x, (str, bytes)) else "U"
@@ -246,6 +253,8 @@ class System:
         ``parameters``: only the parts written in these parameter symbols (those whose values
         changed: ``with_parameters``); every part by default. ``p``: the parameter values
         (default: the model's)."""
+        if parameters is not None and not any(part.reads(parameters) for part in self.parts):
+            return []  # a controller's torques: read by forces alone
         q, qd = self.initial_state()
         p = self.parameter_values if p is None else p
         problems, start = [], 0
