@@ -84,23 +84,13 @@ def test_a_row_the_fit_misses_is_corrected_exactly(bricard):
     np.testing.assert_allclose(fitted.q, exact.q, rtol=0, atol=1e-12)
 
 
-def test_a_dense_output_grid_leaves_the_motion_as_a_sparse_one(bricard, monkeypatch):
+def test_a_dense_output_grid_leaves_the_motion_as_a_sparse_one(bricard):
     """The steps do not depend on the output times: the rows of a run every 1 ms at the
     times of a run every 0.5 s are those rows (to the fit's 1e-12), and the rows every 1 ms
-    meet the constraints; a file written as the run goes holds every row. The integrator's
-    own drift starts as θ² at each step's start (row_fit.py): no row fails the fit, so
-    each step corrects NODES rows exactly, no more."""
+    meet the constraints; a file written as the run goes holds every row."""
     sparse = mb.simulate(bricard, 2.0, dt=0.5)
-    from mbsynth.compiled import correction
-    exact, count = correction.Correction._exact, [0]
-
-    def counted(self, Q, QD):
-        count[0] += Q.shape[0]
-        return exact(self, Q, QD)
-    monkeypatch.setattr(correction.Correction, "_exact", counted)
     dense = mb.simulate(bricard, 2.0, dt=1e-3)
     assert dense.stats["steps"] == sparse.stats["steps"]
-    assert count[0] <= row_fit.NODES * dense.stats["steps"] + 2  # the start's and the end's own corrections
     common = np.searchsorted(dense.t, sparse.t)
     np.testing.assert_allclose(dense.t[common], sparse.t, rtol=0, atol=1e-12)
     np.testing.assert_allclose(dense.q[common], sparse.q, rtol=0, atol=1e-12)
@@ -109,6 +99,22 @@ def test_a_dense_output_grid_leaves_the_motion_as_a_sparse_one(bricard, monkeypa
     assert dense.residual_position.max() <= 1e-14 * size and dense.residual_velocity.max() <= 1e-12 * size * rates
     energy = np.array([sum(bricard.energy(t, q, qd)) for t, q, qd in zip(dense.t[::97], dense.q[::97], dense.qd[::97])])
     np.testing.assert_allclose(dense.energy[::97], energy, rtol=0, atol=1e-12 * np.abs(energy).max())
+
+
+@pytest.mark.implementation
+def test_each_step_of_a_run_corrects_nodes_rows_exactly(bricard, monkeypatch):
+    """The integrator's own drift starts as θ² at each step's start, slope included
+    (row_fit.py): on a real run no row fails the fit through NODES exact corrections, so
+    each step corrects NODES rows exactly, no more (without the slope condition some fail)."""
+    from mbsynth.compiled import correction
+    exact, count = correction.Correction._exact, [0]
+
+    def counted(self, Q, QD):
+        count[0] += Q.shape[0]
+        return exact(self, Q, QD)
+    monkeypatch.setattr(correction.Correction, "_exact", counted)
+    dense = mb.simulate(bricard, 2.0, dt=1e-3)
+    assert count[0] <= row_fit.NODES * dense.stats["steps"] + 2  # the start's and the end's own corrections
 
 
 def test_a_dense_grid_reports_every_row_to_progress_and_the_file(bricard, tmp_path):
