@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from . import cache
+from . import cache, row_fit
 
 
 def warm(texts):
@@ -25,8 +25,10 @@ def warm(texts):
         q, qd = system.initial_state()
         engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
         correction = engine.correction()
-        if correction is not None:  # simulate's rows and corrections
+        if correction is not None:  # simulate's rows and corrections, one by one and fitted (row_fit.py)
             correction(q, qd)
+            count = row_fit.MIN_ROWS
+            correction.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
 
 
 def main():

@@ -171,6 +171,26 @@ def judge(Q, QD, found, LI, LF, LX, phi, psi, Rs):
 
 
 @njit(**OPTIONS)
+def fitted(fractions, a, at, Q, QD, Q_at, QD_at, found_at, Q_on, QD_on, found, LI, LF, LX, phi, psi, Rs):
+    """The states Q, Q̇ at ``fractions`` of a step, a span of it from θ = a, moved into
+    Q_on, Q̇_on by the corrections interpolated (row_fit.interpolate) through those of the
+    rows ``at`` (Q_at, Q̇_at, found_at: ``correct``'s), each then judged into ``found``
+    (``judge``; the rows ``at`` get found_at). Returns how many rows fail the judgement,
+    or −1 where a row ``at`` was not corrected (nothing written then)."""
+    for i in range(at.shape[0]):
+        if found_at[i, DONE] == 0.0:
+            return -1
+    row_fit.interpolate(fractions, a, at, Q, QD, Q_at, QD_at, Q_on, QD_on)
+    judge(Q_on, QD_on, found, LI, LF, LX, phi, psi, Rs)
+    for i in range(at.shape[0]):
+        found[at[i]] = found_at[i]
+    failed = 0
+    for r in range(found.shape[0]):
+        failed += found[r, DONE] == 0.0
+    return failed
+
+
+@njit(**OPTIONS)
 def _unit_rates(q, qd, kind, start):
     """Each body's quaternion rate u̇ less its part along u, (u·u̇/uᵀu) u: the velocity step's
     own change along u (its unit-norm row uᵀΔu̇ = −uᵀu̇ moves u̇ only there, a direction
@@ -240,28 +260,25 @@ class Correction:
     def _fitted(self, Q, QD, fractions, a, rows):
         """The states Q, Q̇ at ``fractions``, a span of a step from θ = a (below the first
         fraction: the step's start, on the constraints), corrected into ``rows`` by
-        row_fit.py: each exactly where they are fewer than row_fit.MIN_ROWS; halved where more
-        than row_fit.NODES fail the fit."""
-        if Q.shape[0] < row_fit.MIN_ROWS:
-            rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
-            return
-        at = row_fit.nodes(fractions, a)
-        exact = self._exact(Q[at], QD[at])
-        if not exact.done.all():  # a node the kernel declined: no interpolant through it
-            rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
-            return
-        row_fit.interpolate(fractions, a, at, Q, QD, exact.q, exact.qd, rows.q, rows.qd)
-        with self.lock:
-            judge(rows.q, rows.qd, rows.found, *self.rows.packed, self.rows.phi, self.rows.psi, self.rows.work[0])
-        rows.found[at] = exact.found
-        failed = np.flatnonzero(rows.found[:, DONE] == 0.0)
-        if failed.size > row_fit.NODES:
-            half = Q.shape[0] // 2
-            self._fitted(Q[:half], QD[:half], fractions[:half], a, rows.part(0, half))
-            self._fitted(Q[half:], QD[half:], fractions[half:], fractions[half], rows.part(half, Q.shape[0]))
-        elif failed.size:
-            again = self._exact(Q[failed], QD[failed])
-            rows.q[failed], rows.qd[failed], rows.found[failed] = again
+        row_fit.py (``fitted``): each exactly where they are fewer than row_fit.MIN_ROWS or
+        the kernel declines a node; halved where more than row_fit.NODES fail the fit."""
+        if Q.shape[0] >= row_fit.MIN_ROWS:
+            at = row_fit.nodes(fractions, a)
+            exact = self._exact(Q[at], QD[at])
+            with self.lock:
+                failed = fitted(fractions, a, at, Q, QD, *exact, *rows, *self.rows.packed, self.rows.phi,
+                                self.rows.psi, self.rows.work[0])
+            if 0 <= failed <= row_fit.NODES:
+                if failed:
+                    again = np.flatnonzero(rows.found[:, DONE] == 0.0)
+                    rows.q[again], rows.qd[again], rows.found[again] = self._exact(Q[again], QD[again])
+                return
+            if failed > row_fit.NODES:
+                half = Q.shape[0] // 2
+                self._fitted(Q[:half], QD[:half], fractions[:half], a, rows.part(0, half))
+                self._fitted(Q[half:], QD[half:], fractions[half:], fractions[half], rows.part(half, Q.shape[0]))
+                return
+        rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
 
     def _exact(self, Q, QD):
         """Each state (row of Q, Q̇) corrected by ``correct``, in compiled calls on up to
