@@ -25,6 +25,7 @@ import contextlib
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from . import stepper
 from ..core.errors import SolveError
@@ -201,7 +202,7 @@ class ContinuousIntegration(CutIntegration):
         times.append(solver.t)
         corrected = None if self.correction is None else \
             self.correction.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
-        bounded = np.abs(states).max(axis=1, initial=0.0) <= MAX_STATE  # per row, at once (False where NaN)
+        bounded = _bounded(states)
         self.passed = Passed(times, states, corrected, bounded)
         q_on, qd_on = self._on_constraints(solver.t, q, qd, None if corrected is None else corrected.row(-1), arrays)
         # A before the projection: it moved q by the drift alone
@@ -259,3 +260,16 @@ class ContinuousIntegration(CutIntegration):
         if corrected is not None:
             return corrected[:2]
         return project(self.data, t, q, qd, arrays=arrays) if self.has_rows else (q, qd)
+
+
+@njit(cache=True)
+def _bounded(states):
+    """Per row of ``states``, whether each entry is within MAX_STATE (False where one is NaN)."""
+    within = np.empty(states.shape[0], dtype=np.bool_)
+    for r in range(states.shape[0]):
+        within[r] = True
+        for c in range(states.shape[1]):
+            if not abs(states[r, c]) <= MAX_STATE:
+                within[r] = False
+                break
+    return within

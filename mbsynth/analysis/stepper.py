@@ -6,17 +6,18 @@ drifted too far. An explicit Runge–Kutta pair (RESUMABLE) carries nothing from
 the next but its state (t, y), y's derivative f and its next step's size h_abs, so it goes
 on from a moved state exactly as a new one started there with that first step would (the
 test of this module checks it bit for bit against scipy's own constructor). This is the
-only module that writes an OdeSolver's attributes or reads its interpolant's coefficients;
-``simulate`` calls these functions and ``step()``.
+only module that writes an OdeSolver's attributes or reads its internals (DOP853's extra
+stages and interpolant, ``interpolate``); ``simulate`` calls these functions and ``step()``.
 """
 
 import numpy as np
 import scipy.integrate
+from numba import njit
 
-try:  # DOP853's interpolant and its coefficients F (``interpolate``): scipy's, not public
-    from scipy.integrate._ivp.rk import Dop853DenseOutput
-except ImportError:  # a scipy that moved it: every interpolant through scipy's own call
-    Dop853DenseOutput = None
+# what ``interpolate`` reads of DOP853 (scipy's, not public): its extra stages' tableau (A_EXTRA,
+# C_EXTRA), its interpolant's matrix D and, per step, K_extended; where a scipy lacks them,
+# every interpolant goes through scipy's own call
+DOP853_INTERNALS = all(hasattr(scipy.integrate.DOP853, name) for name in ("A_EXTRA", "C_EXTRA", "D", "n_stages"))
 
 METHODS = {kind.__name__: kind for kind in (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853,
                                             scipy.integrate.Radau, scipy.integrate.BDF, scipy.integrate.LSODA)}
@@ -83,16 +84,55 @@ def cap(solver, max_step):
 
 def interpolate(solver, times, out):
     """The states (a row per time) at ``times`` within the solver's last step, from its
-    interpolant, into ``out``. DOP853's, y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…))))
-    with x the step's fraction (scipy's Dop853DenseOutput, which makes seven passes over the
-    rows), is one product here: y_old + P F with P[j, k] = x_j (1 − x_j) x_j … (k + 1
-    factors, alternating: a running product). Other interpolants through scipy."""
-    dense = solver.dense_output()
-    if Dop853DenseOutput is None or not isinstance(dense, Dop853DenseOutput):
-        out[:] = dense(times).T
+    interpolant, into ``out``. DOP853's as scipy's ``dense_output`` makes it — three extra
+    stages, then y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…)))) with x the step's
+    fraction — with the arithmetic compiled (scipy's costs more than the stages' motion
+    on a small model). Other interpolants through scipy."""
+    if not (DOP853_INTERNALS and isinstance(solver, scipy.integrate.DOP853) and solver.t != solver.t_old):
+        out[:] = solver.dense_output()(times).T
         return
-    x = (np.asarray(times, dtype=float) - dense.t_old) / dense.h
-    factors = np.empty((x.size, len(dense.F)))
-    factors[:, 0::2], factors[:, 1::2] = x[:, None], 1 - x[:, None]
-    np.matmul(np.cumprod(factors, axis=1), dense.F, out=out)
-    out += dense.y_old
+    K, h, t_old, y_old = solver.K_extended, solver.h_previous, solver.t_old, solver.y_old
+    for s, (a, c) in enumerate(zip(solver.A_EXTRA, solver.C_EXTRA), start=solver.n_stages + 1):
+        K[s] = solver.fun(t_old + c * h, _stage_state(K, a, s, h, y_old))
+    F = np.empty((solver.D.shape[0] + 3, y_old.size))
+    _coefficients(K, solver.D, h, solver.y, y_old, solver.f, F)
+    _rows(np.asarray(times, dtype=float), t_old, h, F, y_old, out)
+
+
+@njit(cache=True)
+def _stage_state(K, a, s, h, y_old):
+    """y_old + h Σ_{i<s} a_i K_i: the state of an extra stage."""
+    y = np.empty(y_old.shape[0])
+    for c in range(y.shape[0]):
+        acc = 0.0
+        for i in range(s):
+            acc += K[i, c] * a[i]
+        y[c] = y_old[c] + acc * h
+    return y
+
+
+@njit(cache=True)
+def _coefficients(K, D, h, y, y_old, f, F):
+    """DOP853's interpolant coefficients F: Δy, h f_old − Δy, 2Δy − h (f + f_old), then h D K."""
+    for c in range(y.shape[0]):
+        dy = y[c] - y_old[c]
+        F[0, c], F[1, c], F[2, c] = dy, h * K[0, c] - dy, 2 * dy - h * (f[c] + K[0, c])
+        for r in range(D.shape[0]):
+            acc = 0.0
+            for s in range(K.shape[0]):
+                acc += D[r, s] * K[s, c]
+            F[3 + r, c] = h * acc
+
+
+@njit(cache=True)
+def _rows(times, t_old, h, F, y_old, out):
+    """The interpolant's rows: out[j] = y_old + Σ_k P[j, k] F[k], P[j, k] = x (1 − x) x … (k + 1
+    factors, alternating) at x = (t_j − t_old)/h."""
+    for j in range(times.shape[0]):
+        x = (times[j] - t_old) / h
+        out[j] = y_old
+        p = 1.0
+        for k in range(F.shape[0]):
+            p *= x if k % 2 == 0 else 1.0 - x
+            for c in range(y_old.shape[0]):
+                out[j, c] += p * F[k, c]

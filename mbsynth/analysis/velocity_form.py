@@ -75,12 +75,11 @@ class VelocityForm:
         return state[:self.n], state[self.n:]
 
     def states(self, rows):
-        """(q, q̇) of y per row of ``rows`` (states stacked, B × size): two B × n arrays."""
-        if not self.starts.size:
-            return rows[:, :self.n], rows[:, self.n:]
-        stacked = np.empty((rows.shape[0], 2 * self.n))
-        _states_into(rows, self.starts, stacked)
-        return stacked[:, :self.n], stacked[:, self.n:]
+        """(q, q̇) of y per row of ``rows`` (states stacked, B × size): two B × n arrays,
+        C-contiguous."""
+        q, qd = np.empty((rows.shape[0], self.n)), np.empty((rows.shape[0], self.n))
+        _states_into(rows, self.starts, q, qd)
+        return q, qd
 
     def represents(self, y, q, qd):
         """Whether y converts to exactly (q, q̇)."""
@@ -134,27 +133,34 @@ def _rates_into(y, state_rates, starts):
 
 @njit(cache=True)
 def _state_into(y, starts, out):
-    """(q, q̇) of y into ``out`` (2n): u̇ = E(u)ᵀ h per body, the other entries copied."""
+    """(q, q̇) of y into ``out`` (2n)."""
     n = out.size // 2
-    out[:n] = y[:n]
+    _split_into(y, starts, out[:n], out[n:])
+
+
+@njit(cache=True)
+def _split_into(y, starts, q, qd):
+    """q and q̇ of y into ``q``, ``qd``: u̇ = E(u)ᵀ h per body, the other entries copied."""
+    n = q.size
+    q[:] = y[:n]
     i, j = n, 0  # where y's v is read and q̇ written
     for s in starts:
         while j < s:
-            out[n + j] = y[i]
+            qd[j] = y[i]
             i, j = i + 1, j + 1
         w, x, yy, z = y[s], y[s + 1], y[s + 2], y[s + 3]
         a, b, c = y[i], y[i + 1], y[i + 2]
-        out[n + s] = -x * a - yy * b - z * c
-        out[n + s + 1] = w * a - z * b + yy * c
-        out[n + s + 2] = z * a + w * b - x * c
-        out[n + s + 3] = -yy * a + x * b + w * c
+        qd[s] = -x * a - yy * b - z * c
+        qd[s + 1] = w * a - z * b + yy * c
+        qd[s + 2] = z * a + w * b - x * c
+        qd[s + 3] = -yy * a + x * b + w * c
         i, j = i + 3, s + 4
     while j < n:
-        out[n + j] = y[i]
+        qd[j] = y[i]
         i, j = i + 1, j + 1
 
 
 @njit(cache=True)
-def _states_into(rows, starts, out):
+def _states_into(rows, starts, q, qd):
     for r in range(rows.shape[0]):
-        _state_into(rows[r], starts, out[r])
+        _split_into(rows[r], starts, q[r], qd[r])

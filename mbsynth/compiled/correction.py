@@ -286,6 +286,10 @@ class Correction:
         count = Q.shape[0]
         Q_on, QD_on, found = np.empty(Q.shape), np.empty(QD.shape), np.empty((count, DONE + 1))
         parts = max(1, min(threads.THREADS, count * Q.shape[1] // PER_THREAD))  # read here: a benchmark may lower it
+        if parts == 1:
+            with self.lock:
+                correct(Q, QD, Q_on, QD_on, found, *self.arguments[0])
+            return CorrectedRows(Q_on, QD_on, found)
         bounds = [count * k // parts for k in range(parts + 1)]
 
         def part(k):
