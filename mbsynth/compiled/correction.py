@@ -156,12 +156,17 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             found[b, DONE] = 1.0
 
 
-@njit(nogil=True, **OPTIONS)
-def judge(Q, QD, found, LI, LF, LX, phi, psi, Rs):
-    """found's row for each state (row of Q, Q̇) as ``correct`` leaves it, without moving
-    the state: DONE = 1 where |φ| is within CORRECTION_RTOL of the coordinates' size and
-    |φ̇| within CORRECTION_RATE_RTOL of that times the largest rate (row_fit.py's rows)."""
+@njit(**OPTIONS)
+def judge(Q, QD, found, skip, LI, LF, LX, phi, psi, Rs):
+    """found's row for each state (row of Q, Q̇) but those at ``skip`` (increasing indices),
+    as ``correct`` leaves it, without moving the state: DONE = 1 where |φ| is within
+    CORRECTION_RTOL of the coordinates' size and |φ̇| within CORRECTION_RATE_RTOL of that
+    times the largest rate (row_fit.py's rows)."""
+    skipped = 0
     for b in range(Q.shape[0]):
+        if skipped < skip.shape[0] and skip[skipped] == b:
+            skipped += 1
+            continue
         kinetic, potential, phi_max, psi_max, q_max, qd_max = residuals_energy(Q[b], QD[b], LI, LF, LX, phi, psi, Rs)
         size = max(q_max, 1.0)
         found[b, KINETIC], found[b, POTENTIAL], found[b, PHI_MAX], found[b, PSI_MAX] = \
@@ -181,9 +186,9 @@ def fitted(fractions, a, at, Q, QD, Q_at, QD_at, found_at, Q_on, QD_on, found, L
         if found_at[i, DONE] == 0.0:
             return -1
     row_fit.interpolate(fractions, a, at, Q, QD, Q_at, QD_at, Q_on, QD_on)
-    judge(Q_on, QD_on, found, LI, LF, LX, phi, psi, Rs)
     for i in range(at.shape[0]):
         found[at[i]] = found_at[i]
+    judge(Q_on, QD_on, found, at, LI, LF, LX, phi, psi, Rs)
     failed = 0
     for r in range(found.shape[0]):
         failed += found[r, DONE] == 0.0
