@@ -73,7 +73,7 @@ def interpolate(fractions, a, at, Q, QD, Q_at, QD_at, Q_on, QD_on):
     if anchored:
         for j in range(count):  # T_j'(−1) = (−1)^(j+1) j²: θ = a maps to x = −1
             conditions[points, j] = (j * j) if j % 2 == 1 else -(j * j)
-    coefficients = np.linalg.solve(conditions, deltas)
+    coefficients = _solved(conditions, deltas)
     moved = np.dot(_chebyshev(fractions, a, b, count), coefficients)
     for r in range(k):
         for c in range(n):
@@ -96,3 +96,35 @@ def _chebyshev(fractions, a, b, count):
         for j in range(2, count):
             T[r, j] = 2.0 * x * T[r, j - 1] - T[r, j - 2]
     return T
+
+
+@njit(**OPTIONS)
+def _solved(A, B):
+    """A⁻¹ B by Gaussian elimination with partial pivoting (LAPACK's gesv, without its
+    copies and checks, which cost several times the solve for these NODES + 2 conditions);
+    A and B are overwritten, B holding the answer."""
+    n = A.shape[0]
+    for k in range(n):
+        p = k
+        for r in range(k + 1, n):
+            if abs(A[r, k]) > abs(A[p, k]):
+                p = r
+        if p != k:
+            for c in range(n):
+                A[k, c], A[p, c] = A[p, c], A[k, c]
+            for c in range(B.shape[1]):
+                B[k, c], B[p, c] = B[p, c], B[k, c]
+        for r in range(k + 1, n):
+            f = A[r, k] / A[k, k]
+            if f != 0.0:
+                for c in range(k + 1, n):
+                    A[r, c] -= f * A[k, c]
+                for c in range(B.shape[1]):
+                    B[r, c] -= f * B[k, c]
+    for k in range(n - 1, -1, -1):
+        for c in range(B.shape[1]):
+            acc = B[k, c]
+            for j in range(k + 1, n):
+                acc -= A[k, j] * B[j, c]
+            B[k, c] = acc / A[k, k]
+    return B
