@@ -267,23 +267,23 @@ class Correction:
         fraction: the step's start, on the constraints), corrected into ``rows`` by
         row_fit.py (``fitted``): each exactly where they are fewer than row_fit.MIN_ROWS or
         the kernel declines a node; halved where more than row_fit.NODES fail the fit."""
-        if Q.shape[0] >= row_fit.MIN_ROWS:
-            at = row_fit.nodes(fractions, a)
-            exact = self._exact(Q[at], QD[at])
-            with self.lock:
-                failed = fitted(fractions, a, at, Q, QD, *exact, *rows, *self.rows.packed, self.rows.phi,
-                                self.rows.psi, self.rows.work[0])
-            if 0 <= failed <= row_fit.NODES:
-                if failed:
-                    again = np.flatnonzero(rows.found[:, DONE] == 0.0)
-                    rows.q[again], rows.qd[again], rows.found[again] = self._exact(Q[again], QD[again])
-                return
-            if failed > row_fit.NODES:
-                half = Q.shape[0] // 2
-                self._fitted(Q[:half], QD[:half], fractions[:half], a, rows.part(0, half))
-                self._fitted(Q[half:], QD[half:], fractions[half:], fractions[half], rows.part(half, Q.shape[0]))
-                return
-        rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
+        if Q.shape[0] < row_fit.MIN_ROWS:
+            rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
+            return
+        at = row_fit.nodes(fractions, a)
+        exact = self._exact(Q[at], QD[at])
+        with self.lock:
+            failed = fitted(fractions, a, at, Q, QD, *exact, *rows, *self.rows.packed, self.rows.phi, self.rows.psi,
+                            self.rows.work[0])
+        if failed < 0:  # a node the kernel declined: no interpolant through it
+            rows.q[:], rows.qd[:], rows.found[:] = self._exact(Q, QD)
+        elif failed > row_fit.NODES:
+            half = Q.shape[0] // 2
+            self._fitted(Q[:half], QD[:half], fractions[:half], a, rows.part(0, half))
+            self._fitted(Q[half:], QD[half:], fractions[half:], fractions[half], rows.part(half, Q.shape[0]))
+        elif failed:
+            again = np.flatnonzero(rows.found[:, DONE] == 0.0)
+            rows.q[again], rows.qd[again], rows.found[again] = self._exact(Q[again], QD[again])
 
     def _exact(self, Q, QD):
         """Each state (row of Q, Q̇) corrected by ``correct``, in compiled calls on up to
