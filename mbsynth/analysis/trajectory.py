@@ -252,4 +252,3 @@ class TrajectoryWriter:
             self._last_checkpoint = time.monotonic()
             self._period = self.checkpoint_seconds and max(self.checkpoint_seconds,
                                                            10 * (self._last_checkpoint - started))
-

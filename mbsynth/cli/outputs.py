@@ -6,7 +6,8 @@ command module lists its own in ``OUTPUTS``; ``main`` applies the rule):
   else ModelError naming the flag, the path and why (exit 2);
 - when Ctrl-C stops the command, the message says of each what was left: the output so
   far (a file written as the command goes), the file written, or nothing (the file as it
-  was, or none). Every output is written atomically, so none is ever left half written.
+  was, or none). An output made whole at the end is written atomically (never left half
+  written); one that grows as the command goes keeps what it had (analysis.trajectory).
 """
 
 from functools import partial
