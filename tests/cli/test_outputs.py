@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from processes import HANG, needs_proc
+from processes import HANG
 
 import mbsynth as mb
 from mbsynth.cli import main
@@ -134,27 +134,26 @@ OUTPUT_FLAGS = [
 
 
 @pytest.mark.parametrize("line,flag", OUTPUT_FLAGS, ids=[f"{line.split()[0]} {flag}" for line, flag in OUTPUT_FLAGS])
-@pytest.mark.parametrize("bad", ["a folder", "/proc", "a file as the folder"])
+@pytest.mark.parametrize("bad", ["the other kind", "/proc", "under a file"])
 def test_an_output_that_cannot_be_written_is_refused_before_the_run(tmp_path, line, flag, bad):
-    """The user's --plot, --html or --out naming a folder, a place in /proc or a path under
-    a file: exit 2 at once, naming the flag, the path and why; nothing is written."""
+    """The user's --plot, --html or --out naming a folder (--trajectories a file), a place
+    in /proc or a path under a file: exit 2 at once, naming the flag, the path and why;
+    nothing is written."""
     if bad == "/proc" and not Path("/proc/self").exists():
         pytest.skip("no /proc here")
     (tmp_path / "a_file").write_text("")
-    base = {"a folder": tmp_path / "out", "/proc": Path("/proc/out"), "a file as the folder": tmp_path / "a_file/out"}[bad]
+    base = {"the other kind": tmp_path / "out", "/proc": Path("/proc/out"),
+            "under a file": tmp_path / "a_file" / "out"}[bad]
     words = line.format(model=EXAMPLE3, auto=AUTO, d=tmp_path, bad=base).split()
-    path = words[words.index(flag) + 1]
-    folder_flag = flag == "--trajectories"
-    if bad == "a folder":
-        if folder_flag:
-            path = str(tmp_path / "out.npz")
-            words[words.index(flag) + 1] = path
-            Path(path).write_text("")  # a file where the folder of trajectories goes
-        else:
-            Path(path).mkdir()
-    why = {"a folder": f"{path} is a file, not a folder" if folder_flag else f"{path} is a folder",
+    path = Path(words[words.index(flag) + 1])
+    takes_a_folder = flag == "--trajectories"
+    if bad == "the other kind" and takes_a_folder:
+        path.write_text("")
+    elif bad == "the other kind":
+        path.mkdir()
+    why = {"the other kind": f"{path} is a file, not a folder" if takes_a_folder else f"{path} is a folder",
            "/proc": "no file can be created in /proc (No such file or directory)",
-           "a file as the folder": f"{tmp_path}/a_file is not a folder"}[bad]
+           "under a file": f"{tmp_path}/a_file is not a folder"}[bad]
     before = sorted(tmp_path.iterdir())
     code, out, err = mbsynth(*words)
     assert code == 2 and err == f"error: {flag} {path}: cannot be written there: {why}\n", (code, err)
@@ -166,7 +165,8 @@ def test_an_output_folder_given_as_a_csv_leaves_no_partial_file(tmp_path):
     (by the command, or by mb.simulate given that path)."""
     (tmp_path / "d.csv").mkdir()
     code, _, err = mbsynth("simulate", EXAMPLE3, "--t-end", "0.1", "--out", tmp_path / "d.csv")
-    assert code == 2 and err == f"error: --out {tmp_path}/d.csv: cannot be written there: {tmp_path}/d.csv is a folder\n"
+    folder = tmp_path / "d.csv"
+    assert code == 2 and err == f"error: --out {folder}: cannot be written there: {folder} is a folder\n"
     with pytest.raises(mb.ModelError, match="d.csv is a folder"):
         mb.simulate(mb.load(EXAMPLE3), 0.1, out=tmp_path / "d.csv")
     assert [p.name for p in tmp_path.iterdir()] == ["d.csv"]
@@ -175,7 +175,8 @@ def test_an_output_folder_given_as_a_csv_leaves_no_partial_file(tmp_path):
 def test_an_output_suffix_is_read_in_any_case(tmp_path):
     """run.NPZ is an .npz file, p.PNG a PNG figure, run.CSV a CSV table, V.HTML a page;
     run.txt is none of them, refused with the suffixes the flag takes."""
-    code, out, err = mbsynth("simulate", EXAMPLE3, "--t-end", "0.1", "--out", "run.NPZ", "--plot", "p.PNG", cwd=tmp_path)
+    code, out, err = mbsynth("simulate", EXAMPLE3, "--t-end", "0.1", "--out", "run.NPZ", "--plot", "p.PNG",
+                             cwd=tmp_path)
     assert code == 0 and "wrote run.NPZ" in out and "wrote p.PNG" in out, err
     saved = mb.load_trajectory(tmp_path / "run.NPZ")
     assert saved.t[-1] == pytest.approx(0.1) and saved.status == "completed"
