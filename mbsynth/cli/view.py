@@ -6,8 +6,8 @@ from ..view import viewer
 from ..core.errors import ModelError, SimulationError
 from ..analysis.simulate import simulate
 from ..analysis.trajectory import load_trajectory
-from .outputs import Output
 from ..io import load
+from .outputs import Output
 from .parsers import check_flags, model_of
 
 OUTPUTS = (Output("--html", (".html",)),)
