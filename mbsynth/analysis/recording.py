@@ -21,6 +21,7 @@ class Recorder:
 
     def __init__(self, data, rows, out=None):
         self.data, self.out = data, out
+        self.run = run_of(data)
         self.outputs = OutputEvaluator(data)
         n, m = len(data.coordinates), len(self.outputs.names)
         _check_fits(rows, row_bytes(n, m), out)
@@ -33,7 +34,8 @@ class Recorder:
     def open(self):
         """Start the file, if one was asked for (a path that cannot be written fails here)."""
         if self.out is not None:
-            self.writer = TrajectoryWriter(self.out, self.data.coordinates, self.outputs.names, rows=self.trajectory)
+            self.writer = TrajectoryWriter(self.out, self.data.coordinates, self.outputs.names, rows=self.trajectory,
+                                           run=self.run)
 
     @property
     def t(self):
@@ -96,7 +98,17 @@ class Recorder:
         c = {name: column[rows] for name, column in self.columns.items()}
         return Trajectory(tuple(self.data.coordinates), c["t"], c["q"], c["qd"], c["energy"], c["kinetic"],
                           c["residual_position"], c["residual_velocity"], status, outputs=c["outputs"],
-                          output_names=tuple(self.outputs.names))
+                          output_names=tuple(self.outputs.names), **self.run)
+
+
+def run_of(data):
+    """The model a run on ``data`` runs (Trajectory's ``model``, ``model_file``,
+    ``parameters``): its name, its file, and the values of its parameters not defined by
+    others as the run starts (those defined by them follow from these)."""
+    system = data.system
+    defined = system.definitions or {}
+    return {"model": system.name, "model_file": system.source_file,
+            "parameters": {name: value for name, value in data.parameters.items() if name not in defined}}
 
 
 def row_bytes(n, m):

@@ -5,9 +5,13 @@ position and velocity constraint residuals, the total energy, and the model's de
 ``outputs`` (one column per name in ``output_names``: mbsynth.model.outputs). Files:
 
 - ``.npz``: arrays ``t``, ``q``, ``qd``, ``coordinates`` (plus ``energy``,
-  ``residual_position``, ``residual_velocity``, ``status``, ``outputs``, ``output_names``);
+  ``residual_position``, ``residual_velocity``, ``status``, ``outputs``, ``output_names``,
+  and the run's model: ``model`` (its name), ``model_file``, ``parameter_names``,
+  ``parameter_values``: the values of its parameters not defined by others, at the start);
 - ``.csv``: a header ``t, <coordinate>..., <coordinate>_dot..., energy, <output>...`` and
   one row per time.
+
+A file's format is its suffix in any case (``run.NPZ`` is an .npz file: core.files.file_format).
 
 ``TrajectoryWriter`` writes while a run goes on, so an interrupted or failed run keeps
 everything computed so far, and never leaves half a file under the final name: CSV
@@ -15,7 +19,8 @@ rows are appended to ``FILE.partial``, cut back to its last complete row when th
 ends and renamed to FILE only when the run completed (a CSV has no place for the
 status: an interrupted, failed or killed run leaves its rows in FILE.partial, and no
 FILE of an earlier run); NPZ is checkpointed to a temporary file that replaces FILE
-atomically (and is removed if writing it fails), with the run's status inside.
+atomically (and is removed if writing it fails), with the run's status inside. A path
+that cannot be written (core.files.unwritable) is refused before anything is made.
 """
 
 import csv
@@ -27,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.errors import ModelError
-from ..core.files import write_atomically
+from ..core.files import file_format, unwritable, write_atomically
 
 FORMATS = (".npz", ".csv")
 COMPLETED = "completed"
@@ -47,6 +52,9 @@ class Trajectory:
     stats: dict = field(default_factory=dict)
     outputs: np.ndarray = None  # T × len(output_names): the model's declared outputs
     output_names: tuple = ()
+    model: str = ""  # the name of the model run
+    model_file: str = ""  # its file ("" where it was not read from one)
+    parameters: dict = field(default_factory=dict)  # its parameters not defined by others, at the start
 
     def __post_init__(self):
         if self.outputs is None:
@@ -83,7 +91,7 @@ class Trajectory:
     def save(self, path):
         """Write the whole trajectory to ``path`` (.npz or .csv), atomically; the CSV of a
         run that did not complete goes to ``path``.partial (see the module docstring)."""
-        with TrajectoryWriter(path, self.coordinates, self.output_names) as writer:
+        with TrajectoryWriter(path, self.coordinates, self.output_names, run=run_of(self)) as writer:
             writer.append(self)
             writer.status = self.status
 
@@ -98,24 +106,28 @@ def output_file(path, completed):
     """The file that holds a run's output written to ``path``: ``path`` itself, or for a
     CSV run that did not complete, ``partial_file(path)``."""
     path = Path(path)
-    return path if completed or path.suffix != ".csv" else partial_file(path)
+    return path if completed or file_format(path) != ".csv" else partial_file(path)
 
 
 def load_trajectory(path):
     """Read a trajectory written by ``Trajectory.save`` or a run (.npz, .csv or the
     .csv.partial of a run that did not complete)."""
     path = Path(path)
-    if path.suffix == ".npz":
+    if file_format(path) == ".npz":
         with np.load(path, allow_pickle=False) as data:
             coordinates = tuple(str(c) for c in data["coordinates"])
             get = {k: data[k] for k in data.files}
         n_rows = get["t"].size
         nan = np.full(n_rows, np.nan)
         names = tuple(str(x) for x in get.get("output_names", ()))
+        parameters = dict(zip((str(x) for x in get.get("parameter_names", ())),
+                              (float(x) for x in get.get("parameter_values", ()))))
         return Trajectory(coordinates, get["t"], get["q"], get["qd"], get.get("energy", nan),
                           get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
-                          str(get.get("status", COMPLETED)), outputs=get.get("outputs"), output_names=names)
-    if path.suffix == ".csv" or path.name.endswith(".csv.partial"):
+                          str(get.get("status", COMPLETED)), outputs=get.get("outputs"), output_names=names,
+                          model=str(get.get("model", "")), model_file=str(get.get("model_file", "")),
+                          parameters=parameters)
+    if file_format(path) == ".csv" or path.name.lower().endswith(".csv.partial"):
         with path.open(newline="") as f:
             header = next(csv.reader(f))
         if "energy" not in header[1:]:
@@ -131,29 +143,44 @@ def load_trajectory(path):
     raise ModelError(f"{path}: unknown trajectory format (use {' or '.join(FORMATS)})")
 
 
+def run_of(traj):
+    """The model of the run ``traj`` records, as ``TrajectoryWriter`` takes it (``run=``)."""
+    return {"model": traj.model, "model_file": traj.model_file, "parameters": traj.parameters}
+
+
 class TrajectoryWriter:
     """Writes trajectory rows as they come (see the module docstring)."""
 
-    def __init__(self, path, coordinates, output_names=(), checkpoint_seconds=2.0, rows=None):
+    def __init__(self, path, coordinates, output_names=(), checkpoint_seconds=2.0, rows=None, run=None):
         """``rows``: where the NPZ checkpoints read every row so far (a callable(status) ->
-        Trajectory, a run's recorder) instead of keeping the appended rows themselves."""
+        Trajectory, a run's recorder) instead of keeping the appended rows themselves.
+        ``run``: the model run ({"model", "model_file", "parameters"}: ``run_of``), kept in an NPZ.
+        ModelError for a path of another format or where no file can be written."""
         self.path = Path(path)
-        if self.path.suffix not in FORMATS:
+        self.format = file_format(self.path)
+        if self.format not in FORMATS:
             raise ModelError(f"{self.path}: output must end in {' or '.join(FORMATS)}")
-        if not self.path.parent.is_dir():
-            raise ModelError(f"{self.path}: the folder {self.path.parent} does not exist")
+        why = unwritable(self.path)
+        if why:
+            raise ModelError(f"{self.path}: cannot be written there: {why}")
         self.coordinates, self.output_names = tuple(coordinates), tuple(output_names)
+        self.run = {"model": "", "model_file": "", "parameters": {}, **(run or {})}
         self.checkpoint_seconds = checkpoint_seconds
         self.status = "running"
         self._rows = rows
         self._chunks = []
         self._last_checkpoint, self._period = time.monotonic(), checkpoint_seconds
-        if self.path.suffix == ".csv":
+        if self.format == ".csv":
             self._partial = partial_file(self.path)
             try:
                 self._csv_file = self._partial.open("w", newline="")
+            except OSError as err:
+                raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
+            try:
                 self.path.unlink(missing_ok=True)  # an earlier run's file: not this run's output
             except OSError as err:
+                self._csv_file.close()
+                self._partial.unlink()  # no output of this run: none left behind
                 raise OSError(err.errno, f"cannot write {self.path}: {err.strerror or err}") from err
             self._csv = csv.writer(self._csv_file)
             self._csv.writerow(["t", *self.coordinates, *(c + "_dot" for c in self.coordinates), "energy",
@@ -171,7 +198,7 @@ class TrajectoryWriter:
 
     def append(self, traj):
         """Add the rows of a Trajectory (or a chunk of one)."""
-        if self.path.suffix == ".csv":
+        if self.format == ".csv":
             for row in zip(traj.t, traj.q, traj.qd, traj.energy, traj.outputs):
                 self._csv.writerow([repr(float(row[0])), *map(repr, map(float, row[1])),
                                     *map(repr, map(float, row[2])), repr(float(row[3])), *map(repr, map(float, row[4]))])
@@ -186,7 +213,7 @@ class TrajectoryWriter:
     def close(self):
         """Finish the file: under its final name if the run completed (NPZ: whatever the
         state of the run, which it records)."""
-        if self.path.suffix == ".csv":
+        if self.format == ".csv":
             self._csv_file.close()
             os.truncate(self._partial, self._complete)  # drop a row cut short by a failed write
             if self.status == COMPLETED:
@@ -213,7 +240,10 @@ class TrajectoryWriter:
                        energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
                        residual_velocity=stack("residual_velocity"), status=np.array(self.status),
                        outputs=stack("outputs", len(self.output_names)),
-                       output_names=np.array(self.output_names, dtype=str))
+                       output_names=np.array(self.output_names, dtype=str), model=np.array(self.run["model"]),
+                       model_file=np.array(self.run["model_file"]),
+                       parameter_names=np.array(list(self.run["parameters"]), dtype=str),
+                       parameter_values=np.array(list(self.run["parameters"].values()), dtype=float))
         try:
             write_atomically(self.path, lambda temporary: np.savez(temporary, **columns))
         except OSError as err:

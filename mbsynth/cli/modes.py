@@ -6,11 +6,14 @@ import tempfile
 from pathlib import Path
 
 from ..analysis.modes import format_modes, mode_motion, modes, to_dict
-from .parsers import check_flags, model_of
+from ..core.files import write_atomically
+from .outputs import Output
+from .parsers import model_of
+
+OUTPUTS = (Output("--html", (".html",)),)
 
 
 def run(args):
-    check_flags(args, outputs=(("--html", (".html",)),))
     system = model_of(args)
     result = modes(system, equilibrium=args.equilibrium, steady=args.steady)
     if args.html:
@@ -26,7 +29,7 @@ def run(args):
 
 def write_html(system, result, path):
     """One HTML page: each mode's animation (viewer.to_html, self-contained) in a frame,
-    chosen with a selector."""
+    chosen with a selector; written whole or not at all."""
     from ..view.viewer import to_html  # meshcat: only for --html
     pages = []
     with tempfile.TemporaryDirectory() as folder:
@@ -37,9 +40,10 @@ def write_html(system, result, path):
     options = "".join(f'<option value="{i}">{html.escape(label)}</option>' for i, (label, _) in enumerate(pages))
     frames = "".join(f'<iframe id="m{i}" srcdoc="{html.escape(text)}" style="display:{"block" if i == 0 else "none"}">'
                      "</iframe>" for i, (_, text) in enumerate(pages))
-    Path(path).write_text(
+    document = (
         "<!DOCTYPE html><html><head><meta charset='utf-8'><title>modes of "
         f"{html.escape(result.system_name)}</title><style>iframe{{width:100%;height:90vh;border:0}}</style></head>"
         f"<body><label>mode <select id='mode' onchange=\"for (const f of document.querySelectorAll('iframe')) "
         "f.style.display = f.id === 'm' + this.value ? 'block' : 'none'\">"
-        f"{options}</select></label>{frames}</body></html>", encoding="utf-8")
+        f"{options}</select></label>{frames}</body></html>")
+    write_atomically(path, lambda temporary: temporary.write_text(document, encoding="utf-8"))

@@ -5,7 +5,6 @@ import argparse
 import importlib
 import math
 from collections.abc import Sequence
-from pathlib import Path
 
 from ..core.errors import ModelError
 
@@ -231,22 +230,13 @@ def _robots(commands):
     return robots
 
 
-def check_flags(args, positive=(), outputs=()):
+def check_flags(args, positive=()):
     """ModelError for a flag given a value the command cannot use: each of ``positive``
-    must be a positive finite number; each of ``outputs`` (flag, suffixes) must be a
-    path in an existing folder, ending in one of the suffixes."""
+    must be a positive finite number (output flags: outputs.py)."""
     for flag in positive:
         value = getattr(args, flag.lstrip("-").replace("-", "_"))
         if value is not None and not (math.isfinite(value) and value > 0):
             raise ModelError(f"{flag} must be a positive number, got {value}")
-    for flag, suffixes in outputs:
-        value = getattr(args, flag.lstrip("-").replace("-", "_"))
-        if value is None:
-            continue
-        if Path(value).suffix.lower() not in suffixes:
-            raise ModelError(f"{flag} {value}: the file must end in {', '.join(suffixes)}")
-        if not Path(value).parent.is_dir():
-            raise ModelError(f"{flag} {value}: the folder {Path(value).parent} does not exist")
 
 
 class UsageError(Exception):

@@ -7,11 +7,12 @@ import time
 import traceback
 
 
-def fail(args, error, code):
-    """Report ``error`` in one line (stderr, or JSON on stdout with --json); return ``code``."""
-    if args.debug and isinstance(error, BaseException):
-        traceback.print_exc()
-    message = " ".join(str(error).split("\n"))
+def fail(args, error, code, message=None):
+    """Report the exception ``error`` in one line, ``message`` (default: the error's own),
+    on stderr (JSON on stdout with --json), after its traceback with --debug; return ``code``."""
+    if args.debug:
+        traceback.print_exception(error)
+    message = " ".join(str(error if message is None else message).split("\n"))
     if getattr(args, "json", False):
         print(json.dumps({"error": message}))
     else:

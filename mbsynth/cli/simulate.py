@@ -7,16 +7,17 @@ import time
 from ..core.errors import ModelError, SimulationError
 from ..analysis.simulate import simulate
 from ..analysis.trajectory import output_file
+from .outputs import Output, trajectory_output
 from .parsers import check_flags, model_of
 from .report import ProgressBar, on_terminal
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # scipy solve_ivp's methods
 PLOT_FORMATS = (".png", ".pdf", ".svg")
+OUTPUTS = (trajectory_output("--out"), Output("--plot", PLOT_FORMATS))
 
 
 def run(args):
-    check_flags(args, positive=("--t-end", "--dt", "--rtol", "--atol"),
-                outputs=(("--out", (".npz", ".csv")), ("--plot", PLOT_FORMATS)))
+    check_flags(args, positive=("--t-end", "--dt", "--rtol", "--atol"))
     if args.method not in INTEGRATORS:
         raise ModelError(f"--method {args.method}: not one of {', '.join(INTEGRATORS)}")
     if args.plot_vars and not args.plot:

@@ -6,12 +6,15 @@ import sys
 import time
 
 from ..studies.sweep import parse_ranges, sweep
+from .outputs import Output
 from .parsers import check_flags
+
+OUTPUTS = (Output("--out", (".parquet", ".csv"), growing=True), Output("--trajectories", (), growing=True))
 from .report import on_terminal
 
 
 def run(args):
-    check_flags(args, positive=("--t-end", "--dt", "--workers"), outputs=(("--out", (".parquet", ".csv")),))
+    check_flags(args, positive=("--t-end", "--dt", "--workers"))
     params = parse_ranges(args.param) if args.param else None
     metrics = args.metric or ["energy_drift", "max_residual"]
     options = {} if args.dt is None else {"dt": args.dt}

@@ -1,5 +1,8 @@
 """Where mbsynth keeps files: a writable per-user cache directory, versions of it keyed
-by a digest of sources, pruned when unused.
+by a digest of sources, pruned when unused; and the rules every output file follows:
+its format is its suffix in any case (``file_format``), it is written whole or not at
+all (``write_atomically``), and a path where it cannot be is found before any work
+(``unwritable``).
 
 ``MBSYNTH_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/mbsynth``, else ``~/.cache/mbsynth``;
 when none of them can be written, a directory under the system's temporary directory.
@@ -69,13 +72,45 @@ def mark_and_prune(version):
         pass
 
 
-def write_atomically(path, write):
-    """Make ``path`` by ``write(temporary)``, a path beside it (its suffix kept) unique to this
-    process and thread, then a rename: a reader finds the old file or the whole new one,
-    never a part, also when several processes write the same path. ``write``'s error
-    leaves no temporary behind and is raised."""
+def file_format(path):
+    """The format of the file at ``path``: its suffix in lower case (``run.NPZ`` is an
+    .npz file), for every file mbsynth writes or reads back."""
+    return Path(path).suffix.lower()
+
+
+def unwritable(path, folder=False):
+    """Why ``write_atomically`` cannot make ``path`` (``folder``: why ``path`` cannot be
+    made a folder and filled, as ``mkdir(parents=True)`` would), or None where it can.
+    Tried by creating and removing a file where the output goes: the only test that holds
+    for every user and file system (root may write anywhere by its mode bits, yet /proc
+    takes no new file)."""
     path = Path(path)
-    temporary = path.with_name(f".{path.stem}.{os.getpid()}.{threading.get_ident()}.tmp{path.suffix}")
+    if not folder and path.is_dir():
+        return f"{path} is a folder"
+    if folder and path.exists() and not path.is_dir():
+        return f"{path} is a file, not a folder"
+    where = path if folder else path.parent
+    if not folder and not where.is_dir():
+        return f"the folder {where} does not exist" if not where.exists() else f"{where} is not a folder"
+    while not where.exists():  # a folder to be made: its nearest existing ancestor must take it
+        where = where.parent
+    if not where.is_dir():
+        return f"{where} is not a folder"
+    try:
+        tempfile.NamedTemporaryFile(dir=where, prefix=".mbsynth-probe-").close()
+    except OSError as err:
+        return f"no file can be created in {where} ({err.strerror or err})"
+    return None
+
+
+def write_atomically(path, write):
+    """Make ``path`` by ``write(temporary)``, a path beside it unique to this
+    process and thread, ending in its format (``file_format``: a writer that goes by the
+    suffix reads ``x.NPZ``'s temporary as .npz), then a rename: a reader finds the old file
+    or the whole new one, never a part, also when several processes write the same path.
+    ``write``'s error leaves no temporary behind and is raised."""
+    path = Path(path)
+    temporary = path.with_name(f".{path.stem}.{os.getpid()}.{threading.get_ident()}.tmp{file_format(path)}")
     try:
         write(temporary)
         os.replace(temporary, path)

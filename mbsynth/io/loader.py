@@ -8,6 +8,7 @@ import difflib
 import functools
 import keyword
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import sympy as sp
@@ -38,7 +39,7 @@ def load(path, parameters=None):
     """Read the model file at ``path`` and return its ``System``; ``parameters`` ({name:
     value}): values instead of the file's (what the file builds from them, e.g. a flexible
     body's FE model, is built with them)."""
-    return build(read_document(path), parameters)
+    return replace(build(read_document(path), parameters), source_file=str(Path(path).resolve()))
 
 
 def loads(text, name="<string>", folder=None, parameters=None):

@@ -57,6 +57,7 @@ class System:
     initial_definitions: dict = None  # initial value name -> sympy expression of parameters
     source: str = ""  # the model file's text, for workers that rebuild the System
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
+    source_file: str = ""  # the model file it was read from (mbsynth.load), its absolute path
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
     fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load

@@ -36,7 +36,7 @@ import sympy as sp
 
 from ..core.errors import ModelError, SolveError
 from ..core.expressions import ExpressionError, parse
-from ..core.files import write_atomically
+from ..core.files import file_format, write_atomically
 from ..io import load, loads
 from ..analysis.simulate import simulate
 from ..symbolic.derive import T_SYMBOL
@@ -239,7 +239,7 @@ def sweep(model, params=None, t_end=1.0, *, samples=None, metrics=("energy_drift
         raise ModelError(f"workers={workers} (--workers) sizes the local cluster mbsynth starts; with the "
                          f"scheduler {scheduler} its own workers run the sweep: give one or the other")
     runs = _runs(system, params, samples)
-    if out is not None and Path(out).suffix not in (".parquet", ".csv"):
+    if out is not None and file_format(out) not in (".parquet", ".csv"):
         raise ModelError(f"{out}: results must be .parquet or .csv")
     metric_list = [Metric(m) for m in metrics]
     for metric in metric_list:
@@ -406,7 +406,7 @@ def _check_settings(out, found, settings):
 def _read_table(path):
     path = Path(path)
     try:
-        table = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
+        table = pd.read_parquet(path) if file_format(path) == ".parquet" else pd.read_csv(path)
     except (OSError, ValueError) as err:
         raise ModelError(f"{path}: cannot read the results of an earlier sweep: {err}") from None
     if "error" in table:
@@ -416,5 +416,6 @@ def _read_table(path):
 
 def _write_results(out, table):
     path = Path(out)
-    write_atomically(path, lambda temporary: table.to_parquet(temporary, index=False) if path.suffix == ".parquet"
+    parquet = file_format(path) == ".parquet"
+    write_atomically(path, lambda temporary: table.to_parquet(temporary, index=False) if parquet
                      else table.to_csv(temporary, index=False))

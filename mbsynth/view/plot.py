@@ -7,11 +7,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
+from ..core.files import write_atomically  # noqa: E402
+
 MAX_LINES = 12
 
 
 def plot_trajectory(traj, path, title=None, system=None, names=None):
-    """Write a three-panel figure of ``traj`` to ``path`` (PNG, PDF or SVG).
+    """Write a three-panel figure of ``traj`` to ``path`` (PNG, PDF or SVG, by its suffix
+    in any case), whole or not at all (core.files.write_atomically).
 
     Top panel: the columns ``names`` (coordinates ``part.c``, velocities ``part.c_dot``,
     outputs); else the model's declared outputs; else, for a ``system`` with joints, the
@@ -34,8 +37,10 @@ def plot_trajectory(traj, path, title=None, system=None, names=None):
     ax_r.legend(fontsize="small")
     fig.suptitle(title or "trajectory")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        write_atomically(path, lambda temporary: fig.savefig(temporary, dpi=110))
+    finally:
+        plt.close(fig)
 
 
 def _series(traj, system, names):

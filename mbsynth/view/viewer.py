@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.files import write_atomically
 from ..core.kinematics import matrix_quaternion
 from .scene import FPS, build_scene
 
@@ -43,7 +44,8 @@ STOP_SECONDS = 5.0
 
 
 def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS, follow=None, deformation_scale=1.0):
-    """Write the animation of ``trajectory`` as one self-contained HTML file; returns its Path.
+    """Write the animation of ``trajectory`` as one self-contained HTML file, whole or not
+    at all (core.files.write_atomically); returns its Path.
 
     follow: the camera follows the centre of mass (True), stays on the box that holds the
     whole motion (False), or (None) follows when the centre of mass travels further than
@@ -55,7 +57,7 @@ def to_html(system, trajectory, path, *, axes=False, joints=False, fps=FPS, foll
         view.draw(scene)
         html = view.html()
     path = Path(path)
-    path.write_text(html, encoding="utf-8")
+    write_atomically(path, lambda temporary: temporary.write_text(html, encoding="utf-8"))
     return path
 
 
