@@ -30,7 +30,6 @@ interval of integration (``begin``):
 import logging
 
 import numpy as np
-from numba import njit
 
 from ..core.errors import SolveError
 from ..model.angle_singularity import AngleParts, explain
@@ -97,7 +96,7 @@ class StateDerivative:
             if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
                 raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
-        if self.angles and _nearest(y, self.angles.middle, self.angles.proper) < ANGLES_NEAR:
+        if self.angles and self.angles.nearest(y) < ANGLES_NEAR:
             self.angle_calls += 1
             if self.angle_calls > ANGLES_CRAWL_CALLS:
                 raise self._angles_crawl(t, y)
@@ -194,13 +193,3 @@ class StateDerivative:
         raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
                          f"{', '.join(culprits[:6])}{self._angles_note(np.nan_to_num(q))}", coordinates=culprits)
 
-
-@njit(cache=True)
-def _nearest(y, middle, proper):
-    """The least |det H| over the parts that turn by angles (AngleParts.distances) at the
-    stage y, whose first entries are q: at every stage of a model with such parts, so compiled."""
-    nearest = np.inf
-    for k in range(middle.size):
-        angle = y[middle[k]]
-        nearest = min(nearest, abs(np.sin(angle)) if proper[k] else abs(np.cos(angle)))
-    return nearest

@@ -64,10 +64,10 @@ def _least_energy_velocities(system, t, q, given):
 def _check_rates(system, arrays, rows, given, W, right, x):
     """SolveError where the ``given`` rates contradict the velocity rows (W x = right has no
     solution: x, its least-squares one, misses a row by more than ON_MANIFOLD_RTOL of the
-    row's norm times |x|), naming those rows and, as the model has them, what the rates may be: the rates
-    of independent coordinates (position rows alone) or of independent speeds (with
-    non-holonomic rows, such as rolling without slipping), examples picked by coordinate
-    partitioning."""
+    row's norm times |x|), naming those rows and, as the model has them, what the rates may
+    be: those of independent coordinates (position rows alone) or of independent speeds
+    (with non-holonomic rows, such as rolling without slipping), examples picked by
+    coordinate partitioning."""
     scale = np.linalg.norm(W, axis=1) * np.linalg.norm(x) + np.abs(right)  # a row's size at x, rounding's scale
     missed = np.abs(W @ x - right) > ON_MANIFOLD_RTOL * scale
     names = [name for name, row in zip([c for c, kept in zip(system.constraint_names, rows) if kept], missed) if row]

@@ -13,9 +13,10 @@ model/balances.py), ``near`` along a run (analysis/derivative.py).
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from ..core.tolerances import ANGLES_IN_NULLSPACE
-from .parts.euler_body import singular_values_text
+from .parts.euler_body import proper_euler, singular_values_text
 
 
 @dataclass(frozen=True)
@@ -79,15 +80,20 @@ class AngleParts:
         self.angles = np.array([[index[f"{p.name}.{c}"] for c in p.coordinates[3:]] for p in self.parts],
                                dtype=np.int64).reshape(-1, 3)
         self.middle = self.angles[:, 1].copy()
-        self.proper = np.array([p.sequence[0] == p.sequence[2] for p in self.parts], dtype=bool)
+        self.proper = np.array([proper_euler(p.sequence) for p in self.parts], dtype=np.bool_)
 
     def __bool__(self):
         return bool(self.parts)
 
     def distances(self, q):
-        """Per part, |det H| at q (euler_body.singular_distance): 0 at its singular position."""
-        middle = q[self.middle]
-        return np.abs(np.where(self.proper, np.sin(middle), np.cos(middle)))
+        """Per part, |det H| at q: |cos| of its middle angle (Tait–Bryan) or |sin| (proper
+        Euler), the sine of its distance to the singular position (0 there). ``q`` may be
+        longer (a run's stage y, whose first entries are q)."""
+        return _distances(q, self.middle, self.proper)
+
+    def nearest(self, q):
+        """The least of ``distances`` (np.inf without parts): read at every stage of a run."""
+        return _distances(q, self.middle, self.proper).min(initial=np.inf)
 
     def near(self, q, within):
         """The AngleSingularity of each part whose |det H| at q is below ``within``, nearest first."""
@@ -122,3 +128,12 @@ class AngleParts:
         direction = {self.coordinates[j]: float(x) for j, x in zip(self.angles[i], w) if abs(x) > ANGLES_IN_NULLSPACE}
         return AngleSingularity(part.name, part.sequence, self.coordinates[self.middle[i]], float(q[self.middle[i]]),
                                 direction)
+
+
+@njit(cache=True)
+def _distances(q, middle, proper):
+    """AngleParts.distances, compiled: a run reads them at every stage."""
+    found = np.empty(middle.size)
+    for k in range(middle.size):
+        found[k] = abs(np.sin(q[middle[k]])) if proper[k] else abs(np.cos(q[middle[k]]))
+    return found

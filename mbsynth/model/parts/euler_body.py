@@ -54,16 +54,6 @@ class EulerBody(Part):
         return euler_rotation(self.sequence, self.q[3:]) * euler_rate_matrix(self.sequence, self.q[3:]) \
             * sp.Matrix(self.qd[3:])
 
-    @property
-    def middle(self):
-        """The name of the middle angle, whose value alone decides the singular position."""
-        return self.coordinates[4]
-
-    def singular_distance(self, middle):
-        """How far the middle angle's value(s) ``middle`` lie from the singular position
-        (``singular_distance``)."""
-        return singular_distance(self.sequence, middle)
-
     def singular_direction(self, angles):
         """The unit null vector of H at the numeric ``angles`` (over the three angles): the
         angle rates that turn the body not at all at the singular position."""
@@ -80,12 +70,6 @@ def coordinates(sequence):
 def proper_euler(sequence):
     """Whether ``sequence`` turns about its first axis again last (zxz), not Tait–Bryan."""
     return sequence[0] == sequence[2]
-
-
-def singular_distance(sequence, middle):
-    """|det H| at the middle angle(s) ``middle``: |cos| (Tait–Bryan) or |sin| (proper
-    Euler), the sine of the distance to the singular position, where it is 0 (numpy)."""
-    return np.abs(np.sin(middle) if proper_euler(sequence) else np.cos(middle))
 
 
 def singular_values_text(sequence):
