@@ -16,7 +16,13 @@ interval of integration (``begin``):
   A), which a tight tolerance chases with ever smaller steps; more than CRAWL_CALLS
   evaluations (RELAXED_CRAWL_CALLS in an interval already relaxed) after the interval's
   first stage near one (``Motion.singular``) raise Crawl, for the cut integrator to
-  integrate the interval again more loosely (cut.py);
+  integrate the interval again more loosely (cut.py); one that crawls still at the loosest
+  tolerance (``may_crawl`` False) raises SolveError naming the rows after STUCK_CALLS;
+- a crawl near the singular position of a part's angles (model/angle_singularity.py): there
+  the angle rates grow like 1/|det H| and the steps shrink without end; more than
+  ANGLES_CRAWL_CALLS evaluations in an interval at stages within ANGLES_NEAR of it raise
+  SolveError naming the part, its angles and their singular value (no tolerance helps: the
+  coordinates fail there). A collapse or a state that explodes near it names it too;
 - the stages near a singular position, per interval (``note_singular``), and whether the
   motion was not unique at any stage.
 """
@@ -26,6 +32,7 @@ import logging
 import numpy as np
 
 from ..core.errors import SolveError
+from ..model.angle_singularity import AngleParts, explain
 
 log = logging.getLogger(__name__)
 
@@ -34,6 +41,11 @@ COLLAPSE_CALLS = 1000  # ~80 steps of an explicit pair
 COLLAPSE_SPAN = 1e-8
 CRAWL_CALLS = 240
 RELAXED_CRAWL_CALLS = 1000
+STUCK_CALLS = 20000  # an interval that crawls this long near a singular position at the loosest tolerance stops
+ANGLES_NEAR = 1e-2  # |det H| of a part's angles below this (0.57° from their singular position): angle rates
+# above 100 times the angular velocity
+ANGLES_CRAWL_CALLS = 5000  # ~400 steps of an explicit pair within ANGLES_NEAR in one interval: a body that
+# passes by needs a few, one that falls onto the position (a bicycle lying down) never gets past it
 
 
 class Crawl(Exception):
@@ -52,6 +64,7 @@ class StateDerivative:
         self.singular = []  # (t, rows) of the interval's stages near a singular position
         self.singular_positions = []  # per interval with such stages: {t_from, t_to, rows}
         self.on_manifold = None  # (q, q̇) -> the state on the constraints or None: a step across a singular position
+        self.angles = AngleParts(data)  # the parts that turn by angles, watched for their singular position
         self.use(None)
         self.begin(0.0, 0.0)
 
@@ -66,10 +79,12 @@ class StateDerivative:
     def begin(self, t, t_next, relaxed=False, may_crawl=True):
         """Count the evaluations from here: an interval from t to t_next; ``relaxed``: it is
         integrated more loosely already (it may crawl longer); ``may_crawl``: False where it
-        cannot be relaxed further (no Crawl raised)."""
+        cannot be relaxed further (SolveError after STUCK_CALLS instead of Crawl)."""
         self.calls, self.t_mark, self.span = 0, t, t_next - t
         self.singular_call = None  # the interval's evaluation count at its first stage near a singular position
-        self.crawl_calls = (RELAXED_CRAWL_CALLS if relaxed else CRAWL_CALLS) if may_crawl else np.inf
+        self.may_crawl = may_crawl
+        self.crawl_calls = (RELAXED_CRAWL_CALLS if relaxed else CRAWL_CALLS) if may_crawl else STUCK_CALLS
+        self.angle_calls = 0  # the interval's evaluations within ANGLES_NEAR of the angles' singular position
 
     def __call__(self, t, y):
         self.t_failed = t
@@ -81,6 +96,10 @@ class StateDerivative:
             if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
                 raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
+        if self.angles and self.angles.nearest(y) < ANGLES_NEAR:
+            self.angle_calls += 1
+            if self.angle_calls > ANGLES_CRAWL_CALLS:
+                raise self._angles_crawl(t, y)
         found = None if self.fast is None else self.fast(t, self.form.stage_state(y))  # unique, far from singular
         if found is None:
             if not np.abs(y).max(initial=0.0) <= MAX_STATE:  # a stage of a trial step gone wild (NaN included):
@@ -92,7 +111,7 @@ class StateDerivative:
                 self.singular.append((t, motion.singular))
                 self.singular_call = self.calls if self.singular_call is None else self.singular_call
         if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
-            raise Crawl
+            raise Crawl if self.may_crawl else self._stuck(t, y)
         return self.form.rates(y, found if found is not None else np.concatenate([qd, motion.qdd]))
 
     def _on_manifold(self, y):
@@ -126,6 +145,31 @@ class StateDerivative:
             self.singular_positions.append(dict(t_from=t_from, t_to=t_to, rows=sorted(rows)))
             log.info("singular position near t = %.6g (nearly dependent rows %s)", t_from, ", ".join(sorted(rows)))
 
+    def _stuck(self, t, y):
+        """The SolveError of an interval that crawls near a singular position of the rows
+        at the loosest tolerance."""
+        self.t_failed = t
+        rows = sorted({r for _, names in self.singular for r in names})
+        return SolveError(f"the steps crawl near a singular position of the constraints ({STUCK_CALLS} evaluations "
+                          f"of this interval at the loosest tolerance; nearly dependent rows "
+                          f"{', '.join(rows)}){self._angles_note(y[:self.n])}",
+                          constraints=rows)
+
+    def _angles_crawl(self, t, y):
+        """The SolveError of a crawl at the singular position of a part's angles, at (t, y)."""
+        self.t_failed = t
+        near = self.angles.near(y[:self.n], ANGLES_NEAR)
+        return SolveError(f"the steps crawl at the singular position of a part's angles ({ANGLES_CRAWL_CALLS} "
+                          f"evaluations of this interval within {ANGLES_NEAR:g} of it): "
+                          f"{explain(near, 'approaching')}",
+                          coordinates=[a.coordinate for a in near])
+
+    def _angles_note(self, q):
+        """'; ' and the parts whose angles are within ANGLES_NEAR of their singular position at
+        q (what a collapse there chases), or ''."""
+        near = self.angles.near(q, ANGLES_NEAR) if self.angles else []
+        return f"; {explain(near, 'near')}" if near else ""
+
     def collapse(self, t, y, why):
         """The SolveError of a step-size collapse at (t, y), naming the coordinates of the
         largest accelerations (within a factor 10 of the largest): what the steps chase."""
@@ -134,7 +178,7 @@ class StateDerivative:
         qdd = np.abs(data.motion(t, *self.form.to_state(y), baumgarte=self.baumgarte, drift=True).qdd)
         fastest = [(c, a) for c, a in zip(data.coordinates, qdd) if a >= qdd.max() / 10]
         return SolveError(f"step-size collapse, the integrator gave up ({why}); fastest changing: "
-                          f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}",
+                          f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}{self._angles_note(y[:self.n])}",
                           coordinates=[c for c, _ in fastest])
 
     def check(self, t, q, qd):
@@ -147,4 +191,5 @@ class StateDerivative:
         names = [*self.data.coordinates, *(c + "_dot" for c in self.data.coordinates)]
         culprits = [names[i] for i in np.flatnonzero(~np.isfinite(y) | (np.abs(y) > MAX_STATE))]
         raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
-                         f"{', '.join(culprits[:6])}", coordinates=culprits)
+                         f"{', '.join(culprits[:6])}{self._angles_note(np.nan_to_num(q))}", coordinates=culprits)
+

@@ -2,7 +2,8 @@
 
 Counts coordinates and constraints, the ranks of M, A and M̂ = [M; A], whether the
 motion is unique, each indeterminate direction, and for each the balance
-wᵀ(Q + C) = 0 that would close the model (see model/balances.py). How firm the verdict is:
+wᵀ(Q + C) = 0 that would close the model (see model/balances.py), or, where a part's angles
+are at their singular position, that part (model/angle_singularity.py). How firm the verdict is:
 the condition number of the equilibrated M̂, the rank tolerance, the verdict margin
 (equations.py) and a warning when that margin is below ``VERDICT_MARGIN``.
 """
@@ -11,6 +12,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..model.angle_singularity import AngleParts
 from ..model.balances import balances
 from ..core.equations import rank_report
 from ..core.errors import SolveError
@@ -42,6 +44,9 @@ class Diagnosis:
     warnings: list = field(default_factory=list)
     joints: dict = field(default_factory=dict)  # joint -> {coordinates, position, rate, acceleration, ...}
     free_joints: list = field(default_factory=list)  # per indeterminate direction: {joint: rate per unit}
+    # the parts whose angles are at their singular position (AngleSingularity.to_dict): indeterminate directions
+    # of the coordinates, left out of ``balances``
+    angle_singularities: list = field(default_factory=list)
 
     @property
     def consistent(self):
@@ -78,7 +83,8 @@ def diagnose(system, t=0.0, q=None, qd=None):
                    "state_dependent": c.state_dependent} for c in system.closures],
         constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
         rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report),
-        joints=_joints(system, t, q, qd, motion), free_joints=_moved_joints(system, t, q, report.nullspace))
+        joints=_joints(system, t, q, qd, motion), free_joints=_moved_joints(system, t, q, report.nullspace),
+        angle_singularities=[a.to_dict() for a in AngleParts(system).set_aside(q, report.nullspace)[0]])
 
 
 def _joints(system, t, q, qd, motion):

@@ -186,10 +186,13 @@ def linearize(system, t, q, qd, inputs=None, speeds=None):
     ``inputs``: parameter names B is taken for (they must enter only the forces Q + C);
     by default the robots' joint torques ``tau_*`` and the parameters named ``tau_*`` or
     ``u_*``. ``speeds``: with non-holonomic rows, the coordinates whose rates are the
-    independent speeds (by default picked by coordinate partitioning). Raises SolveError
-    where no linearization on the manifold exists."""
+    independent speeds, or those rates' names as ``state_names`` and ``mbsynth modes`` give
+    them (``<coordinate>_dot``); by default picked by coordinate partitioning. Both are lists
+    of names (TypeError for one string). Raises SolveError where no linearization on the
+    manifold exists."""
     q, qd = finite_state(system, q, qd)
-    inputs = default_inputs(system) if inputs is None else tuple(inputs)
+    inputs = default_inputs(system) if inputs is None else names_of(inputs, "inputs")
+    speeds = None if speeds is None else names_of(speeds, "speeds")
     _refuse_unsupported(system, t, q, qd)
     motion = system.motion(t, q, qd)
     if not motion.unique:
@@ -227,26 +230,38 @@ def linearize(system, t, q, qd, inputs=None, speeds=None):
     return Linearization(A, B, N, T, names, inputs, system.coordinates, float(t), q, qd, motion.qdd)
 
 
+def names_of(value, what):
+    """``value``, a collection of names, as a tuple; TypeError for one string (it would be
+    read letter by letter)."""
+    if isinstance(value, str):
+        raise TypeError(f"{what}: a list of names, got the string {value!r} (write [{value!r}])")
+    return tuple(value)
+
+
 def _speeds(system, held, N, pivots, names):
     """(S, speeds): the basis S (n × s) of the velocities every row allows at the state
     (null of Φ_q and of the non-holonomic rows' A), the identity on the s independent
-    speeds at indices ``speeds``: the coordinates ``names`` when given, else those picked
-    by coordinate partitioning (``tangent_basis``). Without non-holonomic rows, (N, pivots)."""
+    speeds at indices ``speeds``: the coordinates ``names`` (or their rates, ``_dot``) when
+    given, else those picked by coordinate partitioning (``tangent_basis``). Without
+    non-holonomic rows, (N, pivots)."""
     W, _ = held.velocity_matrices
     if names is None:
         if not held.velocity_rows.any():
             return N, pivots
         return tangent_basis(system, W, held.position_rows | held.velocity_rows)
-    unknown = [c for c in names if c not in system.coordinates]
+    given = list(names)
+    names = [c if c in system.coordinates else c.removesuffix("_dot") for c in given]  # a speed's rate name
+    unknown = [g for g, c in zip(given, names) if c not in system.coordinates]
     if unknown:
-        raise SolveError(f"model '{system.name}': unknown speed coordinate(s) {unknown}", coordinates=unknown)
+        raise SolveError(f"model '{system.name}': unknown speed(s) {unknown}: name coordinates or their rates "
+                         "(<coordinate>_dot, as mbsynth modes lists the independent speeds)", coordinates=unknown)
     S, _ = tangent_basis(system, W, held.position_rows | held.velocity_rows)
     speeds = np.array(sorted(system.coordinates.index(c) for c in names), dtype=int)
     if speeds.size != S.shape[1] or np.linalg.matrix_rank(S[speeds]) < S.shape[1]:
-        raise SolveError(f"model '{system.name}': speeds {list(names)} do not fix the velocities the rows allow "
+        raise SolveError(f"model '{system.name}': speeds {given} do not fix the velocities the rows allow "
                          f"({S.shape[1]} independent speed(s) here, e.g. "
                          f"{[system.coordinates[i] for i in tangent_basis(system, W)[1]]})",
-                         coordinates=list(names))
+                         coordinates=names)
     return S @ np.linalg.inv(S[speeds]), speeds
 
 

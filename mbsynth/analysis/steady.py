@@ -11,10 +11,11 @@ coordinate but the cyclic ones moves.
 """
 
 import numpy as np
+import scipy.linalg
 import scipy.optimize
 
 from ..core.errors import NoEquilibrium, SolveError
-from ..core.tolerances import ACCELERATION_TOL, RANK_RTOL
+from ..core.tolerances import ACCELERATION_TOL, ON_MANIFOLD_RTOL, RANK_RTOL
 from .linearization import finite_state, linearize
 from .projection import project_positions
 
@@ -52,11 +53,41 @@ def _least_energy_velocities(system, t, q, given):
     W = np.vstack([arrays.A[rows], fix])
     right = np.concatenate([-arrays.psi[rows], list(given.values())])
     particular = np.linalg.lstsq(W, right, rcond=None)[0]
+    _check_rates(system, arrays, rows, given, W, right, particular)
     _, s, Vt = np.linalg.svd(W)
     free = Vt[int(np.sum(s > RANK_RTOL * s[0])):].T if s.size else np.eye(n)
     M = system.evaluate(t, q, particular).M
     y = np.linalg.lstsq(free.T @ M @ free, -free.T @ M @ particular, rcond=None)[0] if free.size else []
     return particular + free @ y if free.size else particular
+
+
+def _check_rates(system, arrays, rows, given, W, right, x):
+    """SolveError where the ``given`` rates contradict the velocity rows (W x = right has no
+    solution: x, its least-squares one, misses a row by more than ON_MANIFOLD_RTOL of the
+    row's norm times |x|), naming those rows and, as the model has them, what the rates may
+    be: those of independent coordinates (position rows alone) or of independent speeds
+    (with non-holonomic rows, such as rolling without slipping), examples picked by
+    coordinate partitioning."""
+    scale = np.linalg.norm(W, axis=1) * np.linalg.norm(x) + np.abs(right)  # a row's size at x, rounding's scale
+    missed = np.abs(W @ x - right) > ON_MANIFOLD_RTOL * scale
+    names = [name for name, row in zip([c for c, kept in zip(system.constraint_names, rows) if kept], missed) if row]
+    if not names:
+        return
+    A = W[:len(W) - len(given)]
+    _, s, Vt = np.linalg.svd(A)
+    free = Vt[int(np.sum(s > RANK_RTOL * s[0])):] if s.size else np.eye(system.n)
+    independent = [system.coordinates[i] for i in sorted(scipy.linalg.qr(free, pivoting=True)[2][:len(free)])]
+    rates = {system.coordinates[i]: v for i, v in given.items()}
+    nonholonomic = [name for name, phi, psi in zip(system.constraint_names, arrays.phi, arrays.psi)
+                    if np.isnan(phi) and np.isfinite(psi)]
+    if nonholonomic:
+        ties = (f"the position rows and the velocity rows {nonholonomic} (rolling without slipping, a knife edge) "
+                f"leave {len(independent)} independent speed(s), e.g. the rates of {independent}")
+    else:
+        ties = (f"the position rows fix every rate from {len(independent)} independent coordinate(s), e.g. "
+                f"{independent}")
+    raise SolveError(f"model '{system.name}': the rates {rates} contradict the rows {names}: {ties}; give rates "
+                     "the rows allow (those of independent ones; the others follow)", constraints=names)
 
 
 def _solved(system, t, q, given, solve, index):

@@ -17,7 +17,7 @@ def run(args):
         print(json.dumps(report.to_dict(), indent=2))
     else:
         print(format_check(report, args.model, args.coordinates))
-    return 0 if report.consistent and not report.suggested_constraints else 1
+    return 0 if report.consistent and not report.suggested_constraints and not report.angle_singularities else 1
 
 
 def format_check(report, path, coordinates="joints"):
@@ -35,6 +35,9 @@ def format_check(report, path, coordinates="joints"):
         lines.append("  motion: unique (Result 3)")
     else:
         lines.append(f"  motion: NOT unique, {report.n - report.rank_Mhat} indeterminate direction(s)")
+        for singular in report.angle_singularities:
+            lines.append(f"    direction {_format_direction(singular['direction'])}")
+            lines.append(f"      {singular['message']}")
         for balance, moved in zip(report.balances, report.free_joints or [{}] * len(report.balances)):
             lines.append(f"    direction {_format_direction(balance['direction'])}")
             if in_joints and moved:

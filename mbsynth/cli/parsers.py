@@ -23,8 +23,8 @@ EXIT_CODES = {
                    "any Unix command): nothing more is printed",
 }
 VERDICTS = {  # what exit 1 means for each command (none: the command has no verdict)
-    "check": "a force balance is missing (the motion is not unique beyond free directions), or no motion "
-             "exists at the initial state",
+    "check": "a force balance is missing (the motion is not unique beyond free directions), a part's angles "
+             "are at their singular position, or no motion exists at the initial state",
     "simulate": "the run had to stop (its output up to there is kept)",
     "sweep": "a run failed (its row holds the error)",
     "view": "the simulation had to stop (the motion up to there is drawn)",

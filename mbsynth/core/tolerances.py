@@ -43,6 +43,8 @@ STACKED_CHECK_RTOL = 1e-12  # grouped.py: a stacked call must agree with the sin
 
 # ---- the model (model/)
 BALANCE_ZERO_RTOL = 1e-9  # balances.py: a sampled balance below this (relative to the force scale) is zero
+ANGLES_IN_NULLSPACE = 1e-6  # angle_singularity.py: a body's turning-nothing angle rates (unit) within this of
+# null([M; A]) make that indeterminate direction the angles' singular position (√RANK_RTOL: M holds H twice)
 DEPENDENT_RTOL = 1e-8  # reactions.py: a row takes part in a dependency when its weight in one exceeds this
 COULOMB_LOAD_RTOL = 1e-12  # friction.py: Coulomb loads N have converged when they change by less than this
 

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
+from .angle_singularity import AngleParts
 from .connectors.base import Connector
 from ..core.equations import rank_report
 from ..core.errors import ModelError
@@ -54,7 +55,9 @@ class Balance:
 
 
 def balances(system, t=0.0, q=None, qd=None):
-    """The balances of every indeterminate direction of ``system`` (none when unique).
+    """The balances of every indeterminate direction of ``system`` (none when unique), but
+    those of a part's angles at their singular position (angle_singularity.py: the
+    coordinates' fault, no balance closes them).
 
     Where [M; A] (with the parameter values substituted) does not depend on the state,
     its null space is found exactly (sympy). Otherwise, or where the exact dimension
@@ -66,7 +69,7 @@ def balances(system, t=0.0, q=None, qd=None):
     q = q0 if q is None else np.asarray(q, dtype=float)
     qd = qd0 if qd is None else np.asarray(qd, dtype=float)
     arrays = system.evaluate(t, q, qd)
-    numeric = rank_report(arrays.M, arrays.A).nullspace
+    numeric = AngleParts(system).set_aside(q, rank_report(arrays.M, arrays.A).nullspace)[1]
     if numeric.shape[1] == 0:
         return []  # before the sympy form of the model: seconds on a robot
     values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in system.parameters.items()}

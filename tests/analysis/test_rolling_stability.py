@@ -12,6 +12,7 @@ import sympy as sp
 from scipy.optimize import brentq
 
 import mbsynth as mb
+from mbsynth.analysis.modes import to_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
@@ -209,6 +210,47 @@ def test_speeds_can_be_chosen_and_are_checked(bicycle):
     assert np.abs(_nonzero(chosen.eigenvalues) - np.sort_complex(TABLE_2[v])).max() < 1e-8
     with pytest.raises(mb.SolveError, match="do not fix the velocities"):
         mb.linearize(moving, 0.0, *moving.initial_state(), speeds=["rear_frame.x", "rear_wheel.x", "front_wheel.x"])
+
+
+def test_speeds_take_the_names_modes_prints_and_refuse_one_string(bicycle):
+    """``mbsynth modes --steady`` lists the independent speeds as rates (rear_frame.x_dot, …):
+    those names choose the same speeds as the coordinates' (the same A), as does the list
+    modes prints; one string, which would be read letter by letter, is refused."""
+    moving = bicycle.with_parameters(v=5.0)
+    state = moving.initial_state()
+    printed = to_dict(mb.modes(moving, steady=True))["independent_speeds"]
+    assert all(name.endswith("_dot") for name in printed) and len(printed) == 3
+    default = mb.linearize(moving, 0.0, *state)
+    np.testing.assert_array_equal(mb.linearize(moving, 0.0, *state, speeds=printed).A, default.A)
+    chosen = ["rear_frame.x", "rear_frame.angle_x", "front_frame.angle_z"]
+    np.testing.assert_array_equal(mb.linearize(moving, 0.0, *state, speeds=[f"{c}_dot" for c in chosen]).A,
+                                  mb.linearize(moving, 0.0, *state, speeds=chosen).A)
+    with pytest.raises(TypeError, match=r"speeds: a list of names, got the string 'rear_frame.x_dot'"):
+        mb.linearize(moving, 0.0, *state, speeds="rear_frame.x_dot")
+    with pytest.raises(TypeError, match=r"inputs: a list of names, got the string 'v'"):
+        mb.linearize(moving, 0.0, *state, inputs="v")
+    with pytest.raises(mb.SolveError, match=r"unknown speed\(s\) \['rear_frame.v_dot'\]: name coordinates or their "
+                                            r"rates \(<coordinate>_dot"):
+        mb.linearize(moving, 0.0, *state, speeds=["rear_frame.v_dot", "rear_frame.x", "front_frame.angle_z"])
+
+
+def test_steady_motion_with_contradictory_rates_says_what_the_rows_allow():
+    """Rates the velocity rows cannot meet are refused, naming the rows and what the model
+    allows: a pendulum on a rod (position rows alone: the rate of one independent coordinate;
+    nothing said of rolling) and a rolling disk (the slip rows: independent speeds)."""
+    pendulum = mb.load(MODELS / "mechanisms" / "simple_pendulum.yaml")  # at (-1, 0): the rod row says x_dot = 0
+    with pytest.raises(mb.SolveError) as err:
+        mb.steady_motion(pendulum, {"bob.x": 1.0})
+    assert str(err.value) == ("model 'simple_pendulum': the rates {'bob.x': 1.0} contradict the rows ['rod']: the "
+                              "position rows fix every rate from 1 independent coordinate(s), e.g. ['bob.y']; give "
+                              "rates the rows allow (those of independent ones; the others follow)")
+    assert err.value.constraints == ("rod",)
+    disk = mb.load(MODELS / "rolling" / "turning_disk.yaml")
+    with pytest.raises(mb.SolveError) as err:
+        mb.steady_motion(disk, {"disk.angle_z": 2.0, "disk.angle_z2": 0.0, "disk.x": 5.0}, q=disk.initial_state()[0])
+    assert "contradict the rows ['contact[slip_x]']" in str(err.value)
+    assert ("the position rows and the velocity rows ['contact[slip_x]', 'contact[slip_y]'] (rolling without "
+            "slipping, a knife edge) leave 3 independent speed(s)") in str(err.value)
 
 
 def test_steady_motion_from_a_forward_speed(bicycle):

@@ -9,9 +9,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 
 import mbsynth as mb
+from mbsynth.analysis import cut, derivative
 from mbsynth.analysis.cut import RELAXED_RTOL
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -102,6 +104,21 @@ def test_a_span_that_crawls_near_a_singular_position_is_integrated_again_at_a_lo
     assert traj.stats["evaluations"] < 2000
     assert error < 1e-9
     assert traj.max_residual < 1e-10
+
+
+def test_a_span_that_crawls_still_at_the_loosest_tolerance_stops_naming_the_rows(monkeypatch):
+    """The crawl above with the loosest tolerance lowered to its first relaxation and the
+    count it may crawl there (STUCK_CALLS) to 50: no further loosening exists, so the run
+    stops within the bound with a SimulationError naming the nearly dependent rows, the
+    rows before it kept (no loop without progress)."""
+    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setattr(cut, "RELAXED_MAX", RELAXED_RTOL)
+    monkeypatch.setattr(derivative, "STUCK_CALLS", 50)
+    with pytest.raises(mb.SimulationError) as err:
+        crossing(1e-3, 0.3)
+    assert "the steps crawl near a singular position of the constraints (50 evaluations of this interval at the " \
+           "loosest tolerance; nearly dependent rows ground0[x]" in str(err.value)
+    assert err.value.trajectory.t.tolist() == [0.0] and "ground0[x]" in err.value.constraints
 
 
 def test_crossings_at_a_tight_tolerance_are_stepped_across_on_the_exact_motion(monkeypatch):

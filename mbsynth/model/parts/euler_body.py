@@ -54,11 +54,27 @@ class EulerBody(Part):
         return euler_rotation(self.sequence, self.q[3:]) * euler_rate_matrix(self.sequence, self.q[3:]) \
             * sp.Matrix(self.qd[3:])
 
+    def singular_direction(self, angles):
+        """The unit null vector of H at the numeric ``angles`` (over the three angles): the
+        angle rates that turn the body not at all at the singular position."""
+        H = np.array(euler_rate_matrix(self.sequence, [float(a) for a in angles]), dtype=float)
+        return np.linalg.svd(H)[2][-1]
+
 
 def coordinates(sequence):
     """The coordinate names: x, y, z and ``angle_<axis>`` for each turn of ``sequence``
     (``angle_<axis>2`` for the second turn about the same axis)."""
     return ("x", "y", "z", *(f"angle_{axis}{'2' if axis in sequence[:i] else ''}" for i, axis in enumerate(sequence)))
+
+
+def proper_euler(sequence):
+    """Whether ``sequence`` turns about its first axis again last (zxz), not Tait–Bryan."""
+    return sequence[0] == sequence[2]
+
+
+def singular_values_text(sequence):
+    """Where the middle angle of ``sequence`` is singular, in words."""
+    return "0 and ±π" if proper_euler(sequence) else "±π/2"
 
 
 def angles_of(sequence, R):
