@@ -331,8 +331,10 @@ def _verdict_line(result, steady):
         return f"verdict: stable: every mode decays; the slowest, {exponent}, decides"
     if verdict.kind == "unstable":
         return f"verdict: unstable: {exponent} grows (Re s > 0): {what} is not one the model keeps"
+    why = {"vibration": "undamped: it neither grows nor decays", "free": "a free direction, which nothing restores"}
     return (f"verdict: neutral: the largest real part, of {exponent}, is zero within {STABILITY_RTOL:g} of the "
-            "largest |s| (undamped, or at a boundary of stability): the linearization does not decide")
+            f"largest |s| ({why.get(result.modes[verdict.mode].kind, 'at a boundary of stability')}): the "
+            "linearization does not decide")
 
 
 def _largest(result, mode):
