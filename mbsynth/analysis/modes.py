@@ -294,7 +294,8 @@ def format_modes(result, digits=6):
     steady = bool(np.any(lin.qd))
     speeds = lin.A.shape[0] - lin.k
     lines = [f"modes of {result.system_name} {'about its steady motion' if steady else 'at rest'} at t = {result.t:g}",
-             f"  {_count(lin.k, 'degree')} of freedom, independent coordinates: {', '.join(lin.state_names[:lin.k]) or 'none'}"]
+             f"  {_count(lin.k, 'degree')} of freedom, independent coordinates: "
+             f"{', '.join(lin.state_names[:lin.k]) or 'none'}"]
     if speeds != lin.k or steady:
         lines.append(f"  {_count(speeds, 'independent speed')} (the non-holonomic rows give the other rates): "
                      f"{', '.join(lin.state_names[lin.k:]) or 'none'}")

@@ -231,7 +231,8 @@ class TrajectoryWriter:
             return parts[0] if len(parts) == 1 else np.concatenate(parts)  # one: the rows themselves, no copy
 
         columns = dict(t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
-                       energy=stack("energy"), power=stack("power"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
+                       energy=stack("energy"), power=stack("power"), kinetic=stack("kinetic"),
+                       residual_position=stack("residual_position"),
                        residual_velocity=stack("residual_velocity"), status=np.array(self.status),
                        outputs=stack("outputs", len(self.output_names)),
                        output_names=np.array(self.output_names, dtype=str))

@@ -84,7 +84,8 @@ def test_pd_pendulum_rest_is_stable():
     assert run.stdout.splitlines()[-1].startswith("verdict: stable: every mode decays; the slowest, mode ")
 
 
-@pytest.mark.parametrize("model, quaternion", [("knife_edge", None), ("rolling_disk", "disk is turned by a quaternion")])
+@pytest.mark.parametrize("model, quaternion", [("knife_edge", None),
+                                               ("rolling_disk", "disk is turned by a quaternion")])
 def test_not_steady_advice_names_quaternions_only_where_there_are(model, quaternion):
     run = modes(MODELS / "rolling" / f"{model}.yaml", "--steady")
     assert run.returncode == 1 and run.stdout == ""
