@@ -131,9 +131,21 @@ class Linearization:
         with the absolute yaw of a steered part) are split off first
         (``_deflated_eigenvalues``)."""
         A = self._structural
-        values = [_deflated_eigenvalues(A[np.ix_(b, b)]) for b in self.blocks]
+        values = [_deflated(A[np.ix_(b, b)])[0] for b in self.blocks]
         values = np.concatenate(values).astype(complex) if values else np.zeros(0, complex)
         return values[np.lexsort((values.real, values.imag))]
+
+    @property
+    def zero_states(self):
+        """One name per exact zero of ``eigenvalues``: a cyclic coordinate or conserved speed
+        alone in its block (``cyclic``), or a direction split off within a block, named by
+        the states it moves, largest 1 (``rear_wheel.angle_z + front_frame.angle_z``: the
+        heading of the whole bicycle, steered part and all)."""
+        A, names = self._structural, []
+        for b in self.blocks:
+            directions = _deflated(A[np.ix_(b, b)])[1]
+            names += [_combination([self.state_names[i] for i in b], d) for d in directions.T]
+        return tuple(names)
 
     @property
     def blocks(self):
@@ -161,23 +173,37 @@ class Linearization:
         return np.where(np.abs(self.A) > STRUCTURAL_ZERO_RTOL * scale, self.A, 0.0)
 
 
-def _deflated_eigenvalues(A):
-    """The eigenvalues of the square A: zero for each direction of its null space (singular
-    values below STRUCTURAL_ZERO_RTOL times the largest), split off by the orthogonal change
-    of basis [Z W] (A Z = 0 makes it block-triangular), and again on WᵀAW until none is
-    left; then those of what remains. Exact zeros stay zero and a small eigenvalue near
-    them (a mode at its stability boundary) keeps its accuracy."""
-    zeros = 0
+def _deflated(A):
+    """(the eigenvalues of the square A, its zero directions): zero for each direction of
+    its null space (singular values below STRUCTURAL_ZERO_RTOL times the largest), split off
+    by the orthogonal change of basis [Z W] (A Z = 0 makes it block-triangular), and again
+    on WᵀAW until none is left; then those of what remains. Exact zeros stay zero and a
+    small eigenvalue near them (a mode at its stability boundary) keeps its accuracy. The
+    directions: A's columns (one per zero), Z and the later ones turned back by the Ws."""
+    found, basis = [], np.eye(A.shape[0])
     while A.size:
         _, sv, Vt = np.linalg.svd(A)
         null = sv <= STRUCTURAL_ZERO_RTOL * sv[0] if sv[0] > 0 else np.ones(sv.size, bool)
         if not null.any():
             break
+        found.append(basis @ Vt[null].T)
         W = Vt[~null].T
-        A = W.T @ A @ W
-        zeros += int(null.sum())
+        A, basis = W.T @ A @ W, basis @ W
     rest = np.linalg.eigvals(A) if A.size else np.zeros(0)
-    return np.concatenate([rest.astype(complex), np.zeros(zeros, complex)])
+    directions = np.hstack(found) if found else np.zeros((basis.shape[0], 0))
+    return np.concatenate([rest.astype(complex), np.zeros(directions.shape[1], complex)]), directions
+
+
+def _combination(names, direction):
+    """The direction as a sum of the ``names`` it moves (components above NAME_RTOL of
+    the largest), largest 1: ``x``, ``x + y``, ``x − 0.5 y``."""
+    direction = direction / direction[np.argmax(np.abs(direction))]
+    terms = [(x, name) for x, name in zip(direction, names) if abs(x) > NAME_RTOL]
+    text = ""
+    for x, name in terms:
+        size = "" if abs(abs(x) - 1) <= NAME_RTOL else f"{abs(x):.3g} "
+        text += (f"{'−' if x < 0 else ''}" if not text else f" {'−' if x < 0 else '+'} ") + size + name
+    return text
 
 
 def linearize(system, t, q, qd, inputs=None, speeds=None):

@@ -23,7 +23,7 @@ from .projection import project_positions
 from .statics import equilibrium as find_equilibrium
 from .steady import check_steady
 from .trajectory import Trajectory
-from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL
+from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL, STABILITY_RTOL
 
 SHOWN = 3  # coordinates named per mode in the table
 DEGENERATE_RTOL = 1e-6  # eigenvalues this close (relative) are one repeated mode, split by rounding
@@ -66,10 +66,10 @@ class NodeShape:
 @dataclass(frozen=True)
 class Modes:
     """The modes of ``system_name`` at (t, q) (moving at ``qd`` about a steady motion),
-    lowest frequency first, and the linearization; ``cyclic``: the states whose zero
-    eigenvalues are not modes (cyclic coordinates, conserved speeds); ``zeros``: how many
-    zero eigenvalues those and any others make (0 at a holonomic rest, whose zeros are
-    free modes)."""
+    lowest frequency first, and the linearization; ``cyclic``: one name per zero eigenvalue
+    that is not a mode (cyclic coordinates, conserved speeds and directions that combine
+    them: ``Linearization.zero_states``); ``zeros``: how many (0 at a holonomic rest, whose
+    zeros are free modes)."""
 
     system_name: str
     coordinates: tuple
@@ -92,10 +92,36 @@ class Modes:
 
     @property
     def stable(self):
-        """Whether no eigenvalue has a positive real part (beyond rounding)."""
-        values = self.linearization.eigenvalues
-        scale = np.abs(values).max(initial=0.0)
-        return bool(np.all(values.real <= MODE_ZERO_RTOL * scale))
+        """Whether no eigenvalue has a positive real part (beyond STABILITY_RTOL): the
+        ``verdict`` is stable or neutral."""
+        return self.verdict.kind != "unstable"
+
+    @property
+    def verdict(self):
+        """The ``Verdict``: decided by the mode whose exponent has the largest real part (the
+        zero eigenvalues of ``cyclic`` aside: they move along the family of motions)."""
+        scale = np.abs(self.linearization.eigenvalues).max(initial=0.0)
+        if not self.modes:
+            return Verdict("neutral", None, None, STABILITY_RTOL * scale)
+        index = max(range(len(self.modes)), key=lambda i: self.modes[i].eigenvalue.real)
+        s = self.modes[index].eigenvalue
+        margin = STABILITY_RTOL * scale
+        kind = "unstable" if s.real > margin else "stable" if s.real < -margin else "neutral"
+        return Verdict(kind, index, s, margin)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Whether a rest or steady motion keeps itself: ``kind`` "stable" (every mode decays),
+    "unstable" (one grows) or "neutral" (the slowest neither grows nor decays, within
+    ``margin`` = STABILITY_RTOL times the largest |s|: undamped vibration, a free direction,
+    a speed at a boundary of stability); ``mode``: the index in ``Modes.modes`` of the one
+    that decides (the largest real part), ``eigenvalue`` its exponent (None without modes)."""
+
+    kind: str
+    mode: int
+    eigenvalue: complex
+    margin: float
 
 
 def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, qd=None, steady=False):
@@ -122,18 +148,20 @@ def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, 
     k = lin.k
     values = lin.eigenvalues
     scale = np.abs(values).max(initial=0.0)
-    free = np.abs(values) <= MODE_ZERO_RTOL * scale
+    rest = _holonomic_rest(lin)
+    # zeros: at a holonomic rest in pairs, a free direction and its rate (modes of their own); else the
+    # exact zeros of the cyclic directions (Linearization.zero_states), every other exponent a mode
+    free = np.abs(values) <= MODE_ZERO_RTOL * scale if rest else values == 0
     found = []
-    if _holonomic_rest(lin):  # zeros in pairs: a free direction and its rate
+    if rest:
         found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
     upper = [s for s in values[~free] if s.imag >= -MODE_ZERO_RTOL * scale]  # one of each conjugate pair
     for group in _degenerate_groups(upper):
         for s, x in zip(group, _eigenspace(lin.A, group, k)):
             found.append(_mode(system, t, q, lin, s, x, scale))
     found.sort(key=lambda m: (m.frequency, m.eigenvalue.real))
-    cyclic = () if _holonomic_rest(lin) else lin.cyclic
-    return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin, qd, cyclic,
-                 0 if _holonomic_rest(lin) else int(free.sum()))
+    cyclic = () if rest else lin.zero_states
+    return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin, qd, cyclic, len(cyclic))
 
 
 def _holonomic_rest(lin):
@@ -258,29 +286,56 @@ def mode_motion(system, result, index, amplitude=0.05, periods=2, frames=60):
 
 
 def format_modes(result, digits=6):
-    """The modes as a text table: one row per mode, the joints (or, in a model without
-    joint values, the coordinates) that move most, relative to the largest."""
+    """The modes as a text table under a header that says about what state they are taken
+    and in which coordinates: one row per mode, the joints (or, in a model without joint
+    values, the coordinates) that move most, relative to the largest; then the zero
+    eigenvalues that are no modes and the verdict (``Modes.verdict``)."""
     lin = result.linearization
-    independent = ", ".join(lin.state_names[:lin.k]) or "none"
-    about = "about its steady motion" if np.any(lin.qd) else "at rest"
-    speeds = (f", {lin.A.shape[0] - lin.k} independent speed(s): {', '.join(lin.state_names[lin.k:])}"
-              if lin.A.shape[0] != 2 * lin.k or np.any(lin.qd) else "")
-    lines = [f"modes of {result.system_name} {about} at t = {result.t:g}: {lin.k} degree(s) of freedom "
-             f"(independent coordinates: {independent}{speeds})",
-             f"{'#':>3}  {'frequency [Hz]':>15}  {'damping ratio':>13}  {'kind':<10}  {'eigenvalue [rad/s]':<26}"
-             "  largest motion"]
+    steady = bool(np.any(lin.qd))
+    speeds = lin.A.shape[0] - lin.k
+    lines = [f"modes of {result.system_name} {'about its steady motion' if steady else 'at rest'} at t = {result.t:g}",
+             f"  {_count(lin.k, 'degree')} of freedom, independent coordinates: "
+             f"{', '.join(lin.state_names[:lin.k]) or 'none'}"]
+    if speeds != lin.k or steady:
+        lines.append(f"  {_count(speeds, 'independent speed')} (the non-holonomic rows give the other rates): "
+                     f"{', '.join(lin.state_names[lin.k:]) or 'none'}")
+    if steady:
+        lines.append("  each eigenvalue s is a stability exponent: a small disturbance grows or decays as e^(s t)")
+    lines.append(f"{'#':>3}  {'frequency [Hz]':>15}  {'damping ratio':>13}  {'kind':<10}  {'eigenvalue [rad/s]':<26}"
+                 "  largest motion")
     for i, mode in enumerate(result.modes, 1):
         s = mode.eigenvalue
         lines.append(f"{i:>3}  {mode.frequency:>15.{digits}g}  {mode.damping_ratio:>13.4g}  {mode.kind:<10}  "
                      f"{f'{s.real:.{digits}g}{s.imag:+.{digits}g}j':<26}  {_largest(result, mode)}")
         lines += [f"{'':>5}{_nodes(name, nodes)}" for name, nodes in (mode.node_shape or {}).items()]
     if result.zeros:
-        named = f" (cyclic coordinates and conserved speeds: {', '.join(result.cyclic)})" if result.cyclic else ""
-        lines.append(f"zero eigenvalues: {result.zeros}{named}")
-    if not result.stable:
-        lines.append("unstable: an eigenvalue has a positive real part (the equilibrium is not a rest one keeps)"
-                     if not np.any(lin.qd) else "unstable: an eigenvalue has a positive real part")
+        lines.append(f"zero eigenvalues: {result.zeros}, no modes: directions along the family of "
+                     f"{'steady motions' if steady else 'rests'} (cyclic coordinates, conserved speeds): "
+                     f"{', '.join(result.cyclic)}")
+    lines.append(_verdict_line(result, steady))
     return "\n".join(lines)
+
+
+def _count(number, noun):
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
+def _verdict_line(result, steady):
+    """The verdict in words: stable, unstable or neutral, and the exponent that decides."""
+    verdict = result.verdict
+    what = "the steady motion" if steady else "the rest"
+    if verdict.mode is None:
+        return f"verdict: neutral ({what} has no mode beyond the zero eigenvalues)"
+    s = verdict.eigenvalue
+    exponent = f"mode {verdict.mode + 1}, s = {s.real:.6g}{s.imag:+.6g}j"
+    if verdict.kind == "stable":
+        return f"verdict: stable: every mode decays; the slowest, {exponent}, decides"
+    if verdict.kind == "unstable":
+        return f"verdict: unstable: {exponent} grows (Re s > 0): {what} is not one the model keeps"
+    why = {"vibration": "undamped: it neither grows nor decays", "free": "a free direction, which nothing restores"}
+    return (f"verdict: neutral: the largest real part, of {exponent}, is zero within {STABILITY_RTOL:g} of the "
+            f"largest |s| ({why.get(result.modes[verdict.mode].kind, 'at a boundary of stability')}): the "
+            "linearization does not decide")
 
 
 def _largest(result, mode):
@@ -330,7 +385,7 @@ def to_dict(result):
            "qd": dict(zip(result.coordinates, map(float, lin.qd))),
            "eigenvalues": [[float(x.real), float(x.imag)] for x in lin.eigenvalues],
            "zero_eigenvalues": result.zeros, "cyclic": list(result.cyclic),
-           "stable": result.stable, "modes": []}
+           "stable": result.stable, "verdict": _verdict_entry(result.verdict), "modes": []}
     for mode in result.modes:
         entry = {"eigenvalue": [mode.eigenvalue.real, mode.eigenvalue.imag], "frequency_hz": mode.frequency,
                  "damping_ratio": None if np.isnan(mode.damping_ratio) else mode.damping_ratio, "kind": mode.kind,
@@ -345,6 +400,15 @@ def to_dict(result):
                 entry["node_shape_imag"] = {name: _node_entry(nodes, np.imag) for name, nodes in mode.node_shape.items()}
         out["modes"].append(entry)
     return out
+
+
+def _verdict_entry(verdict):
+    """A Verdict as JSON-ready data: its kind, the deciding mode (1-based, as in the table)
+    and exponent, and the margin that separates stable, neutral and unstable."""
+    s = verdict.eigenvalue
+    return {"kind": verdict.kind, "mode": None if verdict.mode is None else verdict.mode + 1,
+            "eigenvalue": None if s is None else [s.real, s.imag], "margin": verdict.margin,
+            "stability_rtol": STABILITY_RTOL}
 
 
 def _node_entry(nodes, part):

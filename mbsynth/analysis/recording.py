@@ -1,5 +1,6 @@
 """The run loop's recording stage: one row per output time — the state, its kinetic and
-total energy, its largest constraint residuals and the model's declared outputs — kept for
+total energy, the power of its forces that derive from no potential (Data.power), its
+largest constraint residuals and the model's declared outputs — kept for
 the Trajectory and, when a file is asked for, written as the run goes
 (trajectory.TrajectoryWriter)."""
 
@@ -22,12 +23,13 @@ class Recorder:
     def __init__(self, data, rows, out=None):
         self.data, self.out = data, out
         self.run = run_of(data)
+        self.powered = bool(data.system.working_forces())  # else every row's power is 0: none evaluated
         self.outputs = OutputEvaluator(data)
         n, m = len(data.coordinates), len(self.outputs.names)
         _check_fits(rows, row_bytes(n, m), out)
         self.count = 0
         self.columns = dict(t=np.empty(rows), q=np.empty((rows, n)), qd=np.empty((rows, n)), energy=np.empty(rows),
-                            kinetic=np.empty(rows), residual_position=np.empty(rows),
+                            power=np.empty(rows), kinetic=np.empty(rows), residual_position=np.empty(rows),
                             residual_velocity=np.empty(rows), outputs=np.empty((rows, m)))
         self.writer = None
 
@@ -77,6 +79,8 @@ class Recorder:
         c = self.columns
         c["t"][rows_at], c["q"][rows_at], c["qd"][rows_at] = times, q, qd
         c["kinetic"][rows_at], c["energy"][rows_at] = kinetic, kinetic + potential
+        c["power"][rows_at] = ([self.data.power(t, q_row, qd_row) for t, q_row, qd_row in zip(times, q, qd)]
+                               if self.powered else 0.0)
         c["residual_position"][rows_at], c["residual_velocity"][rows_at] = residual_position, residual_velocity
         if self.outputs:
             for i, (t, q_row, qd_row) in enumerate(zip(times, q, qd)):
@@ -98,7 +102,7 @@ class Recorder:
         c = {name: column[rows] for name, column in self.columns.items()}
         return Trajectory(tuple(self.data.coordinates), c["t"], c["q"], c["qd"], c["energy"], c["kinetic"],
                           c["residual_position"], c["residual_velocity"], status, outputs=c["outputs"],
-                          output_names=tuple(self.outputs.names), **self.run)
+                          output_names=tuple(self.outputs.names), power=c["power"], **self.run)
 
 
 def run_of(data):
@@ -114,7 +118,7 @@ def run_of(data):
 def row_bytes(n, m):
     """The bytes of one row of a run with n coordinates and m outputs (its output time
     included)."""
-    return 8 * (2 * n + m + 6)
+    return 8 * (2 * n + m + 7)
 
 
 def _check_fits(rows, size, out):

@@ -25,8 +25,10 @@ Two contracts:
   symmetric part of −M_t K, its curvatures taken by magnitude (``_Model``). Minimizing Ψ on
   the manifold ends at a minimum: where the steps come to a rest at which H has a negative
   curvature (a maximum or saddle), a step along that curvature goes on down; so the rest
-  found from anywhere, near the upright double pendulum too, is a stable one, unless the
-  start rests already (then it is returned as it is, stable or not).
+  found from anywhere, near the upright double pendulum too, is a stable one; a start that
+  rests at a maximum or saddle (the upright pendulum exactly) is left the same way, along
+  its most negative curvature (the eigenvector's sign as LAPACK gives it: the same in every
+  run).
 - ``nearest=True``: the equilibrium, stable or not, a Newton iteration on the force balance
   a(u) = 0 reaches from q: Ψ = ½ q̈ᵀ M q̈ (= ½ aᵀ M_t a), modelled as ½ ‖a + K p‖²_M
   (Levenberg–Marquardt). From a start near an equilibrium, that one (the inverted pendulum
@@ -67,7 +69,7 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
     an array in the model's coordinates: by default a stable rest, a minimum of the potential
     on the constraints that steps down from q reach (in a model with one, the rest; with
     several, mostly the one the damped motion from q comes to, not always), or q itself
-    where it rests already; with ``nearest=True`` the equilibrium, stable or not, that
+    where it rests stably already; with ``nearest=True`` the equilibrium, stable or not, that
     Newton's iteration on the force balance reaches from q (the one near q where q starts
     near one: an inverted pendulum near the top). Module docstring. Raises NoEquilibrium
     when no rest is found from q, or when the rest found is not isolated (the coordinates
@@ -98,14 +100,14 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
         resolution = tolerance * (1.0 + np.abs(K).max())
         model = None
         if np.abs(lin.qdd).max() <= resolution:
-            model = None if nearest or iteration == 0 else _Model(system, t, q, lin, K, nearest, resolution)
+            model = None if nearest else _Model(system, t, q, lin, K, nearest, resolution)
             if model is None or not model.unstable:
                 _check_isolated(system, t, q, lin, K)
                 return q
-            model.downhill()  # a maximum or saddle the steps came to: on down from it
+            model.downhill()  # a maximum or saddle (the start, or where the steps came to): on down from it
         model = model or _Model(system, t, q, lin, K, nearest, resolution)
         if radius is None:
-            radius = model.size(model.along_force) * limit / np.abs(lin.basis @ model.along_force).max()
+            radius = model.first_radius(lin.basis, limit)
         q, radius = _step(system, t, q, lin, model, merit, radius, limit, elastic)
     worst = int(np.argmax(np.abs(lin.qdd)))
     raise NoEquilibrium(f"model '{system.name}': no static equilibrium found from the given configuration: after "
@@ -158,6 +160,12 @@ class _Model:
         """The model of a rest's neighbourhood with its negative curvature kept: its steps go
         down along it (the trust region's hard case)."""
         self.c, self.d = np.zeros_like(self.c), self.curvature
+
+    def first_radius(self, basis, limit):
+        """The first step's Δ: that of a move by ``limit`` in the largest coordinate along the
+        force or, at a rest (a maximum or saddle), along the most negative curvature."""
+        p = self.along_force if np.any(self.along_force) else self.P[:, np.argmin(self.d)]
+        return self.size(p) * limit / np.abs(basis @ p).max()
 
     def size(self, p):
         """‖p‖_M."""

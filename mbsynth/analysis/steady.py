@@ -19,6 +19,8 @@ from ..core.tolerances import ACCELERATION_TOL, ON_MANIFOLD_RTOL, RANK_RTOL
 from .linearization import finite_state, linearize
 from .projection import project_positions
 
+QUATERNION = ("qw", "qx", "qy", "qz")  # the coordinates of a part turned by a unit quaternion (Part.groups)
+
 
 def steady_motion(system, rates, q=None, t=0.0, solve=(), tolerance=ACCELERATION_TOL):
     """(q, q̇) of a steady motion of ``system``: ``q`` (default its initial positions) put on
@@ -130,5 +132,17 @@ def check_steady(system, lin, tolerance=ACCELERATION_TOL):
         raise NoEquilibrium(f"model '{system.name}' does not move steadily here: "
                             + "; ".join(([f"{moving} move but the dynamics depends on them"] if moving else [])
                                         + ([f"the rates of {changing} change"] if changing else []))
-                            + " (a steady motion moves only cyclic coordinates, at constant speeds: a spin angle "
-                              "of a body with rotation: zxy, not a quaternion)", coordinates=moving + changing)
+                            + " (a steady motion moves only cyclic coordinates, at constant speeds"
+                            + _quaternion_hint(system) + ")", coordinates=moving + changing)
+
+
+def _quaternion_hint(system):
+    """For a model with parts turned by a quaternion, whose spin is no coordinate of its
+    own: the advice to turn them by angles, the spin last."""
+    turned = [part.name for part in system.parts if QUATERNION in part.groups]
+    if not turned:
+        return ""
+    one = len(turned) == 1
+    return (f"; {', '.join(turned[:4])}{', ...' if len(turned) > 4 else ''} {'is' if one else 'are'} turned by a "
+            f"quaternion, whose spin is no cyclic coordinate: give {'it' if one else 'them'} rotation: zxy, the "
+            "spin angle last")

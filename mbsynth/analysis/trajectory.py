@@ -1,10 +1,11 @@
 """Trajectories and their files.
 
 A ``Trajectory`` holds one row per output time: ``t``, ``q``, ``qd``, the largest
-position and velocity constraint residuals, the total energy, and the model's declared
-``outputs`` (one column per name in ``output_names``: mbsynth.model.outputs). Files:
+position and velocity constraint residuals, the total energy, the power of the forces that
+derive from no potential (``Data.power``: dampers, actuation, friction), and the model's
+declared ``outputs`` (one column per name in ``output_names``: mbsynth.model.outputs). Files:
 
-- ``.npz``: arrays ``t``, ``q``, ``qd``, ``coordinates`` (plus ``energy``,
+- ``.npz``: arrays ``t``, ``q``, ``qd``, ``coordinates`` (plus ``energy``, ``power``,
   ``residual_position``, ``residual_velocity``, ``status``, ``outputs``, ``output_names``,
   and the run's model: ``model`` (its name), ``model_file``, ``parameter_names``,
   ``parameter_values``: the values of its parameters not defined by others, at the start);
@@ -30,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import scipy.interpolate
 
 from ..core.errors import ModelError
 from ..core.files import file_format, unwritable, write_atomically
@@ -52,6 +54,7 @@ class Trajectory:
     stats: dict = field(default_factory=dict)
     outputs: np.ndarray = None  # T × len(output_names): the model's declared outputs
     output_names: tuple = ()
+    power: np.ndarray = None  # per row: the power of the forces that derive from no potential (Data.power)
     model: str = ""  # the name of the model run
     model_file: str = ""  # its file ("" where it was not read from one)
     parameters: dict = field(default_factory=dict)  # its parameters not defined by others, at the start
@@ -59,16 +62,33 @@ class Trajectory:
     def __post_init__(self):
         if self.outputs is None:
             self.outputs = np.zeros((len(self.t), len(self.output_names)))
+        if self.power is None:
+            self.power = np.zeros(len(self.t))
+
+    @property
+    def work(self):
+        """W(t): the work those forces did from the first row on, per row (negative where
+        they dissipate): ``power`` integrated over the rows through its cubic spline (an
+        error of order dt⁴ in the output interval dt); NaN where the power is not known (a
+        CSV file keeps none)."""
+        if self.t.size < 2 or not np.any(self.power):
+            return np.zeros(self.t.size)
+        if not np.all(np.isfinite(self.power)):
+            return np.full(self.t.size, np.nan)
+        return scipy.interpolate.CubicSpline(self.t, self.power).antiderivative()(self.t)
 
     @property
     def energy_drift(self):
-        """max |E(t) − E(0)| relative to max(|E(0)|, the largest kinetic energy): a
-        pendulum whose energy is zero at the start still gets a meaningful scale."""
+        """max |E(t) − E(0) − W(t)| (the change of T + V beyond the work of the forces that
+        derive from no potential, ``work``: the integration's error where nothing else
+        changes the energy, ``System.unaccounted_work``) relative to max(|E(0)|, the largest
+        kinetic energy): a pendulum whose energy is zero at the start still gets a
+        meaningful scale."""
         E = self.energy
         if E.size == 0 or not np.all(np.isfinite(E)):
             return float("nan")
         scale = max(abs(E[0]), float(np.nanmax(np.abs(self.kinetic))) if self.kinetic.size else 0.0)
-        return 0.0 if scale == 0 else float(np.abs(E - E[0]).max() / scale)
+        return 0.0 if scale == 0 else float(np.abs(E - E[0] - self.work).max() / scale)
 
     @property
     def max_residual(self):
@@ -125,8 +145,8 @@ def load_trajectory(path):
         return Trajectory(coordinates, get["t"], get["q"], get["qd"], get.get("energy", nan),
                           get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
                           str(get.get("status", COMPLETED)), outputs=get.get("outputs"), output_names=names,
-                          model=str(get.get("model", "")), model_file=str(get.get("model_file", "")),
-                          parameters=parameters)
+                          power=get.get("power", nan), model=str(get.get("model", "")),
+                          model_file=str(get.get("model_file", "")), parameters=parameters)
     if file_format(path) == ".csv" or path.name.lower().endswith(".csv.partial"):
         with path.open(newline="") as f:
             header = next(csv.reader(f))
@@ -139,7 +159,7 @@ def load_trajectory(path):
         nan = np.full(data.shape[0], np.nan)
         return Trajectory(tuple(header[1:1 + n]), data[:, 0], data[:, 1:1 + n], data[:, 1 + n:1 + 2 * n],
                           data[:, energy], nan, nan, nan, outputs=data[:, energy + 1:],
-                          output_names=tuple(header[energy + 1:]))
+                          output_names=tuple(header[energy + 1:]), power=nan)
     raise ModelError(f"{path}: unknown trajectory format (use {' or '.join(FORMATS)})")
 
 
@@ -237,7 +257,8 @@ class TrajectoryWriter:
             return parts[0] if len(parts) == 1 else np.concatenate(parts)  # one: the rows themselves, no copy
 
         columns = dict(t=stack("t"), q=stack("q", n), qd=stack("qd", n), coordinates=np.array(self.coordinates),
-                       energy=stack("energy"), kinetic=stack("kinetic"), residual_position=stack("residual_position"),
+                       energy=stack("energy"), power=stack("power"), kinetic=stack("kinetic"),
+                       residual_position=stack("residual_position"),
                        residual_velocity=stack("residual_velocity"), status=np.array(self.status),
                        outputs=stack("outputs", len(self.output_names)),
                        output_names=np.array(self.output_names, dtype=str), model=np.array(self.run["model"]),

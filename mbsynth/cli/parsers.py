@@ -210,11 +210,13 @@ def _modes(commands):
     _model_argument(modes)
     modes.add_argument("--equilibrium", action="store_true",
                        help="first find a stable rest from the initial state: a minimum of the potential on "
-                            "the constraints that steps down from it reach (mb.equilibrium)")
+                            "the constraints that steps down from it reach (mb.equilibrium; a start at a maximum "
+                            "or saddle is left along its steepest way down)")
     modes.add_argument("--steady", action="store_true",
                        help="linearize about the model's initial motion, a steady one (a bicycle rolling upright, a "
                             "disk rolling in a circle: only cyclic coordinates move, at constant rates): its "
-                            "eigenvalues are the motion's stability exponents")
+                            "eigenvalues are the motion's stability exponents, and the verdict (stable, unstable "
+                            "or neutral) names the one with the largest real part")
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.add_argument("--html", metavar="FILE.html",
                        help="write an HTML page animating each mode in meshcat (a selector per mode)")

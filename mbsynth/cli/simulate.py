@@ -41,6 +41,7 @@ def run(args):
                "steps": traj.stats.get("steps"), "evaluations": traj.stats.get("evaluations"),
                "wall_time_s": round(time.perf_counter() - started, 3), "max_residual": traj.max_residual,
                "energy_drift": traj.energy_drift, "working_forces": system.working_forces(),
+               "work": float(traj.work[-1]) if traj.t.size else 0.0, "unaccounted_work": system.unaccounted_work(),
                "initial_changes": traj.stats.get("initial_changes", {}),
                "singular_positions": [{"t_from": float(e["t_from"]), "t_to": float(e["t_to"]), "rows": e["rows"]}
                                       for e in traj.stats.get("singular_positions", [])],
@@ -100,9 +101,17 @@ def format_summary(s):
 
 
 def _energy_line(s):
-    """The relative change of T + V: "drift" only where nothing in the model does work."""
-    working = s["working_forces"]
-    if not working:
-        return f"relative energy drift {s['energy_drift']:.3g}"
-    return (f"relative energy change {s['energy_drift']:.3g} (work of {', '.join(working[:4])}"
-            f"{', ...' if len(working) > 4 else ''})")
+    """The relative change of T + V beyond the work of the forces that derive from no
+    potential (dampers, actuation): "drift" only where that work is all accounted."""
+    working, unaccounted = s["working_forces"], s["unaccounted_work"]
+    accounted = [name for name in working if name not in unaccounted]
+    work = f" after the work of {_names(accounted)} ({s['work']:.3g} J)" if accounted else ""
+    if not unaccounted:
+        return f"relative energy drift {s['energy_drift']:.3g}{work}"
+    return (f"relative energy change {s['energy_drift']:.3g}{work}; energy not conserved: the work of "
+            f"{_names(unaccounted)} is not accounted")
+
+
+def _names(names, shown=4):
+    """The first ``shown`` of ``names``, joined."""
+    return ", ".join(names[:shown]) + (", ..." if len(names) > shown else "")

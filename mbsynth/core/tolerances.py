@@ -60,6 +60,8 @@ ACCELERATION_TOL = 1e-10  # statics.py: largest |q̈| (SI units) accepted at an 
 ISOLATED_RTOL = 1e-9  # statics.py: a singular value of K below this times the largest: a free direction
 MODE_ZERO_RTOL = 1e-6  # modes.py: an eigenvalue below this times the largest |s| is zero (a free direction):
 # a zero stiffness computed with rounding error ε splits a double zero eigenvalue into ±√ε, so the cut is near √ε
+STABILITY_RTOL = 1e-6  # modes.py: an exponent whose real part is within this times the largest |s| of 0 is
+# neutral (it neither grows nor decays to the linearization's accuracy: rounding splits a double zero into ±√ε)
 COMPONENT_TOL = 1e-12  # diagnose.py: a direction's component below this is left out of its description
 AXIS_TOL = 1e-9  # diagnose.py: a unit vector within this of a body's or the world's axis is that axis
 

@@ -169,6 +169,12 @@ class Data:
         q, qd = self._state(q, qd)
         return self.evaluator.energies(t, q, qd, self.p)
 
+    def power(self, t, q, qd):
+        """The power of the forces that derive from no potential (``Evaluator.power``): the
+        rate at which they change T + V."""
+        q, qd = self._state(q, qd)
+        return self.evaluator.power(t, q, qd, self.p)
+
     def branch_problems(self, q=None, t=0.0):
         return self.system.branch_problems(q, t, self.p)
 

@@ -6,7 +6,8 @@ An ``Evaluator(system)`` (a Data's, data.py) gives
   C, and the residuals φ, φ̇ (NaN on rows without that level) — drift control and
   projection (projection.py) need them together;
 - ``parts(t, q, qd)``: the block-diagonal M and the stacked Q of (2.1), force elements included;
-- ``energies(t, q, qd)``: kinetic and potential energies of the parts and force elements.
+- ``energies(t, q, qd)``: kinetic and potential energies of the parts and force elements;
+- ``power(t, q, qd)``: the power of the forces that derive from no potential.
 
 The results equal those of calling each connector and part (``Connector.evaluate``,
 ``residuals``, ``Part.evaluate``, ``energy``), which remain the reference.
@@ -66,6 +67,9 @@ class Evaluator:
         forces = system.forces
         self.forces = Batch([f._evaluate for f in forces], [f.indices for f in forces], 2)
         self.f_cols = np.concatenate([np.zeros(0, int)] + [f.indices for f in forces])
+        self.working = ([(part, r) for part, r in zip(system.parts, ranges) if part.working],
+                        [f for f in forces if not f.conservative],
+                        any(x != 0 for c in constraints for x in c.C.values()))  # parts, elements, a non-ideal C
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
@@ -123,4 +127,15 @@ class Evaluator:
         """(kinetic, potential): the parts' T and V, and the force elements' potentials, summed."""
         T, V = self.energy(t, q, qd, p)
         return float(T.sum()), float(V.sum() + self.forces(t, q, qd, p)[1].sum())
+
+    def power(self, t, q, qd, p):
+        """q̇ᵀ Q_nc at (t, q, q̇): the power of the parts' forces beyond T and V (dampers,
+        generalized forces), of the force elements' efforts and of the constraints' non-ideal
+        C (2.6; viscous friction) — d(T + V)/dt where nothing holds t explicitly and no
+        Coulomb friction acts (``System.unaccounted_work``)."""
+        parts, elements, nonideal = self.working
+        total = sum(part.power(t, q[r], qd[r], p) for part, r in parts) + sum(e.power(t, q, qd, p) for e in elements)
+        if nonideal:
+            total += float(qd @ np.bincount(self.c_cols, weights=self.rows(t, q, qd, p)[2], minlength=self.n))
+        return float(total)
 

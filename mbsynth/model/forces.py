@@ -43,6 +43,9 @@ class ForceElement:
         self._evaluate = compile_function(
             (T_SYMBOL, [q[i] for i in local], [qd[i] for i in local], list(params)),
             [Q.extract(local, [0]), self.V])
+        self._power = None  # compiled when first asked (``power``), from:
+        self._power_terms = None if self.conservative or self.V == 0 else (
+            Q.extract(local, [0]), self.V, [q[i] for i in local], [qd[i] for i in local], list(params))
 
     @classmethod
     def along_rates(cls, name, efforts, gradients, placed, params, joint=None):
@@ -57,6 +60,7 @@ class ForceElement:
         local = sorted(local, key=coordinates.__getitem__)
         element = cls.__new__(cls)
         element.name, element.joint, element.conservative, element.V = name, joint, False, sp.S.Zero
+        element._power = element._power_terms = None
         constants = {**constants, **dict(zip(marks, efforts))}
         element._Q, element._placed = None, (column, slots, coordinates, constants, q, qd)
         element.indices = np.array([coordinates[j] for j in local], dtype=int)
@@ -80,11 +84,30 @@ class ForceElement:
         with quiet_at_zero_length():
             return self._evaluate(t, q[self.indices], qd[self.indices], p)[0].ravel()
 
+    def power(self, t, q, qd, p):
+        """The power q̇ᵀ(Q_e + ∂V/∂q) = Σ effort·rate of the element's efforts at the full
+        state: what they add to d(T + V)/dt (0 for a conservative element)."""
+        if self.conservative:
+            return 0.0
+        if self._power_terms is None:  # no potential: all of Q_e is the efforts'
+            return float(qd[self.indices] @ self.evaluate(t, q, qd, p))
+        if self._power is None:
+            self._power = _power_function(*self._power_terms)
+        with quiet_at_zero_length():
+            return float(self._power(t, q[self.indices], qd[self.indices], p)[0])
+
     def potential(self, t, q, qd, p):
         return float(self._evaluate(t, q[self.indices], qd[self.indices], p)[1])
 
     def symbolic(self):
         return self.Q
+
+
+def _power_function(Q, V, q, qd, params):
+    """The compiled Σ q̇_i (Q_i + ∂V/∂q_i) over the element's coordinates ``q``: its
+    efforts' power (Q = −∂V/∂q + Σ effort ∂rate/∂q̇, each rate linear in q̇)."""
+    power = sum((v * (f + sp.diff(V, x)) for x, v, f in zip(q, qd, Q)), sp.S.Zero)
+    return compile_function((T_SYMBOL, q, qd, params), [power])
 
 
 @functools.lru_cache(maxsize=256)

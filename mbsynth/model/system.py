@@ -413,18 +413,34 @@ class System:
 
     def working_forces(self):
         """The names of what can change the total energy T + V: force elements with efforts
-        (actuation, dampers), parts with generalized forces or an explicit t, constraints
-        with a non-ideal C (friction) or an explicit t (a prescribed motion). Empty: the
-        energy is conserved, and its change along a run is drift."""
-        found = [e.name for e in self.forces if not e.conservative]
-        for part in self.parts:
-            own = part.__dict__.get("_symbolic")  # parts shared from a template hold neither
-            if any(f != 0 for f in getattr(part, "forces", ())) or (own and any(T_SYMBOL in x.free_symbols
-                                                                                  for x in own[2:])):
-                found.append(part.name)
-        for con in self.connectors:
-            own = con.__dict__.get("_symbolic")  # placed (joint) rows hold neither
-            if getattr(con, "coulomb", None) or (own and (any(x != 0 for x in own[2]) or any(
-                    T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ()))))):
-                found.append(con.name)
+        (actuation, dampers), parts with forces beyond T and V (generalized forces, modal or
+        Rayleigh damping, a spring's damper) or an explicit t, constraints with a non-ideal C
+        (friction) or an explicit t (a prescribed motion). Empty: the energy is conserved,
+        and its change along a run is drift."""
+        found = [e.name for e in self.forces if not e.conservative or T_SYMBOL in e.V.free_symbols]
+        found += [part.name for part in self.parts if part.working or _time_in_part(part)]
+        found += [con.name for con in self.connectors
+                  if getattr(con, "coulomb", None) or any(x != 0 for x in con.C.values()) or _time_in_rows(con)]
         return found
+
+    def unaccounted_work(self):
+        """The names among ``working_forces`` whose work a run does not integrate
+        (``Data.power``): an explicit t in a potential, a kinetic energy or a constraint,
+        and Coulomb friction (its force depends on q̈)."""
+        found = [e.name for e in self.forces if T_SYMBOL in e.V.free_symbols]
+        found += [part.name for part in self.parts if _time_in_part(part)]
+        found += [con.name for con in self.connectors if getattr(con, "coulomb", None) or _time_in_rows(con)]
+        return found
+
+
+def _time_in_part(part):
+    """Whether the part's T or V holds t (parts shared from a template hold neither)."""
+    own = part.__dict__.get("_symbolic")
+    return bool(own) and any(T_SYMBOL in x.free_symbols for x in own[2:])
+
+
+def _time_in_rows(con):
+    """Whether the connector's b or velocity residual ψ holds t: a prescribed motion
+    (placed joint rows hold neither)."""
+    own = con.__dict__.get("_symbolic")
+    return bool(own) and any(T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ())))

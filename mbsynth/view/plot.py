@@ -19,8 +19,9 @@ def plot_trajectory(traj, path, title=None, system=None, names=None):
     Top panel: the columns ``names`` (coordinates ``part.c``, velocities ``part.c_dot``,
     outputs); else the model's declared outputs; else, for a ``system`` with joints, the
     joint coordinates (angles unwrapped); else its first coordinates. Middle: kinetic and
-    potential energy, and their sum's change labelled "energy drift" only where nothing in
-    the model does work (``System.working_forces``). Bottom: the constraint residuals."""
+    potential energy, the work of the forces that derive from no potential, and the change
+    of T + V beyond that work, labelled "energy drift" only where nothing else changes the
+    energy (``System.unaccounted_work``). Bottom: the constraint residuals."""
     fig, (ax_q, ax_e, ax_r) = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     series, label = _series(traj, system, names)
     for name, values in series[:MAX_LINES]:
@@ -62,16 +63,29 @@ def _series(traj, system, names):
 
 
 def _energy(axes, traj, system):
-    """Kinetic and potential energy; their sum's change, named drift only when no force works."""
+    """Kinetic and potential energy, the work W of the forces that derive from no potential
+    (where the model has any), and the change of T + V beyond it: named drift only where
+    nothing else changes the energy (``System.unaccounted_work``)."""
     potential = traj.energy - traj.kinetic
     axes.plot(traj.t, traj.kinetic, label="kinetic T")
     axes.plot(traj.t, potential, label="potential V")
     working = system.working_forces() if system is not None else None
-    change = traj.energy - traj.energy[0]
-    if working == []:
-        axes.plot(traj.t, change, label="energy drift (T + V)(t) − (T + V)(0)")
+    unaccounted = system.unaccounted_work() if system is not None else None
+    accounted = [name for name in working or () if name not in (unaccounted or ())]
+    work = traj.work
+    if accounted:
+        axes.plot(traj.t, work, label=f"work W of {_names(accounted)}")
+    change = traj.energy - traj.energy[0] - work
+    beyond = " − W(t)" if accounted else ""
+    if unaccounted == []:
+        axes.plot(traj.t, change, label=f"energy drift (T + V)(t) − (T + V)(0){beyond}")
     else:
-        doing = f" (work of {', '.join(working[:3])}{', ...' if len(working) > 3 else ''})" if working else ""
-        axes.plot(traj.t, change, label=f"(T + V)(t) − (T + V)(0){doing}")
+        doing = f" (not conserved: work of {_names(unaccounted)})" if unaccounted else ""
+        axes.plot(traj.t, change, label=f"(T + V)(t) − (T + V)(0){beyond}{doing}")
     axes.set_ylabel("energy [J]")
     axes.legend(fontsize="small")
+
+
+def _names(names, shown=3):
+    """The first ``shown`` of ``names``, joined."""
+    return ", ".join(names[:shown]) + (", ..." if len(names) > shown else "")

@@ -3,7 +3,7 @@ the search does not use — closed forms of the configuration from the models' g
 applied forces Q balanced by the constraints (Q orthogonal to the null space of A, taken
 here by an SVD), the constraints met, and a minimum of V (no small move on the constraints
 lowers it) — and its two contracts: the stable rest by default (also from a maximum or
-saddle the steps come to), the equilibrium near the start with ``nearest=True``."""
+saddle the steps come to or start at), the equilibrium near the start with ``nearest=True``."""
 
 from pathlib import Path
 
@@ -125,6 +125,20 @@ def test_loops_come_to_a_balanced_minimum_from_random_starts(name, seed):
     q = mb.equilibrium(system, system.initial_state()[0] + 0.3 * rng.normal(size=system.n))
     assert_balanced(system, q)
     assert_minimum(system, q, rng)
+
+
+@pytest.mark.parametrize("second", [180, 0], ids=["maximum", "saddle"])
+def test_started_at_rest_upright_it_comes_down_to_the_stable_rest(second):
+    """Rests exactly where the potential has a maximum (both rods up) or a saddle (the first
+    up, the second hanging): the default contract is a stable rest, so the search leaves
+    them along their negative curvature and ends hanging, a minimum of V."""
+    system = mb.load(RODS)
+    l = system.parameters["l"]
+    start = rods_start(system, tilted(180), tilted(second))
+    assert np.abs(mb.equilibrium(system, start, nearest=True) - start).max() < 1e-12  # it does rest there
+    q = mb.equilibrium(system, start)
+    assert q == pytest.approx([0, 0, -l, 0, 0, -2 * l], abs=1e-9)
+    assert_minimum(system, q, np.random.default_rng(0))
 
 
 def test_pd_pendulum_from_far_away():

@@ -284,13 +284,16 @@ def test_equilibrium_goes_down_to_the_hanging_double_pendulum(start):
     assert system.energy(0.0, q, np.zeros(2))[1] == pytest.approx(hanging_potential(system.parameters), rel=1e-12)
 
 
-def test_equilibrium_at_a_rest_keeps_it_unstable_or_not():
-    """Started exactly upright, the pendulum rests already: that rest is the answer, and
-    its modes say it is unstable."""
+def test_equilibrium_started_at_an_unstable_rest():
+    """Started exactly upright, the pendulum rests, unstably (its modes say so): with
+    ``nearest=True`` that rest is the answer; by default, a stable rest, the hanging one."""
     system = mb.load(MODELS / "rigid" / "double_pendulum_angles.yaml")
-    q = mb.equilibrium(system, np.array([np.pi, 0.0]))
-    assert q == pytest.approx([np.pi, 0.0], abs=1e-12)
-    assert not mb.modes(system, q).stable
+    upright = np.array([np.pi, 0.0])
+    assert mb.equilibrium(system, upright, nearest=True) == pytest.approx(upright, abs=1e-12)
+    assert mb.modes(system, upright).verdict.kind == "unstable"
+    q = mb.equilibrium(system, upright)
+    assert (q + np.pi) % (2 * np.pi) - np.pi == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert system.energy(0.0, q, np.zeros(2))[1] == pytest.approx(hanging_potential(system.parameters), rel=1e-12)
 
 
 def test_modes_equilibrium_command_of_the_double_pendulum(capsys):

@@ -51,6 +51,9 @@ class Part:
     # coordinates that move together (a point's x, y, z; a quaternion's four numbers): one
     # scale for all of them in the projection's metric (projection.py); others stand alone
     groups = ()
+    # q̇ᵀ Q_nc in the part's symbols: the power of its forces that derive from neither T nor V
+    # (dampers, generalized forces); a subclass with such forces sets it before Part.__init__
+    power_expression = sp.S.Zero
 
     def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None,
                  shared=None):
@@ -70,6 +73,7 @@ class Part:
         args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
         self._evaluate = compile_function(args, template[:2], constants)
         self._energy = compile_function(args, template[2:], constants)
+        self._power, self._power_args = None, (args, constants)  # compiled when first asked (``power``)
         self._reads = None  # the symbols M and Q are written in (``reads``), once asked
 
     def _materialized(self):
@@ -105,6 +109,19 @@ class Part:
         """(kinetic, potential) energy of this part."""
         T, V = self._energy(t, q, qd, p)
         return float(T), float(V)
+
+    @property
+    def working(self):
+        """Whether the part's forces beyond T and V can do work (``power`` not identically 0)."""
+        return self.power_expression != 0
+
+    def power(self, t, q, qd, p):
+        """The power q̇ᵀ Q_nc of the part's forces beyond T and V (``power_expression``) at
+        its own coordinates q, velocities qd: what they add to d(T + V)/dt."""
+        if self._power is None:
+            args, constants = self._power_args
+            self._power = compile_function(args, [self.power_expression], constants)
+        return float(self._power(t, q, qd, p)[0])
 
     def symbolic(self):
         """(M, Q) as sympy matrices of the model's symbols."""

@@ -63,6 +63,9 @@ class FlexibleBody(Part):
         self.damping = np.zeros((r, r)) if damping is None else np.asarray(damping, float)
         if self.damping.shape != (r, r):
             raise ModelError(f"flexible body '{name}': damping is {self.damping.shape}, the reduction has {r} coordinates")
+        eta_dot = sp.Matrix(qd[7:])
+        if self.damping.any():
+            self.power_expression = -(eta_dot.T * _numbers(self.damping) * eta_dot)[0]  # the damping's: −η̇ᵀDη̇
         self.stiffening = np.zeros((3, 3, r, r)) if stiffening is None else np.asarray(stiffening, float)
         if self.stiffening.shape != (3, 3, r, r):
             raise ModelError(f"flexible body '{name}': stiffening is {self.stiffening.shape}, expected {(3, 3, r, r)}")

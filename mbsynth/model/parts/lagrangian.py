@@ -19,6 +19,7 @@ class LagrangianPart(Part):
 
     def __init__(self, name, coordinates, q, qd, T, V, forces, params, frames=(), geometry=()):
         self.forces = tuple(sp.sympify(f) for f in forces)  # generalized forces beyond V (they may do work)
+        self.power_expression = sum((v * f for v, f in zip(qd, self.forces)), sp.S.Zero)
         M, Q = lagrange(T, V, list(forces), q, qd)
         self.groups = same_units(coordinates, M)
         super().__init__(name, coordinates, q, qd, M, Q, T, V, params, frames, geometry)

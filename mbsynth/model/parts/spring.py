@@ -48,6 +48,7 @@ class Spring(Part):
     def __init__(self, name, q, qd, stiffness, rest_length, damping, mass, gravity, params, initial=None):
         p1, p2 = sp.Matrix(q[:3]), sp.Matrix(q[3:])
         V_spring, efforts = spring_damper(p1, p2, stiffness, rest_length, damping, q, qd)
+        self.power_expression = sum((effort * rate for effort, rate in efforts), sp.S.Zero)  # the damper's
         V = V_spring - mass * (sp.Matrix(gravity).T * (p1 + p2))[0] / 2
         I3 = sp.eye(3)
         M = mass / 6 * sp.Matrix(sp.BlockMatrix([[2 * I3, I3], [I3, 2 * I3]]))
