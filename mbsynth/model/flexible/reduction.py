@@ -56,6 +56,7 @@ LOOK_PAST = 4  # modes asked for beyond a count, to see whether the last one's f
 DENSE_MODES_MAX = 120  # up to this many DOFs the modes come from a dense solver, every finite one at once
 RIGID_RANK_RTOL = 1e-9  # singular values of the rigid-body modes at the interface below this fraction: a motion it leaves
 FINITE_RTOL = 1e-12  # a dense mode with 1/(λ + shift) below FINITE_RTOL / shift is an infinite one (M φ = 0)
+EIGSH_RESTARTS = 300  # eigsh's restarts at most (tens suffice about this shift): a spectrum lost in rounding ends
 START_SEED = 0  # eigsh's start vector (and any restart it draws) from this seed: the same modes in every process
 
 
@@ -127,14 +128,11 @@ def craig_bampton(fe, interface, *, count=None, max_frequency=None, shift=None):
             raise ModelError(singular + "a motion of the other nodes has no stiffness (a mechanism, or a piece "
                              "the interface does not reach)") from err
         T[i, :] = -interior.solve(K[i][:, b].toarray())
+        if len(i):
+            _resolved(Mii, Kii, _weight(fe, i, Mii, interior), singular)
     omega, shapes = normal_modes(Mii, Kii, count=count, max_frequency=max_frequency, shift=shift, source=fe.source)
-    lowest = omega[0] ** 2 if len(omega) else _lowest(Mii, Kii, shift, fe.source)
-    if lowest <= ZERO_RTOL * _scale(Mii, Kii):
-        raise ModelError(singular + f"its lowest mode, ω² = {lowest:.3g} (rad/s)², is at the rounding level of K "
-                         f"({ZERO_RTOL:g} · tr K / tr M = {ZERO_RTOL * _scale(Mii, Kii):.3g}): a motion the interface "
-                         "does not stop (a mechanism, a piece it does not reach), or a model finer than double "
-                         "precision resolves (an Euler–Bernoulli beam's ω² spread grows as elements⁴: fewer "
-                         "elements, or theory: timoshenko)")
+    if len(b) and len(i):
+        _resolved(Mii, Kii, omega[0] ** 2 if len(omega) else _lowest(Mii, Kii, shift, fe.source), singular)
     Phi = np.zeros((fe.size, len(omega)))
     Phi[i] = shapes
     return _reduction(fe, "craig_bampton", nodes, np.hstack([T, Phi]), slice(len(b), len(b) + len(omega)), omega)
@@ -182,14 +180,17 @@ def normal_modes(M, K, *, count=None, max_frequency=None, shift=None, rigid=True
             return first + count if first + count <= len(lam) else None
         return next((start for start, end in clusters if start >= first and np.mean(lam[start:end]) > limit), None)
 
+    def enough(lam, clusters):
+        stop = stop_at(lam, clusters)
+        return np.sum(lam <= zero) > RIGID_MODES_MAX or (stop is not None and stop <= clusters[-1][0])
+
     batch = FIRST_BATCH if count is None else count + (0 if rigid else RIGID_MODES_MAX) + LOOK_PAST
-    lam, vectors = _solve(M, K, shift, batch, lambda lam, clusters: (stop := stop_at(lam, clusters)) is not None
-                          and stop <= clusters[-1][0], zero, source)
+    lam, vectors = _solve(M, K, shift, batch, enough, zero, source)
+    if np.sum(lam <= zero) > RIGID_MODES_MAX:
+        raise ModelError(f"{source}: {np.sum(lam <= zero)} modes or more at zero frequency (ω² ≤ {zero:.3g}, the "
+                         f"rounding level of K), more than a body's {RIGID_MODES_MAX} rigid-body motions: a mechanism, "
+                         f"unconnected pieces, or {_TOO_FINE}")
     first, clusters = first_kept(lam), _clusters(lam, zero)
-    if first > RIGID_MODES_MAX:
-        raise ModelError(f"{source}: {first} modes at zero frequency (ω² ≤ {zero:.3g}, the rounding level of K), more "
-                         f"than a free body's {RIGID_MODES_MAX} rigid-body motions: a mechanism, unconnected pieces, "
-                         "or a model finer than double precision resolves")
     stop = stop_at(lam, clusters)
     if stop is None and count is not None:
         found = (f"eigsh finds only {len(lam) - first}" if n > DENSE_MODES_MAX else
@@ -198,7 +199,7 @@ def normal_modes(M, K, *, count=None, max_frequency=None, shift=None, rigid=True
         raise ModelError(f"{source}: {count} modes asked for, but {found}"
                          + (" besides the rigid-body ones" if first else "") + f" ({why})")
     if stop is None:
-        if len(lam) < M.shape[0] - 2 or n <= DENSE_MODES_MAX:
+        if n <= DENSE_MODES_MAX:
             stop = len(lam)  # every finite mode lies below max_frequency
         else:
             raise ModelError(f"{source}: more than {len(lam)} modes lie below {max_frequency} Hz (eigsh takes at most "
@@ -259,15 +260,18 @@ def _sparse_modes(M, K, sigma, operator, k, source):
     rng = np.random.default_rng(START_SEED)
     try:
         lam, vectors = scipy.sparse.linalg.eigsh(K, k=k, M=M, sigma=sigma, OPinv=operator, which="LM",
-                                                 v0=rng.uniform(-1.0, 1.0, M.shape[0]), rng=rng)
+                                                 v0=rng.uniform(-1.0, 1.0, M.shape[0]), rng=rng,
+                                                 maxiter=EIGSH_RESTARTS)
     except scipy.sparse.linalg.ArpackError as err:
-        raise ModelError(f"{source}: eigsh found no {k} modes ({err}); fewer modes, or more than the mass "
-                         "matrix has finite ones?") from err
+        raise ModelError(f"{source}: eigsh found no {k} modes ({err}); fewer modes, more than the mass matrix has "
+                         f"finite ones, or {_TOO_FINE}?") from err
     return _ritz(M, K, operator.matmat(M @ vectors), source)
 
 
 _NEITHER = ("{}: K + s M is singular for every s: some motion has neither mass nor stiffness "
             "(with a lumped mass, a free beam's twist about its own axis)")
+_TOO_FINE = ("a model whose stiffness spans more scales than double precision resolves (an Euler–Bernoulli "
+             "beam's ω² spread grows as elements⁴: fewer elements, or theory: timoshenko)")
 _SYMMETRIC = dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})  # Cholesky's
 
 
@@ -331,6 +335,24 @@ def _stops_rigid_motion(fe, b, singular):
         if u @ (fe.stiffness @ u) <= ZERO_RTOL * _scale(fe.mass, fe.stiffness) * (u @ (fe.mass @ u)):
             raise ModelError(singular + "the interface does not stop every rigid-body motion (add interface nodes: "
                              "three not on one line for nodes without rotations)")
+
+
+def _weight(fe, i, Mii, interior):
+    """Rayleigh's estimate of the lowest ω² with the interface held, from the static deflections
+    u = K_ii⁻¹ M_ii g under the model's own weight along each axis: min (gᵀM_ii u)/(uᵀM_ii u),
+    at least the lowest ω² (three solves with the factor at hand)."""
+    g = (np.arange(fe.size)[i] % fe.dofs_per_node)[:, None] == np.arange(3)
+    load = Mii @ g.astype(float)
+    u = interior.solve(load)
+    return float(np.min(np.einsum("ik,ik->k", u, load) / np.einsum("ik,ik->k", u, Mii @ u)))
+
+
+def _resolved(Mii, Kii, lowest, singular):
+    """Refuse a Craig–Bampton interior whose lowest ω² (or an upper bound of it) is at the rounding level."""
+    if lowest <= ZERO_RTOL * _scale(Mii, Kii):
+        raise ModelError(singular + f"its lowest mode, ω² ≤ {lowest:.3g} (rad/s)², is at the rounding level of K "
+                         f"({ZERO_RTOL:g} · tr K / tr M = {ZERO_RTOL * _scale(Mii, Kii):.3g}): a motion the interface "
+                         f"does not stop (a mechanism, a piece it does not reach), or {_TOO_FINE}")
 
 
 def _scale(M, K):
