@@ -5,6 +5,9 @@ singular M too), a tip load's static deflection is PL³/3EI whatever the number 
 and the free-interface modes are the free–free beam's."""
 
 import re
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -216,3 +219,19 @@ def test_an_unconnected_piece_is_refused():
                     np.vstack([one.nodes, two.nodes + [0.0, 1.0, 0.0]]))
     with pytest.raises(ModelError, match=re.escape("with the interface nodes [0] held, the stiffness is singular")):
         craig_bampton(both, [0], count=2)
+
+
+def test_a_round_beams_reductions_are_the_same_in_two_processes():
+    """A pinned round strip's free-interface modes (pairs kept whole) and its Craig–Bampton
+    reduction, on eigsh's side: byte for byte the same bases and frequencies in two processes."""
+    script = ("import hashlib, sys; sys.path.insert(0, sys.argv[1]); from flexible_beams import strip, STRIP; "
+              "from mbsynth.model.flexible.reduction import craig_bampton, free_interface; "
+              "fe = strip(60, Iy=STRIP['Iz']); "
+              "rs = [free_interface(fe, [0], count=4, rigid=False), craig_bampton(fe, [0, 60], count=6)]; "
+              "print([(len(r.frequencies), hashlib.sha256(r.basis.tobytes() + r.frequencies.tobytes()).hexdigest()) "
+              "for r in rs])")
+    here = str(Path(__file__).parent)
+    runs = [subprocess.Popen([sys.executable, "-c", script, here], stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [run.communicate(timeout=120)[0] for run in runs]
+    assert all(run.returncode == 0 for run in runs)
+    assert outs[0] == outs[1] and "(4, " in outs[0] and "(6, " in outs[0]
