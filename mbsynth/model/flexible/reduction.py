@@ -46,7 +46,8 @@ from .matrices import FEModel
 
 ZERO_RTOL = 1e-15  # ω² below ZERO_RTOL · tr K / tr M is rounding of K's null space (a few ε of the largest ω²)
 SHIFT_RTOL = 1e-14  # the default shift −SHIFT_RTOL · tr K / tr M: 10× the zero level (rigid-body modes factor)
-DENSE_SHIFT_RTOL = 1e-8  # the dense solver's shift (it needs no convergence; a dense Cholesky wants the margin)
+DENSE_SHIFT_RTOL = 1e-8  # the dense solver's shift: finite modes up to 1e4 · tr K / tr M stay apart from a singular
+# M's infinite ones (FINITE_RTOL); a dense solve needs no convergence, and the Ritz quotients refine the lowest
 CLUSTER_RTOL = 1e-4  # modes whose ω² differ by less than this fraction span one eigenspace (a 2,000-element
 # beam's equal frequencies come out 1e-5 apart)
 TIE_RTOL = 1e-4  # components within this fraction of the largest tie: the first DOF of them fixes a cluster's basis
@@ -129,7 +130,7 @@ def craig_bampton(fe, interface, *, count=None, max_frequency=None, shift=None):
                              "the interface does not reach)") from err
         T[i, :] = -interior.solve(K[i][:, b].toarray())
         if len(i):
-            _resolved(Mii, Kii, _weight(fe, i, Mii, interior), singular)
+            _resolved(Mii, Kii, _rayleigh_bound(fe, i, Mii, interior), singular)
     omega, shapes = normal_modes(Mii, Kii, count=count, max_frequency=max_frequency, shift=shift, source=fe.source)
     if len(b) and len(i):
         _resolved(Mii, Kii, omega[0] ** 2 if len(omega) else _lowest(Mii, Kii, shift, fe.source), singular)
@@ -337,7 +338,7 @@ def _stops_rigid_motion(fe, b, singular):
                              "three not on one line for nodes without rotations)")
 
 
-def _weight(fe, i, Mii, interior):
+def _rayleigh_bound(fe, i, Mii, interior):
     """Rayleigh's estimate of the lowest ω² with the interface held, from the static deflections
     u = K_ii⁻¹ M_ii g under the model's own weight along each axis: min (gᵀM_ii u)/(uᵀM_ii u),
     at least the lowest ω² (three solves with the factor at hand)."""
