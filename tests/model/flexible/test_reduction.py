@@ -235,3 +235,16 @@ def test_a_round_beams_reductions_are_the_same_in_two_processes():
     outs = [run.communicate(timeout=120)[0] for run in runs]
     assert all(run.returncode == 0 for run in runs)
     assert outs[0] == outs[1] and "(4, " in outs[0] and "(6, " in outs[0]
+
+
+def test_a_beam_finer_than_double_precision_resolves_is_refused_in_seconds():
+    """100,008 DOFs: 16,667 Euler–Bernoulli elements spread ω² over 10¹⁸, past the rounding
+    level of K; Craig–Bampton refuses them with that reason (from Rayleigh's bound, before any
+    eigen-solve). As many Timoshenko elements (ω² spread ∝ elements²) reduce, to the same beam
+    of 1,000 elements within 1e-5 (rounding: 2e-6)."""
+    with pytest.raises(ModelError, match=re.escape("its lowest mode, ω² ≤ 206 (rad/s)², is at the rounding level of K")
+                       + ".*Euler–Bernoulli beam's ω² spread grows as elements⁴"):
+        craig_bampton(strip(16667, **ROUND), [0], count=2)
+    timoshenko = dict(ROUND, theory="timoshenko", shear_factor=5 / 6)
+    fine = craig_bampton(strip(16667, **timoshenko), [0], count=2).frequencies
+    np.testing.assert_allclose(fine, craig_bampton(strip(1000, **timoshenko), [0], count=2).frequencies, rtol=1e-5)
