@@ -5,13 +5,18 @@ singular M too), a tip load's static deflection is PL³/3EI whatever the number 
 and the free-interface modes are the free–free beam's."""
 
 import re
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.linalg
+import scipy.sparse
 
-from flexible_beams import FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
+from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
 from mbsynth.core.errors import ModelError
+from mbsynth.model.flexible.matrices import fe_model
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface, normal_modes
 
 N = 60  # elements
@@ -145,3 +150,101 @@ def test_a_singular_lumped_mass_gives_the_statically_condensed_modes(elements):
     if elements == 3:
         with pytest.raises(ModelError, match="10 modes asked for, but the mass matrix gives only 9 finite ones"):
             normal_modes(M, K, count=10)
+
+
+ROUND = dict(Iy=STRIP["Iz"])  # a round strip: each bending frequency twice, once per plane
+
+
+@pytest.mark.parametrize("elements, mesh", [(10, 4e-5), (60, 1e-7)])  # 60 interior DOFs: dense; 360: eigsh
+def test_a_round_beams_equal_modes_come_whole_in_the_section_planes(elements, mesh):
+    """Clamped at node 0, a round strip's fixed-interface modes come in pairs at the clamped–free
+    Euler–Bernoulli frequencies (to the mesh's error); each pair's basis is fixed: its first shape bends the strip in
+    the section's xy plane, the second in xz, each positive where it moves most, whatever
+    basis the solver gave (another eigsh start: the same shapes). A count that would split a
+    pair is refused; max_frequency takes pairs whole."""
+    fe = strip(elements, **ROUND)
+    reduced = craig_bampton(fe, [0], count=4)
+    shapes = reduced.basis[:, reduced.modes]
+    np.testing.assert_allclose(reduced.frequencies, np.repeat(euler_bernoulli(CLAMPED_FREE[:2], STRIP["Iz"]), 2),
+                               rtol=mesh)
+    np.testing.assert_allclose(plane_share(fe.mass, shapes, "xy"), [1, 0, 1, 0], atol=1e-9)
+    energy = np.sqrt(fe.mass.diagonal())[:, None] * shapes  # the sign: + where √M_jj |φ_j| is largest
+    assert np.all(shapes[np.argmax(np.abs(energy), axis=0), range(4)] > 0)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("mbsynth.model.flexible.reduction.START_SEED", 12345)
+        again = craig_bampton(fe, [0], count=4).basis[:, reduced.modes]
+    np.testing.assert_allclose(again, shapes, atol=1e-7 * np.abs(shapes).max())
+    with pytest.raises(ModelError, match=re.escape("3 modes would split modes 3 to 4, which share the frequency "
+                                                   f"{reduced.frequencies[2] / (2 * np.pi):.6g}"
+                                                   " Hz (a repeated mode, as a round section's two bending planes): "
+                                                   "ask for 2 or 4 modes")):
+        craig_bampton(fe, [0], count=3)
+    cut = reduced.frequencies[2] * (1 + 1e-6) / (2 * np.pi)  # just above the second pair, halfway into its rounding
+    assert len(craig_bampton(fe, [0], max_frequency=cut).frequencies) == 4
+
+
+def test_free_interface_gives_every_mode_asked_for_or_refuses():
+    """A free strip of 2 elements has 18 finite modes, 6 of them rigid-body ones: 12 flexible
+    modes asked for are 12 given (the dense solver's, as scipy's generalized eigh finds them),
+    13 are refused. On eigsh's side (n − 2 modes at most) too many are refused by that limit."""
+    fe = strip(2)
+    flexible = free_interface(fe, count=12, rigid=False)
+    exact = np.sqrt(scipy.linalg.eigh(fe.stiffness.toarray(), fe.mass.toarray(), eigvals_only=True)[6:])
+    np.testing.assert_allclose(flexible.frequencies, exact, rtol=1e-9)
+    with pytest.raises(ModelError, match="13 modes asked for, but the mass matrix gives only 12 finite ones besides "
+                                         "the rigid-body ones"):
+        free_interface(fe, count=13, rigid=False)
+    with pytest.raises(ModelError, match=re.escape("120 modes asked for, but eigsh finds only 118 besides the "
+                                                   "rigid-body ones (at most n − 2 = 124 modes)")):
+        free_interface(strip(20), count=120, rigid=False)
+
+
+def test_a_2000_element_beam_reduces_in_seconds_to_the_closed_form():
+    """Craig–Bampton of a clamped round strip of 2,000 elements (12,006 DOFs; its ω² span 10¹⁴):
+    the first three bending pairs at the Euler–Bernoulli frequencies to 1e-5 (rounding of the
+    stiff matrix: ~1e-5), in seconds."""
+    fe = strip(2000, **ROUND)
+    reduced = craig_bampton(fe, [0], count=6)
+    np.testing.assert_allclose(reduced.frequencies, np.repeat(euler_bernoulli(CLAMPED_FREE, STRIP["Iz"]), 2),
+                               rtol=1e-5)
+    np.testing.assert_allclose(plane_share(fe.mass, reduced.basis[:, reduced.modes], "xy"), [1, 0] * 3, atol=1e-9)
+
+
+def test_an_unconnected_piece_is_refused():
+    """Two strips in one FE model, the interface on the first only: the second is free with the
+    interface held, which Craig–Bampton refuses (its rigid-body geometry is stopped, the piece
+    is not)."""
+    one, two = strip(4), strip(4)
+    both = fe_model(scipy.sparse.block_diag([one.mass, two.mass]), scipy.sparse.block_diag([one.stiffness, two.stiffness]),
+                    np.vstack([one.nodes, two.nodes + [0.0, 1.0, 0.0]]))
+    with pytest.raises(ModelError, match=re.escape("with the interface nodes [0] held, the stiffness is singular")):
+        craig_bampton(both, [0], count=2)
+
+
+def test_a_round_beams_reductions_are_the_same_in_two_processes():
+    """A pinned round strip's free-interface modes (pairs kept whole) and its Craig–Bampton
+    reduction, on eigsh's side: byte for byte the same bases and frequencies in two processes."""
+    script = ("import hashlib, sys; sys.path.insert(0, sys.argv[1]); from flexible_beams import strip, STRIP; "
+              "from mbsynth.model.flexible.reduction import craig_bampton, free_interface; "
+              "fe = strip(60, Iy=STRIP['Iz']); "
+              "rs = [free_interface(fe, [0], count=4, rigid=False), craig_bampton(fe, [0, 60], count=6)]; "
+              "print([(len(r.frequencies), hashlib.sha256(r.basis.tobytes() + r.frequencies.tobytes()).hexdigest()) "
+              "for r in rs])")
+    here = str(Path(__file__).parent)
+    runs = [subprocess.Popen([sys.executable, "-c", script, here], stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [run.communicate(timeout=120)[0] for run in runs]
+    assert all(run.returncode == 0 for run in runs)
+    assert outs[0] == outs[1] and "(4, " in outs[0] and "(6, " in outs[0]
+
+
+def test_a_beam_finer_than_double_precision_resolves_is_refused_in_seconds():
+    """100,008 DOFs: 16,667 Euler–Bernoulli elements spread ω² over 10¹⁸, past the rounding
+    level of K; Craig–Bampton refuses them with that reason (from Rayleigh's bound, before any
+    eigen-solve). As many Timoshenko elements (ω² spread ∝ elements²) reduce, to the same beam
+    of 1,000 elements within 1e-5 (rounding: 2e-6)."""
+    with pytest.raises(ModelError, match=re.escape("its lowest mode, ω² ≤ 206 (rad/s)², is at the rounding level of K")
+                       + ".*Euler–Bernoulli beam's ω² spread grows as elements⁴"):
+        craig_bampton(strip(16667, **ROUND), [0], count=2)
+    timoshenko = dict(ROUND, theory="timoshenko", shear_factor=5 / 6)
+    fine = craig_bampton(strip(16667, **timoshenko), [0], count=2).frequencies
+    np.testing.assert_allclose(fine, craig_bampton(strip(1000, **timoshenko), [0], count=2).frequencies, rtol=1e-5)
