@@ -96,7 +96,7 @@ def _read_reduction(builder, fe, node, path):
 
     node = builder.section(node, path, "flexible_reduction")
     method = node["method"]
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         builder.fail(path + ("method",), f"method must be craig_bampton or free_interface, got {method!r}")
     interface = node.get("interface", [])
     if not isinstance(interface, list) or not all(_is_count(j) for j in interface):
@@ -130,10 +130,10 @@ def _read_reduction(builder, fe, node, path):
         reduction = _fe_layer(builder, path, free_interface, fe, interface, count=count, max_frequency=limit,
                               rigid=False)
     if reduction.size == 0:
-        first = _first_mode(fe, method, interface)
         if count is not None:
             builder.fail(path + ("modes",), f"modes: 0 {RIGID}" + (" (or add interface nodes)" if method ==
                                                                    "craig_bampton" else ""))
+        first = _first_mode(fe, method, interface)
         builder.fail(where, f"max_frequency {limit:g} Hz is below the first {METHODS[method]} mode"
                             + (f", {first:.6g} Hz" if first is not None else "") + f": it {RIGID}")
     return reduction

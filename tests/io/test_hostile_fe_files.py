@@ -78,6 +78,23 @@ def folder(tmp_path_factory):
     return path
 
 
+def test_every_key_refuses_every_value_that_is_no_number(folder):
+    """Each of NOT_NUMBERS at each beam and reduction key (all of them, not a sample): refused
+    at that section's line (but ``interface: [1]``, a list of one node); and each at
+    ``fe.dofs_per_node`` at that key."""
+    for key in sorted(BEAM) + ["theory", "mass", "axis", "up", "G", "shear_factor"]:
+        for value in NOT_NUMBERS:
+            message = refused_or_loaded(model("beam: " + flow(BEAM | {key: value})), folder, ("beam",))
+            assert message is not None or value == "~", (key, value)
+    for key in ("method", "interface", "modes", "max_frequency", "reference"):
+        for value in set(NOT_NUMBERS) - {"[1]"} if key == "interface" else NOT_NUMBERS:  # [1]: node 1, fine
+            assert refused_or_loaded(model("fe: {bundle: rod.npz}", REDUCTION | {key: value}), folder,
+                                     ("reduction",)) is not None, (key, value)
+    for value in NOT_NUMBERS + ["4", "0", "6.0", "[6]", "six"]:
+        message = refused_or_loaded(model(f"fe: {{bundle: rod.npz, dofs_per_node: {value}}}"), folder, ("fe",))
+        assert value == "~" or "at subsystems.rod.fe.dofs_per_node: dofs_per_node must be 3 or 6" in message, value
+
+
 BEAM_KEYS = st.sampled_from(sorted(BEAM) + ["theory", "mass", "axis", "up", "G", "shear_factor"])
 
 
@@ -157,7 +174,7 @@ HOSTILE_ARRAYS = [
 ]
 
 
-@fuzz(120)
+@fuzz(80)
 @given(dense=st.booleans(), data=st.data())
 def test_hostile_bundle_arrays(folder, dense, data):
     """A bundle whose arrays were deleted, replaced by hostile ones (text, complex, booleans,
