@@ -35,7 +35,7 @@ def read_flexible_body(builder, name, spec, path):
 def _read_fe(builder, spec, path):
     """(the FE model of ``beam:`` or ``fe:`` (exactly one), its stress stiffness u ↦ K_G or
     None: files carry no element data)."""
-    from ..model.flexible.beam import beam, stress_stiffness  # scipy: loaded only by models with flexible bodies
+    from ..model.flexible.beam import beam, number_problem, stress_stiffness  # scipy: only for flexible bodies
     from ..model.flexible.files import read_fe
     from ..model.flexible.matrices import check_dofs_per_node
 
@@ -49,6 +49,9 @@ def _read_fe(builder, spec, path):
     if key == "beam":
         numbers = {k: builder.fixed_value(builder.constant(node[k], where + (k,)), where + (k,)) for k in BEAM_NUMBERS
                    if k in node}
+        for k, value in numbers.items():
+            if number_problem(k, value):
+                builder.fail(where + (k,), number_problem(k, value))
         elements = node["elements"]
         if not isinstance(elements, int) or isinstance(elements, bool):
             builder.fail(where + ("elements",), f"elements must be a positive integer, got {elements!r}")

@@ -63,7 +63,7 @@ def test_a_count_of_modes_is_not_a_boolean(tmp_path):
 
 
 def test_poissons_ratio_of_minus_one_is_refused(tmp_path):
-    refused(tmp_path, "beam: " + BEAM.replace("nu: 0.3", "nu: -1"), CB, 5, "beam",
+    refused(tmp_path, "beam: " + BEAM.replace("nu: 0.3", "nu: -1"), CB, 5, "beam.nu",
             ["nu (Poisson's ratio) must be above -1 and at most 0.5"])
 
 
@@ -92,9 +92,14 @@ def test_an_empty_or_truncated_bundle(tmp_path, damage, words):
 @pytest.mark.parametrize("mass, words", [
     (FE.mass.toarray().astype(str), ["rod.npz [mass]: the mass matrix must hold real numbers, not text"]),
     (FE.mass.toarray() + 0j, ["rod.npz [mass]: the mass matrix must hold real numbers, not complex numbers"]),
+    (FE.mass.toarray() + 0.5, ["rod.npz [mass]: the mass matrix gives the body's rigid translations along x, y, z "
+                               "the masses 12.6, 12.6, 12.6 and the couplings 12.5, 12.5, 12.5"]),
 ])
-def test_text_and_complex_matrices_are_refused_not_cast(tmp_path, mass, words):
-    """Complex entries, even with zero imaginary parts, are not silently made real."""
+def test_text_complex_and_unphysical_mass_matrices_are_refused(tmp_path, mass, words):
+    """Complex entries, even with zero imaginary parts, are not silently made real; a mass
+    matrix whose rigid translations have other masses than the body's 0.1 kg (ρAL) in some
+    direction (0.5 added to all 30 × 30 entries: 25 × 0.5 more on each x, y, z translation, as
+    much between them) is no body's, whose part M(q) would not be positive semidefinite."""
     np.savez(tmp_path / "rod.npz", nodes=FE.nodes, mass=mass, stiffness=FE.stiffness.toarray())
     refused(tmp_path, "fe: {bundle: rod.npz}", CB, 5, "fe.bundle", words)
 

@@ -42,17 +42,15 @@ def beam(length, elements, *, area, Iy, Iz, J, E, density, G=None, nu=None, shea
         raise ModelError(f"{where}: elements must be an integer from 1 to {BEAM_ELEMENTS_MAX}, not {elements!r}")
     if (G is None) == (nu is None):
         raise ModelError(f"{where}: give exactly one of G (shear modulus) and nu (Poisson's ratio)")
-    if nu is not None and not -1 < nu <= 0.5:
-        raise ModelError(f"{where}: nu (Poisson's ratio) must be above -1 and at most 0.5 (an isotropic "
-                         f"material's), not {nu!r}")
     if theory == "timoshenko" and shear_factor is None:
         raise ModelError(f"{where}: a Timoshenko beam needs shear_factor (κ: 5/6 rectangle, 0.9 circle, about)")
     if theory == "euler_bernoulli" and shear_factor is not None:
         raise ModelError(f"{where}: shear_factor is for theory: timoshenko; an Euler–Bernoulli beam has no shear strain")
-    for name, value in dict(length=length, area=area, Iy=Iy, Iz=Iz, J=J, E=E, G=G, density=density,
+    for name, value in dict(length=length, area=area, Iy=Iy, Iz=Iz, J=J, E=E, G=G, nu=nu, density=density,
                             shear_factor=shear_factor).items():
-        if value is not None and not (np.isfinite(value) and value > 0):
-            raise ModelError(f"{where}: {name} must be a positive number, not {value!r}")
+        problem = value is not None and number_problem(name, value)
+        if problem:
+            raise ModelError(f"{where}: {problem}")
     G = E / (2 * (1 + nu)) if G is None else G
     frame = _section_axes(axis, up, where)
     h = length / elements
@@ -61,6 +59,15 @@ def beam(length, elements, *, area, Iy, Iz, J, E, density, G=None, nu=None, shea
     nodes = np.asarray(start, float) + np.outer(np.linspace(0.0, length, elements + 1), frame[0])
     label = f"beam ({theory}, {mass} mass, {elements} elements)"
     return fe_model(M, K, nodes, dofs_per_node=6, where=dict(mass=label, stiffness=label, nodes=label))
+
+
+def number_problem(name, value):
+    """Why ``value`` cannot be the number ``name`` of ``beam`` (nu: Poisson's ratio of an
+    isotropic material, −1 < ν ≤ 0.5; the others: positive and finite), or None."""
+    if name == "nu":
+        return None if -1 < value <= 0.5 else (f"nu (Poisson's ratio) must be above -1 and at most 0.5 (an isotropic "
+                                               f"material's), not {value!r}")
+    return None if np.isfinite(value) and value > 0 else f"{name} must be a positive number, not {value!r}"
 
 
 def geometric_stiffness(length, elements, force, *, axis=(1.0, 0.0, 0.0)):

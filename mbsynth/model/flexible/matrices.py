@@ -20,6 +20,7 @@ import scipy.sparse.linalg
 from ...core.errors import ModelError
 
 FE_SYMMETRY_RTOL = 1e-8  # largest |A − Aᵀ| accepted, relative to max |A| (exports round to ~8 digits)
+FE_TRANSLATION_MASS_RTOL = 1e-6  # the rigid translations' 3 × 3 mass must be m·I to this, relative to m
 FE_SEMIDEFINITE_RTOL = 1e-8  # A + FE_SEMIDEFINITE_RTOL · max|A| · I must be positive definite
 DOFS_PER_NODE = (3, 6)  # ux uy uz (solids), and θx θy θz (beams, shells)
 DENSE_CHECK_MAX = 3000  # up to this many DOFs the lowest eigenvalue an error reports is found by a dense solver
@@ -70,6 +71,7 @@ def fe_model(mass, stiffness, nodes, *, dofs_per_node=None, where=None):
                          + (f"; dofs_per_node = {dofs_per_node}" if dofs_per_node is not None else ""))
     for A, what, name in ((M, "mass matrix", where["mass"]), (K, "stiffness matrix", where["stiffness"])):
         _symmetric_semidefinite(A, name, what)
+    _isotropic_translation(M, d, where["mass"])
     source = where["mass"] if where["mass"] == where["stiffness"] else f"{where['mass']}, {where['stiffness']}"
     return FEModel(M, K, X, d, source)
 
@@ -127,6 +129,21 @@ def _symmetric_semidefinite(A, name, what):
         lowest = _lowest_eigenvalue((A + A.T) / 2)
         raise ModelError(f"{name}: the {what} is not positive semidefinite: an eigenvalue {lowest:.6g} "
                          f"({lowest / scale:.2g} of max |A|; DOFs number from 0, node by node)")
+
+
+def _isotropic_translation(M, d, name):
+    """A body's rigid translations all carry its mass m: Sᵀ M S = m I, S (n × 3) moving every
+    node by a unit x, y or z (the floating frame's equations, invariants.py, rest on it)."""
+    n = M.shape[0]
+    S = scipy.sparse.csr_array((np.ones(n // d * 3), (np.arange(n).reshape(-1, d)[:, :3].ravel(),
+                                                      np.tile(np.arange(3), n // d))), shape=(n, 3))
+    Mt = (S.T @ (M @ S)).toarray()
+    m = np.trace(Mt) / 3
+    if not np.abs(Mt - m * np.eye(3)).max() <= FE_TRANSLATION_MASS_RTOL * abs(m):
+        masses = ", ".join(f"{x:.6g}" for x in np.diag(Mt))
+        raise ModelError(f"{name}: the mass matrix gives the body's rigid translations along x, y, z the masses "
+                         f"{masses} and the couplings {Mt[0, 1]:.6g}, {Mt[0, 2]:.6g}, {Mt[1, 2]:.6g}; a body has one "
+                         "mass m in every direction (the sum of its translation blocks m·I; DOFs node by node)")
 
 
 def _largest(A):
