@@ -4,6 +4,8 @@ damping, centrifugal stiffening (beams), frames at FE nodes and initial state (s
 schema.py). Every error of the
 FE layer is reported at the key that caused it, with the model file and line."""
 
+import numpy as np
+
 from ..core.errors import ModelError
 from ..model.parts import FlexibleBody
 from ..model.parts.flexible_body import coordinates, modal_damping, rayleigh_damping
@@ -33,8 +35,9 @@ def read_flexible_body(builder, name, spec, path):
 def _read_fe(builder, spec, path):
     """(the FE model of ``beam:`` or ``fe:`` (exactly one), its stress stiffness u ↦ K_G or
     None: files carry no element data)."""
-    from ..model.flexible.beam import beam, stress_stiffness  # scipy: loaded only by models with flexible bodies
+    from ..model.flexible.beam import beam, number_problem, stress_stiffness  # scipy: only for flexible bodies
     from ..model.flexible.files import read_fe
+    from ..model.flexible.matrices import check_dofs_per_node
 
     given = [k for k in ("beam", "fe") if k in spec]
     if len(given) != 1:
@@ -46,6 +49,9 @@ def _read_fe(builder, spec, path):
     if key == "beam":
         numbers = {k: builder.fixed_value(builder.constant(node[k], where + (k,)), where + (k,)) for k in BEAM_NUMBERS
                    if k in node}
+        for k, value in numbers.items():
+            if number_problem(k, value):
+                builder.fail(where + (k,), number_problem(k, value))
         elements = node["elements"]
         if not isinstance(elements, int) or isinstance(elements, bool):
             builder.fail(where + ("elements",), f"elements must be a positive integer, got {elements!r}")
@@ -59,8 +65,10 @@ def _read_fe(builder, spec, path):
             ("bundle" not in files and len(files) != 3):
         builder.fail(where, "give either bundle (one .npz) or all three of mass, stiffness and nodes")
     dofs = node.get("dofs_per_node")
+    if dofs is not None:
+        dofs = _fe_layer(builder, where + ("dofs_per_node",), check_dofs_per_node, dofs)
     if "bundle" in files:
-        return _fe_layer(builder, where, read_fe, files["bundle"], dofs_per_node=dofs), None
+        return _fe_layer(builder, where + ("bundle",), read_fe, files["bundle"], dofs_per_node=dofs), None
     return _fe_layer(builder, where, read_fe, **files, dofs_per_node=dofs), None
 
 
@@ -76,6 +84,8 @@ def _file(builder, text, path):
     if not isinstance(text, str) or not text:
         builder.fail(path, f"expected a file name, got {text!r}")
     file = builder.doc.folder / text
+    if file.is_dir():
+        builder.fail(path, f"{text!r} is a folder ({file}), not a file")
     if not file.is_file():
         builder.fail(path, f"file {text!r} not found (looked for {file})")
     return file
@@ -83,36 +93,79 @@ def _file(builder, text, path):
 
 def _read_reduction(builder, fe, node, path):
     """Craig–Bampton with its reference node held at the frame, or free-interface modes
-    without rigid ones."""
+    without rigid ones; refused where it leaves no elastic coordinate, or where holding the
+    reference node does not fix the frame (translation-only nodes)."""
     from ..model.flexible.reduction import craig_bampton, free_interface
 
     node = builder.section(node, path, "flexible_reduction")
     method = node["method"]
+    if not isinstance(method, str) or method not in METHODS:
+        builder.fail(path + ("method",), f"method must be craig_bampton or free_interface, got {method!r}")
     interface = node.get("interface", [])
-    if not isinstance(interface, list) or not all(isinstance(j, int) and not isinstance(j, bool) for j in interface):
+    if not isinstance(interface, list) or not all(_is_count(j) for j in interface):
         builder.fail(path + ("interface",), f"interface must be a list of node indices, got {interface!r}")
     chosen = [k for k in ("modes", "max_frequency") if k in node]
     if len(chosen) != 1:
         builder.fail(path, f"choose the modes by exactly one of modes (a count) and max_frequency (Hz); got "
                            f"{', '.join(chosen) or 'neither'}")
     count = node.get("modes")
+    if count is not None and not _is_count(count):
+        builder.fail(path + ("modes",), f"modes must be a count (an integer ≥ 0), got {count!r}")
     where = path + ("max_frequency",)
     limit = builder.fixed_value(builder.constant(node["max_frequency"], where), where) if "max_frequency" in node else None
+    if limit is not None and not limit >= 0:
+        builder.fail(where, f"max_frequency must be ≥ 0 Hz, got {limit!r}")
     if method == "craig_bampton":
+        if fe.dofs_per_node != 6:
+            builder.fail(path + ("method",), TRANSLATION_ONLY.format(fe.dofs_per_node))
         if not interface:
             builder.fail(path + ("interface",), "Craig–Bampton needs at least one interface node")
         reference = node.get("reference", interface[0])
-        if reference not in interface:
+        if not _is_count(reference) or reference not in interface:
             builder.fail(path + ("reference",), f"the reference node {reference!r} (held at the part's frame) "
                                                 f"must be one of the interface nodes {interface}")
         reduction = _fe_layer(builder, path, craig_bampton, fe, interface, count=count, max_frequency=limit)
-        return _fe_layer(builder, path, reduction.hold, reference)
-    if method == "free_interface":
+        reduction = _fe_layer(builder, path, reduction.hold, reference)
+    else:
         if "reference" in node:
             builder.fail(path + ("reference",), "free-interface modes hold no node at the frame: reference is "
                                                 "for craig_bampton")
-        return _fe_layer(builder, path, free_interface, fe, interface, count=count, max_frequency=limit, rigid=False)
-    builder.fail(path + ("method",), f"method must be craig_bampton or free_interface, got {method!r}")
+        reduction = _fe_layer(builder, path, free_interface, fe, interface, count=count, max_frequency=limit,
+                              rigid=False)
+    if reduction.size == 0:
+        if count is not None:
+            builder.fail(path + ("modes",), f"modes: 0 {RIGID}" + (" (or add interface nodes)" if method ==
+                                                                   "craig_bampton" else ""))
+        first = _first_mode(fe, method, interface)
+        builder.fail(where, f"max_frequency {limit:g} Hz is below the first {METHODS[method]} mode"
+                            + (f", {first:.6g} Hz" if first is not None else "") + f": it {RIGID}")
+    return reduction
+
+
+METHODS = {"craig_bampton": "fixed-interface", "free_interface": "free"}  # method -> the modes it keeps
+RIGID = ("leaves the reduction no elastic coordinate: the part would be rigid (a rigid_body); choose at least one "
+         "mode")
+TRANSLATION_ONLY = ("Craig–Bampton holds its reference node at the part's frame, which fixes the frame's rotation "
+                    "only for a node with rotations (6 DOFs); these nodes have {} (translations): the rotation about "
+                    "the reference node would stay in the reduced coordinates, the frame's own rotation twice. Use "
+                    "method: free_interface (its elastic modes leave every rigid motion to the frame)")
+
+
+def _is_count(value):
+    """An integer ≥ 0 written as one (a bool is not: YAML's true is Python's 1)."""
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 0
+
+
+def _first_mode(fe, method, interface):
+    """The lowest mode (Hz) the reduction ``method`` would keep, or None where it has none."""
+    from ..model.flexible.reduction import craig_bampton, free_interface
+
+    try:
+        reduction = (craig_bampton(fe, interface, count=1) if method == "craig_bampton"
+                     else free_interface(fe, interface, count=1, rigid=False))
+    except ModelError:
+        return None
+    return reduction.frequencies[0] / (2 * np.pi) if len(reduction.frequencies) else None
 
 
 def _read_stiffening(builder, reduction, stress_stiffness, value, path):

@@ -425,7 +425,9 @@ class _Builder:
     def check_parts(self, system):
         """Each part's M must be finite and positive semi-definite at the initial state."""
         for part, problem in system.part_problems():
-            self.fail(("subsystems", part) + (("T",) if "semi-definite" in problem else ()), problem)
+            spec = (self.root.get("subsystems") or {}).get(part)
+            energy = "semi-definite" in problem and isinstance(spec, dict) and "T" in spec  # a lagrangian part's T
+            self.fail(("subsystems", part) + (("T",) if energy else ()), problem)
 
     def check_branches(self, system):
         """No joint may be assembled at the initial state (its rows hold) in a pose its rows

@@ -19,7 +19,7 @@ from .angle_singularity import AngleParts
 from .connectors.base import Connector
 from ..core.equations import rank_report
 from ..core.errors import ModelError
-from ..symbolic.derive import T_SYMBOL, tidy
+from ..symbolic.derive import T_SYMBOL, exceeds, tidy
 from .system import Closure
 from ..core.tolerances import BALANCE_ZERO_RTOL
 
@@ -33,12 +33,15 @@ class Balance:
     ``direction``: {coordinate: component} at the diagnosed state, largest component +1.
     ``expression``: wᵀ(Q + C) in the model's symbols (0 when identically zero: a free
     direction). ``state_dependent``: w itself changes with the state, so the balance
-    holds along the motion only while the null space keeps its form.
+    holds along the motion only while the null space keeps its form. ``value``: wᵀ(Q + C)
+    at the diagnosed state, w scaled as ``direction`` (printed for an expression too large
+    to write).
     """
 
     direction: dict
     expression: sp.Expr
     state_dependent: bool
+    value: float = 0.0
 
     @property
     def free(self):
@@ -46,12 +49,19 @@ class Balance:
 
     @property
     def equation(self):
-        return f"{sp.sstr(self.expression)} = 0"
+        """wᵀ(Q + C) = 0 written out; beyond SYMBOLIC_SIZE_MAX nodes, its value at the
+        diagnosed state instead (``numeric``)."""
+        return self.numeric if exceeds(self.expression, SYMBOLIC_SIZE_MAX) else f"{sp.sstr(self.expression)} = 0"
 
     @property
     def readable_equation(self):
         """``equation`` as a person reads it (``readable``)."""
-        return f"{readable(self.expression)} = 0"
+        return self.numeric if exceeds(self.expression, SYMBOLIC_SIZE_MAX) else f"{readable(self.expression)} = 0"
+
+    @property
+    def numeric(self):
+        return (f"wᵀ(Q + C) = 0 along the direction, {self.value:.6g} at this state (its expression, of more than "
+                f"{SYMBOLIC_SIZE_MAX} symbols and operations, is not written out)")
 
 
 def balances(system, t=0.0, q=None, qd=None):
@@ -79,20 +89,28 @@ def balances(system, t=0.0, q=None, qd=None):
     state[T_SYMBOL] = t
     dynamic = set(system.q_symbols) | set(system.qd_symbols) | {T_SYMBOL}
     Mhat = M.col_join(A).subs(values)
-    symbolic_w = [] if Mhat.free_symbols & dynamic else Mhat.nullspace(simplify=True)
+    exact = not Mhat.free_symbols & dynamic and not exceeds(Mhat, SYMBOLIC_SIZE_MAX)
+    symbolic_w = Mhat.nullspace(simplify=True) if exact else []
     if len(symbolic_w) == numeric.shape[1]:
         W, state_dependent = sp.Matrix.hstack(*symbolic_w), False
     else:
         W, state_dependent = sp.Matrix(_rational_rows(numeric.T)).T, True
-    free, balanced = _separate(W.T * force, values, system, q, qd, t)
+    free, balanced = _separate(np.array(W.evalf(), dtype=float), system, q, qd, t)
     result = []
     for combos, is_free in ((free, True), (balanced, False)):
         if not combos:
             continue
         for w in _canonical(W * sp.Matrix(combos).T, state, dynamic):
-            expression = sp.S.Zero if is_free else tidy((w.T * force)[0])
-            result.append(Balance(_direction(w, state, system.coordinates), expression, state_dependent))
+            expression = sp.S.Zero if is_free else tidy((w.T * force)[0])  # tidy: bounded (derive.py)
+            vector = np.array(w.subs(state).evalf(), dtype=float).ravel()
+            vector /= vector[np.argmax(np.abs(vector))]
+            result.append(Balance({c: float(v) for c, v in zip(system.coordinates, vector) if abs(v) > 1e-12},
+                                  expression, state_dependent, float(vector @ (arrays.Q + arrays.C))))
     return result
+
+
+SYMBOLIC_SIZE_MAX = 400  # nodes of an expression (or of a matrix's non-numeric entries) beyond which it is not
+# factored, put through a simplifying nullspace or printed: minutes on a flexible body's balance (50,000 nodes)
 
 
 READABLE_DIGITS = 6  # significant digits of the numbers in a printed balance
@@ -104,7 +122,8 @@ def readable(expression):
     so that its largest coefficient is 1, the terms of a sum below READABLE_DROP times its
     largest left out, numbers rounded to READABLE_DIGITS significant digits — the rationals
     of a numeric null vector (state-dependent directions) come out as short decimals."""
-    factored = sp.factor(expression) if expression.is_polynomial() else expression
+    small = not exceeds(expression, SYMBOLIC_SIZE_MAX)
+    factored = sp.factor(expression) if small and expression.is_polynomial() else expression
     if sum(not factor.is_Number for factor in sp.Mul.make_args(factored)) < 2:  # no product to show
         factored = expression
     if factored.is_Add:
@@ -142,16 +161,15 @@ def _rounded(expression):
                                 if not (x.is_Integer and abs(x) < small)})
 
 
-def _separate(g, values, system, q, qd, t):
-    """Split the span of the balances g = Wᵀ(Q + C) into combinations that vanish
-    identically (free directions) and a basis of the rest, by sampling random states."""
+def _separate(W, system, q, qd, t):
+    """Split the span of the balances g = Wᵀ(Q + C) (W: the null vectors, numbers) into
+    combinations that vanish identically (free directions) and a basis of the rest, by
+    sampling Q + C numerically at random states (``System.evaluate``)."""
     rng = np.random.default_rng(0)
-    args = list(system.q_symbols) + list(system.qd_symbols) + [T_SYMBOL]
-    f = sp.lambdify(args, list(g.subs(values)), modules="numpy")
     samples = []
     for _ in range(SAMPLES):
-        x = np.concatenate([q + rng.normal(size=q.size), qd + rng.normal(size=qd.size), [t + rng.normal()]])
-        samples.append(np.asarray(f(*x), dtype=float))
+        x = system.evaluate(t + rng.normal(), q + rng.normal(size=q.size), qd + rng.normal(size=qd.size))
+        samples.append(W.T @ (x.Q + x.C))
     G = np.array(samples)  # SAMPLES x r
     scale = np.abs(G).max()
     if scale == 0:
@@ -177,12 +195,6 @@ def _canonical(D, state, dynamic):
     else:
         D = D * D.extract(pivots, list(range(D.shape[1]))).inv()
     return [D[:, j] for j in range(D.shape[1])]
-
-
-def _direction(w, state, coordinates):
-    values = np.array([float(x) for x in w.subs(state).evalf()])
-    values /= values[np.argmax(np.abs(values))]
-    return {c: float(v) for c, v in zip(coordinates, values) if abs(v) > 1e-12}
 
 
 def close(system, max_rounds=None):

@@ -269,7 +269,26 @@ def _runs(system, params, samples):
     unknown = sorted({k for r in runs for k in r} - set(system.parameters))
     if unknown:
         raise ModelError(f"model '{system.name}' has no parameter(s) {unknown}; it has {sorted(system.parameters)}")
+    _refuse_built_parameters(system, sorted({k for r in runs for k in r}))
     return runs
+
+
+def _refuse_built_parameters(system, swept):
+    """A ModelError, before any run, where a swept parameter (or one defined by an expression
+    of it) is one the model file built something from at load (``System.fixed_parameters``:
+    a flexible body's FE model), naming that file, line and key: a run only changes numbers."""
+    fixed, defined = system.fixed_parameters or {}, system.definitions or {}
+    for name in swept:
+        follows = {name}
+        for parameter in system.parameters:  # in order: a definition reads earlier parameters
+            if parameter in defined and {str(s) for s in defined[parameter].free_symbols} & follows:
+                follows.add(parameter)
+        built = sorted(follows & set(fixed))
+        if built:
+            through = "" if built[0] == name else f" (defined by an expression of the swept '{name}')"
+            raise ModelError(f"{fixed[built[0]]}: parameter '{built[0]}'{through} is built into the model when the "
+                             f"file is loaded, and a sweep's runs only change numbers: sweep other parameters, or "
+                             f"run the model once per value (--set {name}=VALUE)")
 
 
 class _client:

@@ -28,6 +28,9 @@ _LARGEST = sp.Float(np.finfo(float).max)
 # t = 1) where numpy's give inf, which the checks of M, Q, A, b then report
 _FLOAT64 = {"pi": np.float64(np.pi), "e": np.float64(np.e)}
 SIMPLIFY_MAX_OPS = 60  # sympy.simplify takes seconds beyond this, growing fast (nested sin, exp)
+# an expression of more nodes has more than SIMPLIFY_MAX_OPS operations (a node adds at most about
+# three nodes per operation): not counted by count_ops, which takes seconds on a flexible body's
+SIMPLIFY_MAX_NODES = 10 * SIMPLIFY_MAX_OPS
 
 
 def lagrange(T, V, F, q, qd, t=T_SYMBOL):
@@ -51,7 +54,23 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
 
 def tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
     """sympy.simplify for expressions small enough to be worth it (it is slow on big ones)."""
-    return sp.simplify(expr) if sp.count_ops(expr) <= max_ops else expr
+    small = not exceeds(expr, SIMPLIFY_MAX_NODES) and sp.count_ops(expr) <= max_ops
+    return sp.simplify(expr) if small else expr
+
+
+def exceeds(expr, limit):
+    """Whether ``expr`` (or a matrix's entries that are not numbers) has more than ``limit``
+    nodes, counted only up to there: a size test in time bounded by ``limit``."""
+    entries = expr if isinstance(expr, sp.MatrixBase) else [sp.sympify(expr)]
+    count = 0
+    for entry in entries:
+        if entry.is_Number:
+            continue
+        for _ in sp.preorder_traversal(entry):
+            count += 1
+            if count > limit:
+                return True
+    return False
 
 
 def jacobian(exprs, symbols):

@@ -375,3 +375,33 @@ def test_failed_rows_are_kept_until_run_again(cluster, tmp_path, monkeypatch):
         sweep(MODEL, {"m1": [1.0, -1.0]}, 0.2, out=out, scheduler=cluster.scheduler_address, **FAST)
     kept = pd.read_csv(out)
     assert list(kept["status"]) == ["ok", "failed"] and "not positive semi-definite" in kept["error"].iloc[1]
+
+
+FLEXIBLE_ROD = """\
+name: rod
+parameters: {L: 1.0, I0: 1.0e-9, Iy: 2*I0, g: 9.81}
+gravity: [0, 0, -g]
+subsystems:
+  rod:
+    type: flexible_body
+    beam: {length: L, elements: 4, area: 1e-4, Iy: Iy, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000}
+    reduction: {method: craig_bampton, interface: [0], modes: 1}
+"""
+
+
+@pytest.mark.parametrize("param, words", [
+    ("L=1:2:3", ":7, key subsystems.rod.beam.length: parameter 'L' is built into the model"),
+    ("I0=1e-9:2e-9:3", ":7, key subsystems.rod.beam.Iy: parameter 'Iy' (defined by an expression of the swept 'I0')"),
+])
+def test_sweeping_a_parameter_the_fe_model_is_built_from_is_refused_before_any_run(tmp_path, param, words):
+    """``mbsynth sweep`` of the beam's length (or of a parameter another one the beam reads is
+    defined by): exit 2 before the cluster starts, naming the model file, the line and the key
+    of the beam that reads it; no results file."""
+    path = tmp_path / "rod.yaml"
+    path.write_text(FLEXIBLE_ROD)
+    out = tmp_path / "o.csv"
+    result = subprocess.run([sys.executable, "-m", "mbsynth.cli", "sweep", str(path), "--param", param, "--t-end",
+                             "0.1", "--out", str(out), "--workers", "1"], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith(f"error: {path}:7, key ") and words in result.stderr, result.stderr
+    assert "--set" in result.stderr and not out.exists()

@@ -23,6 +23,7 @@ from .matrices import fe_model
 GAUSS = np.polynomial.legendre.leggauss(5)  # exact to degree 9; the products here are of degree ≤ 6
 THEORIES = ("euler_bernoulli", "timoshenko")
 MASSES = ("consistent", "lumped")
+BEAM_ELEMENTS_MAX = 100_000  # 600,000 DOFs: beyond, the assembly alone takes gigabytes, and a beam's few modes need no finer mesh
 
 
 def beam(length, elements, *, area, Iy, Iz, J, E, density, G=None, nu=None, shear_factor=None,
@@ -36,19 +37,21 @@ def beam(length, elements, *, area, Iy, Iz, J, E, density, G=None, nu=None, shea
         raise ModelError(f"{where}: theory must be one of {', '.join(THEORIES)}, not {theory!r}")
     if mass not in MASSES:
         raise ModelError(f"{where}: mass must be one of {', '.join(MASSES)}, not {mass!r}")
-    if not (isinstance(elements, (int, np.integer)) and elements >= 1):
-        raise ModelError(f"{where}: elements must be a positive integer, not {elements!r}")
+    if isinstance(elements, (bool, np.bool_)) or not (isinstance(elements, (int, np.integer))
+                                                       and 1 <= elements <= BEAM_ELEMENTS_MAX):
+        raise ModelError(f"{where}: elements must be an integer from 1 to {BEAM_ELEMENTS_MAX}, not {elements!r}")
     if (G is None) == (nu is None):
         raise ModelError(f"{where}: give exactly one of G (shear modulus) and nu (Poisson's ratio)")
-    G = E / (2 * (1 + nu)) if G is None else G
     if theory == "timoshenko" and shear_factor is None:
         raise ModelError(f"{where}: a Timoshenko beam needs shear_factor (κ: 5/6 rectangle, 0.9 circle, about)")
     if theory == "euler_bernoulli" and shear_factor is not None:
         raise ModelError(f"{where}: shear_factor is for theory: timoshenko; an Euler–Bernoulli beam has no shear strain")
-    for name, value in dict(length=length, area=area, Iy=Iy, Iz=Iz, J=J, E=E, G=G, density=density,
-                            shear_factor=shear_factor or 1.0).items():
-        if not (np.isfinite(value) and value > 0):
-            raise ModelError(f"{where}: {name} must be a positive number, not {value!r}")
+    for name, value in dict(length=length, area=area, Iy=Iy, Iz=Iz, J=J, E=E, G=G, nu=nu, density=density,
+                            shear_factor=shear_factor).items():
+        problem = value is not None and number_problem(name, value)
+        if problem:
+            raise ModelError(f"{where}: {problem}")
+    G = E / (2 * (1 + nu)) if G is None else G
     frame = _section_axes(axis, up, where)
     h = length / elements
     local_K, local_M = _element(h, area, Iy, Iz, J, E, G, density, shear_factor, theory, mass)
@@ -56,6 +59,15 @@ def beam(length, elements, *, area, Iy, Iz, J, E, density, G=None, nu=None, shea
     nodes = np.asarray(start, float) + np.outer(np.linspace(0.0, length, elements + 1), frame[0])
     label = f"beam ({theory}, {mass} mass, {elements} elements)"
     return fe_model(M, K, nodes, dofs_per_node=6, where=dict(mass=label, stiffness=label, nodes=label))
+
+
+def number_problem(name, value):
+    """Why ``value`` cannot be the number ``name`` of ``beam`` (nu: Poisson's ratio of an
+    isotropic material, −1 < ν ≤ 0.5; the others: positive and finite), or None."""
+    if name == "nu":
+        return None if -1 < value <= 0.5 else (f"nu (Poisson's ratio) must be above -1 and at most 0.5 (an isotropic "
+                                               f"material's), not {value!r}")
+    return None if np.isfinite(value) and value > 0 else f"{name} must be a positive number, not {value!r}"
 
 
 def geometric_stiffness(length, elements, force, *, axis=(1.0, 0.0, 0.0)):

@@ -15,6 +15,8 @@ Two layouts:
 DOFs run node by node (matrices.py). Every error names the file and what is wrong.
 """
 
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +24,15 @@ import scipy.io
 import scipy.sparse
 
 from ...core.errors import ModelError
-from .matrices import fe_model
+from .matrices import DOFS_PER_NODE, check_dofs_per_node, fe_model, real_array
 
 ARRAYS = ("mass", "stiffness", "nodes")
+# what numpy raises for a file that is not a whole .npz: empty or truncated, not a zip, a damaged member
+NPZ_ERRORS = (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error)
+# what scipy.sparse.load_npz raises for arrays that do not make its sparse format
+SPARSE_NPZ_ERRORS = (ValueError, TypeError, IndexError, KeyError)
+# what scipy.io.mmread raises for a file that is not Matrix Market (its reader's header and body checks)
+MTX_ERRORS = (ValueError, OSError, IndexError, OverflowError, RuntimeError, TypeError)
 
 
 def read_fe(path=None, *, mass=None, stiffness=None, nodes=None, dofs_per_node=None):
@@ -69,15 +77,16 @@ def _read_bundle(path, dofs_per_node):
         raise ModelError(f"{path}: no array 'nodes' (N × 3 node coordinates); it holds {sorted(arrays)}")
     nodes = _nodes(arrays["nodes"], path)
     if dofs_per_node is None and "dofs_per_node" in arrays:
-        dofs_per_node = int(arrays["dofs_per_node"])
-    size = len(nodes) * (dofs_per_node or 0) or None
-    matrices = {name: _bundle_matrix(arrays, name, path, size) for name in ("mass", "stiffness")}
+        dofs_per_node = check_dofs_per_node(arrays["dofs_per_node"], path)
+    sizes = [len(nodes) * d for d in ((dofs_per_node,) if dofs_per_node is not None else DOFS_PER_NODE)]
+    matrices = {name: _bundle_matrix(arrays, name, path, sizes) for name in ("mass", "stiffness")}
     where = {name: f"{path} [{name}]" for name in ARRAYS}
     return fe_model(matrices["mass"], matrices["stiffness"], nodes, dofs_per_node=dofs_per_node, where=where)
 
 
-def _bundle_matrix(arrays, name, path, size):
-    """A bundle's dense ``name`` or its COO triplets (n from ``size``, else the largest index)."""
+def _bundle_matrix(arrays, name, path, sizes):
+    """A bundle's dense ``name`` or its COO triplets, n the first of ``sizes`` (the DOFs the
+    nodes may have) that holds every index."""
     if name in arrays:
         return arrays[name]
     keys = [f"{name}_{k}" for k in ("rows", "cols", "values")]
@@ -87,29 +96,33 @@ def _bundle_matrix(arrays, name, path, size):
     if not len(rows) == len(cols) == len(values):
         raise ModelError(f"{path}: {name}_rows, {name}_cols, {name}_values have lengths "
                          f"{len(rows)}, {len(cols)}, {len(values)}: they must be equal")
-    if len(rows) and (rows.min() < 0 or cols.min() < 0 or not np.issubdtype(rows.dtype, np.integer)
-                      or not np.issubdtype(cols.dtype, np.integer)):
+    if rows.dtype.kind not in "iu" or cols.dtype.kind not in "iu" or len(rows) and min(rows.min(), cols.min()) < 0:
         raise ModelError(f"{path}: {name}_rows and {name}_cols must be non-negative integers (0-based)")
-    n = size if size is not None else int(max(rows.max(initial=-1), cols.max(initial=-1)) + 1)
-    if len(rows) and max(rows.max(), cols.max()) >= n:
-        raise ModelError(f"{path}: {name} has an entry at index {int(max(rows.max(), cols.max()))} "
-                         f"but the nodes give {n} DOFs (0..{n - 1})")
-    return scipy.sparse.coo_array((values.astype(float), (rows, cols)), shape=(n, n)).tocsr()
+    values = real_array(values, f"{path} [{name}_values]", name)
+    largest = int(max(rows.max(initial=-1), cols.max(initial=-1)))
+    n = next((size for size in sizes if largest < size), sizes[-1])
+    if largest >= n:
+        raise ModelError(f"{path}: {name} has an entry at index {largest} but the nodes give "
+                         f"{'at most ' if len(sizes) > 1 else ''}{n} DOFs "
+                         f"(0..{n - 1})")
+    return scipy.sparse.coo_array((values, (rows, cols)), shape=(n, n)).tocsr()
 
 
 def _read_one(path, what):
-    if not path.is_file():
-        raise ModelError(f"{path}: no such file (the {what})")
+    _check_file(path, f"the {what}")
     suffix = path.suffix.lower()
     if suffix == ".mtx":
         try:
             return scipy.io.mmread(path)
-        except (ValueError, OSError, IndexError) as err:
-            raise ModelError(f"{path}: not a readable Matrix Market file ({err})") from err
+        except MTX_ERRORS as err:
+            raise ModelError(f"{path}: not a readable Matrix Market file ({type(err).__name__}: {err})") from err
     if suffix == ".npz":
         arrays = _load_npz(path)
         if {"data", "indices", "indptr", "format", "shape"} <= set(arrays) or {"row", "col", "data", "format", "shape"} <= set(arrays):
-            return scipy.sparse.load_npz(path)
+            try:
+                return scipy.sparse.load_npz(path)
+            except SPARSE_NPZ_ERRORS as err:
+                raise ModelError(f"{path}: not a readable scipy.sparse .npz file ({type(err).__name__}: {err})") from err
         if len(arrays) != 1:
             raise ModelError(f"{path}: a {what} .npz must hold one array (or be scipy.sparse.save_npz's); "
                              f"it holds {sorted(arrays)}")
@@ -123,18 +136,25 @@ def _read_one(path, what):
     raise ModelError(f"{path}: the {what} must be a {kinds} file")
 
 
-def _load_npz(path):
+def _check_file(path, what):
     if not path.is_file():
-        raise ModelError(f"{path}: no such file")
+        raise ModelError(f"{path}: " + ("is a folder" if path.is_dir() else "no such file") + f" ({what})")
+
+
+def _load_npz(path):
+    _check_file(path, "an .npz file")
     try:
-        with np.load(path, allow_pickle=False) as data:
+        data = np.load(path, allow_pickle=False)
+        if not isinstance(data, np.lib.npyio.NpzFile):
+            raise ModelError(f"{path}: one array (numpy.save's .npy), not an .npz archive (numpy.savez's)")
+        with data:
             return {k: data[k] for k in data.files}
-    except (ValueError, OSError) as err:
-        raise ModelError(f"{path}: not a readable .npz file ({err})") from err
+    except NPZ_ERRORS as err:
+        raise ModelError(f"{path}: not a readable .npz file ({type(err).__name__}: {err})") from err
 
 
 def _nodes(X, path):
-    X = X.toarray() if scipy.sparse.issparse(X) else np.asarray(X)
+    X = real_array(X.toarray() if scipy.sparse.issparse(X) else X, path, "node coordinates")
     if X.ndim != 2 or X.shape[1] != 3:
         raise ModelError(f"{path}: node coordinates must be N × 3 (x y z per node), got shape {X.shape}")
-    return X.astype(float)
+    return X

@@ -55,6 +55,9 @@ class FlexibleBody(Part):
     def __init__(self, name, q, qd, reduction, gravity, params, frames=None, damping=None, geometry=(),
                  initial=None, stiffening=None):
         r = reduction.size
+        if r == 0:
+            raise ModelError(f"flexible body '{name}': its reduction has no elastic coordinate: a part without one "
+                             "is a rigid_body")
         if len(q) != 7 + r:
             raise ModelError(f"flexible body '{name}': {len(q)} coordinate symbols, its reduction needs {7 + r}")
         self.reduction, self.gravity = reduction, sp.Matrix(gravity)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+import mbsynth as mb
 from flexible_beams import strip
 from mbsynth.model.flexible.reduction import craig_bampton
 from mbsynth.model.parts.flexible_body import FlexibleBody, coordinates, modal_damping, rayleigh_damping
@@ -199,3 +200,10 @@ def test_modal_damping_damps_each_reduced_mode_at_its_ratio():
     s = s[s.imag > 0]
     ratio = -s.real / np.abs(s)
     np.testing.assert_allclose(ratio, 0.05, rtol=1e-9)
+
+
+def test_a_reduction_without_elastic_coordinates_is_refused():
+    """Guyan's reduction held at its only interface node leaves no η: a ModelError naming the
+    part (the loader names the key and why first), not a sympy shape error."""
+    with pytest.raises(mb.ModelError, match="flexible body 'beam': its reduction has no elastic coordinate"):
+        flexible_body(craig_bampton(strip(4), [0], count=0).hold(0))
