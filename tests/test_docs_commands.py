@@ -189,3 +189,18 @@ def test_every_python_block_runs_as_shown(page, number, code, workdir):
     done = subprocess.run([sys.executable, "-c", code], cwd=workdir, env=env, capture_output=True, text=True,
                           timeout=SNIPPET_TIMEOUT)
     assert done.returncode == 0, f"{page}, python block {number}:\n{done.stderr[-3000:]}"
+
+
+def test_the_readme_states_what_the_quick_start_needs():
+    """The README's quick start names what a fresh machine needs, as the project declares
+    it: the Python of pyproject.toml's requires-python with venv (the Makefile's first
+    step), make, the network, the disk, and Chromium installed by `make test` as root."""
+    import tomllib
+    readme = (ROOT / "README.md").read_text()
+    quick_start = readme.split("## Quick start", 1)[1].split("\n## ", 1)[0]
+    oldest = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["requires-python"].removeprefix(">=")
+    assert f"Python {oldest} or newer with its `venv` module" in quick_start
+    assert "-m venv" in (ROOT / "Makefile").read_text() and "apt-get install" in (
+        ROOT / "scripts" / "install-chromium.sh").read_text()
+    for needed in ("`make`", "the network", "GB of disk", "Chromium", "scripts/install-chromium.sh", "minutes"):
+        assert needed in quick_start, needed
