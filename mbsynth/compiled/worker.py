@@ -9,16 +9,19 @@ interrupted. So at exit (``atexit``, after the other threads are joined) the Wor
 no more tasks (the queued ones start again in the next process that needs them), and the
 exit waits for the compilation in progress, if any, and then keeps numba's compiler lock:
 the wait is at most one function's compilation, and no thread of the process enters LLVM
-after it (one that tries waits on the lock until the process ends).
+after it (one that tries waits on the lock until the process ends). Ctrl-C during the wait
+ends the process at once with status 130, without running LLVM's destructors.
 """
 
 import atexit
+import os
 import queue
 import sys
 import threading
 import time
 
 _workers = []  # every Worker made, closed at exit
+INTERRUPTED = 130  # the exit status of a process ended by Ctrl-C (128 + SIGINT), as the CLI's
 POLL = 0.01  # seconds between looks at a numba import in progress at exit (it takes about a second)
 
 
@@ -68,9 +71,14 @@ def _at_exit():
     until the process ends (module docstring)."""
     for worker in _workers:
         worker.close()
-    lock = _compiler_lock()
-    if lock is not None:
-        lock.acquire()  # released by the end of the process
+    try:
+        lock = _compiler_lock()
+        if lock is not None:
+            lock.acquire()  # released by the end of the process
+    except KeyboardInterrupt:  # Ctrl-C during the wait: leave now, past LLVM's destructors (os._exit runs none)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(INTERRUPTED)
 
 
 def _compiler_lock():

@@ -1,10 +1,13 @@
 """Leaving Python while a compilation runs on another thread (worker.py): the process waits
 for the numba compilation in progress and exits cleanly — status 0, no LLVM assertion —
-whatever its compile threads are doing; builds not started are dropped."""
+whatever its compile threads are doing; builds not started are dropped; Ctrl-C during the
+wait ends it at once."""
 
+import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -73,3 +76,26 @@ def test_a_build_asked_for_while_python_exits_is_refused():
         system = mb.load("models/rigid/double_pendulum_spatial.yaml")
         """)
     assert (done.stdout, done.stderr) == ("None\n", "")
+
+
+@pytest.mark.implementation
+def test_ctrl_c_while_the_exit_waits_ends_the_process_at_once(tmp_path):
+    """Ctrl-C while the exit waits for a compilation: the process ends at once with status
+    130 (interrupted), still without an LLVM abort, and prints nothing more."""
+    (tmp_path / "heavy.py").write_text(HEAVY)
+    env = {"PATH": "/usr/bin:/bin", "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": f"{ROOT}:{tmp_path}"}
+    script = textwrap.dedent(f"""
+        import time
+        from mbsynth.compiled.worker import Worker
+        from heavy import f
+        Worker("compile", f.compile).submit("float64(float64)")
+        time.sleep({STARTED})
+        print("leaving", flush=True)
+        """)
+    process = subprocess.Popen([sys.executable, "-c", script], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    assert process.stdout.readline() == "leaving\n"
+    time.sleep(STARTED)  # in the exit's wait
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=60)
+    assert (process.returncode, out, err) == (130, "", "")
