@@ -24,10 +24,12 @@ docs: $(DOCS_STAMP) $(TEST_STAMP)
 install: $(STAMP)
 
 $(VENV)/bin/python:
+	@echo "making the virtual environment $(VENV) ($(PYTHON) -m venv)"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 
 $(STAMP): pyproject.toml | $(VENV)/bin/python
+	@echo "installing mbsynth and its dependencies into $(VENV) (pip, from the network: about 2 minutes)"
 	$(PY) -m pip install --quiet -e .
 	$(PY) -m mbsynth.compiled
 	touch $@

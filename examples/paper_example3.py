@@ -10,6 +10,8 @@ full column rank. When a mass is zero the rank drops, and the missing equation i
 force balance, which mbsynth derives and can append by itself (`closure: auto`).
 """
 
+import shlex
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +23,10 @@ from mbsynth.analysis.diagnose import diagnose
 MODELS = Path(__file__).resolve().parent.parent / "models" / "paper"
 OUT = Path(__file__).resolve().parent.parent / "out"
 np.set_printoptions(precision=4, suppress=True)
+NEXT = [  # what the walk suggests next (its last lines), each a command that runs as printed
+    ("check", MODELS / "example3_m2_zero_auto.yaml"),
+    ("simulate", MODELS / "example3_two_masses.yaml", "--t-end", "4", "--plot", OUT / "example3.png"),
+]
 
 
 def section(title):
@@ -72,8 +78,24 @@ def main():
     page = mb.viewer.to_html(system, trajectory, OUT / "example3.html")
     print(f"simulated 4 s (max constraint residual {trajectory.max_residual:.1e}); the animation plays "
           f"offline in any browser:\n{page}")
-    print("\nNext: `mbsynth check models/paper/*.yaml` reports the same for every example;")
-    print("`mbsynth view MODEL.yaml` shows any model's motion live.")
+    print("\nNext, from this folder: the same report for another example of the paper, and a run with its plot:")
+    for words in NEXT:
+        print("  " + command(*words))
+
+
+def command(*words):
+    """The command line ``mbsynth WORDS`` as it runs from the current folder: the ``mbsynth``
+    program beside this interpreter (``.venv/bin/mbsynth`` under ``make run``), else this
+    interpreter with ``-m mbsynth``; paths relative to the current folder where they are in it."""
+    program = Path(sys.executable).parent / "mbsynth"
+    head = [shown(program)] if program.is_file() else [shown(Path(sys.executable)), "-m", "mbsynth"]
+    return shlex.join(head + [shown(word) if isinstance(word, Path) else word for word in words])
+
+
+def shown(path):
+    """``path`` relative to the current folder when it lies inside it, else absolute."""
+    path = path.absolute()
+    return str(path.relative_to(Path.cwd())) if path.is_relative_to(Path.cwd()) else str(path)
 
 
 if __name__ == "__main__":

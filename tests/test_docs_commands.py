@@ -11,10 +11,17 @@ command; ``--workers`` dropped with it). Commands that differ only in what is sh
 once. Not run, only their paths checked: ``view`` without ``--html`` (LIVE: it serves a
 live viewer until Ctrl-C). Files a page asks its reader to make (MADE_BY_THE_READER) are made
 as the page says. Every path named on these pages (``models/...``, ``tests/...``,
-``benchmarks/...``, ...) exists."""
+``benchmarks/...``, ...) exists.
 
+Every ```python block of the README and of docs/*.md runs as shown, each in a fresh
+process in that folder (the tutorials' blocks run in order, one namespace per page:
+test_tutorials.py); a block that cannot run says why on its first line (NOT_RUN)."""
+
+import os
 import re
 import shlex
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -35,6 +42,10 @@ MADE_BY_THE_READER = {  # getting-started: "example 3 with m1: 0.0, no extra con
     "open_model.yaml": lambda: EXAMPLE3.read_text().replace("m1: 1.5", "m1: 0.0"),
 }
 VERDICTS_SHOWN = {"check open_model.yaml": 1}  # the page shows the verdict: NOT unique, no motion
+BLOCK = re.compile(r"^```python\n(.*?)^```$", re.S | re.M)
+NOT_RUN = "# not run: "  # a block's first line that says why it cannot run as shown
+SNIPPET_PAGES = [page for page in PAGES if page.parent.name != "tutorials"]  # the tutorials: test_tutorials.py
+SNIPPET_TIMEOUT = 240  # seconds: a block runs in seconds; this bounds a hang
 NAMED = re.compile(r"(?<![\w/.-])((?:models|benchmarks|examples|tests|mbsynth|docs|scripts)/[\w./*-]*[\w*])")
 
 
@@ -154,3 +165,42 @@ def test_shortening_keeps_the_command():
     assert shortened(["view", "m.yaml", "--html", "v.html"])[-2:] == ["--t-end", "0.2"]
     assert paths(["simulate", "models/m.yaml", "--t-end", "1", "--out", "run.npz", "--plot", "out/p.png"]) == [
         ("models/m.yaml", True), ("run.npz", False), ("out/p.png", False)]
+
+
+def shown_snippets():
+    """(page name, number on the page, code) of every ```python block."""
+    return [(page.relative_to(ROOT).as_posix(), k, code) for page in SNIPPET_PAGES
+            for k, code in enumerate(BLOCK.findall(page.read_text()), start=1)]
+
+
+SNIPPETS = shown_snippets()
+
+
+def test_the_pages_show_python_blocks():
+    assert {page for page, _, _ in SNIPPETS} >= {"README.md", "docs/api.md", "docs/guide.md"}
+
+
+@pytest.mark.parametrize("page, number, code", SNIPPETS, ids=[f"{page}:{k}" for page, k, _ in SNIPPETS])
+def test_every_python_block_runs_as_shown(page, number, code, workdir):
+    if code.startswith(NOT_RUN):
+        pytest.skip(f"{page}, block {number}: {code.splitlines()[0][len(NOT_RUN):]}")
+    env = {**os.environ, "MPLBACKEND": "agg",
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    done = subprocess.run([sys.executable, "-c", code], cwd=workdir, env=env, capture_output=True, text=True,
+                          timeout=SNIPPET_TIMEOUT)
+    assert done.returncode == 0, f"{page}, python block {number}:\n{done.stderr[-3000:]}"
+
+
+def test_the_readme_states_what_the_quick_start_needs():
+    """The README's quick start names what a fresh machine needs, as the project declares
+    it: the Python of pyproject.toml's requires-python with venv (the Makefile's first
+    step), make, the network, the disk, and Chromium installed by `make test` as root."""
+    import tomllib
+    readme = (ROOT / "README.md").read_text()
+    quick_start = readme.split("## Quick start", 1)[1].split("\n## ", 1)[0]
+    oldest = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["requires-python"].removeprefix(">=")
+    assert f"Python {oldest} or newer with its `venv` module" in quick_start
+    assert "-m venv" in (ROOT / "Makefile").read_text() and "apt-get install" in (
+        ROOT / "scripts" / "install-chromium.sh").read_text()
+    for needed in ("`make`", "the network", "GB of disk", "Chromium", "scripts/install-chromium.sh", "minutes"):
+        assert needed in quick_start, needed

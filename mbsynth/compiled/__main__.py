@@ -4,15 +4,19 @@ On two cores: first the kernel's largest parts for both variants of ``kernel.mot
 helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
 correction) in a helper (``python -m mbsynth.compiled rigid``) while this process compiles the
 general ones; then each warm-up model here, loading what is missing from the cache (all of
-it, unless a helper failed).
+it, unless a helper failed). Each stage says on stderr what it compiles and how far it is
+(``[k/N]``); when the cache holds the kernels already, it says so and only loads them.
 """
 
+import os
 import sys
 import time
 
 import numpy as np
 
 from . import cache, row_fit
+
+COLD_TIME = "about 2-3 minutes on 2 cores"  # measured: `make install` on a 2-core machine
 
 
 def warm(texts):
@@ -37,15 +41,33 @@ def main():
         warm([WARM_RIGID])
         return
     from . import ahead, background, kernel
+    cold = not background.compiled()
+    where = os.environ.get("NUMBA_CACHE_DIR") or cache.cache_dir()
+    if cold:
+        say(f"compiling the fast path's kernels once ({COLD_TIME}); every later run loads them "
+            f"from the cache ({where}) in about a second instead of compiling for tens of seconds")
+    else:
+        say(f"the fast path's kernels are compiled already ({where}): loading them to check (seconds)")
+    stages = ([("the kernel's largest parts, in helper processes", None)] if cold else []) + [
+        (f"the general kernel on warm-up model {k} of {len(WARM_MODELS)}", text)
+        for k, text in enumerate(WARM_MODELS, start=1)] + [("the rigid tree's kernel", WARM_RIGID)]
     rigid = []
-    if not background.compiled():
-        ahead.start(kernel.RIGID_TREE, kernel.GENERAL)
-        ahead.finish()
-        rigid = ahead.spawn(__spec__.name, "rigid")
-    warm(WARM_MODELS)
-    ahead.wait(rigid)
-    warm([WARM_RIGID])
-    print(f"mbsynth fast path compiled into {cache.cache_dir()} in {time.perf_counter() - started:.1f} s")
+    for k, (what, text) in enumerate(stages, start=1):
+        say(f"[{k}/{len(stages)}] {what} ({time.perf_counter() - started:.0f} s so far)")
+        if text is None:
+            ahead.start(kernel.RIGID_TREE, kernel.GENERAL)
+            ahead.finish()
+            rigid = ahead.spawn(__spec__.name, "rigid")  # beside the general models
+            continue
+        if text is WARM_RIGID:
+            ahead.wait(rigid)
+        warm([text])
+    print(f"mbsynth fast path compiled into {where} in {time.perf_counter() - started:.1f} s")
+
+
+def say(line):
+    """A line of progress, on stderr."""
+    print(f"mbsynth: {line}", file=sys.stderr, flush=True)
 
 
 # A body on a spherical joint with a particle on a rod, without and with a loop (a second,

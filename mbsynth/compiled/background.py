@@ -13,8 +13,9 @@ A Template is kept in the ``TemplateSlot`` of the System's structure (``System.s
 the Systems that differ only in parameter values share it), built at most once for all
 of them. A Data (data.py) decides with ``compiled()`` whether a run waits for it.
 
-The worker is a daemon thread (worker.py): leaving Python never waits for a compilation;
-one cut short starts again next time.
+The worker is a daemon thread (worker.py): leaving Python waits only for the numba
+compilation in progress (one interrupted would abort the process); a build not finished
+starts again next time, and one asked for while Python exits is refused (the KKT path).
 """
 
 import contextlib
@@ -111,8 +112,9 @@ def _build_task(system, slot):
     try:
         built = _build(system)
     except Exception as err:
-        log.warning("model %s: the compiled path is unavailable (%s: %s); using the KKT path",
-                    name, type(err).__name__, err)
+        if not _worker.closed:  # else Python is exiting: what failed is the exit's doing
+            log.warning("model %s: the compiled path is unavailable (%s: %s); using the KKT path",
+                        name, type(err).__name__, err)
         failed, built = err.with_traceback(None), None  # its frames would hold the System
     else:
         failed = None
@@ -121,6 +123,11 @@ def _build_task(system, slot):
         slot.future.set_exception(failed)
     else:
         slot.future.set_result(built)
+
+
+def _refuse(system, slot):
+    """A build that will not run: Python is exiting (worker.py)."""
+    slot.future.set_exception(RuntimeError(f"model {system.name}: not built, Python is exiting"))
 
 
 def _build(system):
@@ -149,4 +156,4 @@ def build(system):
     return None if built is None else built.engine(system.parameter_values)
 
 
-_worker = Worker("mbsynth-compile", _build_task)
+_worker = Worker("mbsynth-compile", _build_task, drop=_refuse)

@@ -72,7 +72,8 @@ def _build(raw):
         evaluate = load(source(*raw.structure()), prefix="mbsynth_structure").evaluate
         evaluate.compile(SIGNATURE)  # here, not at the first call (which may be on the caller's thread)
     except Exception as err:  # noqa: BLE001 - numpy serves
-        log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
+        if not _worker.closed:  # else Python is exiting: what failed is the exit's doing
+            log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
         return
     raw.kernel = evaluate
 
