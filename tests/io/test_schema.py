@@ -29,7 +29,7 @@ BASE = {"parameters": {"m": 1.0, "k": 10.0, "L": 0.5, "R": 0.2, "g": 9.81, "F": 
 # a flexible body of one mode (the section examples' beam has 20 elements)
 ROD = {"type": "flexible_body", "beam": {"length": 1.0, "elements": 20, "area": 1e-4, "Iy": 1e-9, "Iz": 1e-9, "J": 2e-9,
                                          "E": 2.1e11, "nu": 0.3, "density": 7850},
-       "reduction": {"method": "craig_bampton", "interface": [0], "modes": 1}}
+       "reduction": {"method": "craig_bampton", "interface": [0], "modes": 2}}  # a round section: its bending pair whole
 
 # Where each section's mapping sits: (path of the mapping in the model, its minimal valid
 # content, the model's other entries it needs). Keys are then added to that mapping.
