@@ -164,6 +164,8 @@ class _Translator:
     def visit_Attribute(self, node):
         return self.lookup(node, _dotted_name(node) or self.fail(node, f"'{self.source(node)}' is not a name"))
 
+    visit_Subscript = visit_Attribute
+
     def lookup(self, node, name):
         if name in self.symbols:
             return self.symbols[name]
@@ -225,11 +227,16 @@ def _number(value):
 
 
 def _dotted_name(node):
-    parts = []
-    while isinstance(node, ast.Attribute):
-        parts.append(node.attr)
+    """``a.b.c`` of a chain of attributes, or None; a copy of a repeated substructure is
+    named with its index, ``cell[2].bar.x`` (an integer in brackets after a name)."""
+    pieces = []
+    while not isinstance(node, ast.Name):
+        if isinstance(node, ast.Attribute):
+            pieces.append("." + node.attr)
+        elif (isinstance(node, ast.Subscript) and isinstance(node.slice, ast.Constant)
+              and type(node.slice.value) is int and node.slice.value >= 0):
+            pieces.append(f"[{node.slice.value}]")
+        else:
+            return None
         node = node.value
-    if not isinstance(node, ast.Name):
-        return None
-    parts.append(node.id)
-    return ".".join(reversed(parts))
+    return node.id + "".join(reversed(pieces))

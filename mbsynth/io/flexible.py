@@ -29,7 +29,7 @@ def read_flexible_body(builder, name, spec, path):
     q, qd = builder.part_symbols(name, coordinates(r))
     geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
     return _fe_layer(builder, path, FlexibleBody, name, q, qd, reduction, builder.gravity,
-                     builder.param_symbols.values(), frames, damping, geometry, initial, stiffening)
+                     builder.parameter_symbols, frames, damping, geometry, initial, stiffening)
 
 
 def _read_fe(builder, spec, path):

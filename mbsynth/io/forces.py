@@ -40,12 +40,12 @@ def read_forces(builder):
         if name in names:
             builder.fail(path + ("name",), f"duplicate force name '{name}'")
         names.add(name)
-        elements.append(READERS[kind](builder, name, spec, path))
+        elements.append(READERS[kind](builder, builder.full_name(name), spec, path))
     return elements
 
 
 def _args(builder):
-    return builder.q, builder.qd, builder.param_symbols.values()
+    return builder.q, builder.qd, builder.parameter_symbols
 
 
 def _spring(builder, name, spec, path):

@@ -47,7 +47,7 @@ def read_friction(builder, spec, path, kind):
 
 def read_joint_forces(builder, spec, path, joint):
     """The force elements of a joint's ``actuation`` and ``spring`` keys."""
-    args = (builder.q, builder.qd, builder.param_symbols.values())
+    args = (builder.q, builder.qd, builder.parameter_symbols)
     elements = []
     if "actuation" in spec:
         efforts = read_actuation(builder, spec["actuation"], path + ("actuation",), joint)

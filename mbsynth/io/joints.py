@@ -2,6 +2,10 @@
 
 A joint's ``actuation``, ``spring`` and ``friction`` keys are read by ``joint_forces``."""
 
+import difflib
+import re
+from dataclasses import replace
+
 import sympy as sp
 
 from ..core.joint_kinds import JOINT_KINDS
@@ -16,18 +20,34 @@ CONTACT_TYPES = {"rolling_disk": ("rigid_body", "euler_body"), "knife_edge": ("r
 
 
 def read_world(builder):
-    """Frames fixed in the world (``world: {frames: {...}}``)."""
+    """Frames fixed in the world (``world: {frames: {...}}``); in an included file, placed
+    by its ``placement:`` (substructures.py)."""
     node = builder.section(builder.root.get("world"), ("world",), "world")
-    return read_frames(builder, "world", node.get("frames"), ("world", "frames"), offsets=True)
+    frames = read_frames(builder, "world", node.get("frames"), ("world", "frames"), offsets=True)
+    if builder.placement.identity:
+        return frames
+    return [replace(f, position=p, rotation=R) for f in frames for p, R in [builder.placement.frame(f.position,
+                                                                                                 f.rotation)]]
 
 
 def frame_reference(builder, text, path):
     """(part or None for the world, Frame) of ``part.frame``, ``part`` (its own origin and
-    axes), ``world`` or ``world.frame``."""
+    axes), ``world``, ``world.frame`` or a port of an included file (``left_leg.hip``); a
+    part of an included file is named in full (``left_leg.thigh.knee``), a copy by its
+    number or an expression of parameters for it (``cell[N - 1].right``)."""
     if not isinstance(text, str) or not text:
         builder.fail(path, f"expected a frame such as 'link.top' or 'world', got {text!r}")
-    part_name, _, frame_name = text.partition(".")
-    if part_name == "world":
+    if "[" in text:
+        text = _BRACKETS.sub(lambda m: _index(builder, m.group(1), path), text)
+    port = builder.assembly.ports.get(builder.full_name(text))
+    if port is not None:
+        return port
+    if text in builder.parts:
+        part_name, frame_name = text, ""
+    else:
+        part_name, _, frame_name = text.rpartition(".")
+    if text == "world" or part_name == "world":
+        frame_name = "" if text == "world" else frame_name
         frames, part = builder.world_frames, None
     elif part_name in builder.parts:
         part = builder.parts[part_name]
@@ -36,13 +56,38 @@ def frame_reference(builder, text, path):
             builder.fail(path, f"a {part.kind} part has no frame of its own: name one of its frames "
                                f"({', '.join(frames) or 'it declares none'})")
     else:
-        builder.fail(path, f"unknown part '{part_name}' in frame '{text}'; parts: "
-                           f"{', '.join(['world', *builder.parts])}")
+        builder.fail(path, unknown_frame(builder, text))
     if not frame_name:
-        return part, Frame(part_name, "origin", sp.zeros(3, 1), sp.eye(3))
+        if part is None:
+            position, rotation = builder.placement.frame(sp.zeros(3, 1), sp.eye(3))
+            return None, Frame("world", "origin", position, rotation)
+        return part, Frame(part.name, "origin", sp.zeros(3, 1), sp.eye(3))
     if frame_name not in frames:
         builder.fail(path, f"'{part_name}' has no frame '{frame_name}'; it has: {', '.join(frames) or 'none'}")
     return part, frames[frame_name]
+
+
+def unknown_frame(builder, text):
+    """Why ``text`` names no frame: an unknown part, a copy's index out of range, an
+    included file's unknown port or part."""
+    head = text.split(".")[0]
+    base, _, index = head.partition("[")
+    copies = sorted(name for name, _ in builder.children)
+    for name, children in builder.children:
+        if base == name and index:
+            if not index.rstrip("]").isdigit() or int(index.rstrip("]")) >= len(children):
+                return f"'{head}' is out of range: '{name}' has copies {name}[0] … {name}[{len(children) - 1}]"
+        if head == name or (base == name and index):
+            child = next((c for c in children if c.prefix == builder.prefix + head + "."), children[0])
+            ports = sorted(port[len(child.prefix):] for port in builder.assembly.ports if port.startswith(child.prefix))
+            rest = text[len(head) + 1:]
+            return (f"'{head}' (the file {child.doc.name}) has no port or part frame '{rest}'; its ports: "
+                    f"{', '.join(ports) or 'none'}; its parts: {', '.join(sorted(child.parts)[:20])}")
+    names = ["world", *(name for name in builder.parts if "." not in name), *copies]
+    close = difflib.get_close_matches(head, names, n=3)
+    hint = f" (did you mean {', '.join(close)}?)" if close else ""
+    shown = names if len(names) <= 30 else names[:30] + [f"… {len(names) - 30} more"]
+    return f"unknown part '{head}' in frame '{text}'{hint}; parts: {', '.join(shown)}"
 
 
 def read_joints(builder):
@@ -53,54 +98,59 @@ def read_joints(builder):
     if not isinstance(node, list):
         builder.fail(("joints",), "expected a list of joints")
     joints, forces, names = [], [], set()
-    for i, spec in enumerate(node):
-        path = ("joints", i)
-        if isinstance(spec, dict) and spec.get("type") in CONTACT_TYPES:
-            joints.append(read_contact(builder, spec, path, names))
-            continue
-        spec = builder.section(spec, path, "joint")
-        name = _joint_name(builder, spec, path, names)
-        kind = spec["type"]
-        if kind not in JOINT_KINDS:
-            builder.fail(path + ("type",), f"unknown joint type {kind!r}; known: "
-                                           f"{', '.join((*JOINT_KINDS, *CONTACT_TYPES))}")
-        parent, frame_a = frame_reference(builder, spec["parent"], path + ("parent",))
-        child, frame_b = frame_reference(builder, spec["child"], path + ("child",))
-        if child is None or child is parent:
-            builder.fail(path + ("child",), "the child of a joint must be a part other than its parent")
-        length = None
-        if kind == "distance":
-            if "length" not in spec:
-                builder.fail(path, "a distance joint needs 'length'")
-            length = builder.constant(spec["length"], path + ("length",))
-            if builder.value(length) <= 0:
-                builder.fail(path + ("length",), "length must be positive")
-        elif "length" in spec:
-            builder.fail(path + ("length",), f"only a distance joint has a length, not a {kind} joint")
-        friction = read_friction(builder, spec, path, kind)
-        joint = Joint(name, kind, parent, frame_a, child, frame_b, builder.q, builder.qd,
-                      builder.param_symbols.values(), length, friction)
+    for i, spec, suffix, loop in _each_joint(builder, node):
+        with builder.extra_names(loop):
+            joint = _read_joint(builder, spec, ("joints", i), names, suffix)
         joints.append(joint)
-        forces.append((spec, path, joint))
+        if isinstance(joint, Joint):
+            forces.append((spec, ("joints", i), joint))
     builder.register_joints(joints)  # joint values in the expressions of actuation and springs
     elements = [e for spec, path, joint in forces for e in read_joint_forces(builder, spec, path, joint)]
     return joints, elements
 
 
-def read_contact(builder, spec, path, names):
+def _read_joint(builder, spec, path, names, suffix):
+    """A joint or ground contact of the ``joints:`` list."""
+    if isinstance(spec, dict) and spec.get("type") in CONTACT_TYPES:
+        return read_contact(builder, spec, path, names, suffix)
+    spec = builder.section(spec, path, "joint")
+    name = _joint_name(builder, spec, path, names, suffix)
+    kind = spec["type"]
+    if kind not in JOINT_KINDS:
+        builder.fail(path + ("type",), f"unknown joint type {kind!r}; known: "
+                                       f"{', '.join((*JOINT_KINDS, *CONTACT_TYPES))}")
+    parent, frame_a = frame_reference(builder, spec["parent"], path + ("parent",))
+    child, frame_b = frame_reference(builder, spec["child"], path + ("child",))
+    if child is None or child is parent:
+        builder.fail(path + ("child",), "the child of a joint must be a part other than its parent")
+    length = None
+    if kind == "distance":
+        if "length" not in spec:
+            builder.fail(path, "a distance joint needs 'length'")
+        length = builder.constant(spec["length"], path + ("length",))
+        if builder.value(length) <= 0:
+            builder.fail(path + ("length",), "length must be positive")
+    elif "length" in spec:
+        builder.fail(path + ("length",), f"only a distance joint has a length, not a {kind} joint")
+    friction = read_friction(builder, spec, path, kind)
+    return Joint(name, kind, parent, frame_a, child, frame_b, builder.q, builder.qd,
+                 builder.parameter_symbols, length, friction)
+
+
+def read_contact(builder, spec, path, names, suffix=""):
     """A ground contact: ``rolling_disk`` (``child`` the disk's centre frame, z along its
     axis; ``radius``; ``ground`` the height of the plane, 0 by default) or ``knife_edge``
     (``child`` a frame whose x axis is the blade)."""
     kind = spec["type"]
     hosts = CONTACT_TYPES[kind]
     spec = builder.section(spec, path, kind)
-    name = _joint_name(builder, spec, path, names)
+    name = _joint_name(builder, spec, path, names, suffix)
     part, frame = frame_reference(builder, spec["child"], path + ("child",))
     if part is None or part.kind not in hosts:
         named = dict.fromkeys("rigid_body" if h == "euler_body" else h for h in hosts)  # a model file's types
         builder.fail(path + ("child",), f"a {kind} is a frame on a {' or '.join(named)}, not on "
                                         f"{'the world' if part is None else 'a ' + part.kind}")
-    args = (builder.q, builder.qd, builder.param_symbols.values())
+    args = (builder.q, builder.qd, builder.parameter_symbols)
     if kind == "knife_edge":
         return KnifeEdge(name, part, frame, *args)
     radius = builder.constant(spec["radius"], path + ("radius",))
@@ -110,10 +160,50 @@ def read_contact(builder, spec, path, names):
                        *args)
 
 
-def _joint_name(builder, spec, path, names):
+def _joint_name(builder, spec, path, names, suffix=""):
+    """The model's name of the joint (``for:`` copies: ``name[i]``), checked unique in the file."""
     name = spec["name"]
     builder.identifier(name, path + ("name",), "joint name")
-    if name in names:
+    if name + suffix in names:
         builder.fail(path + ("name",), f"duplicate joint name '{name}'")
-    names.add(name)
-    return name
+    names.add(name + suffix)
+    return builder.full_name(name + suffix)
+
+
+_BRACKETS = re.compile(r"\[([^\[\]]*)\]")
+
+
+def _each_joint(builder, node):
+    """(index in ``joints:``, entry, name suffix) of each joint; an entry with ``for: {i:
+    [first, last]}`` gives one joint per i = first … last (both included), named
+    ``name[i]``, with each ``[expression of i]`` in its frames replaced by its value
+    (``parent: cell[i].right``, ``child: cell[i+1].left``)."""
+    for i, spec in enumerate(node):
+        if not (isinstance(spec, dict) and "for" in spec):
+            yield i, spec, "", {}
+            continue
+        path = ("joints", i, "for")
+        loop = spec["for"]
+        if not (isinstance(loop, dict) and len(loop) == 1):
+            builder.fail(path, "expected one name and its range, e.g. 'for: {i: [0, N - 2]}'")
+        (variable, bounds), = loop.items()
+        builder.identifier(variable, path + (variable,), "loop name")
+        if variable in builder.param_symbols:
+            builder.fail(path + (variable,), f"the loop name '{variable}' is a parameter's")
+        first, last = (builder.fixed_value(x, path + (variable, k))
+                       for k, x in enumerate(builder.constants(bounds, path + (variable,), 2)))
+        if first != int(first) or last != int(last):
+            builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] must be of whole numbers")
+        for k in range(int(first), int(last) + 1):
+            copy = type(spec)({key: value for key, value in spec.items() if key != "for"})
+            copy.line, copy.key_lines = spec.line, spec.key_lines
+            yield i, copy, f"[{k}]", {variable: sp.Integer(k)}
+
+
+def _index(builder, text, path):
+    """``[text]`` of a frame name, ``text`` an expression of parameters (and of a ``for:``
+    entry's name): the whole number it gives, in brackets."""
+    number = builder.fixed_value(builder.constant(text, path), path)
+    if number != int(number) or number < 0:
+        builder.fail(path, f"[{text}] is {number:g}: a copy's number is a whole number ≥ 0")
+    return f"[{int(number)}]"

@@ -4,6 +4,7 @@ Every mistake in a file raises ``ModelError`` reading ``file:line: at key.path: 
 Expressions are parsed by ``mbsynth.core.expressions`` (never evaluated as code).
 """
 
+import contextlib
 import difflib
 import functools
 import keyword
@@ -21,7 +22,7 @@ from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..core.errors import ModelError
 from ..model.parts import LagrangianPart
 from ..symbolic.derive import T_SYMBOL, joint_values_in
-from ..model.system import System
+from ..model.system import Substructure, System
 from .flexible import read_flexible_body
 from .forces import read_forces
 from .joints import read_joints, read_world
@@ -29,7 +30,9 @@ from .outputs import read_outputs
 from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import connect_robots, read_robot, read_robots
 from .schema import SECTIONS
+from .placement import Placement, place_initial
 from .source import Document, LineDict, LineList, read_document
+from .substructures import Scoped, read_includes, read_ports
 
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
@@ -51,19 +54,63 @@ def loads(text, name="<string>", folder=None, parameters=None):
 
 def build(doc, parameters=None):
     """Build the System described by a parsed Document (``parameters``: as in ``load``)."""
-    return _Builder(doc, parameters).system()
+    return _Builder(doc, Assembly(parameters)).system()
+
+
+class Assembly:
+    """What every file of a model adds to, the model file's own and those it includes as
+    substructures (substructures.py): the parameters, parts, coordinates and names, each
+    under its full name (``left_leg.thigh.x``)."""
+
+    def __init__(self, overrides=None):
+        self.overrides = dict(overrides or {})  # load()'s parameters, by full name
+        self.values = {}  # parameter symbol -> value, in the model's order
+        self.definitions = {}  # parameter name -> expression of earlier ones
+        self.fixed = {}  # parameter name -> where a file builds something from its value at load
+        self.parameter_symbols = ()
+        self.parts = {}  # full name -> part, in the model's order
+        self.owners = {}  # full part name -> (its builder, its entry name there)
+        self.ports = {}  # full port name -> (part, frame)
+        self.documents = {}  # resolved path -> Document: a file used N times is read once
+        self.q, self.qd = [], []
+        self.index = {}  # coordinate symbol -> its place in q
+        self.global_symbols = None
+        self.constraint_symbols = None
 
 
 class _Builder:
-    def __init__(self, doc, parameters=None):
+    def __init__(self, doc, assembly, include=None):
+        """``include``: substructures.Include when this builder reads a file included by
+        another (its names prefixed, its poses placed), None for the model file itself."""
         self.doc = doc
         self.root = doc.root
-        self.overrides = dict(parameters or {})
-        self.fixed = {}  # parameter name -> where the file builds something from its value at load
+        self.assembly = assembly
+        self.include = include
+        self.prefix = include.prefix if include else ""
+        self.placement = include.placement if include else Placement()
+        self.children = []  # (entry name, [child builders]) of the file's ``type: model`` entries
+        self.chain = include.chain if include else ()  # (file, line) of the entries that include this file
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
-        raise self.doc.error(path, message)
+        """Raise ModelError ``file:line: at key.path: message``; in an included file, with
+        the chain of entries that included it."""
+        error = self.doc.error(path, message)
+        if self.include:
+            chain = ", ".join(f"{name}:{line}" for name, line in reversed(self.chain))
+            error = ModelError(f"{error} (in '{self.prefix[:-1]}', included from {chain})")
+        raise error
+
+    @contextlib.contextmanager
+    def extra_names(self, names):
+        """Expressions of parameters read meanwhile may use ``names`` too ({name: value}:
+        a copy's ``index``)."""
+        saved = self.param_symbols
+        self.param_symbols = {**saved, **names}
+        try:
+            yield
+        finally:
+            self.param_symbols = saved
 
     def mapping(self, node, path, allowed, required=()):
         if node is None:
@@ -106,7 +153,7 @@ class _Builder:
         their argument as complex), min and max no second one (a DiracDelta)."""
         if not expr.has(sp.Abs, sp.sign, sp.Min, sp.Max):
             return expr
-        variables = sorted(expr.free_symbols - set(self.param_symbols.values()), key=str)
+        variables = sorted(expr.free_symbols - set(self.parameter_symbols), key=str)
         derived = [expr.diff(v) for v in variables]
         derived += [d.diff(v) for d in derived for v in (variables if second is None else second)]
         if any(d.has(sp.Derivative, sp.DiracDelta) for d in derived):
@@ -131,7 +178,7 @@ class _Builder:
         are recorded as fixed there (``System.fixed_parameters``)."""
         where = f"{self.doc.name}:{self.doc.line_of(path)}, key {'.'.join(map(str, path))}"
         for symbol in sp.sympify(expr).free_symbols:
-            self.fixed.setdefault(str(symbol), where)
+            self.assembly.fixed.setdefault(str(symbol), where)
         return self.value(expr)
 
     def sized_list(self, node, path, size):
@@ -160,84 +207,178 @@ class _Builder:
         return ([sp.Symbol(f"{name}.{c}") for c in coordinates],
                 [sp.Symbol(f"{name}.{c}_dot") for c in coordinates])
 
+    # -- names of a file included as a substructure --------------------------------
+    def full_name(self, name):
+        """The model's name of this file's ``name`` (``left_leg.thigh`` for ``thigh``)."""
+        return self.prefix + name
+
+    def own_name(self, name):
+        """This file's name for the model's ``name`` (the inverse of ``full_name``)."""
+        return name[len(self.prefix):]
+
+    @property
+    def parameter_symbols(self):
+        """Every parameter symbol of the model, in order: the arguments of compiled code."""
+        return self.assembly.parameter_symbols
+
+    @property
+    def param_values(self):
+        return self.assembly.values
+
+    @property
+    def builders(self):
+        """This builder and those of the files it includes, depth first (files in entry order)."""
+        yield self
+        for _, copies in self.children:
+            for child in copies:
+                yield from child.builders
+
+    @property
+    def included_first(self):
+        """``builders`` with every file after those it includes (its joints join theirs)."""
+        for _, copies in self.children:
+            for child in copies:
+                yield from child.included_first
+        yield self
+
     # -- sections -------------------------------------------------------------------
     def system(self):
         root = self.section(self.root, (), "model")
         name = root.get("name", _stem(self.doc.name))
         if not isinstance(name, str):
             self.fail(("name",), f"expected a string, got {_kind(name)}")
-        self.parameters = self.read_parameters()
-        self.robots = read_robots(self)  # before any part is built: their torque parameters join the model's
-        self.override_robot_parameters()
-        self.param_symbols = {p: sp.Symbol(p) for p in self.parameters}
-        self.param_values = {sp.Symbol(k): v for k, v in self.parameters.items()}
-        self.gravity = self.constants(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3)
-        self.world_frames = {f.name: f for f in read_world(self)}
-        parts = self.read_subsystems()
-        self.parts = {part.name: part for part in parts}
-        self.q = [sym for part in parts for sym in part.q]
-        self.qd = [sym for part in parts for sym in part.qd]
-        self.global_symbols = Names(self.param_symbols, t=T_SYMBOL)
-        for part in parts:
-            for c, qs, qds in zip(part.coordinates, part.q, part.qd):
-                self.global_symbols[f"{part.name}.{c}"] = qs
-                self.global_symbols[f"{part.name}.{c}_dot"] = qds
-        self.constraint_symbols = Names(self.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
-        args = (self.q, self.qd, self.param_symbols.values())
-        constraints = [c for part in parts for c in part.own_constraints(*args)]
-        robot_joints, robot_forces = connect_robots(self)
-        self.register_joints(robot_joints, robot=True)
-        joints, joint_forces = read_joints(self)
-        constraints += robot_joints + self.read_constraints() + joints
-        self.check_names(constraints)
-        initial = self.read_initial(parts)
-        system = System.build(name, parts, constraints, self.q, self.qd, self.parameters, initial,
-                              initial_fixed=self.read_initial_fixed(initial),
-                              forces=[*robot_forces, *read_forces(self), *joint_forces])
-        system = replace(system, definitions=self.definitions, initial_definitions=self.initial_definitions,
-                         source=self.doc.text, source_folder=str(self.doc.folder),
-                         robots=tuple(entry.robot for entry in self.robots.values()),
-                         outputs=read_outputs(self, constraints), fixed_parameters=dict(self.fixed),
-                         load_parameters=dict(self.overrides), built_parameters=dict(system.parameters))
-        self.check_parts(system)
-        self.check_branches(system)
-        closure = root.get("closure", "none")
-        if closure not in ("auto", "none"):
-            self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
-        return close(system) if closure == "auto" else system
-
-    def override_robot_parameters(self):
-        """The given ``parameters`` of load() over the robots' torque parameters (the file's
-        own took theirs in read_parameters); a name the model lacks is a ModelError."""
-        unknown = sorted(set(self.overrides) - set(self.parameters))
+        self.plan()
+        model = self.assembly
+        unknown = sorted(set(model.overrides) - {str(s) for s in model.values})
         if unknown:
             raise ModelError(f"{self.doc.name}: the model has no parameter(s) {unknown}; "
-                             f"it has {sorted(self.parameters)}")
-        self.parameters.update(self.overrides)
+                             f"it has {sorted(str(s) for s in model.values)}")
+        model.parameter_symbols = tuple(model.values)
+        self.gravity = self.constants(root.get("gravity", LineList([0, 0, 0])), ("gravity",), 3)
+        for builder in self.builders:
+            builder.gravity = self.gravity  # a substructure's gravity is the model's
+            builder.world_frames = {f.name: f for f in read_world(builder)}
+        parts = self.read_subsystems()
+        model.q += [sym for part in parts for sym in part.q]
+        model.qd += [sym for part in parts for sym in part.qd]
+        model.global_symbols = Names({str(s): s for s in model.parameter_symbols}, t=T_SYMBOL)
+        for part in parts:
+            for c, qs, qds in zip(part.coordinates, part.q, part.qd):
+                model.global_symbols[f"{part.name}.{c}"] = qs
+                model.global_symbols[f"{part.name}.{c}_dot"] = qds
+        model.constraint_symbols = Names(model.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
+        model.index = {s: i for i, s in enumerate(model.q)}
+        for builder in self.builders:
+            builder.scope_names(parts)
+        args = (model.q, model.qd, model.parameter_symbols)
+        constraints = [c for part in parts for c in part.own_constraints(*args)]
+        forces = []
+        for builder in self.included_first:  # a substructure's joints before those that join it
+            more_constraints, more_forces = builder.connect()
+            constraints, forces = constraints + more_constraints, forces + more_forces
+        self.check_names(constraints)
+        values, definitions, given = self.read_initial()
+        initial = {key: self.value(value) for key, value in values.items()}
+        fixed = set().union(*(builder.read_initial_fixed(given) for builder in self.builders))
+        system = System.build(name, parts, constraints, model.q, model.qd, self.parameters_by_name(), initial,
+                              initial_fixed=fixed, forces=forces)
+        outputs = [output for builder in self.included_first for output in read_outputs(builder, constraints)]
+        system = replace(system, definitions=model.definitions, initial_definitions=definitions,
+                         initial_given=frozenset(given), source=self.doc.text, source_folder=str(self.doc.folder),
+                         robots=tuple(entry.robot for b in self.builders for entry in b.robots.values()),
+                         outputs=tuple(outputs), fixed_parameters=dict(model.fixed),
+                         load_parameters=dict(model.overrides), built_parameters=dict(system.parameters),
+                         substructures=self.substructures())
+        self.check_parts(system)
+        self.check_branches(system)
+        closures = [builder for builder in self.builders if builder.read_closure() == "auto"]
+        return close(system) if closures else system
+
+    def plan(self):
+        """This file's parameters, robots and included files (theirs in turn), before any
+        part is built: every part's compiled code takes all the model's parameters."""
+        self.read_parameters()
+        self.robots = read_robots(self)  # their torque parameters join the model's
+        for name, value in self.robots_parameters():
+            self.add_parameter(name, sp.Float(value) if name not in self.assembly.overrides
+                               else sp.Float(self.assembly.overrides[name]), None)
+        self.check_subsystems()
+        self.children = read_includes(self)
+
+    def robots_parameters(self):
+        """(full name, default) of the robots' torque parameters this file has not set."""
+        return [(name, value) for entry in self.robots.values() for name, value in entry.parameters.items()
+                if sp.Symbol(name) not in self.assembly.values]
+
+    def parameters_by_name(self):
+        return {str(symbol): value for symbol, value in self.assembly.values.items()}
+
+    def add_parameter(self, name, expr, path):
+        """Parameter ``name`` (full name) = ``expr`` (an expression of earlier ones, in full
+        names); ``path``: where the file gives it (None: no line to name)."""
+        value = _real(expr, self.assembly.values)
+        if value is None:
+            given = self.assembly.overrides.get(name, expr)
+            message = f"parameter '{name}' = {given!r} is not a finite real number"
+            if path is None:
+                raise ModelError(f"{self.doc.name}: {message}")
+            self.fail(path, message)
+        symbol = sp.Symbol(name)
+        self.assembly.values[symbol] = value
+        if expr.free_symbols:
+            self.assembly.definitions[name] = expr
+        return symbol
 
     def read_parameters(self):
-        """Parameter values in order; ``self.definitions`` keeps the expression of each one
-        defined by earlier ones (which follows them in ``System.with_parameters``); a number
-        is no definition: its value stays until changed itself."""
-        self.definitions = {}
+        """Parameter values in order (the model's ``definitions`` keep the expression of
+        each one defined by earlier ones, which follows them in ``System.with_parameters``;
+        a number is no definition: its value stays until changed itself). A value given to
+        ``load`` wins, then one given by the including file's entry (its ``parameters:``)."""
         node = self.root.get("parameters", LineDict())
         node = self.mapping(node, ("parameters",), set(node) if isinstance(node, dict) else set())
-        values, symbols = {}, {}
+        given = self.include.parameters if self.include else {}
+        self.parameters = {}  # this file's name -> value
+        self.param_symbols = {}  # this file's name -> the model's symbol
         for key, text in node.items():
             path = ("parameters", key)
             self.identifier(key, path, "parameter")
-            expr = sp.Float(self.overrides[key]) if key in self.overrides else self.expression(text, path, symbols)
-            value = _real(expr, values)
-            if value is None:
-                given = self.overrides.get(key, text)
-                self.fail(path, f"parameter '{key}' = {given!r} is not a finite real number")
-            values[sp.Symbol(key)] = value
-            symbols[key] = sp.Symbol(key)
-            if expr.free_symbols:
-                self.definitions[key] = expr
-        return {str(k): v for k, v in values.items()}
+            name = self.full_name(key)
+            if name in self.assembly.overrides:
+                expr = sp.Float(self.assembly.overrides[name])
+            elif key in given:
+                expr = given[key]
+            else:
+                expr = self.expression(text, path, self.param_symbols)
+            symbol = self.add_parameter(name, expr, path)
+            self.parameters[key] = self.assembly.values[symbol]
+            self.param_symbols[key] = symbol
 
     def read_subsystems(self):
+        """The parts of this file and of the files it includes, in the file's order."""
+        node = self.root["subsystems"]
+        parts, included = [], dict(self.children)
+        self.own_parts = []
+        for name, spec in node.items():
+            path = ("subsystems", name)
+            if name in included:
+                for child in included[name]:
+                    parts += child.read_subsystems()
+                continue
+            kind = spec.get("type")
+            if kind not in SUBSYSTEM_TYPES:
+                self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: "
+                                            f"{', '.join((*SUBSYSTEM_TYPES, 'model'))}")
+            made = SUBSYSTEM_TYPES[kind](self, self.full_name(name), spec, path)
+            made = made if isinstance(made, list) else [made]  # a robot gives one part per link
+            for part in made:
+                self.assembly.parts[part.name] = part
+                self.assembly.owners[part.name] = (self, name)
+            self.own_parts += made
+            parts += made
+        return parts
+
+    def check_subsystems(self):
+        """The ``subsystems:`` mapping: a mapping of named entries, each a mapping."""
         node = self.root["subsystems"]
         if node is not None and not isinstance(node, LineDict):
             self.fail(("subsystems",), f"expected a mapping of named parts, e.g. 'wheel: {{type: lagrangian, ...}}', "
@@ -245,7 +386,6 @@ class _Builder:
         if not node:
             self.fail(("subsystems",), "the mapping is empty: a model needs at least one part, e.g. "
                                        "'wheel: {type: lagrangian, ...}'")
-        parts = []
         for name, spec in node.items():
             path = ("subsystems", name)
             self.identifier(name, path, "subsystem name")
@@ -253,12 +393,43 @@ class _Builder:
                 self.fail(path, f"subsystem '{name}' has the name of a parameter or of the world")
             if not isinstance(spec, LineDict):
                 self.fail(path, f"expected a mapping with 'type' and the part's data, got {_kind(spec)}")
-            kind = spec.get("type")
-            if kind not in SUBSYSTEM_TYPES:
-                self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: {', '.join(SUBSYSTEM_TYPES)}")
-            made = SUBSYSTEM_TYPES[kind](self, name, spec, path)
-            parts += made if isinstance(made, list) else [made]  # a robot gives one part per link
-        return parts
+        return node
+
+    def scope_names(self, parts):
+        """This file's view of the model's names: its parts, coordinates, parameters and
+        joint values under the names the file uses (those of the model file itself: all)."""
+        model = self.assembly
+        if not self.prefix:
+            self.parts = model.parts
+            self.global_symbols, self.constraint_symbols = model.global_symbols, model.constraint_symbols
+            self.coordinates = [(str(s), i) for i, s in enumerate(model.q)]
+            return
+        parts = self.all_parts()
+        self.parts = {self.own_name(part.name): part for part in parts}
+        self.global_symbols = Scoped(model.global_symbols, self.prefix)
+        self.constraint_symbols = Scoped(model.constraint_symbols, self.prefix)
+        self.coordinates = [(self.own_name(str(s)), model.index[s]) for part in parts for s in part.q]
+
+    def connect(self):
+        """(constraints, force elements) this file adds once every part is known: its
+        robots' joints, its constraints and joints, its force elements."""
+        read_ports(self)
+        robot_joints, robot_forces = connect_robots(self)
+        self.register_joints(robot_joints, robot=True)
+        joints, joint_forces = read_joints(self)
+        return robot_joints + self.read_constraints() + joints, robot_forces + read_forces(self) + joint_forces
+
+    def read_closure(self):
+        closure = self.root.get("closure", "none")
+        if closure not in ("auto", "none"):
+            self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
+        return closure
+
+    def substructures(self):
+        """The tree of files this model is made of (model/system.py's Substructure)."""
+        return tuple(Substructure(child.prefix[:-1], str(child.doc.name), tuple(p.name for p in child.own_parts),
+                                  child.substructures())
+                     for _, copies in self.children for child in copies)
 
     def read_lagrangian(self, name, spec, path):
         self.section(spec, path, "lagrangian")
@@ -285,7 +456,7 @@ class _Builder:
         forces = [self.expression(forces_node[c], path + ("forces", c), symbols) if c in forces_node
                   else sp.S.Zero for c in coords]
         frames = read_frames(self, name, spec.get("frames"), path + ("frames",), True, symbols)
-        return LagrangianPart(name, coords, q, qd, T, V, forces, self.param_symbols.values(), frames,
+        return LagrangianPart(name, coords, q, qd, T, V, forces, self.parameter_symbols, frames,
                                    read_geometry(self, spec.get("geometry"), path + ("geometry",)))
 
     def read_constraints(self):
@@ -303,12 +474,13 @@ class _Builder:
             if name in names:
                 self.fail(path + ("name",), f"duplicate constraint name '{name}'")
             names.add(name)
+            name = self.full_name(name)
             given = [k for k in kinds if k in spec]
             if len(given) != 1:
                 self.fail(path, f"constraint '{name}' needs exactly one of {', '.join(kinds)}; got {given or 'none'}")
             kind = given[0]
             C = self.read_nonideal(spec, path) if "C" in spec else None
-            args = (self.q, self.qd, self.param_symbols.values())
+            args = (self.q, self.qd, self.parameter_symbols)
             kpath = path + (kind,)
             if kind == "acceleration":
                 a, b = self.read_acceleration_row(spec[kind], kpath)
@@ -332,78 +504,126 @@ class _Builder:
 
     def read_acceleration_row(self, node, path):
         node = self.section(node, path, "acceleration_row")
-        coords = list(self.coordinate_names())
+        coords = [name for name, _ in self.coordinates]
         row = node["A"]
         if isinstance(row, LineList):
             if len(row) != len(coords):
                 self.fail(path + ("A",), f"a row of A needs {len(coords)} entries (one per coordinate: "
                                          f"{', '.join(coords)}), got {len(row)}")
-            a = [self.expression(x, path + ("A", i), self.global_symbols) for i, x in enumerate(row)]
+            entries = dict(zip(coords, row))
+            where = {c: path + ("A", i) for i, c in enumerate(coords)}
         else:
             entries = self.mapping(row, path + ("A",), set(coords))
-            a = [self.expression(entries[c], path + ("A", c), self.global_symbols) if c in entries
-                 else sp.S.Zero for c in coords]
+            where = {c: path + ("A", c) for c in coords}
+        a = self.over_coordinates({c: self.expression(x, where[c], self.global_symbols) for c, x in entries.items()})
         b = self.expression(node.get("b", 0), path + ("b",), self.global_symbols)
         if all(x == 0 for x in a):
             self.fail(path + ("A",), "the row of A is all zero")
         return a, b
 
     def read_nonideal(self, spec, path):
-        coords = list(self.coordinate_names())
-        node = self.mapping(spec["C"], path + ("C",), set(coords))
-        return [self.expression(node[c], path + ("C", c), self.global_symbols) if c in node
-                else sp.S.Zero for c in coords]
+        node = self.mapping(spec["C"], path + ("C",), {name for name, _ in self.coordinates})
+        return self.over_coordinates({c: self.expression(x, path + ("C", c), self.global_symbols)
+                                      for c, x in node.items()})
+
+    def over_coordinates(self, entries):
+        """A list over every coordinate of the model from {this file's coordinate name:
+        expression}, zero elsewhere."""
+        row = [sp.S.Zero] * len(self.q)
+        for name, i in self.coordinates:
+            if name in entries:
+                row[i] = entries[name]
+        return row
+
+    @property
+    def q(self):
+        return self.assembly.q
+
+    @property
+    def qd(self):
+        return self.assembly.qd
 
     def register_joints(self, joints, robot=False):
         """Put the joints' values (``<joint>.angle``, ``<joint>.rate``, …: joint_values.py)
         among the names expressions may use; a joint and a part share one namespace. A
         URDF may give a joint its child link's name: such a robot joint has no values in
         expressions (its part's coordinates keep the name)."""
+        model = self.assembly
         for joint in joints:
-            if not isinstance(joint, Joint) or (robot and joint.name in self.parts):
+            if not isinstance(joint, Joint) or (robot and joint.name in model.parts):
                 continue
-            if joint.name in self.parts:
-                self.fail(self.entry_named(joint.name) or ("subsystems", joint.name),
-                          f"joint '{joint.name}' has the name of part '{joint.name}': joints and parts share one "
-                          f"namespace ('{joint.name}.angle', '{joint.name}.x'), rename one of them")
-            if joint.name in self.parameters or joint.name == "world":
-                entry = self.entry_named(joint.name)
-                clash = "the world (its frames are 'world.<frame>')" if joint.name == "world" else "a parameter"
+            own = self.own_name(joint.name)
+            if joint.name in model.parts:
+                self.fail(self.entry_of(own) or ("subsystems", own),
+                          f"joint '{own}' has the name of part '{own}': joints and parts share one "
+                          f"namespace ('{own}.angle', '{own}.x'), rename one of them")
+            if own in self.parameters or own == "world":
+                entry = self.entry_of(own)
+                clash = "the world (its frames are 'world.<frame>')" if own == "world" else "a parameter"
                 self.fail(entry + ("name",) if entry else ("subsystems",),
-                          f"joint '{joint.name}' has the name of {clash}: rename the joint")
+                          f"joint '{own}' has the name of {clash}: rename the joint")
             values = functools.cache(functools.partial(value_expressions, joint))
             symbols = functools.cache(functools.partial(constraint_symbols, joint))
             for key in value_names(joint):  # derived when an expression uses them (sympy: tenths of a second)
-                self.global_symbols[f"{joint.name}.{key}"] = _Deferred(values, key)
-                self.constraint_symbols[f"{joint.name}.{key}"] = _Deferred(symbols, key)
+                model.global_symbols[f"{joint.name}.{key}"] = _Deferred(values, key)
+                model.constraint_symbols[f"{joint.name}.{key}"] = _Deferred(symbols, key)
 
-    def coordinate_names(self):
-        return (str(s) for s in self.q)
-
-    def read_initial(self, parts):
-        """Initial values: each part's own ``initial:``, then the model's ``initial:``
-        mapping by coordinate name (one place per coordinate)."""
-        values = {f"{part.name}.{k}": v for part in parts for k, v in part.initial.items()}
-        self.initial_definitions = {}
-        coords = list(self.coordinate_names())
+    def read_initial(self):
+        """(values, definitions, given) of the initial state in this file's axes, by full
+        name: each part's own ``initial:``, those of the included files placed (their
+        ``placement:``), then the file's ``initial:`` mapping by coordinate name (one
+        place per coordinate). ``definitions``: the values given by expressions (which
+        follow ``with_parameters``); ``given``: the names the files set."""
+        values = {f"{part.name}.{k}": v for part in self.own_parts for k, v in part.initial.items()}
+        definitions, given = {}, set(values)
+        for _, copies in self.children:
+            for child in copies:
+                more, more_definitions, more_given = child.read_initial()
+                placed = child.placed_initial(more)
+                values.update(placed)
+                definitions.update({k: placed.get(k, v) for k, v in more_definitions.items()})
+                if placed is not more:  # placed by expressions of parameters: they follow them too
+                    definitions.update({k: v for k, v in placed.items() if sp.sympify(v).free_symbols})
+                given |= more_given | {k for k, v in placed.items() if k not in more and not k.endswith("_dot")}
+        coords = [name for name, _ in self.coordinates]
         allowed = set(coords) | {c + "_dot" for c in coords}
         node = self.mapping(self.root.get("initial", LineDict()), ("initial",), allowed)
         for key, text in node.items():
-            if key in values:
+            name = self.full_name(key)
+            if name in given:
                 self.fail(("initial", key), f"'{key}' is already set by the part's own initial: mapping")
-            self.initial_definitions[key] = self.constant(text, ("initial", key))
-            values[key] = self.value(self.initial_definitions[key])
-        return values
+            definitions[name] = values[name] = self.constant(text, ("initial", key))
+            given.add(name)
+        return values, definitions, given
 
-    def read_initial_fixed(self, initial):
+    def placed_initial(self, values):
+        """The initial ``values`` of this file's parts (this file's axes) in the including
+        file's axes: moved by this file's ``placement:`` (placement.py)."""
+        relative = self.include.relative
+        if relative.identity:
+            return values
+        where = self.include.path + ("placement",)
+        placed = {}
+        for part in self.all_parts():
+            start = len(part.name) + 1
+            own = {k[start:]: v for k, v in values.items() if k.startswith(part.name + ".")}
+            moved = place_initial(part, own, relative, lambda why: self.include.parent.fail(where, why))
+            placed.update({f"{part.name}.{k}": v for k, v in moved.items()})
+        return placed
+
+    def all_parts(self):
+        """The parts of this file and of the files it includes."""
+        return [part for builder in self.builders for part in builder.own_parts]
+
+    def read_initial_fixed(self, given):
         """Names whose initial values must be kept exactly (a list; each must be set)."""
         node = self.root.get("initial_fixed", LineList())
         if not isinstance(node, list):
             self.fail(("initial_fixed",), f"expected a list of names from 'initial:', got {_kind(node)}")
         for i, key in enumerate(node):
-            if key not in initial:
+            if not isinstance(key, str) or self.full_name(key) not in given:
                 self.fail(("initial_fixed", i), f"'{key}' has no initial value to keep")
-        return set(node)
+        return {self.full_name(key) for key in node}
 
     def check_names(self, constraints):
         """A name given to a constraint or joint must not be another one's (nor a part's own
@@ -411,23 +631,36 @@ class _Builder:
         seen = set()
         for con in constraints:
             if con.name in seen:
-                place = self.entry_named(con.name)
-                self.fail(place + ("name",) if place else ("constraints",),
-                          f"the name '{con.name}' is given to two constraints or joints")
+                builder, place = self.entry_named(con.name)
+                builder.fail(place + ("name",) if place else ("constraints",),
+                             f"the name '{builder.own_name(con.name)}' is given to two constraints or joints")
             seen.add(con.name)
 
     def entry_named(self, name):
-        """The path of the last constraint or joint entry named ``name``, or None."""
+        """(the builder of the file, the path of its last constraint or joint entry) that
+        gives the model's constraint ``name``; (this builder, None) when none does."""
+        for builder in reversed(list(self.builders)):  # the longest prefix first
+            if name.startswith(builder.prefix):
+                place = builder.entry_of(builder.own_name(name))
+                if place:
+                    return builder, place
+        return self, None
+
+    def entry_of(self, name):
+        """The path of this file's last constraint or joint entry named ``name`` (a joint
+        of a ``for:`` entry: ``name[i]``), or None."""
+        base = name.split("[")[0]
         places = [(key, i) for key in ("constraints", "joints") for i, spec in enumerate(self.root.get(key) or ())
-                  if isinstance(spec, dict) and spec.get("name") == name]
+                  if isinstance(spec, dict) and spec.get("name") in (name, base)]
         return places[-1] if places else None
 
     def check_parts(self, system):
         """Each part's M must be finite and positive semi-definite at the initial state."""
         for part, problem in system.part_problems():
-            spec = (self.root.get("subsystems") or {}).get(part)
+            builder, own = self.assembly.owners.get(part, (self, part))
+            spec = (builder.root.get("subsystems") or {}).get(own)
             energy = "semi-definite" in problem and isinstance(spec, dict) and "T" in spec  # a lagrangian part's T
-            self.fail(("subsystems", part) + (("T",) if energy else ()), problem)
+            builder.fail(("subsystems", own) + (("T",) if energy else ()), problem)
 
     def check_branches(self, system):
         """No joint may be assembled at the initial state (its rows hold) in a pose its rows
@@ -438,7 +671,8 @@ class _Builder:
         apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED}
         for joint, problem in system.branch_problems(q):
             if joint not in apart:
-                self.fail(self.entry_named(joint) or ("initial",), problem)
+                builder, place = self.entry_named(joint)
+                builder.fail(place or ("initial",), problem)
 
 
 SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,

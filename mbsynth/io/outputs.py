@@ -11,16 +11,18 @@ KINDS = tuple(key.name for key in SECTIONS["output"].keys)
 
 
 def read_outputs(builder, constraints):
-    """The Outputs the file declares; ``constraints``: the model's connectors."""
+    """The Outputs the file declares (under their full names, ``left_leg.height``);
+    ``constraints``: the model's connectors."""
     node = builder.root.get("outputs")
     if node is None:
         return ()
     node = builder.mapping(node, ("outputs",), set(node) if isinstance(node, dict) else set())
-    by_name = {c.name: c for c in constraints}
+    by_name = {builder.own_name(c.name): c for c in constraints if c.name.startswith(builder.prefix)}
     outputs = []
-    for name, spec in node.items():
-        path = ("outputs", name)
-        builder.identifier(name, path, "output name")
+    for own, spec in node.items():
+        path = ("outputs", own)
+        builder.identifier(own, path, "output name")
+        name = builder.full_name(own)
         if name in BUILT_IN_COLUMNS:
             builder.fail(path, f"output name '{name}' is a column every trajectory has ({', '.join(BUILT_IN_COLUMNS)}, "
                                "the coordinates and velocities); choose another")

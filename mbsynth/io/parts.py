@@ -35,9 +35,9 @@ def read_rigid_body(builder, name, spec, path):
                                 sequence=sequence if euler else None)
     geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
     if euler:
-        return EulerBody(name, sequence, q, qd, mass, inertia, builder.gravity, builder.param_symbols.values(),
+        return EulerBody(name, sequence, q, qd, mass, inertia, builder.gravity, builder.parameter_symbols,
                          frames, geometry, initial)
-    return RigidBody(name, q, qd, mass, inertia, builder.gravity, builder.param_symbols.values(), frames,
+    return RigidBody(name, q, qd, mass, inertia, builder.gravity, builder.parameter_symbols, frames,
                      geometry, initial)
 
 
@@ -51,7 +51,7 @@ def read_particle(builder, name, spec, path):
         if key in node:
             values = builder.numbers(node[key], path + ("initial", key), 3)
             initial.update({f"{c}{suffix}": v for c, v in zip("xyz", values)})
-    return Particle(name, q, qd, read_mass(builder, spec, path), builder.gravity, builder.param_symbols.values(),
+    return Particle(name, q, qd, read_mass(builder, spec, path), builder.gravity, builder.parameter_symbols,
                     frames, read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
 
 
@@ -64,7 +64,7 @@ def read_planar_body(builder, name, spec, path):
     frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=True)
     initial = read_body_initial(builder, spec.get("initial"), path + ("initial",), planar=True)
     return PlanarBody(name, q, qd, read_mass(builder, spec, path), inertia, builder.gravity,
-                      builder.param_symbols.values(), frames,
+                      builder.parameter_symbols, frames,
                       read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
 
 
@@ -83,7 +83,7 @@ def read_spring(builder, name, spec, path):
         suffix = "_dot" if velocity else ""
         initial.update({c + suffix: v for c, v in zip(names, builder.numbers(values, path + ("initial", key), 3))})
     return Spring(name, q, qd, stiffness, rest_length, damping, mass, builder.gravity,
-                  builder.param_symbols.values(), initial)
+                  builder.parameter_symbols, initial)
 
 
 def read_mass(builder, spec, path):
@@ -123,16 +123,17 @@ def read_inertia(builder, node, path):
     return J
 
 
-def read_rotation(builder, node, path):
+def read_rotation(builder, node, path, fixed=False):
     """A numeric 3 × 3 rotation from ``rpy`` (URDF: Rz(yaw) Ry(pitch) Rx(roll)), ``axis``
-    (z along the vector) or ``quaternion`` (w, x, y, z); identity when none is given."""
+    (z along the vector) or ``quaternion`` (w, x, y, z); identity when none is given.
+    ``fixed``: its parameters are built in at load (``builder.fixed_value``)."""
     given = [k for k in ORIENTATION_KEYS if k in node]
     if len(given) > 1:
         builder.fail(path, f"give at most one of {', '.join(ORIENTATION_KEYS)}, got {', '.join(given)}")
     if not given:
         return np.eye(3)
     key = given[0]
-    values = builder.numbers(node[key], path + (key,), 4 if key == "quaternion" else 3)
+    values = builder.numbers(node[key], path + (key,), 4 if key == "quaternion" else 3, fixed)
     if key == "rpy":
         return rpy_matrix(*values)
     if np.linalg.norm(values) == 0:

@@ -45,7 +45,10 @@ class RobotEntry:
         except ModelError as err:
             builder.fail(path + ("robot",), str(err))
         self.name, self.spec, self.path = name, spec, path
-        self.robot = Robot.plan(description, prefix=f"{name}_", floating=floating)
+        self.robot = Robot.plan(description, prefix=f"{name}_", floating=floating, scope=builder.prefix)
+        if not builder.placement.identity:
+            builder.fail(path, "a robot in a placed substructure is not supported: give its pose with 'base:' "
+                               "and include the file without a placement")
 
     @property
     def parameters(self):
@@ -62,16 +65,16 @@ class RobotEntry:
         given = builder.mapping(self.spec.get("initial"), where, movable)
         positions = {joint: builder.value(builder.constant(text, where + (joint,))) for joint, text in given.items()}
         self.robot = replace(self.robot, base=(np.array(position), rotation), positions=positions)
-        return self.robot.bodies(builder.gravity, builder.param_symbols.values())
+        return self.robot.bodies(builder.gravity, builder.parameter_symbols)
 
     def connect(self, builder):
         """(joints, torque force elements) of the robot, once every part is known."""
-        return self.robot.connect(builder.parts, builder.q, builder.qd, builder.param_symbols.values())
+        return self.robot.connect(builder.assembly.parts, builder.q, builder.qd, builder.parameter_symbols)
 
 
 def read_robots(builder):
-    """{entry name: RobotEntry} of the model's ``type: robot`` subsystems, read before any
-    part; their torque parameters join ``builder.parameters`` (a value given there wins)."""
+    """{entry name: RobotEntry} of the file's ``type: robot`` subsystems, read before any
+    part (the loader adds their torque parameters to the model's; a value the file gives wins)."""
     node = builder.root.get("subsystems")
     entries = {}
     for name, spec in (node.items() if isinstance(node, dict) else ()):
@@ -79,15 +82,13 @@ def read_robots(builder):
             path = ("subsystems", name)
             builder.identifier(name, path, "subsystem name")
             entries[name] = RobotEntry(builder, name, spec, path)
-            for key, value in entries[name].parameters.items():
-                builder.parameters.setdefault(key, value)
     return entries
 
 
 def read_robot(builder, name, spec, path):
     """The parts of a ``type: robot`` entry (a list: the loader adds each)."""
     others = set(builder.root["subsystems"]) - {name}
-    for part in builder.robots[name].robot.parts.values():
+    for part in map(builder.own_name, builder.robots[name].robot.parts.values()):
         if part in others or part in builder.parameters:
             builder.fail(path, f"robot '{name}' has a link part '{part}', the name of another subsystem or "
                                "of a parameter: rename one of them")

@@ -61,6 +61,7 @@ _TYPE = {  # the ``type`` key of a part; its value selects the section
     "spring": "spring (with optional mass) between two free ends",
     "robot": "a whole robot from a URDF, one rigid body per link",
     "flexible_body": "a reduced finite-element body on a floating frame (docs/flexible.md)",
+    "model": "another model file as a substructure, its names prefixed by the entry's (docs/substructures.md)",
 }
 _DESCRIPTION = Key("description", "string", "free text, ignored by the loader", "'the left wheel'")
 _NAME = Key("name", "plain name", "the element's name in reports", "spring_1", default="<type>_<index>")
@@ -96,7 +97,8 @@ SECTIONS = {section.name: section for section in (
                  "particles, planar bodies, spring masses and flexible bodies [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
              Key("world", "mapping (section *world*)", "frames fixed in the world", "{frames: {pin: {}}}"),
              _required("subsystems", "mapping name → part", "the parts, each with a ``type`` "
-                       "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*, *flexible_body*)", "{wheel: {type: particle, mass: m}}"),
+                       "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*, *flexible_body*, "
+                       "*model_part*)", "{wheel: {type: particle, mass: m}}"),
              Key("constraints", "list of constraints (section *constraint*)",
                  "constraints written as equations in the parts' coordinates", "[{holonomic: a.x - b.x}]",
                  default="[]"),
@@ -114,7 +116,31 @@ SECTIONS = {section.name: section for section in (
                  "torques between frames", "[{type: spring, between: [a.tip, world], stiffness: k, rest_length: 0.3}]", default="[]"),
              Key("outputs", "mapping name → expression or output (section *output*)",
                  "quantities recorded along a run", "{height: body.z, pin_force: {reaction: pin.force}}",
-                 default="{}"))),
+                 default="{}"),
+             Key("ports", "mapping name → frame", "frames a file that includes this one joins to as "
+                 "``<entry>.<port>`` (docs/substructures.md)", "{hip: pelvis.hip}", default="{}"))),
+    Section("model_part", "``subsystems: {NAME: {type: model, ...}}``",
+            "Another model file as a substructure: its parts, joints, constraints, forces, outputs, "
+            "initial values and parameters join the model, every name prefixed by the entry's "
+            "(``NAME.thigh``, ``NAME.thigh.x``, ``NAME.L``; copies ``NAME[0]`` …). Its ``gravity`` "
+            "and ``name`` are the including model's.",
+            (_TYPE_KEY["model"],
+             _required("file", "file name", "the model file, relative to this one", "leg.yaml"),
+             Key("parameters", "mapping name → " + _EXPR, "values of the file's parameters, as expressions "
+                 "of this file's (and ``index``)", "{L: 0.4, m: m_leg}", default="the file's own"),
+             Key("placement", "mapping (section *placement*)", "a rigid transform of the whole file: its "
+                 "world frames and its parts' initial poses and velocities", "{position: [0, 0.2, 0]}",
+                 default="identity"),
+             Key("count", "expression of parameters, a whole number ≥ 1", "copies ``NAME[0]`` … "
+                 "``NAME[count-1]``; ``index`` is each copy's number in ``parameters`` and ``placement``",
+                 "N", default="one copy, named NAME"),
+             _DESCRIPTION)),
+    Section("placement", "``placement:`` of a ``type: model`` entry",
+            "Where the included file's axes sit in this file's: a position and at most one "
+            "orientation key (expressions may use ``index``). Placements compose through nesting.",
+            (Key("position", "list of 3 " + _EXPRS, "the origin of the file's axes", "[index*L, 0, 0]",
+                 default="[0, 0, 0]"),
+             *_ORIENTATION)),
     Section("world", "``world:``", "The world's own frames (joints and springs may attach to them).",
             (Key("frames", "mapping name → frame", "named frames fixed in the world (section *frame*)",
                  "{anchor: {position: [0, 0, 1]}}", default="{}"),)),
@@ -341,6 +367,9 @@ SECTIONS = {section.name: section for section in (
              _required("parent", "frame", "frame A, on the parent part or the world", "world.pin"),
              _required("child", "frame", "frame B, on the child part", "link.top"),
              Key("length", _EXPR + ", > 0", "the distance kept by a ``distance`` joint (required there)", "0.5"),
+             Key("for", "mapping name → [first, last]", "one joint per whole number from first to last (both "
+                 "included), named ``name[i]``; ``[expression]`` in its frames is replaced by its value",
+                 "{i: [0, N - 2]}"),
              _DESCRIPTION,
              Key("actuation", "expression, or mapping (section *joint_actuation*)", "torque (revolute) or "
                  "force (prismatic) along the joint's axis", "tau*sin(t)"),

@@ -37,6 +37,18 @@ class Closure:
 
 
 @dataclass(frozen=True)
+class Substructure:
+    """A model file included in another (``type: model``): ``name`` its prefix in the
+    model's names (``robot.left_leg``), ``file`` its path, ``parts`` the full names of the
+    parts its own ``subsystems:`` give, ``children`` the substructures it includes."""
+
+    name: str
+    file: str
+    parts: tuple
+    children: tuple = ()
+
+
+@dataclass(frozen=True)
 class System:
     """An assembled model. Build it with ``mbsynth.load`` or ``System.build``."""
 
@@ -58,6 +70,7 @@ class System:
     source: str = ""  # the model file's text, for workers that rebuild the System
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     source_file: str = ""  # the model file it was read from (mbsynth.load), its absolute path
+    substructures: tuple = ()  # Substructure: the model files this one includes, as a tree
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
     fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load

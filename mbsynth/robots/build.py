@@ -139,14 +139,16 @@ class Robot:
     positions: dict = field(default_factory=dict)
 
     @classmethod
-    def plan(cls, description, prefix="", floating=False, base=None):
-        """Names for the parts, connectors and torque parameters of ``description``."""
+    def plan(cls, description, prefix="", floating=False, base=None, scope=""):
+        """Names for the parts, connectors and torque parameters of ``description``, each
+        after ``scope`` (a substructure's ``left_leg.``)."""
         base = (np.zeros(3), np.eye(3)) if base is None else tuple(np.asarray(x, dtype=float) for x in base)
-        parts = _unique({link: prefix + identifier(link) for link in description.links})
+        parts = _unique({link: scope + prefix + identifier(link) for link in description.links})
         joints = _unique({j.name: prefix + identifier(j.name) for j in description.joints}
                          | {None: prefix + "fixed_base"})
-        base_joint = joints.pop(None)
-        torques = {j.name: f"tau_{joints[j.name]}" for j in description.joints if j.kind != "fixed"}
+        base_joint = scope + joints.pop(None)
+        torques = {j.name: f"{scope}tau_{joints[j.name]}" for j in description.joints if j.kind != "fixed"}
+        joints = {key: scope + name for key, name in joints.items()}
         return cls(description, prefix, floating, base, parts, joints, torques, base_joint)
 
     @property

@@ -33,6 +33,7 @@ ROD = {"type": "flexible_body", "beam": {"length": 1.0, "elements": 20, "area": 
 
 # Where each section's mapping sits: (path of the mapping in the model, its minimal valid
 # content, the model's other entries it needs). Keys are then added to that mapping.
+LEG = "parameters: {L: 0.4, m: 1}\nsubsystems: {foot: {type: particle, mass: m}}\n"  # a file to include
 HOSTS = {
     "model": ((), None, {}),
     "world": (("world",), {}, {}),
@@ -67,6 +68,8 @@ HOSTS = {
     "force_force": (("forces", 0), {"type": "force", "at": "body.tip", "value": [0, 0, 1]}, {}),
     "force_torque": (("forces", 0), {"type": "torque", "part": "body", "value": [0, 0, 1]}, {}),
     "output": (("outputs", "watch"), {}, {}),
+    "model_part": (("subsystems", "leg"), {"type": "model", "file": "leg.yaml"}, {}),
+    "placement": (("subsystems", "leg", "placement"), {}, {("subsystems", "leg"): {"type": "model", "file": "leg.yaml"}}),
     "flexible_body": (("subsystems", "rod"), dict(ROD), {}),
     "flexible_beam": (("subsystems", "rod", "beam"), dict(ROD["beam"]), {("subsystems", "rod"): dict(ROD)}),
     "flexible_fe": (("subsystems", "rod", "fe"), {}, {("subsystems", "rod"): {k: v for k, v in ROD.items() if k != "beam"}}),
@@ -129,6 +132,7 @@ def _model(name, keys, extra=None):
 
 def _error(text, tmp_path):
     (tmp_path / "arm.urdf").write_text(URDF)
+    (tmp_path / "leg.yaml").write_text(LEG)
     try:
         mb.loads(text, name="schema_case.yaml", folder=tmp_path)
     except mb.ModelError as err:

@@ -1,0 +1,171 @@
+"""Model files as parts of other model files: ``type: model`` entries and ``ports:``.
+
+    subsystems:
+      left_leg:
+        type: model
+        file: leg.yaml                  # relative to this file
+        parameters: {L: 0.4, m: m_leg}  # the child's parameters, as expressions of this file's
+        placement: {position: [0, 0.2, 0], rpy: [0, 0, pi/2]}
+      cell: {type: model, file: cell.yaml, count: N, placement: {position: [index*L, 0, 0]}}
+
+Everything the included file declares (parts, joints, constraints, forces, outputs,
+initial values, parameters) joins the model under its entry's name as a prefix: part
+``thigh`` becomes ``left_leg.thigh``, its coordinate ``left_leg.thigh.x``, the parameter
+``L`` ``left_leg.L``; ``count: N`` makes copies ``cell[0]`` … ``cell[N-1]`` (``index`` is
+their number in ``parameters`` and ``placement``). The file's ``ports: {hip: pelvis.hip}``
+names frames the including file joins to as ``left_leg.hip``. The paper's sub-systems
+(section 2): each file is a system with its own equation of motion, and the composite is
+one again, so it may be included in turn.
+
+This module reads the entries (``read_includes``: before any part is built, so that every
+parameter is known) and the ports (``read_ports``); the loader's builders do the rest, one
+per file copy, each reading its file under its prefix (``Scoped`` gives a builder its
+file's view of the model's names).
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+
+from ..core.errors import ModelError
+from .parts import read_rotation
+from .placement import Placement
+from .source import read_document
+
+COUNT_MAX = 100_000  # copies of one entry: a bound on a mistaken count, far above any machine's parts
+
+
+@dataclass
+class Include:
+    """One copy of an included file: its ``prefix`` in the model's names (``left_leg.``),
+    ``relative`` placement in the including file's axes and ``placement`` in the world's,
+    the ``parameters`` its entry gives ({the file's name: expression in full names}), the
+    including ``parent`` builder, the entry's ``path`` there, and the ``chain`` of
+    (file, line) entries that led to it."""
+
+    prefix: str
+    relative: Placement
+    placement: Placement
+    parameters: dict
+    parent: object
+    path: tuple
+    chain: tuple
+
+
+def read_includes(builder):
+    """[(entry name, [child builders, one per copy])] of the file's ``type: model``
+    entries, each child's parameters read (and its own included files, depth first)."""
+    node = builder.root.get("subsystems")
+    children = []
+    for name, spec in (node.items() if isinstance(node, dict) else ()):
+        if isinstance(spec, dict) and spec.get("type") == "model":
+            children.append((name, _read_entry(builder, name, spec, ("subsystems", name))))
+    return children
+
+
+def _read_entry(builder, name, spec, path):
+    builder.section(spec, path, "model_part")
+    doc = _child_document(builder, spec, path)
+    declared = doc.root.get("parameters") if isinstance(doc.root.get("parameters"), dict) else {}
+    given = builder.mapping(spec.get("parameters"), path + ("parameters",), set(declared))
+    count = _count(builder, spec, path)
+    line = builder.doc.line_of(path)
+    children = []
+    for index in range(count if count is not None else 1):
+        local = f"{name}[{index}]" if count is not None else name
+        names = {"index": sp.Integer(index)} if count is not None else {}
+        with builder.extra_names(names):
+            parameters = {key: builder.constant(text, path + ("parameters", key)) for key, text in given.items()}
+            relative = _placement(builder, spec.get("placement"), path + ("placement",))
+        include = Include(builder.prefix + local + ".", relative, builder.placement.then(relative), parameters,
+                          builder, path, builder.chain + ((builder.doc.name, line),))
+        child = type(builder)(doc, builder.assembly, include)
+        child.plan()
+        children.append(child)
+    return children
+
+
+def _child_document(builder, spec, path):
+    """The Document of the entry's ``file`` (read once per model), refused when the file
+    includes itself through the chain that led here."""
+    text = spec["file"]
+    if not isinstance(text, str) or not text.strip():
+        builder.fail(path + ("file",), f"expected a model file name, got {text!r}")
+    file = (builder.doc.folder / text).resolve()
+    if not file.is_file():
+        builder.fail(path + ("file",), f"no such model file '{text}' (looked for {file})")
+    files = [Path(str(name)).resolve() for name, _ in builder.chain] + [Path(str(builder.doc.name)).resolve()]
+    if file in files:
+        chain = " → ".join(f"{name}:{line}" for name, line in builder.chain + ((builder.doc.name,
+                                                                                builder.doc.line_of(path)),))
+        builder.fail(path + ("file",), f"'{text}' includes itself: {chain} → {file}")
+    documents = builder.assembly.documents
+    if file not in documents:
+        try:
+            documents[file] = read_document(file)
+        except ModelError as err:
+            raise builder.doc.error(path + ("file",), f"in the included file: {err}") from None
+    return documents[file]
+
+
+def _count(builder, spec, path):
+    """The entry's number of copies, or None for one copy named by the entry alone."""
+    if "count" not in spec:
+        return None
+    value = builder.fixed_value(builder.constant(spec["count"], path + ("count",)), path + ("count",))
+    if value != int(value) or value < 1:
+        builder.fail(path + ("count",), f"count must be a whole number ≥ 1, got {value:g}")
+    if value > COUNT_MAX:
+        builder.fail(path + ("count",), f"count {value:g} is more than {COUNT_MAX} copies")
+    return int(value)
+
+
+def _placement(builder, node, path):
+    """The entry's ``placement:`` (a position and at most one of rpy, axis, quaternion)
+    as a Placement; its turn is built in at load (its parameters become fixed ones)."""
+    if node is None:
+        return Placement()
+    node = builder.section(node, path, "placement")
+    position = builder.constants(node.get("position", [0, 0, 0]), path + ("position",), 3)
+    return Placement(read_rotation(builder, node, path, fixed=True), position)
+
+
+def read_ports(builder):
+    """Register the file's ``ports: {name: frame}``, each under its full name; the frame
+    may be a port of a file this one includes."""
+    from .joints import frame_reference  # joints.py reads frames through the ports
+
+    node = builder.root.get("ports")
+    if node is None:
+        return
+    node = builder.mapping(node, ("ports",), set(node) if isinstance(node, dict) else set())
+    for name, text in node.items():
+        builder.identifier(name, ("ports", name), "port name")
+        if name in builder.parts or name in builder.parameters:
+            builder.fail(("ports", name), f"port '{name}' has the name of a part or parameter of the file")
+        builder.assembly.ports[builder.full_name(name)] = frame_reference(builder, text, ("ports", name))
+
+
+class Scoped(Mapping):
+    """The names of ``names`` that start with ``prefix``, under the rest of their name:
+    an included file's view of the model's names (with ``t``, time)."""
+
+    def __init__(self, names, prefix):
+        self.names, self.prefix = names, prefix
+
+    def __getitem__(self, name):
+        if name == "t":
+            return self.names["t"]
+        return self.names[self.prefix + name]
+
+    def __contains__(self, name):
+        return name == "t" or self.prefix + name in self.names
+
+    def __iter__(self):
+        size = len(self.prefix)
+        return (name[size:] for name in self.names if name.startswith(self.prefix))
+
+    def __len__(self):
+        return sum(1 for _ in self)
