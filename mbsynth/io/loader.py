@@ -171,7 +171,9 @@ class _Builder:
 
     def value(self, expr):
         """The float value of an expression of parameters."""
-        return float(sp.sympify(expr).subs(self.param_values))
+        if isinstance(expr, (int, float)):
+            return float(expr)
+        return float(_at(sp.sympify(expr), self.param_values))
 
     def fixed_value(self, expr, path):
         """``value(expr)`` for something built once at load (an FE model): its parameters
@@ -684,10 +686,17 @@ def _real(expr, values):
     """The float value of ``expr`` at the parameter ``values``, or None when that is not a
     finite real number."""
     try:
-        value = complex(expr.subs(values).evalf())
+        value = complex(_at(expr, values).evalf())
     except (TypeError, ValueError, OverflowError):  # a value sympy cannot make a number
         return None
     return value.real if value.imag == 0 and np.isfinite(value.real) else None
+
+
+def _at(expr, values):
+    """``expr`` with its parameters replaced by their ``values`` (only those it holds: a
+    model of many substructures has thousands)."""
+    symbols = expr.free_symbols
+    return expr.subs({s: values[s] for s in symbols if s in values}) if symbols else expr
 
 
 def _kind(value):
