@@ -9,7 +9,11 @@ with one degree of freedom (IFToMM A02)."""
 import json
 import subprocess
 import sys
+from dataclasses import replace
 
+import mbsynth as mb
+from mbsynth.analysis.diagnose import diagnose
+from mbsynth.cli.check import format_check
 from n_four_bar_files import write_n_four_bar
 
 
@@ -58,3 +62,16 @@ def test_a_flat_model_prints_no_tree(tmp_path):
     result = check(tmp_path / "four_bar_cell.yaml")
     assert result.returncode == 0, result.stderr
     assert "substructures" not in result.stdout
+
+
+def test_a_thousand_copies_print_as_runs_of_alike_copies(tmp_path):
+    """The text report of 1,000 copies (the counts of the N = 2 model's cells, copied; copy 500
+    with one degree of freedom more) is three lines of copies, not 1,000."""
+    report = diagnose(mb.load(write_n_four_bar(tmp_path)))
+    cell = report.substructures[0]
+    copies = [dict(cell, name=f"cell[{k}]", degrees_of_freedom=3 if k == 500 else 2) for k in range(1000)]
+    text = format_check(replace(report, substructures=copies), tmp_path / "n_four_bar.yaml")
+    assert [line.strip() for line in text.splitlines() if line.strip().startswith("cell[")] == [
+        "cell[0…499]: 500 copies of four_bar_cell.yaml, each 6 coordinates, 4 rows, 2 DOF",
+        "cell[500]: four_bar_cell.yaml, 6 coordinates, 4 rows, 3 DOF",
+        "cell[501…999]: 499 copies of four_bar_cell.yaml, each 6 coordinates, 4 rows, 2 DOF"]
