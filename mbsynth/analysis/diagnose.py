@@ -5,7 +5,8 @@ motion is unique, each indeterminate direction, and for each the balance
 wᵀ(Q + C) = 0 that would close the model (see model/balances.py), or, where a part's angles
 are at their singular position, that part (model/angle_singularity.py). How firm the verdict is:
 the condition number of the equilibrated M̂, the rank tolerance, the verdict margin
-(equations.py) and a warning when that margin is below ``VERDICT_MARGIN``.
+(equations.py) and a warning when that margin is below ``VERDICT_MARGIN``. For a model made
+of model files, each one's coordinates, rows and degrees of freedom (substructure_counts.py).
 """
 
 from dataclasses import asdict, dataclass, field
@@ -18,6 +19,7 @@ from ..core.equations import rank_report
 from ..core.errors import SolveError
 from ..core.kinematics import body_rate_matrix, quaternion_matrix, rotation_z
 from ..core.tolerances import AXIS_TOL, BALANCE_ZERO_RTOL, COMPONENT_TOL, VERDICT_MARGIN
+from .substructure_counts import substructure_counts
 
 
 
@@ -47,6 +49,8 @@ class Diagnosis:
     # the parts whose angles are at their singular position (AngleSingularity.to_dict): indeterminate directions
     # of the coordinates, left out of ``balances``
     angle_singularities: list = field(default_factory=list)
+    # the model files it includes, as a tree: coordinates, rows and degrees of freedom of each (substructure_counts)
+    substructures: list = field(default_factory=list)
 
     @property
     def consistent(self):
@@ -84,7 +88,8 @@ def diagnose(system, t=0.0, q=None, qd=None):
         constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
         rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report),
         joints=_joints(system, t, q, qd, motion), free_joints=_moved_joints(system, t, q, report.nullspace),
-        angle_singularities=[a.to_dict() for a in AngleParts(system).set_aside(q, report.nullspace)[0]])
+        angle_singularities=[a.to_dict() for a in AngleParts(system).set_aside(q, report.nullspace)[0]],
+        substructures=substructure_counts(system, arrays.M, arrays.A))
 
 
 def _joints(system, t, q, qd, motion):

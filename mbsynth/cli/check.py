@@ -1,6 +1,8 @@
 """``mbsynth check MODEL``: is the motion unique? (Result 3 at the initial state)"""
 
 import json
+import os
+import re
 
 from ..analysis.diagnose import diagnose
 from ..compiled.background import default_mode
@@ -29,6 +31,7 @@ def format_check(report, path, coordinates="joints"):
              f"  coordinates n = {report.n}, constraints m = {report.m}",
              f"  rank M = {report.rank_M}, rank A = {report.rank_A}, "
              f"rank [M; A] = {report.rank_Mhat} of {report.n}"]
+    lines += _format_substructures(report, path)
     for closure in report.closures:
         lines.append(f"  closure: auto appended {closure['constraint']}: {closure['equation']}")
     if report.unique:
@@ -85,3 +88,67 @@ def _format_balance(balance):
 
 def _format_direction(direction):
     return "(" + ", ".join(f"{c}: {x:+.4g}" for c, x in direction.items()) + ")"
+
+
+def _format_substructures(report, path):
+    """The tree of the model files the model is made of, the whole model at its root: each
+    one's coordinates, constraint rows and degrees of freedom; alike consecutive copies
+    (``cell[0]`` … ``cell[39]``) on one line."""
+    if not report.substructures:
+        return []
+    folder = os.path.dirname(os.path.abspath(path))
+    lines = ["  substructures (coordinates, rows of the constraints wholly inside, degrees of freedom = "
+             "coordinates − rank of those rows):",
+             f"    {report.model}: {_counts(report.n, report.m, report.n - report.rank_A)}"]
+
+    def add(entries, depth, shown=lambda name: name):
+        for run in _runs(entries):
+            first, file = run[0], os.path.relpath(run[0]["file"], folder)
+            counts = _counts(first["coordinates"], first["rows"], first["degrees_of_freedom"])
+            if len(run) == 1:
+                name = shown(first["name"])
+                lines.append(f"{'  ' * depth}{name}: {file}, {counts}")
+            else:
+                base, start = _copy(first["name"])
+                name = shown(f"{base}[{start}…{_copy(run[-1]['name'])[1]}]")
+                lines.append(f"{'  ' * depth}{name}: {len(run)} copies of {file}, each {counts}")
+            add(first["children"], depth + 1, lambda child, name=name, inside=first["name"]: name + child[len(inside):])
+
+    add(report.substructures, 3)
+    return lines
+
+
+def _runs(entries):
+    """``entries`` split into runs of consecutive copies (``name[k]``, ``name[k + 1]``, …)
+    alike in file and counts, their own included substructures too."""
+    runs = []
+    for entry in entries:
+        if runs and _follows(runs[-1][-1], entry):
+            runs[-1].append(entry)
+        else:
+            runs.append([entry])
+    return runs
+
+
+def _follows(before, entry):
+    (base, k), (base_next, k_next) = _copy(before["name"]), _copy(entry["name"])
+    return base is not None and base == base_next and k_next == k + 1 and _alike(before, entry)
+
+
+def _alike(a, b):
+    """Same file and counts, and alike included substructures (named alike after the prefix)."""
+    keys = ("file", "coordinates", "rows", "degrees_of_freedom")
+    return (all(a[key] == b[key] for key in keys) and len(a["children"]) == len(b["children"])
+            and all(x["name"][len(a["name"]):] == y["name"][len(b["name"]):] and _alike(x, y)
+                    for x, y in zip(a["children"], b["children"])))
+
+
+def _copy(name):
+    """(name without its copy index, the index) of a copy ``cell[3]``; (None, None) otherwise."""
+    match = re.fullmatch(r"(.*)\[(\d+)\]", name)
+    return (match[1], int(match[2])) if match else (None, None)
+
+
+def _counts(coordinates, rows, freedom):
+    return (f"{coordinates} coordinate{'s' * (coordinates != 1)}, {rows} row{'s' * (rows != 1)}, "
+            f"{freedom} DOF")

@@ -96,10 +96,13 @@ def _check(commands):
                     "would close it (the motion is determined where only free directions remain). "
                     "A model with joints gets its accelerations as joint accelerations (a revolute "
                     "joint's angle, a prismatic joint's displacement, ...: the time derivatives of "
-                    "the joints' rates) and the joints each indeterminate direction moves.")
+                    "the joints' rates) and the joints each indeterminate direction moves. A model "
+                    "made of model files (type: model) gets the tree of its substructures: each one's "
+                    "coordinates, rows of the constraints wholly inside it and degrees of freedom.")
     _model_argument(check)
     check.add_argument("--json", action="store_true",
-                       help="print one JSON object (both 'qdd', per coordinate, and 'joints')")
+                       help="print one JSON object (both 'qdd', per coordinate, and 'joints'; "
+                            "'substructures': the tree, every copy its own entry)")
     check.add_argument("--coordinates", choices=("joints", "maximal"), default="joints",
                        help="report accelerations per joint (default, where the model has joints) or per "
                             "coordinate of the parts ('maximal')")

@@ -26,6 +26,10 @@ as a sphere whose radius grows as the cube root of its mass. Default sizes are f
 of the model's own length (``Scene.length``: the largest extent of the drawn points at
 one time), not of the box its motion fills, so a travelling model keeps its proportions.
 
+A model made of model files (``System.substructures``) draws each top-level substructure
+under a path of its own (``cell[0]/...``: meshcat shows and hides it as one), and the parts
+of each in one colour of the palette, the next substructure in the next.
+
 The camera looks at ``Scene.targets``, one point per drawn time: the centre of mass
 (mass-weighted over bodies and particles; the middle of the drawn points if nothing has
 mass) when the view follows the model, else the middle of the box that holds the whole
@@ -128,7 +132,8 @@ def build_scene(system, trajectory, axes=False, joints=False, fps=FPS, follow=No
     specs, lines = [], []
     model_drawn = any(_has_geometry(part) for part in system.parts)
     masses = _masses(system, trajectory.q[rows[0]])
-    colors = {part.name: [*COLORS[PALETTE[i % len(PALETTE)]], 1.0] for i, part in enumerate(system.parts)}
+    groups = {substructure.name for substructure in system.substructures}
+    colors = part_colors(system, groups)
     for part in system.parts:
         specs += _part_specs(part, poses, colors[part.name], axes, model_drawn, masses.get(part.name, 0.0))
         lines += _part_lines(part, poses) + _mesh_lines(part, poses, colors[part.name])
@@ -161,12 +166,35 @@ def build_scene(system, trajectory, axes=False, joints=False, fps=FPS, follow=No
                   (lows - targets).min(axis=0), (highs - targets).max(axis=0))
     heaviest = max((s.mass for s in specs if s.default == "particle"), default=0.0)
     for spec in specs:
-        scene.nodes.append(Node(spec.path, transforms[spec.pose],
+        scene.nodes.append(Node(grouped(spec.path, groups), transforms[spec.pose],
                                 spec.shapes or _default_shapes(spec, length, heaviest), spec.axes))
     for path, a, b, color, radius in lines:
-        scene.nodes.append(Node(path, segment_transforms(positions[a], positions[b]),
+        scene.nodes.append(Node(grouped(path, groups), segment_transforms(positions[a], positions[b]),
                                 [{"shape": "line", "size": [radius * length], "color": color}]))
     return scene
+
+
+def group_of(name, groups):
+    """The top-level substructure (one of ``groups``, the names of ``System.substructures``)
+    whose prefix begins ``name`` (a part's, frame's, joint's or force's full name); None
+    for a name of the including model's own."""
+    head, dot, _ = name.partition(".")
+    return head if dot and head in groups else None
+
+
+def grouped(path, groups):
+    """A node's path under its top-level substructure: ``cell[0]/cell[0].v``,
+    ``cell[0]/structure/cell[0].v.top``; the path itself outside any."""
+    group = group_of(path.rpartition("/")[2], groups)
+    return path if group is None else f"{group}/{path}"
+
+
+def part_colors(system, groups):
+    """{part name: RGBA}: the PALETTE's colours in turn, one per top-level substructure
+    (shared by all its parts) and one per part of the including model's own."""
+    keys = {part.name: group_of(part.name, groups) or part.name for part in system.parts}
+    turn = {key: i for i, key in enumerate(dict.fromkeys(keys.values()))}
+    return {name: [*COLORS[PALETTE[turn[key] % len(PALETTE)]], 1.0] for name, key in keys.items()}
 
 
 def centre_of_mass(weighted, positions):
