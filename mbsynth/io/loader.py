@@ -560,6 +560,12 @@ class _Builder:
                 self.fail(self.entry_of(own) or ("subsystems", own),
                           f"joint '{own}' has the name of part '{own}': joints and parts share one "
                           f"namespace ('{own}.angle', '{own}.x'), rename one of them")
+            base = own.split("[")[0]  # a for: entry's joints are base[i]
+            if base in dict(self.children):
+                entry = self.entry_of(own)
+                self.fail(entry + ("name",) if entry else ("joints",),
+                          f"joint '{base}' has the name of the substructure '{base}' (its names are "
+                          f"'{base}.<name>'): rename the joint")
             if own in self.parameters or own == "world":
                 entry = self.entry_of(own)
                 clash = "the world (its frames are 'world.<frame>')" if own == "world" else "a parameter"

@@ -136,6 +136,12 @@ CASES = {
     "for: over a parameter's name": (
         {"top.yaml": "parameters: {i: 1}\n" + entry("file: cell.yaml, count: 3", DISTANCES.format(last=1))},
         "top.yaml", ["top.yaml:6: at joints[0].for.i:", "parameter"]),
+    "joint named like a substructure": (
+        {"top.yaml": entry("file: cell.yaml", JOIN_TO.format(frame="c.tip").replace("name: j,", "name: c,"))},
+        "top.yaml", ["top.yaml:5: at joints[0].name:", "name of the substructure 'c'"]),
+    "for: joints named like the copies": (
+        {"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last=1).replace("name: link", "name: c"))},
+        "top.yaml", ["top.yaml:4: at joints[0].name:", "name of the substructure 'c'"]),
     "port named like a part": ({"child.yaml": "subsystems:\n  p: {type: particle, mass: 1}\nports: {p: p}\n",
                                 "top.yaml": entry("file: child.yaml")}, "top.yaml",
                                ["child.yaml:3: at ports.p:", "name of a part", "(in 'c', included from top.yaml:2)"]),
