@@ -183,7 +183,8 @@ _BRACKETS = re.compile(r"\[([^\[\]]*)\]")
 
 def _each_joint(builder, node):
     """(index in ``joints:``, entry, name suffix) of each joint; an entry with ``for: {i:
-    [first, last]}`` gives one joint per i = first … last (both included), named
+    [first, last]}`` gives one joint per i = first … last (both included; none when last is
+    first - 1), named
     ``name[i]``, with each ``[expression of i]`` in its frames replaced by its value
     (``parent: cell[i].right``, ``child: cell[i+1].left``)."""
     for i, spec in enumerate(node):
@@ -202,6 +203,9 @@ def _each_joint(builder, node):
                        for k, x in enumerate(builder.constants(bounds, path + (variable,), 2)))
         if first != int(first) or last != int(last):
             builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] must be of whole numbers")
+        if last < first - 1:  # [k, k - 1] is empty (one copy: no joints between copies), a lower last a mistake
+            builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] runs backwards: give [first, last] "
+                                             "with last ≥ first (or first - 1 for none)")
         for k in range(int(first), int(last) + 1):
             copy = type(spec)({key: value for key, value in spec.items() if key != "for"})
             copy.line, copy.key_lines = spec.line, spec.key_lines

@@ -130,6 +130,8 @@ CASES = {
                              ["child.yaml:3: not valid YAML", "(in 'c', included from top.yaml:2)"]),
     "for: range not whole": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last=1.5))},
                              "top.yaml", ["top.yaml:5: at joints[0].for.i:", "whole numbers"]),
+    "for: range backwards": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last="-2"))},
+                             "top.yaml", ["top.yaml:5: at joints[0].for.i:", "runs backwards"]),
     "for: beyond the last copy": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last=2))},
                                   "top.yaml", ["top.yaml:9: at joints[0].child:", "'c[3]' is out of range",
                                                "(with i = 2)"]),
@@ -173,8 +175,12 @@ def test_refused_with_file_and_line(case, tmp_path):
 
 
 def test_cell_alone_is_fine(tmp_path):
-    """The cell every case includes is itself a valid model: the cases fail for their own reason."""
+    """The cell every case includes is itself a valid model, and so are its copies joined by a
+    ``for:`` entry, also over the empty range [0, -1] of one copy: the cases fail for their
+    own reason."""
     (tmp_path / "cell.yaml").write_text(CELL)
     (tmp_path / "top.yaml").write_text(entry("file: cell.yaml, count: 3", DISTANCES.format(last=1)))
-    assert check(tmp_path, "cell.yaml").returncode == 0
-    assert check(tmp_path, "top.yaml").returncode == 0
+    (tmp_path / "one.yaml").write_text(entry("file: cell.yaml, count: 1", DISTANCES.format(last=-1)))
+    for top in ("cell.yaml", "top.yaml", "one.yaml"):
+        result = check(tmp_path, top)
+        assert result.returncode == 0, result.stderr
