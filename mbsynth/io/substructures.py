@@ -143,6 +143,9 @@ def _count(builder, spec, path):
         builder.fail(path + ("count",), f"count must be a whole number ≥ 1, got {value:g}")
     if value > COUNT_MAX:
         builder.fail(path + ("count",), f"count {value:g} is more than {COUNT_MAX} copies")
+    if "index" in builder.param_symbols:
+        builder.fail(path + ("count",), "the file has a parameter 'index', the name each copy's number has in "
+                                        "the entry's parameters and placement: rename the parameter")
     return int(value)
 
 

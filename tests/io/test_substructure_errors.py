@@ -109,6 +109,8 @@ CASES = {
     "parameter the child lacks": ({"top.yaml": entry("file: cell.yaml, parameters: {Ls: 2}")}, "top.yaml",
                                   ["top.yaml:2: at subsystems.c.parameters.Ls:", "not a parameter of",
                                    "cell.yaml", "did you mean 'L'"]),
+    "a parameter named index": ({"top.yaml": "parameters: {index: 1}\n" + entry("file: cell.yaml, count: 2")},
+                                "top.yaml", ["top.yaml:3: at subsystems.c.count:", "parameter 'index'"]),
     "a copy's parameter not real": (
         {"top.yaml": entry("file: cell.yaml, count: 3, parameters: {L: sqrt(1 - index)}")}, "top.yaml",
         ["top.yaml:2: at subsystems.c.parameters.L:", "not a finite real number", "(with index = 2)"]),
