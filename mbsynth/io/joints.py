@@ -184,9 +184,8 @@ _BRACKETS = re.compile(r"\[([^\[\]]*)\]")
 def _each_joint(builder, node):
     """(index in ``joints:``, entry, name suffix) of each joint; an entry with ``for: {i:
     [first, last]}`` gives one joint per i = first … last (both included; none when last is
-    first - 1), named
-    ``name[i]``, with each ``[expression of i]`` in its frames replaced by its value
-    (``parent: cell[i].right``, ``child: cell[i+1].left``)."""
+    first - 1), named ``name[i]``, with each ``[expression of i]`` in its frames replaced by
+    its value (``parent: cell[i].right``, ``child: cell[i+1].left``)."""
     for i, spec in enumerate(node):
         if not (isinstance(spec, dict) and "for" in spec):
             yield i, spec, "", {}
