@@ -68,21 +68,29 @@ def frame_reference(builder, text, path):
 
 
 def unknown_frame(builder, text):
-    """Why ``text`` names no frame: an unknown part, a copy's index out of range, an
-    included file's unknown port or part."""
+    """Why ``text`` names no frame: an unknown part, a copy's index out of range or missing,
+    an index on an entry without copies, an included file's unknown port or part."""
     head = text.split(".")[0]
     base, _, index = head.partition("[")
     copies = sorted(name for name, _ in builder.children)
     for name, children in builder.children:
-        if base == name and index:
-            if not index.rstrip("]").isdigit() or int(index.rstrip("]")) >= len(children):
-                return f"'{head}' is out of range: '{name}' has copies {name}[0] … {name}[{len(children) - 1}]"
-        if head == name or (base == name and index):
-            child = next((c for c in children if c.prefix == builder.prefix + head + "."), children[0])
-            ports = sorted(port[len(child.prefix):] for port in builder.assembly.ports if port.startswith(child.prefix))
-            rest = text[len(head) + 1:]
-            return (f"'{head}' (the file {child.doc.name}) has no port or part frame '{rest}'; its ports: "
-                    f"{', '.join(ports) or 'none'}; its parts: {', '.join(sorted(child.parts)[:20])}")
+        if base != name:
+            continue
+        counted = children[0].prefix != builder.prefix + name + "."  # count: copies name[0] …
+        last = f"{name}[{len(children) - 1}]"
+        if counted and not index:
+            return f"'{name}' has {len(children)} copies (count:): name one of them, {name}[0] … {last}"
+        if index and not counted:
+            return f"'{name}' is one file, not numbered copies (it has no count:): write '{name}.…' without [{index}"
+        if index and (not index.rstrip("]").isdigit() or int(index.rstrip("]")) >= len(children)):
+            return f"'{head}' is out of range: '{name}' has copies {name}[0] … {last}"
+        child = next(c for c in children if c.prefix == builder.prefix + head + ".")
+        ports = sorted(port[len(child.prefix):] for port in builder.assembly.ports if port.startswith(child.prefix))
+        rest = text[len(head) + 1:]
+        problem = (f"has no port or part frame '{rest}'" if rest
+                   else "is a substructure, not a frame: name one of its ports or its parts' frames")
+        return (f"'{head}' (the file {child.doc.name}) {problem}; its ports: "
+                f"{', '.join(ports) or 'none'}; its parts: {', '.join(sorted(child.parts)[:20])}")
     names = ["world", *(name for name in builder.parts if "." not in name), *copies]
     close = difflib.get_close_matches(head, names, n=3)
     hint = f" (did you mean {', '.join(close)}?)" if close else ""
@@ -175,9 +183,9 @@ _BRACKETS = re.compile(r"\[([^\[\]]*)\]")
 
 def _each_joint(builder, node):
     """(index in ``joints:``, entry, name suffix) of each joint; an entry with ``for: {i:
-    [first, last]}`` gives one joint per i = first … last (both included), named
-    ``name[i]``, with each ``[expression of i]`` in its frames replaced by its value
-    (``parent: cell[i].right``, ``child: cell[i+1].left``)."""
+    [first, last]}`` gives one joint per i = first … last (both included; none when last is
+    first - 1), named ``name[i]``, with each ``[expression of i]`` in its frames replaced by
+    its value (``parent: cell[i].right``, ``child: cell[i+1].left``)."""
     for i, spec in enumerate(node):
         if not (isinstance(spec, dict) and "for" in spec):
             yield i, spec, "", {}
@@ -194,6 +202,9 @@ def _each_joint(builder, node):
                        for k, x in enumerate(builder.constants(bounds, path + (variable,), 2)))
         if first != int(first) or last != int(last):
             builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] must be of whole numbers")
+        if last < first - 1:  # [k, k - 1] is empty (one copy: no joints between copies), a lower last a mistake
+            builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] runs backwards: give [first, last] "
+                                             "with last ≥ first (or first - 1 for none)")
         for k in range(int(first), int(last) + 1):
             copy = type(spec)({key: value for key, value in spec.items() if key != "for"})
             copy.line, copy.key_lines = spec.line, spec.key_lines

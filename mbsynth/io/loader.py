@@ -32,7 +32,7 @@ from .robot import connect_robots, read_robot, read_robots
 from .schema import SECTIONS
 from .placement import Placement, place_initial
 from .source import Document, LineDict, LineList, read_document
-from .substructures import Scoped, read_includes, read_ports
+from .substructures import Scoped, included_from, read_includes, read_ports
 
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
@@ -90,27 +90,30 @@ class _Builder:
         self.placement = include.placement if include else Placement()
         self.children = []  # (entry name, [child builders]) of the file's ``type: model`` entries
         self.chain = include.chain if include else ()  # (file, line) of the entries that include this file
+        self.bound = {}  # the extra_names in effect: {name: value}
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
-        """Raise ModelError ``file:line: at key.path: message``; in an included file, with
-        the chain of entries that included it."""
+        """Raise ModelError ``file:line: at key.path: message``, naming the values of the
+        ``extra_names`` in effect (``for:``'s ``i``, a copy's ``index``); in an included file,
+        with the chain of entries that included it."""
+        if self.bound:
+            message += f" (with {', '.join(f'{name} = {value}' for name, value in self.bound.items())})"
         error = self.doc.error(path, message)
         if self.include:
-            chain = ", ".join(f"{name}:{line}" for name, line in reversed(self.chain))
-            error = ModelError(f"{error} (in '{self.prefix[:-1]}', included from {chain})")
+            error = ModelError(f"{error}{included_from(self.prefix[:-1], self.chain)}")
         raise error
 
     @contextlib.contextmanager
     def extra_names(self, names):
         """Expressions of parameters read meanwhile may use ``names`` too ({name: value}:
-        a copy's ``index``)."""
-        saved = self.param_symbols
-        self.param_symbols = {**saved, **names}
+        a copy's ``index``, a ``for:`` entry's name)."""
+        saved, saved_bound = self.param_symbols, self.bound
+        self.param_symbols, self.bound = {**saved, **names}, {**saved_bound, **names}
         try:
             yield
         finally:
-            self.param_symbols = saved
+            self.param_symbols, self.bound = saved, saved_bound
 
     def mapping(self, node, path, allowed, required=()):
         if node is None:
@@ -559,6 +562,12 @@ class _Builder:
                 self.fail(self.entry_of(own) or ("subsystems", own),
                           f"joint '{own}' has the name of part '{own}': joints and parts share one "
                           f"namespace ('{own}.angle', '{own}.x'), rename one of them")
+            base = own.split("[")[0]  # a for: entry's joints are base[i]
+            if base in dict(self.children):
+                entry = self.entry_of(own)
+                self.fail(entry + ("name",) if entry else ("joints",),
+                          f"joint '{base}' has the name of the substructure '{base}' (its names are "
+                          f"'{base}.<name>'): rename the joint")
             if own in self.parameters or own == "world":
                 entry = self.entry_of(own)
                 clash = "the world (its frames are 'world.<frame>')" if own == "world" else "a parameter"

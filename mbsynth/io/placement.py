@@ -66,6 +66,7 @@ def place_initial(part, values, placement, fail):
         for suffix in ("", "_dot"):
             names = [f"q{c}{suffix}" for c in "wxyz"]
             moved.update(zip(names, turn * sp.Matrix([full[n] for n in names])))
+        _scalar_part_positive(moved)
     elif kind == "euler_body" and placement.turns:
         fail(f"part '{part.name}' has angle coordinates ({part.sequence}): a placement that turns it would move "
              "their singular position; give it rotation: quaternion, or place it by translation alone")
@@ -82,6 +83,17 @@ def _move_point(moved, full, names, placement):
     velocity = sp.Matrix([full[f"{c}_dot"] for c in names])
     moved.update(zip(names, _rotated(placement.R, position) + placement.t))
     moved.update(zip((f"{c}_dot" for c in names), _rotated(placement.R, velocity)))
+
+
+def _scalar_part_positive(moved):
+    """q and −q are one orientation: a placed one keeps qw ≥ 0 (its rates turned with it),
+    as an orientation a file gives does (matrix_quaternion), so that a composed model starts
+    at the coordinates of its flat twin."""
+    qw = sp.sympify(moved["qw"])
+    if qw.free_symbols or qw >= 0:
+        return
+    for suffix in ("", "_dot"):
+        moved.update({name: -moved[name] for name in (f"q{c}{suffix}" for c in "wxyz")})
 
 
 def _place_planar(part, moved, full, placement, fail):

@@ -132,12 +132,14 @@ SECTIONS = {section.name: section for section in (
                  "world frames and its parts' initial poses and velocities", "{position: [0, 0.2, 0]}",
                  default="identity"),
              Key("count", "expression of parameters, a whole number ≥ 1", "copies ``NAME[0]`` … "
-                 "``NAME[count-1]``; ``index`` is each copy's number in ``parameters`` and ``placement``",
+                 "``NAME[count-1]``; ``index`` is each copy's number in ``parameters`` and ``placement`` (so "
+                 "this file may have no parameter named ``index``)",
                  "N", default="one copy, named NAME"),
              _DESCRIPTION)),
     Section("placement", "``placement:`` of a ``type: model`` entry",
             "Where the included file's axes sit in this file's: a position and at most one "
-            "orientation key (expressions may use ``index``). Placements compose through nesting.",
+            "orientation key (expressions may use ``index``). Placements compose through nesting; a placed "
+            "body's quaternion keeps qw ≥ 0, as an orientation a file gives does.",
             (Key("position", "list of 3 " + _EXPRS, "the origin of the file's axes", "[index*L, 0, 0]",
                  default="[0, 0, 0]"),
              *_ORIENTATION)),
@@ -368,7 +370,8 @@ SECTIONS = {section.name: section for section in (
              _required("child", "frame", "frame B, on the child part", "link.top"),
              Key("length", _EXPR + ", > 0", "the distance kept by a ``distance`` joint (required there)", "0.5"),
              Key("for", "mapping name → [first, last]", "one joint per whole number from first to last (both "
-                 "included), named ``name[i]``; ``[expression]`` in its frames is replaced by its value",
+                 "included; none for [k, k - 1], the range of one copy; a range running further back is "
+                 "refused), named ``name[i]``; ``[expression]`` in its frames is replaced by its value",
                  "{i: [0, N - 2]}"),
              _DESCRIPTION,
              Key("actuation", "expression, or mapping (section *joint_actuation*)", "torque (revolute) or "

@@ -23,6 +23,7 @@ per file copy, each reading its file under its prefix (``Scoped`` gives a builde
 file's view of the model's names).
 """
 
+import difflib
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -68,8 +69,7 @@ def read_includes(builder):
 def _read_entry(builder, name, spec, path):
     builder.section(spec, path, "model_part")
     doc = _child_document(builder, spec, path)
-    declared = doc.root.get("parameters") if isinstance(doc.root.get("parameters"), dict) else {}
-    given = builder.mapping(spec.get("parameters"), path + ("parameters",), set(declared))
+    given = _given_parameters(builder, doc, spec, path + ("parameters",))
     count = _count(builder, spec, path)
     line = builder.doc.line_of(path)
     children = []
@@ -87,6 +87,20 @@ def _read_entry(builder, name, spec, path):
     return children
 
 
+def _given_parameters(builder, doc, spec, path):
+    """The entry's ``parameters:``, each a parameter the included file declares."""
+    declared = doc.root.get("parameters") if isinstance(doc.root.get("parameters"), dict) else {}
+    node = spec.get("parameters")
+    given = builder.mapping(node, path, set(node) if isinstance(node, dict) else set())
+    for key in given:
+        if key not in declared:
+            close = difflib.get_close_matches(str(key), sorted(map(str, declared)), n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            builder.fail(path + (key,), f"'{key}' is not a parameter of {doc.name}{hint}; it declares: "
+                                        f"{', '.join(map(str, declared)) or 'none'}")
+    return given
+
+
 def _child_document(builder, spec, path):
     """The Document of the entry's ``file`` (read once per model), refused when the file
     includes itself through the chain that led here."""
@@ -94,6 +108,8 @@ def _child_document(builder, spec, path):
     if not isinstance(text, str) or not text.strip():
         builder.fail(path + ("file",), f"expected a model file name, got {text!r}")
     file = (builder.doc.folder / text).resolve()
+    if file.is_dir():
+        builder.fail(path + ("file",), f"'{text}' is a folder, not a model file ({file})")
     if not file.is_file():
         builder.fail(path + ("file",), f"no such model file '{text}' (looked for {file})")
     files = [Path(str(name)).resolve() for name, _ in builder.chain] + [Path(str(builder.doc.name)).resolve()]
@@ -105,9 +121,17 @@ def _child_document(builder, spec, path):
     if file not in documents:
         try:
             documents[file] = read_document(file)
-        except ModelError as err:
-            raise builder.doc.error(path + ("file",), f"in the included file: {err}") from None
+        except ModelError as err:  # the file's own line, then the entries that led to it
+            entry = builder.prefix + path[-1]
+            chain = builder.chain + ((builder.doc.name, builder.doc.line_of(path)),)
+            raise ModelError(f"{err}{included_from(entry, chain)}") from None
     return documents[file]
+
+
+def included_from(name, chain):
+    """The note an error inside an included file ends with: `` (in 'NAME', included from
+    FILE:LINE, …)``, the including entries from the nearest to the model file's."""
+    return f" (in '{name}', included from {', '.join(f'{file}:{line}' for file, line in reversed(chain))})"
 
 
 def _count(builder, spec, path):
@@ -119,6 +143,9 @@ def _count(builder, spec, path):
         builder.fail(path + ("count",), f"count must be a whole number ≥ 1, got {value:g}")
     if value > COUNT_MAX:
         builder.fail(path + ("count",), f"count {value:g} is more than {COUNT_MAX} copies")
+    if "index" in builder.param_symbols:
+        builder.fail(path + ("count",), "the file has a parameter 'index', the name each copy's number has in "
+                                        "the entry's parameters and placement: rename the parameter")
     return int(value)
 
 
