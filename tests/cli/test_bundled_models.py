@@ -36,6 +36,7 @@ MODES = {
     "mechanisms/flyball_governor.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the shaft turns freely
     "mechanisms/four_bar.yaml": "equilibrium",
     "mechanisms/four_bar_3d.yaml": "equilibrium",
+    "mechanisms/four_bar_cell.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # no gravity of its own: rests anywhere
     "mechanisms/massless_link.yaml": ([], 2, NOT_UNIQUE),  # the massless link's free spin
     "mechanisms/massless_rod.yaml": ([], 2, NOT_UNIQUE),
     "mechanisms/n_four_bar.yaml": "rests",
