@@ -5,8 +5,9 @@ The Whipple bicycle: stability of upright rolling
 The benchmark bicycle of Meijaard, Papadopoulos, Ruina and Schwab (Proc. R. Soc. A 463,
 2007, doi 10.1098/rspa.2007.1857), written as it is built: four rigid bodies (the rear
 wheel, the rear frame with its rider, the front frame and the front wheel), three
-revolute joints and two wheels rolling without slipping (``models/rolling/bicycle.yaml``;
-no hand-derived equations). Each body turns by angles z, x, y (``rotation: zxy``), so a
+revolute joints and two wheels rolling without slipping (``models/rolling/bicycle.yaml``,
+its two wheels one file, ``bicycle_wheel.yaml``, included as ``rear`` and ``front``; no
+hand-derived equations). Each body turns by angles z, x, y (``rotation: zxy``), so a
 wheel's spin angle is cyclic and rolling upright at speed v is a steady motion.
 
 ``mb.linearize`` takes the model about that motion in independent coordinates and
@@ -33,7 +34,7 @@ R_REAR = bicycle.parameters["rR"]
 
 def exponents(v):
     """The non-zero eigenvalues of upright rolling at v (m/s), from the rear wheel's spin rate."""
-    q, qd = mb.steady_motion(bicycle, {"rear_wheel.angle_y": v / R_REAR})
+    q, qd = mb.steady_motion(bicycle, {"rear.wheel.angle_y": v / R_REAR})
     values = mb.linearize(bicycle, 0.0, q, qd).eigenvalues
     return values[values != 0]
 
@@ -79,7 +80,7 @@ ax.legend(loc="lower left")
 # about the line through the wheels' contact points, so the wheels still roll), the full
 # nonlinear model recovers: it steers into the fall and rights itself. For a small kick the
 # run follows the linearization's prediction exp(A t) x₀.
-q0, qd0 = mb.steady_motion(bicycle, {"rear_wheel.angle_y": 4.6 / R_REAR})
+q0, qd0 = mb.steady_motion(bicycle, {"rear.wheel.angle_y": 4.6 / R_REAR})
 index = {c: i for i, c in enumerate(bicycle.coordinates)}
 
 
@@ -120,7 +121,7 @@ from mbsynth.view.screenshot import show_still
 page = mb.viewer.to_html(bicycle, run, Path("bicycle_kick.html"))
 fig, ax = plt.subplots(figsize=(7, 5))
 if not show_still(ax, page, Path("bicycle_kick.png"), budget_ms=400):
-    ax.plot(run.q[:, index["rear_wheel.x"]], run.q[:, index["rear_wheel.y"]])
+    ax.plot(run.q[:, index["rear.wheel.x"]], run.q[:, index["rear.wheel.y"]])
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title("Chromium is not installed: the rear contact's track instead of the viewer's picture")

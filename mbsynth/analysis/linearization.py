@@ -139,7 +139,7 @@ class Linearization:
     def zero_states(self):
         """One name per exact zero of ``eigenvalues``: a cyclic coordinate or conserved speed
         alone in its block (``cyclic``), or a direction split off within a block, named by
-        the states it moves, largest 1 (``rear_wheel.angle_z + front_frame.angle_z``: the
+        the states it moves, largest 1 (``rear.wheel.angle_z + front.wheel.angle_z``: the
         heading of the whole bicycle, steered part and all)."""
         A, names = self._structural, []
         for b in self.blocks:

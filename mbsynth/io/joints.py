@@ -14,6 +14,7 @@ from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
+from .placement import place_height
 
 # ground contacts (their keys: schema.py): the part kinds they may sit on
 CONTACT_TYPES = {"rolling_disk": ("rigid_body", "euler_body"), "knife_edge": ("rigid_body", "euler_body", "planar_body")}
@@ -147,8 +148,8 @@ def _read_joint(builder, spec, path, names, suffix):
 
 def read_contact(builder, spec, path, names, suffix=""):
     """A ground contact: ``rolling_disk`` (``child`` the disk's centre frame, z along its
-    axis; ``radius``; ``ground`` the height of the plane, 0 by default) or ``knife_edge``
-    (``child`` a frame whose x axis is the blade)."""
+    axis; ``radius``; ``ground`` the height of the plane, 0 by default, in the file's axes:
+    raised with its placement) or ``knife_edge`` (``child`` a frame whose x axis is the blade)."""
     kind = spec["type"]
     hosts = CONTACT_TYPES[kind]
     spec = builder.section(spec, path, kind)
@@ -164,8 +165,9 @@ def read_contact(builder, spec, path, names, suffix=""):
     radius = builder.constant(spec["radius"], path + ("radius",))
     if builder.value(radius) <= 0:
         builder.fail(path + ("radius",), "radius must be positive")
-    return RollingDisk(name, part, frame, radius, builder.constant(spec.get("ground", 0), path + ("ground",)),
-                       *args)
+    ground = builder.constant(spec.get("ground", 0), path + ("ground",))
+    ground = place_height(builder.placement, ground, lambda why: builder.fail(path, why))
+    return RollingDisk(name, part, frame, radius, ground, *args)
 
 
 def _joint_name(builder, spec, path, names, suffix=""):

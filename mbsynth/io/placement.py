@@ -8,7 +8,8 @@ flexible body's floating frame and a planar body (a turn about z) transform line
 expressions of parameters in their initial values stay expressions (``with_parameters``
 follows them). A part given by its energies (``lagrangian``) has coordinates of its own
 meaning and a body with angle coordinates a singular position a turn would move: neither
-can be placed (translation alone is allowed for the body with angles).
+can be placed (translation alone is allowed for the body with angles). A rolling disk's
+ground z = ground is the file's: raised by t_z, and not tilted (``place_height``).
 """
 
 import numpy as np
@@ -35,6 +36,11 @@ class Placement:
     @property
     def turns(self):
         return not np.array_equal(self.R, np.eye(3))
+
+    @property
+    def tilts(self):
+        """Whether the turn moves the z axis (a horizontal plane would not stay horizontal)."""
+        return abs(self.R[2, 2] - 1) > PLANE_RTOL
 
     def then(self, inner):
         """The transform x ↦ self(inner(x))."""
@@ -78,6 +84,16 @@ def place_initial(part, values, placement, fail):
     return {k: v for k, v in moved.items() if v != full[k] or k in values}
 
 
+def place_height(placement, height, fail):
+    """The world height of the horizontal plane z = ``height`` of a placed file (a rolling
+    contact's ground): ``height`` + t_z. ``fail(message)`` raises for a placement that
+    tilts the plane (a contact's ground is horizontal)."""
+    if placement.tilts:
+        fail("a rolling_disk rolls on the horizontal ground z = ground: the placement of the file that holds it "
+             "may turn it about the vertical and shift it, not tilt it")
+    return height + placement.t[2]
+
+
 def _move_point(moved, full, names, placement):
     position = sp.Matrix([full[c] for c in names])
     velocity = sp.Matrix([full[f"{c}_dot"] for c in names])
@@ -99,7 +115,7 @@ def _scalar_part_positive(moved):
 def _place_planar(part, moved, full, placement, fail):
     """A planar body moves in the xy plane: a turn about z and a shift within the plane."""
     R = placement.R
-    if abs(R[2, 2] - 1) > PLANE_RTOL or placement.t[2] != 0:
+    if placement.tilts or placement.t[2] != 0:
         fail(f"part '{part.name}' is a planar body (it moves in the xy plane): its placement may only turn "
              "about z and shift within the plane")
     angle = float(np.arctan2(R[1, 0], R[0, 0]))

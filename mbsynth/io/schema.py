@@ -386,7 +386,8 @@ SECTIONS = {section.name: section for section in (
              _required("type", "string", "``rolling_disk``", "rolling_disk"),
              _required("child", "frame", "the disk's centre frame on a rigid body, z along its axis", "disk"),
              _required("radius", _EXPR + ", > 0", "the disk's radius", "R"),
-             Key("ground", _EXPR, "height of the plane", "0", default="0"), _DESCRIPTION)),
+             Key("ground", _EXPR, "height of the plane (in an included file, raised by its placement, "
+                 "which may not tilt it)", "0", default="0"), _DESCRIPTION)),
     Section("knife_edge", "an entry of ``joints:`` with ``type: knife_edge``",
             "A blade that slides along itself but not across (a nonholonomic constraint).",
             (_required("name", "plain name", "the contact's name", "blade"),

@@ -34,12 +34,16 @@ class AngleSingularity:
     @property
     def angle(self):
         """The middle angle's name within its part."""
-        return self.coordinate.split(".", 1)[1]
+        return self.own(self.coordinate)
 
     @property
     def kind(self):
         """What parts alike share: (sequence, middle angle, the angles that turn about one axis)."""
-        return self.sequence, self.angle, tuple(c.split(".", 1)[1] for c in self.direction)
+        return self.sequence, self.angle, tuple(self.own(c) for c in self.direction)
+
+    def own(self, coordinate):
+        """``coordinate``'s name within the part (``angle_x`` of ``rear.wheel.angle_x``)."""
+        return coordinate.removeprefix(self.part + ".")
 
     def message(self, where="at"):
         """Which part, where its angles are (``where``: "at", "near" or "approaching") and what to do."""

@@ -107,10 +107,10 @@ def test_parallelogram_chain_hangs_from_random_starts(seed):
     rng = np.random.default_rng(seed)
     q = mb.equilibrium(system, system.initial_state()[0] + 0.3 * rng.normal(size=system.n))
     values = dict(zip(system.coordinates, q))
-    for v in ("v0", "v1", "v2"):
+    for v in ("cell[0].v", "cell[1].v", "v"):
         assert np.cos(values[f"{v}.theta"]) == pytest.approx(-1.0, abs=1e-9)
         assert values[f"{v}.y"] == pytest.approx(-p["L"] / 2, abs=1e-9)
-    for h in ("h0", "h1"):
+    for h in ("cell[0].h", "cell[1].h"):
         assert values[f"{h}.y"] == pytest.approx(-p["L"], abs=1e-9)
     assert system.energy(0.0, q, 0 * q)[1] == pytest.approx(-3.5 * p["m"] * p["g"] * p["L"], rel=1e-10)
 

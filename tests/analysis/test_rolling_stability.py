@@ -209,7 +209,7 @@ def test_speeds_can_be_chosen_and_are_checked(bicycle):
                           speeds=["rear_frame.x", "rear_frame.angle_x", "front_frame.angle_z"])
     assert np.abs(_nonzero(chosen.eigenvalues) - np.sort_complex(TABLE_2[v])).max() < 1e-8
     with pytest.raises(mb.SolveError, match="do not fix the velocities"):
-        mb.linearize(moving, 0.0, *moving.initial_state(), speeds=["rear_frame.x", "rear_wheel.x", "front_wheel.x"])
+        mb.linearize(moving, 0.0, *moving.initial_state(), speeds=["rear_frame.x", "rear.wheel.x", "front.wheel.x"])
 
 
 def test_speeds_take_the_names_modes_prints_and_refuse_one_string(bicycle):
@@ -257,7 +257,7 @@ def test_steady_motion_from_a_forward_speed(bicycle):
     """mb.steady_motion from the rear wheel's spin rate v/rR alone: the bicycle rolls upright
     at v (the least-energy velocities leave no lean or steer rate), as the model file's
     initial state written by hand; its eigenvalues are Table 2's."""
-    q, qd = mb.steady_motion(bicycle, {"rear_wheel.angle_y": 4.0 / 0.3})
+    q, qd = mb.steady_motion(bicycle, {"rear.wheel.angle_y": 4.0 / 0.3})
     q0, qd0 = bicycle.with_parameters(v=4.0).initial_state()
     assert np.abs(q - q0).max() < 1e-12 and np.abs(qd - qd0).max() < 1e-12 * np.abs(qd0).max()
     lin = mb.linearize(bicycle, 0.0, q, qd)

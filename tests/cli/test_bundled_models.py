@@ -36,6 +36,7 @@ MODES = {
     "mechanisms/flyball_governor.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the shaft turns freely
     "mechanisms/four_bar.yaml": "equilibrium",
     "mechanisms/four_bar_3d.yaml": "equilibrium",
+    "mechanisms/four_bar_cell.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # no gravity of its own: rests anywhere
     "mechanisms/massless_link.yaml": ([], 2, NOT_UNIQUE),  # the massless link's free spin
     "mechanisms/massless_rod.yaml": ([], 2, NOT_UNIQUE),
     "mechanisms/n_four_bar.yaml": "rests",
@@ -61,6 +62,7 @@ MODES = {
     "robots/ur5_holding_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),
     "robots/ur5_payload.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the vertical shoulder axis
     "rolling/bicycle.yaml": "steady",
+    "rolling/bicycle_wheel.yaml": "steady",  # one wheel rolling upright alone: its lean oscillates
     "rolling/knife_edge.yaml": (["--steady"], 1, NOT_STEADY),  # its turning grows
     "rolling/rolling_disk.yaml": (["--steady"], 1, NOT_STEADY),  # a quaternion: the spin is not cyclic
     "rolling/turning_disk.yaml": "steady",

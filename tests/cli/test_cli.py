@@ -119,7 +119,7 @@ def test_simulate_names_the_singular_position_it_passed(capsys):
     x, _ = ref.n_four_bar_reference(t, 2)
     horizontal = t[np.argmax(x)]  # B0 farthest along +x: the bars horizontal
     assert first["t_from"] <= horizontal + 1e-5 and first["t_to"] >= horizontal - 1e-5
-    assert "ground0[x]" in first["rows"]
+    assert "cell[0].ground[x]" in first["rows"]
     assert main(["simulate", str(root / "models" / "mechanisms" / "n_four_bar.yaml"), "--t-end", "1"]) == 0
     assert "passed near singular positions at t ≈ 0.7143" in capsys.readouterr().out
 

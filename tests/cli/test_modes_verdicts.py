@@ -45,7 +45,7 @@ def test_upright_rolling_at_5_m_s_is_stable():
     assert complex(*verdict["eigenvalue"]) == pytest.approx(-0.32286642900409, abs=1e-8)
     assert result["modes"][verdict["mode"] - 1]["kind"] == "overdamped"
     assert result["zero_eigenvalues"] == len(result["cyclic"]) == 6
-    assert "rear_wheel.angle_z + front_frame.angle_z" in result["cyclic"]  # the heading, steered part and all
+    assert "rear.wheel.angle_z + front.wheel.angle_z" in result["cyclic"]  # the heading, steered part and all
 
 
 def test_upright_rolling_at_2_m_s_is_unstable():
