@@ -124,7 +124,7 @@ class _Builder:
 
     def value(self, expr):
         """The float value of an expression of parameters."""
-        return float(sp.sympify(expr).subs(self.param_values))
+        return float(_at(sp.sympify(expr), self.param_values))
 
     def fixed_value(self, expr, path):
         """``value(expr)`` for something built once at load (an FE model): its parameters
@@ -294,6 +294,7 @@ class _Builder:
             self.fail(("constraints",), f"expected a list of constraints, got {_kind(node)}")
         kinds = ("holonomic", "nonholonomic", "acceleration")
         constraints, names = [], set()
+        coordinates, velocities = set(self.q), set(self.qd)
         for i, spec in enumerate(node):
             path = ("constraints", i)
             spec = self.section(spec, path, "constraint")
@@ -316,8 +317,8 @@ class _Builder:
                 continue
             expr = self.expression(spec[kind], kpath, self.constraint_symbols)
             self.differentiable(expr, kpath, None if kind == "holonomic" else ())
-            has_q = expr.free_symbols & set(self.q) or joint_values_in(expr)
-            has_qd = expr.free_symbols & set(self.qd)
+            has_q = expr.free_symbols & coordinates or joint_values_in(expr)
+            has_qd = expr.free_symbols & velocities
             if kind == "holonomic" and has_qd:
                 self.fail(kpath, f"constraint '{name}' uses velocities {sorted(map(str, has_qd))}; "
                                  "write it as 'nonholonomic:'")
@@ -450,10 +451,16 @@ def _real(expr, values):
     """The float value of ``expr`` at the parameter ``values``, or None when that is not a
     finite real number."""
     try:
-        value = complex(expr.subs(values).evalf())
+        value = complex(_at(expr, values).evalf())
     except (TypeError, ValueError, OverflowError):  # a value sympy cannot make a number
         return None
     return value.real if value.imag == 0 and np.isfinite(value.real) else None
+
+
+def _at(expr, values):
+    """``expr`` with the ``values`` ({symbol: value}) of its own symbols put in: the
+    substitution looks at those alone, not at a model's thousands of parameters."""
+    return expr.subs({s: values[s] for s in expr.free_symbols if s in values})
 
 
 def _kind(value):
