@@ -60,6 +60,7 @@ class _Builder:
         self.root = doc.root
         self.overrides = dict(parameters or {})
         self.fixed = {}  # parameter name -> where the file builds something from its value at load
+        self.values = {}  # expression of parameters -> its value, each found once (``constant``)
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
@@ -118,13 +119,17 @@ class _Builder:
     def constant(self, text, path):
         """An expression of parameters only (a mass, a length), checked finite and real."""
         expr = self.expression(text, path, self.param_symbols)
-        if _real(expr, self.param_values) is None:
+        value = _real(expr, self.param_values)
+        if value is None:
             self.fail(path, f"{text!r} is not a finite real number")
+        self.values[expr] = value
         return expr
 
     def value(self, expr):
         """The float value of an expression of parameters."""
-        return float(_at(sp.sympify(expr), self.param_values))
+        expr = sp.sympify(expr)
+        found = self.values.get(expr)
+        return float(_at(expr, self.param_values)) if found is None else found
 
     def fixed_value(self, expr, path):
         """``value(expr)`` for something built once at load (an FE model): its parameters
@@ -458,9 +463,10 @@ def _real(expr, values):
 
 
 def _at(expr, values):
-    """``expr`` with the ``values`` ({symbol: value}) of its own symbols put in: the
-    substitution looks at those alone, not at a model's thousands of parameters."""
-    return expr.subs({s: values[s] for s in expr.free_symbols if s in values})
+    """``expr`` with the ``values`` ({symbol: number}) of its own symbols put in, as
+    floats: a replacement of those alone, not a substitution of a model's thousands of
+    parameters."""
+    return expr.xreplace({s: sp.Float(values[s]) for s in expr.free_symbols if s in values})
 
 
 def _kind(value):

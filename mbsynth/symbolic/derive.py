@@ -40,23 +40,37 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
     Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
     M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
     Each entry is simplified when it is small (``tidy``). Derived once per structure
-    (``_lagrange``): the coordinates, velocities and other symbols become placeholder
-    slots, so that copies of a part differing only in the names of their symbols (a cell
-    used a thousand times, each copy with parameters of its own) share one derivation.
-    """
+    (``energy_template``)."""
+    found = energy_template(T, V, F, q, qd, t)
+    if found is None:  # symbols no slot can stand for
+        return tuple(map(sp.Matrix, _lagrange(sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F),
+                                              tuple(q), tuple(qd), t)))
+    (q_slots, qd_slots), constants, (M, Q, _, _, _) = found
+    back = dict(zip(q_slots, q))
+    back.update(zip(qd_slots, qd))
+    back.update(constants)
+    return sp.Matrix(M.xreplace(back)), sp.Matrix(Q.xreplace(back))
+
+
+def energy_template(T, V, F, q, qd, t=T_SYMBOL):
+    """((q slots, q̇ slots), constants, (M, Q, T, V, F)): ``lagrange``'s M and Q, and T, V
+    and the forces F, written in placeholder slots for the coordinates q, the velocities
+    q̇ and the other symbols (parameters; ``constants``: (slot, symbol) pairs, by name).
+    Copies of a part that differ only in the names of their symbols (a cell used a
+    thousand times, each copy with parameters of its own) get the same template, derived
+    and compiled once. None where a symbol is no plain Symbol (``_plain``)."""
     T, V, F = sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F)
     q, qd = tuple(q), tuple(qd)
-    given = set(q) | set(qd) | {t}
-    others = sorted(symbols_in((T, V, *F)) - given, key=str)
+    others = sorted(symbols_in((T, V, *F)) - set(q) - set(qd) - {t}, key=str)
     symbols = q + qd + tuple(others)
-    slots = tuple(_ENERGY[i] for i in range(len(symbols)))
     if len(set(symbols)) < len(symbols) or not all(_plain(s) for s in symbols):
-        return tuple(map(sp.Matrix, _lagrange(T, V, F, q, qd, t)))  # symbols no slot can stand for
+        return None
+    slots = tuple(_ENERGY[i] for i in range(len(symbols)))
     forward = dict(zip(symbols, slots))
-    M, Q = _lagrange(T.xreplace(forward), V.xreplace(forward), tuple(f.xreplace(forward) for f in F),
-                     slots[:len(q)], slots[len(q):2 * len(q)], t)
-    back = dict(zip(slots, symbols))
-    return sp.Matrix(M.xreplace(back)), sp.Matrix(Q.xreplace(back))
+    T, V, F = T.xreplace(forward), V.xreplace(forward), tuple(f.xreplace(forward) for f in F)
+    q_slots, qd_slots = slots[:len(q)], slots[len(q):2 * len(q)]
+    M, Q = _lagrange(T, V, F, q_slots, qd_slots, t)
+    return (q_slots, qd_slots), tuple(zip(slots[2 * len(q):], others)), (M, Q, T, V, F)
 
 
 def _plain(symbol):
@@ -345,15 +359,15 @@ _WHOLE = placeholder("whole")  # a compiled function's argument ``picked``, read
 def _picking(args, position, flat, constants):
     """(``args`` with the list at ``position`` replaced by one symbol, ``_WHOLE``; ``flat``
     with the symbols of that list it reads replaced by placeholders; ``constants`` with
-    (placeholder, symbol) pairs added for them, in the list's order; and where each such
-    symbol stands: (symbol, (position, index in the list)) pairs)."""
+    (placeholder, symbol) pairs added for them, in the list's order; and where each symbol
+    of the list that a constant stands for is: (symbol, (position, index in the list)))."""
     index = _index_of(args[position])
     used = sorted((s for s in symbols_in(flat) if s in index), key=index.__getitem__)
     forward = {s: _PICKED[i] for i, s in enumerate(used)}
+    constants = tuple(constants) + tuple((slot, s) for s, slot in forward.items())
     return (tuple(args[:position]) + (_WHOLE,) + tuple(args[position + 1:]),
-            [x.xreplace(forward) for x in flat] if forward else flat,
-            tuple(constants) + tuple((slot, s) for s, slot in forward.items()),
-            tuple((s, (position, index[s])) for s in used))
+            [x.xreplace(forward) for x in flat] if forward else flat, constants,
+            tuple((v, (position, index[v])) for _, v in constants if v in index))
 
 
 _last_index = ((), {})
@@ -400,7 +414,7 @@ def _compiled(args, flat, placeholders):
         derived.append(canonical(flat, symbols))
         forms, numbers = derived[0]
         try:
-            return fingerprint((slots, len(numbers), forms)), numbers
+            return _structure_digest((slots, len(numbers), forms)), numbers
         except Unstable:  # a Dummy in the forms: a structure of this process alone
             return None, numbers
 
@@ -412,6 +426,13 @@ def _compiled(args, flat, placeholders):
         return slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms
 
     return _lambdified(digest, structure), numbers
+
+
+@functools.lru_cache(maxsize=4096)
+def _structure_digest(structure):
+    """``fingerprint`` of a structure (argument slots, count of numbers, canonical forms):
+    once per structure in a process, however many instances have it."""
+    return fingerprint(structure)
 
 
 _by_structure = {}  # structure digest -> its numpy function, one per structure in this process

@@ -120,7 +120,11 @@ class Part:
         its own coordinates q, velocities qd: what they add to d(T + V)/dt."""
         if self._power is None:
             args, constants = self._power_args
-            self._power = compile_function(args, [self.power_expression], constants, picked=PARAMETERS)
+            expression = self.power_expression
+            if self._shared:  # in the template's coordinate slots
+                q_slots, qd_slots = self._shared[1]
+                expression = sp.sympify(expression).xreplace({**dict(zip(self.q, q_slots)), **dict(zip(self.qd, qd_slots))})
+            self._power = compile_function(args, [expression], constants, picked=PARAMETERS)
         return float(self._power(t, q, qd, p)[0])
 
     def symbolic(self):
