@@ -456,7 +456,8 @@ def _real(expr, values):
     """The float value of ``expr`` at the parameter ``values``, or None when that is not a
     finite real number."""
     try:
-        value = complex(_at(expr, values).evalf())
+        value = _at(expr, values)
+        value = complex(value if value.is_Number else value.evalf())
     except (TypeError, ValueError, OverflowError):  # a value sympy cannot make a number
         return None
     return value.real if value.imag == 0 and np.isfinite(value.real) else None

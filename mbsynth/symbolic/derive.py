@@ -230,15 +230,10 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
         entries = {(r, j): expand_joint_values(x) for r, row in enumerate(rows) for j, x in enumerate(row[0]) if x != 0}
         return (sp.SparseMatrix(len(exprs), len(q), entries), [expand_joint_values(row[1]) for row in rows],
                 [expand_joint_values(row[2]) for row in rows])
-    where = positions(q, qd)
-    free = set().union(*(e.free_symbols for e in exprs))
-    involved = sorted({where[s] for s in free if s in where})
-    others = sorted((s for s in free if s not in where and s != t and _plain(s)), key=str)  # parameters
-    symbols = [q[i] for i in involved] + [qd[i] for i in involved] + others
-    forms, numbers = canonical(exprs, symbols)
-    a, b, psi = _differentiated(forms, len(involved), t)
-    back = {_ARGUMENT[j]: s for j, s in enumerate(symbols)}
-    back.update({_NUMBER[j]: x for j, x in enumerate(numbers)})
+    (a, b, psi), _, slots, involved, constants = differentiated_template(exprs, q, qd, t)
+    back = dict(constants)
+    back.update(zip(slots[0], (q[i] for i in involved)))
+    back.update(zip(slots[1], (qd[i] for i in involved)))
     entries = {}
     for r, row in enumerate(a):
         for j, entry in enumerate(row):
@@ -246,6 +241,24 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
                 entries[r, involved[j]] = entry.xreplace(back)
     return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
             [x.xreplace(back) for x in psi])
+
+
+def differentiated_template(exprs, q, qd, t=T_SYMBOL):
+    """((a rows over the involved coordinates, b, ψ), φ, (q slots, q̇ slots), the involved
+    coordinates (indices), constants) of the constraints ``exprs`` = 0 (none may hold a
+    JointValue), all in placeholder slots (``canonical``): the coordinates and velocities
+    involved, the parameters (constants: (slot, symbol)) and the numbers (constants:
+    (slot, number)). Constraints alike but for their symbols and numbers share it."""
+    where = positions(q, qd)
+    free = set().union(*(e.free_symbols for e in exprs))
+    involved = sorted({where[s] for s in free if s in where})
+    others = sorted((s for s in free if s not in where and s != t and _plain(s)), key=str)  # parameters
+    count = len(involved)
+    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved] + others)
+    constants = tuple(zip((_ARGUMENT[2 * count + j] for j in range(len(others))), others))
+    constants += tuple((_NUMBER[j], x) for j, x in enumerate(numbers))
+    slots = tuple(_ARGUMENT[j] for j in range(count)), tuple(_ARGUMENT[count + j] for j in range(count))
+    return _differentiated(forms, count, t), forms, slots, involved, constants
 
 
 def placed_values(slots, coordinates, constants, q, qd):

@@ -6,6 +6,7 @@ import numpy as np
 import sympy as sp
 
 import mbsynth as mb
+from mbsynth.compiled import codegen, layout
 from mbsynth.symbolic import derive
 
 COPIES = 12
@@ -74,11 +75,16 @@ def test_copies_are_derived_once_and_each_gets_its_own_equations(monkeypatch):
         assert np.allclose(Q, [m * r * thd**2 - k * (r - l), -2 * m * r * rd * thd], rtol=1e-14, atol=0)
 
 
-def test_copies_simulate_on_the_compiled_path_grouped():
+def test_copies_simulate_on_the_compiled_path_in_one_loop_per_form(monkeypatch):
+    monkeypatch.setenv("MBSYNTH_FAST", "wait")  # the compiled path, built now
     system = mb.loads(model(COPIES))
-    data = system.data()
-    assert data.engine is not None  # the compiled path
+    exprs = layout.build(system)[1]
+    text = codegen.source(exprs, system.q_symbols, system.qd_symbols, system.parameter_symbols)
+    assert text.count(f"for _m in range({COPIES}):") >= 5  # M, Q, rows, b, φ of the copies: loops, not copies
+    assert system.data().engine is not None  # the compiled path
     result = mb.simulate(system, 0.05)
-    alone = mb.simulate(mb.loads(model(1, first=4)), 0.05)
-    q4 = result.q[-1][system.coordinates.index("cell_4.r")]
-    assert abs(q4 - alone.q[-1][0]) < 1e-8  # a copy moves as the cell alone (the copies are not coupled)
+    for i in (0, 4, COPIES - 1):  # each copy moves as the cell alone, on the KKT path (the copies are not coupled)
+        monkeypatch.setenv("MBSYNTH_FAST", "off")
+        alone = mb.simulate(mb.loads(model(1, first=i)), 0.05)
+        at = system.coordinates.index(f"cell_{i}.r")
+        assert np.allclose(result.q[-1][at:at + 2], alone.q[-1], rtol=0, atol=1e-8)
