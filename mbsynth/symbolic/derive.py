@@ -390,10 +390,10 @@ def _index_of(symbols):
     """{symbol: its position in ``symbols``}, kept for the last list asked (every part and
     connector of a model asks for its parameters)."""
     global _last_index
-    symbols = tuple(symbols)
-    if _last_index[0] != symbols:  # tuples of the same symbols compare by identity first: fast
-        _last_index = (symbols, {s: i for i, s in enumerate(symbols)})
-    return _last_index[1]
+    symbols, found = tuple(symbols), _last_index  # one read: another thread may replace it
+    if found[0] != symbols:  # tuples of the same symbols compare by identity first: fast
+        found = _last_index = (symbols, {s: i for i, s in enumerate(symbols)})
+    return found[1]
 
 
 class Compiled:
