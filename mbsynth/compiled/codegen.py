@@ -42,31 +42,84 @@ def evaluate_rows(t, q, qd, p, out):
         evaluate(t[row], q[row], qd[row], p, out[row])
 '''
 
+GROUP_MIN = 8  # expressions of one form from this many on are computed in one loop (``source``)
 _modules = {}
 _lock = threading.Lock()
 
 
 def source(exprs, q, qd, p):
     """The module's text for ``exprs`` in the symbols q, q̇ (per coordinate), p and t
-    (printed as the argument ``t``)."""
+    (printed as the argument ``t``). Expressions of one form in other symbols (the copies
+    of a part or constraint, ``_forms``), GROUP_MIN or more of them, are computed in one
+    loop that reads each copy's symbols through index arrays: the text, and numba's
+    compile time, do not grow with the number of copies."""
     reads = {s: f"{prefix}[{i}]" for prefix, symbols in (("q", q), ("qd", qd), ("p", p))
              for i, s in enumerate(symbols)}
-    return HEADER.format(count=len(exprs)) + (assignments(exprs, reads, "out[{}]", "    ") or "    pass") + "\n" + ROWS
+    groups, alone = _forms(exprs, q, qd, p)
+    body = assignments([exprs[k] for k in alone], reads, "out[{}]", "    ", places=alone)
+    loops = [_loop(g, form, kinds, members) for g, ((form, kinds), members) in enumerate(groups.items())]
+    arrays = "".join(array for array, _ in loops)
+    text = "\n".join(filter(None, [body] + [loop for _, loop in loops]))
+    header = HEADER.format(count=len(exprs)) if not loops else HEADER.replace(
+        "from numba import njit\n", "import numpy as np\nfrom numba import njit\n\n" + arrays).format(count=len(exprs))
+    return header + (text or "    pass") + "\n" + ROWS
 
 
-def assignments(exprs, reads, target, indent):
+def _forms(exprs, q, qd, p):
+    """({(form, kinds): [(output, positions)]}, the outputs left alone): each expression
+    written with its symbols of q, q̇, p replaced by slots ``_s0, _s1, …`` (ordered by
+    kind, then by position: copies read theirs in the same order), grouped by that form
+    where GROUP_MIN or more share it."""
+    if len(exprs) < GROUP_MIN:
+        return {}, list(range(len(exprs)))
+    where = {s: (kind, i) for kind, symbols in enumerate((q, qd, p)) for i, s in enumerate(symbols)}
+    found = {}
+    for k, e in enumerate(exprs):
+        e = sp.sympify(e)
+        read = sorted((where[s] for s in e.free_symbols if s in where))
+        form = e.xreplace({s: _SLOTS[j] for j, s in enumerate(sorted((s for s in e.free_symbols if s in where),
+                                                                         key=where.__getitem__))})
+        found.setdefault((form, tuple(kind for kind, _ in read)), []).append((k, tuple(i for _, i in read)))
+    groups = {key: members for key, members in found.items() if len(members) >= GROUP_MIN}
+    alone = sorted(k for key, members in found.items() if key not in groups for k, _ in members)
+    return groups, alone
+
+
+class _Slots(dict):
+    def __missing__(self, j):
+        self[j] = sp.Symbol(f"_s{j}")
+        return self[j]
+
+
+_SLOTS = _Slots()
+_ARRAYS = ("q", "qd", "p")
+
+
+def _loop(g, form, kinds, members):
+    """(module-level index arrays, the loop's lines) for the group ``g`` of outputs of one form."""
+    arrays = f"_g{g}_out = np.array({[k for k, _ in members]}, dtype=np.int64)\n"
+    arrays += "".join(f"_g{g}_{j} = np.array({[at[j] for _, at in members]}, dtype=np.int64)\n"
+                      for j in range(len(kinds)))
+    reads = {_SLOTS[j]: f"{_ARRAYS[kind]}[_g{g}_{j}[_m]]" for j, kind in enumerate(kinds)}
+    body = assignments([form], reads, f"out[_g{g}_out[_m]]", "        ", prefix=f"_g{g}_")
+    return arrays, f"    for _m in range({len(members)}):\n{body}"
+
+
+def assignments(exprs, reads, target, indent, places=None, prefix=""):
     """Python lines (each after ``indent``) that compute ``exprs``: each symbol of ``reads``
     ({symbol: the expression it is read from}) the expressions use read once into a local,
     their common subexpressions (sympy ``cse``) computed once, then ``target.format(k) =``
-    the k-th expression. Symbols not in ``reads`` are printed by their names."""
-    local = {s: sp.Symbol(f"_a{i}") for i, s in enumerate(reads)}
+    the k-th expression (k the k-th of ``places`` where given). Symbols not in ``reads``
+    are printed by their names; the locals' names start with ``_a``/``_x`` and ``prefix``."""
+    local = {s: sp.Symbol(f"_a{prefix}{i}") for i, s in enumerate(reads)}
     renamed = [sp.sympify(e).xreplace(local) for e in exprs]
     used = set().union(*(e.free_symbols for e in renamed)) if renamed else set()
-    steps, results = sp.cse(renamed, symbols=sp.numbered_symbols("_x"), order="none")
+    steps, results = sp.cse(renamed, symbols=sp.numbered_symbols(f"_x{prefix}"), order="none")
     printer = PythonCodePrinter({"standard": "python3"})
+    places = range(len(results)) if places is None else places
     lines = [f"{local[s]} = {where}" for s, where in reads.items() if local[s] in used]
     lines += [f"{s} = {printer.doprint(e)}" for s, e in steps]
-    lines += [f"{target.format(k)} = {printer.doprint(e)}" for k, e in enumerate(results)]
+    lines += [f"{target.format(k)} = {printer.doprint(e)}" for k, e in zip(places, results)]
     return "\n".join(indent + line for line in lines)
 
 

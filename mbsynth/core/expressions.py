@@ -14,6 +14,8 @@ holds no number beyond the double range, no division by zero and nothing complex
 """
 
 import ast
+import functools
+import re
 
 import numpy as np
 import sympy as sp
@@ -61,6 +63,9 @@ def parse(text, symbols):
         raise ExpressionError(f"expression longer than {MAX_LENGTH} characters")
     if not text.strip():
         raise ExpressionError("empty expression")
+    found = _from_form(text.strip(), symbols)
+    if found is not None:
+        return found
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as err:
@@ -70,6 +75,47 @@ def parse(text, symbols):
         raise ExpressionError(f"malformed expression {_short(text)}: "
                               f"{'nested too deeply' if not isinstance(err, ValueError) else err}") from None
     return _check_value(_Translator(symbols, text.strip()).visit(tree.body), text)
+
+
+_NAME = re.compile(r"(?<![\w.])[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*")  # a name, dotted or not, not inside a number
+
+
+def _from_form(text, symbols):
+    """``parse(text, symbols)`` through the text's *form* (each name of ``symbols`` replaced
+    by a positional placeholder ``_v0, _v1, …``), parsed once per form and its placeholders
+    replaced by the symbols: copies of an expression that differ only in their names (a
+    cell used a thousand times) are parsed once. None where that could differ from parsing
+    the text itself: a name that is not a plain Symbol of ``symbols`` (a function, a
+    constant, an expression, an unknown name), or a form that does not parse (the text is
+    parsed then, for its own message)."""
+    names = []
+    for name in _NAME.findall(text):
+        if name not in names:
+            if name in FUNCTIONS or name in CONSTANTS:
+                if name in symbols:
+                    return None
+                continue
+            if name not in symbols or type(symbols[name]) is not sp.Symbol:
+                return None
+            names.append(name)
+    place = {name: f"_v{j}" for j, name in enumerate(names)}
+    form = _NAME.sub(lambda m: place.get(m.group(0), m.group(0)), text)
+    try:
+        expr = _parsed_form(form, len(names))
+    except (ValueError, SyntaxError, RecursionError, MemoryError):  # ExpressionError among them
+        return None
+    return expr.xreplace({_FORM_SLOTS[j]: symbols[name] for j, name in enumerate(names)}) if names else expr
+
+
+_FORM_SLOTS = [sp.Symbol(f"\0v{j}") for j in range(64)]  # names no model symbol has
+
+
+@functools.lru_cache(maxsize=4096)
+def _parsed_form(form, count):
+    if count > len(_FORM_SLOTS):
+        _FORM_SLOTS.extend(sp.Symbol(f"\0v{j}") for j in range(len(_FORM_SLOTS), count))
+    slots = {f"_v{j}": _FORM_SLOTS[j] for j in range(count)}
+    return _check_value(_Translator(slots, form).visit(ast.parse(form, mode="eval").body), form)
 
 
 def _check_value(expr, text):

@@ -91,6 +91,7 @@ class _Builder:
         self.children = []  # (entry name, [child builders]) of the file's ``type: model`` entries
         self.chain = include.chain if include else ()  # (file, line) of the entries that include this file
         self.bound = {}  # the extra_names in effect: {name: value}
+        self.values = {}  # expression of parameters -> its value, each found once (``constant``)
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
@@ -168,15 +169,19 @@ class _Builder:
     def constant(self, text, path):
         """An expression of parameters only (a mass, a length), checked finite and real."""
         expr = self.expression(text, path, self.param_symbols)
-        if _real(expr, self.param_values) is None:
+        value = _real(expr, self.param_values)
+        if value is None:
             self.fail(path, f"{text!r} is not a finite real number")
+        self.values[expr] = value
         return expr
 
     def value(self, expr):
         """The float value of an expression of parameters."""
         if isinstance(expr, (int, float)):
             return float(expr)
-        return float(_at(sp.sympify(expr), self.param_values))
+        expr = sp.sympify(expr)
+        found = self.values.get(expr)
+        return float(_at(expr, self.param_values)) if found is None else found
 
     def fixed_value(self, expr, path):
         """``value(expr)`` for something built once at load (an FE model): its parameters
@@ -470,6 +475,7 @@ class _Builder:
             self.fail(("constraints",), f"expected a list of constraints, got {_kind(node)}")
         kinds = ("holonomic", "nonholonomic", "acceleration")
         constraints, names = [], set()
+        coordinates, velocities = set(self.q), set(self.qd)
         for i, spec in enumerate(node):
             path = ("constraints", i)
             spec = self.section(spec, path, "constraint")
@@ -493,8 +499,8 @@ class _Builder:
                 continue
             expr = self.expression(spec[kind], kpath, self.constraint_symbols)
             self.differentiable(expr, kpath, None if kind == "holonomic" else ())
-            has_q = expr.free_symbols & set(self.q) or joint_values_in(expr)
-            has_qd = expr.free_symbols & set(self.qd)
+            has_q = expr.free_symbols & coordinates or joint_values_in(expr)
+            has_qd = expr.free_symbols & velocities
             if kind == "holonomic" and has_qd:
                 self.fail(kpath, f"constraint '{name}' uses velocities {sorted(map(str, has_qd))}; "
                                  "write it as 'nonholonomic:'")
@@ -695,17 +701,18 @@ def _real(expr, values):
     """The float value of ``expr`` at the parameter ``values``, or None when that is not a
     finite real number."""
     try:
-        value = complex(_at(expr, values).evalf())
+        value = _at(expr, values)
+        value = complex(value if value.is_Number else value.evalf())
     except (TypeError, ValueError, OverflowError):  # a value sympy cannot make a number
         return None
     return value.real if value.imag == 0 and np.isfinite(value.real) else None
 
 
 def _at(expr, values):
-    """``expr`` with its parameters replaced by their ``values`` (only those it holds: a
-    model of many substructures has thousands)."""
-    symbols = expr.free_symbols
-    return expr.subs({s: values[s] for s in symbols if s in values}) if symbols else expr
+    """``expr`` with the ``values`` ({symbol: number}) of its own symbols put in, as
+    floats: a replacement of those alone, not a substitution of a model's thousands of
+    parameters."""
+    return expr.xreplace({s: sp.Float(values[s]) for s in expr.free_symbols if s in values})
 
 
 def _kind(value):

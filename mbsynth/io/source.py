@@ -10,12 +10,14 @@ alias is expanded (a "billion laughs" file: each alias repeats its anchor), and 
 that cannot be read (an integer of thousands of digits, a date that does not exist).
 """
 
+import re
 from pathlib import Path
 
 import yaml
 
 from ..core.errors import ModelError
 
+LINE_BREAK = re.compile("\r\n|[\r\n\x85\u2028\u2029]")  # YAML's line breaks
 MAX_DEPTH = 64  # levels of nested mappings and lists
 MAX_NODES = 100_000  # nodes of a document with every alias expanded
 
@@ -39,8 +41,21 @@ class LineList(list):
     __hash__ = object.__hash__
 
 
-class _Loader(yaml.SafeLoader):
-    """SafeLoader that bounds the nesting depth and the expanded size of a document."""
+try:  # libyaml's scanner and parser (C) under PyYAML's composer and safe constructor: the same
+    from yaml.cyaml import CParser  # documents, events and marks, the events several times faster
+
+    class _Base(yaml.composer.Composer, CParser, yaml.constructor.SafeConstructor, yaml.resolver.Resolver):
+        def __init__(self, text):
+            CParser.__init__(self, text)
+            yaml.constructor.SafeConstructor.__init__(self)
+            yaml.resolver.Resolver.__init__(self)
+            yaml.composer.Composer.__init__(self)
+except ImportError:  # PyYAML built without libyaml
+    _Base = yaml.SafeLoader
+
+
+class _Loader(_Base):
+    """A safe loader that bounds the nesting depth and the expanded size of a document."""
 
     def __init__(self, text, name):
         super().__init__(text)
@@ -127,12 +142,15 @@ class Document:
             loader = _Loader(text, self.name)
             root = loader.get_single_data()
         except yaml.reader.ReaderError as err:
-            line = text.count("\n", 0, err.position) + 1
+            line = min(text.count("\n", 0, err.position) + 1, len(LINE_BREAK.findall(text)) + 1)
             raise ModelError(f"{self.name}:{line}: not valid YAML: character U+{err.character:04X} is not "
                              "allowed in a model file (binary data?)") from None
         except yaml.MarkedYAMLError as err:
             mark = err.problem_mark or err.context_mark
-            line = f":{mark.line + 1}" if mark else ""
+            line = f":{min(mark.line + 1, len(LINE_BREAK.findall(text)) + 1)}" if mark else ""  # libyaml marks the
+            # end of a stream that ends in a line break on the line after it
+            if "maximum nesting depth" in str(err.problem):  # libyaml's own bound, met before MAX_DEPTH is counted
+                raise ModelError(f"{self.name}{line}: nested more than {MAX_DEPTH} levels deep") from None
             raise ModelError(f"{self.name}{line}: not valid YAML: {err.problem or err.context}") from None
         except yaml.YAMLError as err:
             raise ModelError(f"{self.name}: not valid YAML: {err}") from None

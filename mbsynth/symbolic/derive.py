@@ -22,6 +22,7 @@ import sympy as sp
 from .cache import Unstable, fingerprint, placeholder, remembered, remembered_function
 
 T_SYMBOL = sp.Symbol("t")
+PARAMETERS = 3  # the position of the model's parameters among a part's or connector's arguments (t, q, q̇, p)
 _LARGEST = sp.Float(np.finfo(float).max)
 # pi and e as numpy floats, so that all arithmetic of a compiled expression is numpy's:
 # Python floats raise on overflow and division by zero ((2*pi + 1e308)**251, 1/(1 - t) at
@@ -38,8 +39,50 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
 
     Expanding d/dt ∂T/∂q̇ = (∂²T/∂q̇²) q̈ + (∂²T/∂q̇∂q) q̇ + ∂²T/∂q̇∂t gives
     M = ∂²T/∂q̇², Q = F + ∂T/∂q − ∂V/∂q − (∂²T/∂q̇∂q) q̇ − ∂²T/∂q̇∂t.
-    Each entry is simplified when it is small (``tidy``). Kept on disk (cache.py).
-    """
+    Each entry is simplified when it is small (``tidy``). Derived once per structure
+    (``energy_template``)."""
+    found = energy_template(T, V, F, q, qd, t)
+    if found is None:  # symbols no slot can stand for
+        return tuple(map(sp.Matrix, _lagrange(sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F),
+                                              tuple(q), tuple(qd), t)))
+    (q_slots, qd_slots), constants, (M, Q, _, _, _) = found
+    back = dict(zip(q_slots, q))
+    back.update(zip(qd_slots, qd))
+    back.update(constants)
+    return sp.Matrix(M.xreplace(back)), sp.Matrix(Q.xreplace(back))
+
+
+def energy_template(T, V, F, q, qd, t=T_SYMBOL):
+    """((q slots, q̇ slots), constants, (M, Q, T, V, F)): ``lagrange``'s M and Q, and T, V
+    and the forces F, written in placeholder slots for the coordinates q, the velocities
+    q̇ and the other symbols (parameters; ``constants``: (slot, symbol) pairs, by name).
+    Copies of a part that differ only in the names of their symbols (a cell used a
+    thousand times, each copy with parameters of its own) get the same template, derived
+    and compiled once. None where a symbol is no plain Symbol (``_plain``)."""
+    T, V, F = sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F)
+    q, qd = tuple(q), tuple(qd)
+    others = sorted(symbols_in((T, V, *F)) - set(q) - set(qd) - {t}, key=str)
+    symbols = q + qd + tuple(others)
+    if len(set(symbols)) < len(symbols) or not all(_plain(s) for s in symbols):
+        return None
+    slots = tuple(_ENERGY[i] for i in range(len(symbols)))
+    forward = dict(zip(symbols, slots))
+    T, V, F = T.xreplace(forward), V.xreplace(forward), tuple(f.xreplace(forward) for f in F)
+    q_slots, qd_slots = slots[:len(q)], slots[len(q):2 * len(q)]
+    M, Q = _lagrange(T, V, F, q_slots, qd_slots, t)
+    return (q_slots, qd_slots), tuple(zip(slots[2 * len(q):], others)), (M, Q, T, V, F)
+
+
+def _plain(symbol):
+    """Whether a slot (a symbol without assumptions, equal in every process) can stand for
+    ``symbol`` in a derivation: a plain Symbol (a Dummy or an assumption such as positive
+    would change what sympy simplifies)."""
+    return type(symbol) is sp.Symbol and symbol.assumptions0 == _PLAIN
+
+
+@functools.lru_cache(maxsize=1024)
+def _lagrange(T, V, F, q, qd, t):
+    """``lagrange`` of these T, V, F in these q, q̇: once per process, and kept on disk (cache.py)."""
     def derive():
         qs, qds = sp.Matrix(q), sp.Matrix(qd)
         p = sp.Matrix([T]).jacobian(qds).T  # generalized momenta ∂T/∂q̇
@@ -48,8 +91,8 @@ def lagrange(T, V, F, q, qd, t=T_SYMBOL):
              - p.jacobian(qs) * qds - p.diff(t))
         return M.applyfunc(tidy), Q.applyfunc(tidy)
 
-    inputs = (sp.sympify(T), sp.sympify(V), tuple(sp.sympify(f) for f in F), tuple(q), tuple(qd), t)
-    return remembered("lagrange", inputs, derive)
+    M, Q = remembered("lagrange", (T, V, F, q, qd, t), derive)
+    return sp.ImmutableMatrix(M), sp.ImmutableMatrix(Q)
 
 
 def tidy(expr, max_ops=SIMPLIFY_MAX_OPS):
@@ -147,6 +190,9 @@ class Slots:
 
 
 _ARGUMENT, _RATE, _NUMBER = Slots("a"), Slots("r"), Slots("k")
+_ENERGY = Slots("e")  # the symbols of a part's energies (``lagrange``)
+_PLAIN = sp.Symbol("x").assumptions0
+_PICKED = Slots("p")  # the parameters a compiled function reads from its whole parameter argument
 
 
 def _numbers(expr, found):
@@ -176,20 +222,18 @@ def canonical(exprs, symbols):
 
 def differentiated(exprs, q, qd, t=T_SYMBOL):
     """(A rows (sparse, len(exprs) × len(q)), b, velocity-level forms) of the
-    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure."""
+    constraints ``exprs`` = 0 (``differentiate`` each), derived once per structure: the
+    coordinates, velocities and parameters involved become placeholder slots (``canonical``)."""
     exprs = [sp.sympify(e) for e in exprs]
     if any(joint_values_in(e) for e in exprs):  # the chain rule through joint rates (JointValue)
         rows = [differentiate(e, q, qd, t) for e in exprs]
         entries = {(r, j): expand_joint_values(x) for r, row in enumerate(rows) for j, x in enumerate(row[0]) if x != 0}
         return (sp.SparseMatrix(len(exprs), len(q), entries), [expand_joint_values(row[1]) for row in rows],
                 [expand_joint_values(row[2]) for row in rows])
-    where = positions(q, qd)
-    involved = sorted({where[s] for e in exprs for s in e.free_symbols if s in where})
-    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved])
-    a, b, psi = _differentiated(forms, len(involved), t)
-    back = {_ARGUMENT[j]: q[i] for j, i in enumerate(involved)}
-    back.update({_ARGUMENT[len(involved) + j]: qd[i] for j, i in enumerate(involved)})
-    back.update({_NUMBER[j]: x for j, x in enumerate(numbers)})
+    (a, b, psi), _, slots, involved, constants = differentiated_template(exprs, q, qd, t)
+    back = dict(constants)
+    back.update(zip(slots[0], (q[i] for i in involved)))
+    back.update(zip(slots[1], (qd[i] for i in involved)))
     entries = {}
     for r, row in enumerate(a):
         for j, entry in enumerate(row):
@@ -197,6 +241,24 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
                 entries[r, involved[j]] = entry.xreplace(back)
     return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
             [x.xreplace(back) for x in psi])
+
+
+def differentiated_template(exprs, q, qd, t=T_SYMBOL):
+    """((a rows over the involved coordinates, b, ψ), φ, (q slots, q̇ slots), the involved
+    coordinates (indices), constants) of the constraints ``exprs`` = 0 (none may hold a
+    JointValue), all in placeholder slots (``canonical``): the coordinates and velocities
+    involved, the parameters (constants: (slot, symbol)) and the numbers (constants:
+    (slot, number)). Constraints alike but for their symbols and numbers share it."""
+    where = positions(q, qd)
+    free = set().union(*(e.free_symbols for e in exprs))
+    involved = sorted({where[s] for s in free if s in where})
+    others = sorted((s for s in free if s not in where and s != t and _plain(s)), key=str)  # parameters
+    count = len(involved)
+    forms, numbers = canonical(exprs, [q[i] for i in involved] + [qd[i] for i in involved] + others)
+    constants = tuple(zip((_ARGUMENT[2 * count + j] for j in range(len(others))), others))
+    constants += tuple((_NUMBER[j], x) for j, x in enumerate(numbers))
+    slots = tuple(_ARGUMENT[j] for j in range(count)), tuple(_ARGUMENT[count + j] for j in range(count))
+    return _differentiated(forms, count, t), forms, slots, involved, constants
 
 
 def placed_values(slots, coordinates, constants, q, qd):
@@ -269,7 +331,7 @@ def symbols_in(exprs):
     return found
 
 
-def compile_function(args, exprs, constants=(), dtype=float):
+def compile_function(args, exprs, constants=(), dtype=float, picked=None):
     """A numpy function of ``args`` returning a tuple of float arrays, one per entry of
     ``exprs`` (scalars, vectors or matrices), with common subexpressions shared.
     ``dtype=complex`` keeps complex arguments complex (complex-step derivatives,
@@ -277,7 +339,14 @@ def compile_function(args, exprs, constants=(), dtype=float):
 
     ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
     values (numbers or expressions of ``args``) are put in at each evaluation, so that
-    expressions shared by many instances (connectors.joints) are compiled once."""
+    expressions shared by many instances (connectors.joints) are compiled once.
+
+    ``picked``: the position in ``args`` of a list of symbols (the model's parameters) that
+    the function is given whole and of which ``exprs`` read a few: those few become
+    constants picked from it at each evaluation (``_picking``), so that what is compiled is
+    the same however long the list and wherever in it they stand — copies of a part, each
+    with parameters of its own, share one compiled function, and a model of thousands of
+    parameters compiles no function of thousands of arguments."""
     shapes = [e.shape if isinstance(e, sp.MatrixBase) else () for e in exprs]
     flat = [x if isinstance(x, sp.Basic) else sp.sympify(x)
             for e in exprs for x in (e.flat() if isinstance(e, sp.MatrixBase) else [e])]
@@ -285,10 +354,46 @@ def compile_function(args, exprs, constants=(), dtype=float):
         def empty(*_):
             return tuple(np.zeros(s) for s in shapes)
         return empty
+    given, picks = args, ()
+    if picked is not None:
+        args, flat, constants, picks = _picking(args, picked, flat, constants)
     frozen = _frozen(args)
     raw, numbers = _compiled(frozen, tuple(flat), tuple(c[0] for c in constants))
     fixed = np.array([_as_double(x) for x in numbers], dtype=float)
-    return Compiled(raw, _values(frozen, tuple(sp.sympify(c[1]) for c in constants)), fixed, shapes, dtype)
+    values = tuple(sp.sympify(c[1]) for c in constants)
+    if picked is not None and not all(v.is_Number or v in _positions_in(frozen, picks) for v in values):
+        frozen, picks = _frozen(given), ()  # constants of more than numbers and picks: over the whole list
+    return Compiled(raw, _values(frozen, values, picks), fixed, shapes, dtype)
+
+
+_WHOLE = placeholder("whole")  # a compiled function's argument ``picked``, read only through constants
+
+
+def _picking(args, position, flat, constants):
+    """(``args`` with the list at ``position`` replaced by one symbol, ``_WHOLE``; ``flat``
+    with the symbols of that list it reads replaced by placeholders; ``constants`` with
+    (placeholder, symbol) pairs added for them, in the list's order; and where each symbol
+    of the list that a constant stands for is: (symbol, (position, index in the list)))."""
+    index = _index_of(args[position])
+    used = sorted((s for s in symbols_in(flat) if s in index), key=index.__getitem__)
+    forward = {s: _PICKED[i] for i, s in enumerate(used)}
+    constants = tuple(constants) + tuple((slot, s) for s, slot in forward.items())
+    return (tuple(args[:position]) + (_WHOLE,) + tuple(args[position + 1:]),
+            [x.xreplace(forward) for x in flat] if forward else flat, constants,
+            tuple((v, (position, index[v])) for _, v in constants if v in index))
+
+
+_last_index = ((), {})
+
+
+def _index_of(symbols):
+    """{symbol: its position in ``symbols``}, kept for the last list asked (every part and
+    connector of a model asks for its parameters)."""
+    global _last_index
+    symbols, found = tuple(symbols), _last_index  # one read: another thread may replace it
+    if found[0] != symbols:  # tuples of the same symbols compare by identity first: fast
+        found = _last_index = (symbols, {s: i for i, s in enumerate(symbols)})
+    return found[1]
 
 
 class Compiled:
@@ -322,7 +427,7 @@ def _compiled(args, flat, placeholders):
         derived.append(canonical(flat, symbols))
         forms, numbers = derived[0]
         try:
-            return fingerprint((slots, len(numbers), forms)), numbers
+            return _structure_digest((slots, len(numbers), forms)), numbers
         except Unstable:  # a Dummy in the forms: a structure of this process alone
             return None, numbers
 
@@ -334,6 +439,13 @@ def _compiled(args, flat, placeholders):
         return slots + (tuple(_NUMBER[i] for i in range(len(numbers))),), forms
 
     return _lambdified(digest, structure), numbers
+
+
+@functools.lru_cache(maxsize=4096)
+def _structure_digest(structure):
+    """``fingerprint`` of a structure (argument slots, count of numbers, canonical forms):
+    once per structure in a process, however many instances have it."""
+    return fingerprint(structure)
 
 
 _by_structure = {}  # structure digest -> its numpy function, one per structure in this process
@@ -354,8 +466,18 @@ def _lambdified(digest, structure):
             raw = derive()
         else:
             raw = _by_structure[digest] = remembered_function("lambdified", digest, derive)
-        raw.structure = structure  # for compiled/structures.py, which compiles it with numba
+        raw.structure = _kernel_view(structure)  # for compiled/structures.py, which compiles it with numba
     return raw
+
+
+def _kernel_view(structure):
+    """``structure`` as compiled/structures.py reads it: (t, then a tuple of slots per
+    argument): an argument given whole (``compile_function``'s ``picked``, one slot) is
+    read only through constants, no slots of its own."""
+    def view():
+        args, forms = structure()
+        return tuple(() if i and not isinstance(a, tuple) else a for i, a in enumerate(args)), forms
+    return view
 
 
 def _stable_record(record):
@@ -364,13 +486,21 @@ def _stable_record(record):
     return record
 
 
-@functools.lru_cache(maxsize=4096)
-def _values(args, values):
-    """A function of ``args`` giving the array of ``values``: gathered from numbers and picks
-    (k, argument a, position i or None) of the arguments where that is all they are, else
-    lambdified."""
+def _positions_in(args, picks=()):
+    """{symbol: (argument a, position i or None)} of the symbols of ``args`` (nested one
+    deep) and of ``picks`` ((symbol, (a, i)) pairs)."""
     where = {s: (a, None) for a, s in enumerate(args) if isinstance(s, sp.Symbol)}
     where.update({s: (a, i) for a, group in enumerate(args) if isinstance(group, tuple) for i, s in enumerate(group)})
+    where.update(picks)
+    return where
+
+
+@functools.lru_cache(maxsize=4096)
+def _values(args, values, picks=()):
+    """A function of ``args`` giving the array of ``values``: gathered from numbers and picks
+    (k, argument a, position i or None) of the arguments (``picks``: where symbols read from
+    an argument given whole stand) where that is all they are, else lambdified."""
+    where = _positions_in(args, picks)
     if all(v.is_Number or v in where for v in values):  # numbers, and arguments (a joint's effort τ)
         fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
         picks = tuple((k, *where[v]) for k, v in enumerate(values) if not v.is_Number)

@@ -5,8 +5,8 @@ import functools
 import numpy as np
 import sympy as sp
 
-from ...symbolic.derive import (T_SYMBOL, compile_function, differentiated, expand_joint_values, placed_values,
-    positions, symbols_in)
+from ...symbolic.derive import (PARAMETERS, T_SYMBOL, compile_function, differentiated, differentiated_template,
+    expand_joint_values, joint_values_in, placed_values, positions, symbols_in)
 
 
 class Connector:
@@ -38,7 +38,7 @@ class Connector:
         self._rows = compile_function(
             (T_SYMBOL, [q[i] for i in local], [qd[i] for i in local], list(params)),
             [a.extract(list(range(k)), local), self.b, self.C.extract(local, [0]),
-             zeros if self.phi is None else self.phi, zeros if self.psi is None else self.psi])
+             zeros if self.phi is None else self.phi, zeros if self.psi is None else self.psi], picked=PARAMETERS)
 
     def _name_rows(self, name, kind, k, row_labels):
         self.name, self.kind = name, kind
@@ -64,7 +64,7 @@ class Connector:
         self._zero_C = sp.SparseMatrix(len(q), 1, {})
         self._rows = compile_function(
             (T_SYMBOL, [q_slots[j] for j in local], [qd_slots[j] for j in local], list(params)),
-            _placed_rows(rows, tuple(local)), constants=constants)
+            _placed_rows(rows, tuple(local)), constants=constants, picked=PARAMETERS)
 
     @classmethod
     def placed(cls, name, kind, rows, slots, coordinates, q, qd, params, constants=(), row_labels=None):
@@ -98,6 +98,11 @@ class Connector:
 
     @classmethod
     def holonomic(cls, name, phis, q, qd, params, C=None, row_labels=None):
+        phis = [sp.sympify(phi) for phi in phis]
+        if C is None and not any(joint_values_in(phi) for phi in phis):  # rows shared with constraints alike
+            (a, b, psi), forms, slots, involved, constants = differentiated_template(phis, q, qd)
+            return cls.placed(name, "holonomic", (a, b, forms, psi), slots, involved, q, qd, params, constants,
+                              row_labels)
         a, b, psi = differentiated(phis, q, qd)
         phis = [expand_joint_values(phi) for phi in phis]
         return cls(name, "holonomic", a, b, _vector(C, len(q)), phis, psi, q, qd, params, row_labels)

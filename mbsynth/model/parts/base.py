@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
-from ...symbolic.derive import T_SYMBOL, compile_function, placed_values
+from ...symbolic.derive import PARAMETERS, T_SYMBOL, compile_function, placed_values
 
 LINK_FRAME = "link"  # the frame a robot link's body carries at the URDF link frame (robots/build.py)
 
@@ -71,8 +71,8 @@ class Part:
         self._symbolic = None if shared else template
         self._shared = shared and (template, (q_slots, qd_slots), constants)
         args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
-        self._evaluate = compile_function(args, template[:2], constants)
-        self._energy = compile_function(args, template[2:], constants)
+        self._evaluate = compile_function(args, template[:2], constants, picked=PARAMETERS)
+        self._energy = compile_function(args, template[2:], constants, picked=PARAMETERS)
         self._power, self._power_args = None, (args, constants)  # compiled when first asked (``power``)
         self._reads = None  # the symbols M and Q are written in (``reads``), once asked
 
@@ -120,7 +120,11 @@ class Part:
         its own coordinates q, velocities qd: what they add to d(T + V)/dt."""
         if self._power is None:
             args, constants = self._power_args
-            self._power = compile_function(args, [self.power_expression], constants)
+            expression = self.power_expression
+            if self._shared:  # in the template's coordinate slots
+                q_slots, qd_slots = self._shared[1]
+                expression = sp.sympify(expression).xreplace({**dict(zip(self.q, q_slots)), **dict(zip(self.qd, qd_slots))})
+            self._power = compile_function(args, [expression], constants, picked=PARAMETERS)
         return float(self._power(t, q, qd, p)[0])
 
     def symbolic(self):

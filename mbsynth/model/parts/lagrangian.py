@@ -2,12 +2,14 @@
 
 import sympy as sp
 
-from ...symbolic.derive import lagrange
+from ...symbolic.derive import energy_template, lagrange
 from .base import Part
 
 
 class LagrangianPart(Part):
-    """Unconstrained M q̈ = Q (2.1) of a part from Lagrange's equations.
+    """Unconstrained M q̈ = Q (2.1) of a part from Lagrange's equations, derived and
+    compiled once for all parts whose energies differ only in the names of their symbols
+    (``symbolic.energy_template``).
 
     ``q`` and ``qd`` are this part's coordinate and velocity symbols, ``T``, ``V``
     and ``forces`` (one expression per coordinate) sympy expressions of them,
@@ -20,9 +22,15 @@ class LagrangianPart(Part):
     def __init__(self, name, coordinates, q, qd, T, V, forces, params, frames=(), geometry=()):
         self.forces = tuple(sp.sympify(f) for f in forces)  # generalized forces beyond V (they may do work)
         self.power_expression = sum((v * f for v, f in zip(qd, self.forces)), sp.S.Zero)
-        M, Q = lagrange(T, V, list(forces), q, qd)
+        template = energy_template(T, V, self.forces, q, qd)
+        if template is None:  # symbols no slot stands for: derived for this part alone
+            M, Q = lagrange(T, V, self.forces, q, qd)
+            super().__init__(name, coordinates, q, qd, M, Q, T, V, params, frames, geometry)
+        else:  # derived and compiled once for all parts alike, its own symbols put in when asked
+            slots, constants, (M, Q, T, V, _) = template
+            super().__init__(name, coordinates, q, qd, M, Q, T, V, params, frames, geometry,
+                             shared=(*slots, constants))
         self.groups = same_units(coordinates, M)
-        super().__init__(name, coordinates, q, qd, M, Q, T, V, params, frames, geometry)
 
     def pose(self, frame):
         return frame.position, frame.rotation
