@@ -74,6 +74,7 @@ class Assembly:
         self.documents = {}  # resolved path -> Document: a file used N times is read once
         self.q, self.qd = [], []
         self.index = {}  # coordinate symbol -> its place in q
+        self.known = {}  # expression of parameters -> its value (every file's builder finds each once)
         self.global_symbols = None
         self.constraint_symbols = None
 
@@ -91,7 +92,7 @@ class _Builder:
         self.children = []  # (entry name, [child builders]) of the file's ``type: model`` entries
         self.chain = include.chain if include else ()  # (file, line) of the entries that include this file
         self.bound = {}  # the extra_names in effect: {name: value}
-        self.values = {}  # expression of parameters -> its value, each found once (``constant``)
+        self.values = assembly.known  # expression of parameters -> its value, each found once (``checked``)
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
@@ -168,7 +169,13 @@ class _Builder:
 
     def constant(self, text, path):
         """An expression of parameters only (a mass, a length), checked finite and real."""
-        expr = self.expression(text, path, self.param_symbols)
+        return self.checked(self.expression(text, path, self.param_symbols), text, path)
+
+    def checked(self, expr, text, path):
+        """``expr`` (read from ``text`` at ``path``), checked to have a finite real value,
+        which ``value`` then finds again without computing it."""
+        if expr in self.values:
+            return expr
         value = _real(expr, self.param_values)
         if value is None:
             self.fail(path, f"{text!r} is not a finite real number")
@@ -278,6 +285,7 @@ class _Builder:
                 model.global_symbols[f"{part.name}.{c}_dot"] = qds
         model.constraint_symbols = Names(model.global_symbols)  # joint angles as JointValue symbols (symbolic.py)
         model.index = {s: i for i, s in enumerate(model.q)}
+        model.coordinate_set, model.velocity_set = set(model.q), set(model.qd)
         for builder in self.builders:
             builder.scope_names(parts)
         args = (model.q, model.qd, model.parameter_symbols)
@@ -326,7 +334,8 @@ class _Builder:
     def add_parameter(self, name, expr, path):
         """Parameter ``name`` (full name) = ``expr`` (an expression of earlier ones, in full
         names); ``path``: where the file gives it (None: no line to name)."""
-        value = _real(expr, self.assembly.values)
+        value = self.values.get(expr)
+        value = _real(expr, self.assembly.values) if value is None else value
         if value is None:
             given = self.assembly.overrides.get(name, expr)
             message = f"parameter '{name}' = {given!r} is not a finite real number"
@@ -475,7 +484,7 @@ class _Builder:
             self.fail(("constraints",), f"expected a list of constraints, got {_kind(node)}")
         kinds = ("holonomic", "nonholonomic", "acceleration")
         constraints, names = [], set()
-        coordinates, velocities = set(self.q), set(self.qd)
+        coordinates, velocities = self.assembly.coordinate_set, self.assembly.velocity_set
         for i, spec in enumerate(node):
             path = ("constraints", i)
             spec = self.section(spec, path, "constraint")

@@ -44,6 +44,8 @@ class Placement:
 
     def then(self, inner):
         """The transform x ↦ self(inner(x))."""
+        if inner.identity or self.identity:
+            return self if inner.identity else inner
         return Placement(self.R @ inner.R, _rotated(self.R, inner.t) + self.t)
 
     def frame(self, position, rotation):

@@ -31,10 +31,12 @@ from pathlib import Path
 import sympy as sp
 
 from ..core.errors import ModelError
+from ..symbolic.cache import placeholder
 from .parts import read_rotation
 from .placement import Placement
 from .source import read_document
 
+INDEX = placeholder("index")  # a copy's number in its entry's parameters, read once for all copies
 COUNT_MAX = 100_000  # copies of one entry: a bound on a mistaken count, far above any machine's parts
 
 
@@ -73,11 +75,15 @@ def _read_entry(builder, name, spec, path):
     count = _count(builder, spec, path)
     line = builder.doc.line_of(path)
     children = []
+    with builder.extra_names({"index": INDEX} if count is not None else {}):  # read once, for every copy
+        forms = {key: builder.expression(text, path + ("parameters", key), builder.param_symbols)
+                 for key, text in given.items()}
     for index in range(count if count is not None else 1):
         local = f"{name}[{index}]" if count is not None else name
         names = {"index": sp.Integer(index)} if count is not None else {}
         with builder.extra_names(names):
-            parameters = {key: builder.constant(text, path + ("parameters", key)) for key, text in given.items()}
+            parameters = {key: builder.checked(form.xreplace({INDEX: sp.Integer(index)}), given[key],
+                                               path + ("parameters", key)) for key, form in forms.items()}
             relative = _placement(builder, spec.get("placement"), path + ("placement",))
         include = Include(builder.prefix + local + ".", relative, builder.placement.then(relative), parameters,
                           builder, path, builder.chain + ((builder.doc.name, line),))
