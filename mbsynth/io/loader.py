@@ -176,7 +176,7 @@ class _Builder:
         which ``value`` then finds again without computing it."""
         if expr in self.values:
             return expr
-        value = _real(expr, self.param_values)
+        value = float(expr) if expr.is_Number else _real(expr, self.param_values)
         if value is None:
             self.fail(path, f"{text!r} is not a finite real number")
         self.values[expr] = value

@@ -28,14 +28,8 @@ class Placement:
     def __init__(self, R=None, t=None):
         self.R = np.eye(3) if R is None else np.asarray(R, dtype=float)
         self.t = sp.zeros(3, 1) if t is None else sp.Matrix(t)
-
-    @property
-    def identity(self):
-        return np.array_equal(self.R, np.eye(3)) and all(x == 0 for x in self.t)
-
-    @property
-    def turns(self):
-        return not np.array_equal(self.R, np.eye(3))
+        self.turns = not np.array_equal(self.R, np.eye(3))
+        self.identity = not self.turns and all(x == 0 for x in self.t)
 
     @property
     def tilts(self):
