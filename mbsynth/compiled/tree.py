@@ -20,9 +20,12 @@ free accelerations), and eliminating from the leaves to the roots causes no fill
 
 A block alone may be singular (a massless body, a rank-3 inertia); S_iᵀ H^A_i S_i is
 positive definite exactly when the subtree is determinate. A pivot of its Cholesky
-factor below ``PIVOT_RTOL`` of ‖H^A_i‖ ‖s‖², or joint rows that are dependent to that
-tolerance, make ``factor`` report the node: the caller then hands the problem to the
-exact treatment. ``solve`` returns the λ_i too (λ_i = Jr_iᵀ (f^A_i − H^A_i y_i)).
+factor below ``PIVOT_RTOL`` of max(‖H^A_i‖, 1) ‖s‖² — H is divided by the model's largest
+mass (kernel.py), so 1 is the whole model's scale, as in the rank rule of (2.14) — or
+joint rows that are dependent to that tolerance, make ``factor`` report the node: the
+caller then hands the problem to the exact treatment, whose rank rule decides a block
+that is small against the model (a nearly massless link) as it decides any other.
+``solve`` returns the λ_i too (λ_i = Jr_iᵀ (f^A_i − H^A_i y_i)).
 
 The per-node steps are inlined helpers called with constant sizes for a rigid body on a
 revolute (v = 6, k = 5) or a fixed joint (6, 6) and with the node's sizes otherwise: numba
@@ -304,6 +307,7 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
             for c in range(vi):
                 t += Ha[a, c] * Si[c, e]
             Ui[a, e] = t
+    top = max(top, 1.0)  # H is divided by the model's largest mass: a pivot is judged against the model too
     for e in range(m):
         norm = 0.0
         for a in range(vi):

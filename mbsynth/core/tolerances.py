@@ -17,7 +17,8 @@ VERDICT_MARGIN = 1e2  # a singular value within this factor of the rank cut-off 
 # (a mass ratio of 1e-9, 1e3 times the cut-off, is a legitimate model and is not flagged)
 
 # ---- the compiled path (compiled/)
-PIVOT_RTOL = 1e-9  # tree.py: a pivot below this fraction of its scale counts as zero
+PIVOT_RTOL = 1e-9  # tree.py: a pivot below this fraction of its scale (for a mass: its node's or the model's
+# largest, whichever is larger) counts as zero; three decades above RANK_RTOL, so a link near (2.14)'s cut goes there
 SCHUR_ZERO_RTOL = 1e-10  # kernel.py: Schur eigenvalues below this fraction of max(the largest, 1) are zero
 KERNEL_CONSISTENCY_RTOL = 1e-10  # kernel.py: largest part of the right side along dropped directions,
 # relative to b's (tighter than CONSISTENCY_RTOL: the kernel hands a doubtful state to the exact path)

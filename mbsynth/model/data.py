@@ -9,11 +9,10 @@ in a Data made from it:
 - the Evaluator of the connectors and parts (evaluation.py, the KKT path's arrays);
 - the compiled Engine (mbsynth.compiled) at those values, or None: the path ``motion`` takes.
 
-``system.data()`` is a run's Data: its path is fixed when it is made — the compiled
-Engine when the kernels are compiled (in this process or on disk; its Template is waited
-for), else the KKT path throughout — so a run's result never depends on when a background
-compilation finishes. The Data behind a System's own methods (``System.motion``, …) is
-made with ``fixed=False``: it takes the compiled Engine as soon as it is ready.
+A Data's path is fixed when it is made — the compiled Engine when the kernels are compiled
+(in this process or on disk; its Template is waited for), else the KKT path throughout —
+so a result never depends on when a background compilation finishes: ``system.data()``
+(a run's) and the Data behind a System's own methods (``System.motion``, …) alike.
 
 A Data reads as its System for the model's description (coordinates, parts, names,
 ``initial_state``): an algorithm written for a System takes a Data as well, and computes
@@ -35,6 +34,7 @@ from . import friction, reactions
 from .evaluation import Evaluator
 from .joint_values import JointValuesBatch
 
+UNSET = object()  # a Data's engine before its first use
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
 
 
@@ -52,7 +52,7 @@ class Assembly:
 class Shared:
     """What the Systems of one structure (the same parts, connectors and forces; any
     parameter values) share: the compiled Template's slot and the Evaluators made for them,
-    one per kernel setting ("wait", "never": a run's; "when ready": a System's own)."""
+    one per kernel setting ("wait" or "never": ``Data``)."""
 
     def __init__(self, system):
         self.structure = _structure(system)
@@ -69,9 +69,7 @@ class Shared:
     def evaluator(self, system, kernels):
         found = self.evaluators.get(kernels)
         if found is None:
-            found = Evaluator(system)
-            if kernels != "when ready":
-                found.fix_kernels(kernels == "wait")
+            found = Evaluator(system).fix_kernels(kernels == "wait")
             self.evaluators[kernels] = found
         return found
 
@@ -83,16 +81,13 @@ def _structure(system):
 class Data:
     """The workspace of computations on ``system`` at parameter values ``p``."""
 
-    def __init__(self, system, fixed=True):
-        self.system, self.fixed = system, fixed
+    def __init__(self, system):
+        self.system = system
         self.p = system.parameter_values
-        self._kernels = ("wait" if background.compiled() else "never") if fixed else "when ready"
+        self._kernels = "wait" if background.compiled() else "never"
         self._evaluator = None  # made on first use: a compiled run may never need it
-        self._engine = None
         self._joint_values = None  # joint_values.JointValuesBatch, made on first use
-        if fixed:
-            template = background.template(system, wait=self._kernels == "wait")
-            self._engine = None if template is None else template.engine(self.p)
+        self._engine = UNSET  # the compiled Engine, made on first use where the kernels are compiled
 
     def __getattr__(self, name):
         """The System's attribute: the model's description (coordinates, parts, names, …)."""
@@ -120,11 +115,11 @@ class Data:
 
     @property
     def engine(self):
-        """The compiled Engine that serves ``motion``, or None (the KKT path). A run's Data
-        fixed it when made; a System's own takes it once its Template is ready."""
-        if self._engine is None and not self.fixed:
-            template = background.template(self.system)
-            self._engine = None if template is None else template.engine(self.p)
+        """The compiled Engine that serves ``motion``, or None (the KKT path): the path fixed
+        when this Data was made (its Template waited for at the first use)."""
+        if self._engine is UNSET:
+            template = background.template(self.system, wait=self._kernels == "wait")  # else its build starts
+            self._engine = None if template is None or self._kernels == "never" else template.engine(self.p)
         return self._engine
 
     def set_parameters(self, values):
@@ -133,7 +128,7 @@ class Data:
         name, a non-finite value, or a part whose M or Q the values make unusable
         (``System.resolved_parameters``)."""
         self.p = self.system.resolved_parameters(values, self.p)
-        if self._engine is not None:
+        if self._engine is not None and self._engine is not UNSET:
             self._engine = self._engine.template.engine(self.p)
 
     def _state(self, q, qd):
@@ -253,9 +248,6 @@ class Data:
         count = q.shape[0]
         t = np.broadcast_to(np.asarray(t, dtype=float), (count,)).copy()
         engine = self.engine
-        if engine is None and not self.fixed:
-            template = background.template(system, wait=True)
-            engine = self._engine = None if template is None else template.engine(self.p)
         if engine is None:
             qdd, done = np.zeros((count, system.n)), np.zeros(count, dtype=bool)
         else:

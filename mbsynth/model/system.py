@@ -258,8 +258,9 @@ class System:
 
     @functools.cached_property
     def _data(self):
-        """The Data of this System's own methods, made on first use (data.Data, fixed=False)."""
-        return Data(self, fixed=False)
+        """The Data of this System's own methods, made on first use (data.Data: its path
+        fixed as it is made, as a run's)."""
+        return Data(self)
 
     def part_problems(self, parameters=None, p=None):
         """[(part name, message)] for each part whose M or Q is not finite, or whose M is not

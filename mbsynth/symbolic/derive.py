@@ -458,9 +458,9 @@ def _lambdified(digest, structure):
     raw = _by_structure.get(digest)
     if raw is None:
         def derive():
-            args, forms = structure()
+            args, forms = _positional(*structure())
             return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"],
-                               cse=True, dummify=True)
+                               cse=True)
 
         if digest is None:
             raw = derive()
@@ -514,10 +514,31 @@ def _values(args, values, picks=()):
             return out
         gathered.fixed, gathered.picks = fixed, picks  # grouped.py stacks these instead of calling
         return gathered
-    raw = remembered_function("values", (args, values),
-                              lambda: sp.lambdify(args, [beyond_double_as_inf(v) for v in values],
-                                                  modules=[_FLOAT64, "numpy"], dummify=True))
+
+    def derive():
+        named, forms = _positional(args, values)
+        return sp.lambdify(named, [beyond_double_as_inf(v) for v in forms], modules=[_FLOAT64, "numpy"])
+
+    raw = remembered_function("values", (args, values), derive)
     return lambda *given: np.asarray(raw(*given), dtype=float)
+
+
+def _positional(args, forms):
+    """(``args`` with each symbol renamed by its position — ``_2_5`` for args[2][5] — and
+    ``forms`` in those names), for lambdify: its code orders terms by the names, so it reads
+    the same in every process (a Dummy's name counts the Dummies the process made before)."""
+    names = {}
+
+    def rename(x, path):
+        if isinstance(x, (list, tuple)):
+            return tuple(rename(y, path + (i,)) for i, y in enumerate(x))
+        if isinstance(x, sp.Symbol):
+            names[x] = sp.Symbol("_" + "_".join(str(i) for i in path))
+            return names[x]
+        return x
+
+    named = rename(tuple(args), ())
+    return named, [sp.sympify(f).xreplace(names) for f in forms]
 
 
 def _frozen(args):

@@ -97,3 +97,25 @@ def test_the_digest_is_the_same_in_every_process_and_tells_numbers_apart():
     assert fingerprint(sp.Float(1.0) * x) != fingerprint(sp.Integer(1) * x)
     assert fingerprint((x, y)) != fingerprint((y, x))
     assert np.unique([fingerprint(sp.Symbol("x", positive=True)), fingerprint(x)]).size == 2
+
+
+def test_lambdified_code_does_not_depend_on_the_dummies_made_before():
+    """lambdify's code for one structure is the same whatever Dummies the process made before
+    (a Dummy's name counts them, and a sum's terms are printed in the order of the names), so
+    a process that derives it and one that loads it compute with the same rounding."""
+    import inspect
+    import re
+
+    from mbsynth.symbolic import derive
+
+    x, y, z = (derivation_cache.placeholder(tag) for tag in "xyz")
+
+    def code_after(count):
+        """The code, made when the Dummy counter stands at ``count``."""
+        while sp.Dummy._count < count:
+            sp.Dummy()
+        raw = derive._lambdified(None, lambda: ((x, y, z), [x - y + z * y, x * y - z]))
+        return re.sub(r"_Dummy_\d+", "_Dummy", inspect.getsource(raw))
+
+    power = 10 ** (len(str(sp.Dummy._count + 10)))
+    assert code_after(power - 2) == code_after(power + 100)  # names crossing a digit, then not
