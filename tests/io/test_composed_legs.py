@@ -234,3 +234,51 @@ def test_composed_quadruped_equals_its_flat_twin(quadruped, flat):
     assert a.unique and b.unique
     assert np.abs(a.qdd).max() > 0.01  # it moves: far above rounding
     assert np.abs(a.qdd - b.qdd).max() < SAME * max(1.0, np.abs(a.qdd).max())
+
+
+# --- a half turn: one quaternion, written or placed -------------------------------------------
+
+BODY = """\
+name: body
+parameters: {pitch: 0.3}
+subsystems:
+  block:
+    type: rigid_body
+    mass: 1.0
+    inertia: [0.2, 0.25, 0.3]
+    initial: {position: [0.1, 0.2, 0.3], rpy: [0, pitch, 0], angular_velocity: [0.5, -1.0, 2.0]}
+"""
+
+
+@pytest.mark.parametrize("turn", [[0, 0, "pi"], ["pi", 0, 0], [0, "pi - 0.3", 0]])  # each with the pitch: a half turn
+def test_a_half_turn_gives_one_quaternion_written_or_placed(tmp_path, turn):
+    """A body placed by a half turn has w = 0 in its quaternion, where u and −u are equally
+    the orientation and only a convention picks one: the placed body's coordinates (and
+    rates) are those of the same pose written in a file (the rotation and angular velocity
+    computed here, written as a quaternion and as a matrix's rpy)."""
+    (tmp_path / "body.yaml").write_text(BODY)
+    (tmp_path / "top.yaml").write_text(
+        "name: top\nsubsystems:\n  it: {type: model, file: body.yaml, "
+        f"placement: {{rpy: [{', '.join(map(str, turn))}]}}}}\n")
+    placed = mb.load(tmp_path / "top.yaml")
+    angles = [float(eval(str(x), {"pi": np.pi})) for x in turn]
+    P = _turn("z", angles[2]) @ _turn("y", angles[1]) @ _turn("x", angles[0])  # the placement's R = Rz Ry Rx
+    R, omega, position = P @ _turn("y", 0.3), P @ [0.5, -1.0, 2.0], P @ [0.1, 0.2, 0.3]
+    rpy = [np.arctan2(R[2, 1], R[2, 2]), -np.arcsin(R[2, 0]), np.arctan2(R[1, 0], R[0, 0])]  # R = Rz Ry Rx
+    u = placed.initial_state()[0][3:7]
+    assert abs(u[0]) < 1e-12  # a half turn
+    for orientation in (f"rpy: {_listed(rpy)}", f"quaternion: {_listed(u)}", f"quaternion: {_listed(-u)}"):
+        written = mb.loads(BODY.replace("rpy: [0, pitch, 0]", orientation)
+                           .replace("[0.1, 0.2, 0.3]", _listed(position)).replace("[0.5, -1.0, 2.0]", _listed(omega)))
+        (q, qd), (qw, qdw) = placed.initial_state(), written.initial_state()
+        assert np.abs(q - qw).max() < 1e-12 and np.abs(qd - qdw).max() < 1e-12, orientation
+
+
+def _listed(values):
+    return f"[{', '.join(repr(float(x)) for x in values)}]"
+
+
+def _turn(axis, angle):
+    c, s = np.cos(angle), np.sin(angle)
+    return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]), "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
