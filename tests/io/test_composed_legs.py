@@ -67,28 +67,44 @@ def turned(system, q, leg, angle):
 
 # --- (a) it stands ----------------------------------------------------------------------------
 
-def test_quadruped_stands_and_the_ground_carries_its_weight(quadruped):
-    """At rest in its initial pose nothing accelerates (the springs' rest angles are set for a
-    static equilibrium), and the vertical forces of the four ankles on the feet add up to the
-    weight of torso and legs, (m_torso + 4 m_leg) g: the model's momentum balance, checked
-    against the joints' reactions turned into world axes here."""
-    system = quadruped
+def standing_still(system, feet, weight):
+    """Assert that ``system`` rests in its initial pose (q̈ = 0 by the System's solver and by
+    (2.14)) and that the vertical forces of the ankle joints ``feet`` ({joint: the shank
+    part}) on the feet, turned into world axes here, add up to ``weight``, a share each."""
     q, qd = system.initial_state()
     assert not qd.any()
-    motion = system.motion(0.0, q, qd)
-    assert motion.unique
-    assert np.abs(motion.qdd).max() < STILL
+    motion, reference = system.motion(0.0, q, qd), system.motion(0.0, q, qd, method="reference")
+    assert motion.unique and reference.unique
+    assert np.abs(motion.qdd).max() < STILL and np.abs(reference.qdd).max() < STILL
     reactions = system.reactions(0.0, q, qd, motion)
     parts = {part.name: part for part in system.parts}
-    p = system.parameters
     vertical = []
-    for leg, joint in zip(LEGS, ("foot_fl", "foot_fr", "foot_hl", "foot_hr")):
-        i = system.coordinates.index(f"{leg}.shank.qw")
-        frame = np.array(parts[f"{leg}.shank"].frames["foot"].rotation.subs(p), dtype=float)
+    for joint, shank in feet.items():
+        i = system.coordinates.index(f"{shank}.qw")
+        frame = np.array(parts[shank].frames["foot"].rotation.subs(system.parameters), dtype=float)
         vertical.append((rotation(q[i:i + 4]) @ frame @ reactions[joint].force)[2])
-    weight = (p["m_torso"] + 4 * p["m_leg"]) * p["g"]
     assert sum(vertical) == pytest.approx(weight, rel=1e-12)
-    assert vertical == pytest.approx([weight / 4] * 4, rel=1e-9)  # symmetric: a quarter each
+    assert vertical == pytest.approx([weight / len(feet)] * len(feet), rel=1e-9)  # symmetric
+
+
+def test_quadruped_stands_and_the_ground_carries_its_weight(quadruped):
+    """At rest in its initial pose nothing accelerates (the springs' rest angles are set for a
+    static equilibrium), and the ankles carry the weight of torso and legs,
+    (m_torso + 4 m_leg) g: the model's momentum balance, checked against the joints' reactions."""
+    p = quadruped.parameters
+    feet = {joint: f"{leg}.shank" for joint, leg in zip(("foot_fl", "foot_fr", "foot_hl", "foot_hr"), LEGS)}
+    standing_still(quadruped, feet, (p["m_torso"] + 4 * p["m_leg"]) * p["g"])
+
+
+def test_hexapod_of_six_placed_copies_stands():
+    """hexapod.yaml: six copies (``count: 6``, placed by ``index``) of a file that includes
+    leg.yaml in turn (two levels deep, its ankle a placed world frame) stand still on their
+    six ankles, which carry (m_torso + 6 m_leg) g."""
+    hexapod = mb.load(MODELS / "hexapod.yaml")
+    assert [s.name for s in hexapod.substructures] == [f"leg[{i}]" for i in range(6)]
+    p = hexapod.parameters
+    feet = {f"leg[{i}].ankle": f"leg[{i}].leg.shank" for i in range(6)}
+    standing_still(hexapod, feet, (p["m_torso"] + 6 * p["m_leg"]) * p["g"])
 
 
 # --- (b) Result 3 -----------------------------------------------------------------------------
