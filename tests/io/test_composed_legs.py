@@ -17,11 +17,12 @@ MODELS = Path(__file__).resolve().parents[2] / "models" / "legged"
 LEGS = ("front_left", "front_right", "hind_left", "hind_right")
 STILL = 1e-9  # accelerations [m/s², rad/s²] of a model at rest in equilibrium: rounding only
 SAME = 1e-12  # composed and flat: the same arithmetic up to the order of sums
+STANCE = {"start": 0.5}  # the legs start bent as in the stance (the files start a little lower)
 
 
 @pytest.fixture(scope="module")
 def quadruped():
-    return mb.load(MODELS / "quadruped.yaml")
+    return mb.load(MODELS / "quadruped.yaml", parameters=STANCE)
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +35,7 @@ def unbalanced(tmp_path_factory):
     assert "holonomic" in leg and "holonomic" not in cut
     (folder / "leg.yaml").write_text(cut)
     (folder / "quadruped.yaml").write_text((MODELS / "quadruped.yaml").read_text())
-    return mb.load(folder / "quadruped.yaml")
+    return mb.load(folder / "quadruped.yaml", parameters=STANCE)
 
 
 def rotation(u):
@@ -88,7 +89,7 @@ def standing_still(system, feet, weight):
 
 
 def test_quadruped_stands_and_the_ground_carries_its_weight(quadruped):
-    """At rest in its initial pose nothing accelerates (the springs' rest angles are set for a
+    """At rest in its stance nothing accelerates (the springs' rest angles are set for a
     static equilibrium), and the ankles carry the weight of torso and legs,
     (m_torso + 4 m_leg) g: the model's momentum balance, checked against the joints' reactions."""
     p = quadruped.parameters
@@ -100,7 +101,7 @@ def test_hexapod_of_six_placed_copies_stands():
     """hexapod.yaml: six copies (``count: 6``, placed by ``index``) of a file that includes
     leg.yaml in turn (two levels deep, its ankle a placed world frame) stand still on their
     six ankles, which carry (m_torso + 6 m_leg) g."""
-    hexapod = mb.load(MODELS / "hexapod.yaml")
+    hexapod = mb.load(MODELS / "hexapod.yaml", parameters=STANCE)
     assert [s.name for s in hexapod.substructures] == [f"leg[{i}]" for i in range(6)]
     p = hexapod.parameters
     feet = {f"leg[{i}].ankle": f"leg[{i}].leg.shank" for i in range(6)}
@@ -231,7 +232,7 @@ def flat_twin():
 
 @pytest.fixture(scope="module")
 def flat():
-    return mb.loads(flat_twin(), name="quadruped_flat.yaml")
+    return mb.loads(flat_twin(), name="quadruped_flat.yaml", parameters=STANCE)
 
 
 def test_composed_quadruped_equals_its_flat_twin(quadruped, flat):
