@@ -14,6 +14,7 @@ import yaml
 import mbsynth as mb
 
 MODELS = Path(__file__).resolve().parents[2] / "models" / "legged"
+HEXAPOD = Path(__file__).resolve().parent / "data" / "legged" / "hexapod.yaml"  # beside its standing_leg.yaml
 LEGS = ("front_left", "front_right", "hind_left", "hind_right")
 STILL = 1e-9  # accelerations [m/s², rad/s²] of a model at rest in equilibrium: rounding only
 SAME = 1e-12  # composed and flat: the same arithmetic up to the order of sums
@@ -98,10 +99,10 @@ def test_quadruped_stands_and_the_ground_carries_its_weight(quadruped):
 
 
 def test_hexapod_of_six_placed_copies_stands():
-    """hexapod.yaml: six copies (``count: 6``, placed by ``index``) of a file that includes
+    """data/legged/hexapod.yaml: six copies (``count: 6``, placed by ``index``) of a file that includes
     leg.yaml in turn (two levels deep, its ankle a placed world frame) stand still on their
     six ankles, which carry (m_torso + 6 m_leg) g."""
-    hexapod = mb.load(MODELS / "hexapod.yaml", parameters=STANCE)
+    hexapod = mb.load(HEXAPOD, parameters=STANCE)
     assert [s.name for s in hexapod.substructures] == [f"leg[{i}]" for i in range(6)]
     p = hexapod.parameters
     feet = {f"leg[{i}].ankle": f"leg[{i}].leg.shank" for i in range(6)}
