@@ -12,6 +12,7 @@ import sympy as sp
 from ..core.kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
 from ..model.parts import EulerBody, Frame, Particle, PlanarBody, RigidBody, Spring
 from ..model.parts.euler_body import SEQUENCES, angle_rates_of, angles_of, coordinates
+from .placement import quaternion_sign
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
 SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None, "line": None}
@@ -200,6 +201,7 @@ def read_body_initial(builder, node, path, planar, sequence=None):
             values.update(zip((c + "_dot" for c in names), rates))
         return values
     u = matrix_quaternion(read_rotation(builder, node, path))
+    u = quaternion_sign(u) * u
     if any(k in node for k in ORIENTATION_KEYS):
         values.update(zip(("qw", "qx", "qy", "qz"), u))
     if "angular_velocity" not in node:

@@ -19,6 +19,7 @@ from ..core.kinematics import matrix_quaternion
 
 POSE_KINDS = ("rigid_body", "flexible_body")  # a position and a scalar-first unit quaternion
 PLANE_RTOL = 1e-12  # a turn whose R_zz is this close to 1 keeps the xy plane (rpy rounding)
+SIGN_TOL = 1e-12  # a unit quaternion's component below this is rounding (w of a half turn): it cannot fix the sign
 
 
 class Placement:
@@ -68,7 +69,10 @@ def place_initial(part, values, placement, fail):
         for suffix in ("", "_dot"):
             names = [f"q{c}{suffix}" for c in "wxyz"]
             moved.update(zip(names, turn * sp.Matrix([full[n] for n in names])))
-        _scalar_part_positive(moved)
+        names = [f"q{c}" for c in "wxyz"]
+        if not any(sp.sympify(moved[n]).free_symbols for n in names) and \
+                quaternion_sign([float(moved[n]) for n in names]) < 0:
+            moved.update({n: -moved[n] for n in names + [f"{n}_dot" for n in names]})
     elif kind == "euler_body" and placement.turns:
         fail(f"part '{part.name}' has angle coordinates ({part.sequence}): a placement that turns it would move "
              "their singular position; give it rotation: quaternion, or place it by translation alone")
@@ -97,17 +101,6 @@ def _move_point(moved, full, names, placement):
     moved.update(zip((f"{c}_dot" for c in names), _rotated(placement.R, velocity)))
 
 
-def _scalar_part_positive(moved):
-    """q and −q are one orientation: a placed one keeps qw ≥ 0 (its rates turned with it),
-    as an orientation a file gives does (matrix_quaternion), so that a composed model starts
-    at the coordinates of its flat twin."""
-    qw = sp.sympify(moved["qw"])
-    if qw.free_symbols or qw >= 0:
-        return
-    for suffix in ("", "_dot"):
-        moved.update({name: -moved[name] for name in (f"q{c}{suffix}" for c in "wxyz")})
-
-
 def _place_planar(part, moved, full, placement, fail):
     """A planar body moves in the xy plane: a turn about z and a shift within the plane."""
     R = placement.R
@@ -119,6 +112,16 @@ def _place_planar(part, moved, full, placement, fail):
     moved.update(zip(("x", "y"), R2 * sp.Matrix([full["x"], full["y"]]) + placement.t[:2, 0]))
     moved.update(zip(("x_dot", "y_dot"), R2 * sp.Matrix([full["x_dot"], full["y_dot"]])))
     moved["theta"] = full["theta"] + angle
+
+
+def quaternion_sign(u):
+    """+1 or −1: the sign that makes the first of u's components (w, x, y, z) beyond SIGN_TOL
+    positive. u and −u are one orientation; this picks one as every initial pose is read
+    (parts.read_body_initial) and placed, w > 0 but at a half turn, where w is rounding and
+    the sign of ``matrix_quaternion`` would be too: a pose written in a file and the same pose
+    reached by a placement's turn get the same coordinates."""
+    first = next(x for x in u if abs(x) > SIGN_TOL)
+    return 1.0 if first > 0 else -1.0
 
 
 def _rotated(R, v):
