@@ -63,6 +63,7 @@ MODES = {
     "robots/two_arms_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the wrists turn the hanging bar
     "robots/ur5_holding_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),
     "robots/ur5_payload.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the vertical shoulder axis
+    "substructures/pendulum_cell.yaml": "equilibrium",  # one cell of benchmarks/substructures.py
     "rolling/bicycle.yaml": "steady",
     "rolling/bicycle_wheel.yaml": "steady",  # one wheel rolling upright alone: its lean oscillates
     "rolling/knife_edge.yaml": (["--steady"], 1, NOT_STEADY),  # its turning grows
