@@ -296,11 +296,25 @@ def test_every_model_file(path):
             assert rel(motion.qdd, literal_2_14(arrays.M, arrays.Q, arrays.A, arrays.b, arrays.C)) < 1e-8
             continue
         scale = max(np.linalg.norm(ref.qdd), acceleration_scale(system, 0.25, q, qd))
-        assert fast is not None, path.name
+        if fast is None:  # the kernel defers a massless part to (2.14) (its pivot below the cut): only then
+            assert has_massless_part(system, q, qd), path.name
+            assert rel(system.motion(0.25, q, qd).qdd, ref.qdd) < 1e-12
+            continue
         gap = np.linalg.norm(fast.qdd - ref.qdd) / scale
         if gap >= agreement(system, 0.25, q, qd):  # then the kernel's answer must solve the equations better
             mine, theirs = (equation_residual(system, 0.25, q, qd, x.qdd) for x in (fast, ref))
             assert mine <= max(theirs, 1e-14), f"{path.name}: gap {gap:.2e}, residuals {mine:.1e} vs {theirs:.1e}"
+
+
+def has_massless_part(system, q, qd):
+    """Whether a part's block of M is zero at (q, q̇): a link of zero mass and inertia."""
+    M, start = system.evaluate(0.25, q, qd).M, 0
+    for part in system.parts:
+        stop = start + len(part.coordinates)
+        if not np.any(M[start:stop, start:stop]):
+            return True
+        start = stop
+    return False
 
 
 def acceleration_scale(system, t, q, qd):
