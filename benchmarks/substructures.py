@@ -1,4 +1,4 @@
-"""Loading N copies of a one-part lagrangian cell (issue 60, item 6: once per file, not per copy).
+"""Loading N copies of a one-part lagrangian cell: derived and compiled once per file, not per copy.
 
     .venv/bin/python benchmarks/substructures.py [--copies 1000] [--runs 3] [--out FILE]
 
@@ -141,7 +141,7 @@ def main(argv=None):
         "`type: model` entry with `count: N`; `flat`: the same copies written out), each load in a fresh",
         "interpreter after `import mbsynth` (so it includes importing sympy and the loader) with the",
         "disk derivation cache off (`MBSYNTH_DERIVATION_CACHE=off`: every sympy derivation is done in",
-        f"that process); medians of {args.runs} runs; ratios to one composed copy. Issue 60 asks for at most 5×.", "",
+        f"that process); medians of {args.runs} runs; ratios to one composed copy (the bar: at most 5×).", "",
         *rows, "",
         f"The {args.copies}-copy model on the compiled path (asserted): its Template built and its generated",
         f"function compiled (`system.data()`, MBSYNTH_FAST=wait) in {simulated['build']:.1f} s, then",

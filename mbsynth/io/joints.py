@@ -14,6 +14,7 @@ from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
+from .substructures import COUNT_MAX
 from .placement import place_height
 
 # ground contacts (their keys: schema.py): the part kinds they may sit on
@@ -207,6 +208,8 @@ def _each_joint(builder, node):
         if last < first - 1:  # [k, k - 1] is empty (one copy: no joints between copies), a lower last a mistake
             builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] runs backwards: give [first, last] "
                                              "with last ≥ first (or first - 1 for none)")
+        if last - first + 1 > COUNT_MAX:
+            builder.fail(path + (variable,), f"the range [{first:g}, {last:g}] gives more than {COUNT_MAX} joints")
         for k in range(int(first), int(last) + 1):
             copy = type(spec)({key: value for key, value in spec.items() if key != "for"})
             copy.line, copy.key_lines = spec.line, spec.key_lines

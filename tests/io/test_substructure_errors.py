@@ -134,6 +134,8 @@ CASES = {
                              "top.yaml", ["top.yaml:5: at joints[0].for.i:", "whole numbers"]),
     "for: range backwards": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last="-2"))},
                              "top.yaml", ["top.yaml:5: at joints[0].for.i:", "runs backwards"]),
+    "for: range beyond the bound": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last="1e9"))},
+                                    "top.yaml", ["top.yaml:5: at joints[0].for.i:", "more than 100000 joints"]),
     "for: beyond the last copy": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last=2))},
                                   "top.yaml", ["top.yaml:9: at joints[0].child:", "'c[3]' is out of range",
                                                "(with i = 2)"]),

@@ -1,4 +1,4 @@
-"""A composed model and its flat twin are the same System (issue 60, Done when 1).
+"""A composed model and its flat twin are the same System.
 
 The composed model nests two deep: ``top.yaml`` includes ``mid.yaml`` twice (placed by rpy and
 by a quaternion, both with a translation), each ``mid.yaml`` includes ``link.yaml`` (placed by
