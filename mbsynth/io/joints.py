@@ -32,6 +32,20 @@ def read_world(builder):
                                                                                                  f.rotation)]]
 
 
+def read_ports(builder):
+    """Register the file's ``ports: {name: frame}``, each under its full name; the frame
+    may be a port of a file this one includes."""
+    node = builder.root.get("ports")
+    if node is None:
+        return
+    node = builder.mapping(node, ("ports",), set(node) if isinstance(node, dict) else set())
+    for name, text in node.items():
+        builder.identifier(name, ("ports", name), "port name")
+        if name in builder.parts or name in builder.parameters:
+            builder.fail(("ports", name), f"port '{name}' has the name of a part or parameter of the file")
+        builder.assembly.ports[builder.full_name(name)] = frame_reference(builder, text, ("ports", name))
+
+
 def frame_reference(builder, text, path):
     """(part or None for the world, Frame) of ``part.frame``, ``part`` (its own origin and
     axes), ``world``, ``world.frame`` or a port of an included file (``left_leg.hip``); a

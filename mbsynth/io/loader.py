@@ -25,14 +25,14 @@ from ..symbolic.derive import T_SYMBOL, joint_values_in
 from ..model.system import Substructure, System
 from .flexible import read_flexible_body
 from .forces import read_forces
-from .joints import read_joints, read_world
+from .joints import read_joints, read_ports, read_world
 from .outputs import read_outputs
 from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import connect_robots, read_robot, read_robots
 from .schema import SECTIONS
 from .placement import Placement, place_initial
 from .source import Document, LineDict, LineList, read_document
-from .substructures import Scoped, included_from, read_includes, read_ports
+from .substructures import Scoped, included_from, read_includes
 
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
 ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there

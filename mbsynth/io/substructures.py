@@ -18,9 +18,9 @@ names frames the including file joins to as ``left_leg.hip``. The paper's sub-sy
 one again, so it may be included in turn.
 
 This module reads the entries (``read_includes``: before any part is built, so that every
-parameter is known) and the ports (``read_ports``); the loader's builders do the rest, one
-per file copy, each reading its file under its prefix (``Scoped`` gives a builder its
-file's view of the model's names).
+parameter is known); ``io/joints.py`` reads the ports with the other frames (``read_ports``).
+The loader's builders do the rest, one per file copy, each reading its file under its prefix
+(``Scoped`` gives a builder its file's view of the model's names).
 """
 
 import difflib
@@ -163,22 +163,6 @@ def _placement(builder, node, path):
     node = builder.section(node, path, "placement")
     position = builder.constants(node.get("position", [0, 0, 0]), path + ("position",), 3)
     return Placement(read_rotation(builder, node, path, fixed=True), position)
-
-
-def read_ports(builder):
-    """Register the file's ``ports: {name: frame}``, each under its full name; the frame
-    may be a port of a file this one includes."""
-    from .joints import frame_reference  # joints.py reads frames through the ports
-
-    node = builder.root.get("ports")
-    if node is None:
-        return
-    node = builder.mapping(node, ("ports",), set(node) if isinstance(node, dict) else set())
-    for name, text in node.items():
-        builder.identifier(name, ("ports", name), "port name")
-        if name in builder.parts or name in builder.parameters:
-            builder.fail(("ports", name), f"port '{name}' has the name of a part or parameter of the file")
-        builder.assembly.ports[builder.full_name(name)] = frame_reference(builder, text, ("ports", name))
 
 
 class Scoped(Mapping):
