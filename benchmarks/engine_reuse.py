@@ -73,7 +73,7 @@ def measure(spec, repeats, rng):
     base = load(spec)
     loaded = time.perf_counter() - started
     started = time.perf_counter()
-    engine_for(base, wait=True)
+    engine_for(base)
     built = time.perf_counter() - started
     m = base.parameters["m"]
     first = {way: [] for way in WAYS}
@@ -93,7 +93,7 @@ def main():
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
     rng = np.random.default_rng(1)
-    engine_for(load("chain:2"), wait=True)  # the kernels, compiled or loaded
+    engine_for(load("chain:2"))  # the kernels, compiled or loaded
     lines = ["# Engine reuse", "",
              f"`{' '.join(['benchmarks/engine_reuse.py'] + sys.argv[1:])}` on {platform.node()} "
              f"({platform.processor() or platform.machine()}, {os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}. "
@@ -107,7 +107,7 @@ def main():
                      f"{first['no reuse']:.4f} | {first['no reuse'] / first['reuse']:.1f}× |")
         print(lines[-1], flush=True)
     base = load(args.sweep_model)
-    engine_for(base, wait=True)
+    engine_for(base)
     values = base.parameters["m"] * rng.uniform(0.9, 1.1, args.runs)
     swept = {way: sweep(base, way, values) for way in reversed(WAYS)}
     lines += ["", f"Sweep: {args.runs} runs of {base.name} (0.2 s, outputs every 0.02 s) at other values of m.", "",

@@ -73,7 +73,7 @@ def _checked(module, engine):
 
 def compare(label, old, new):
     case = chain_case(int(label)) if label.isdigit() else robot_case(label, label in ("talos", "solo12"))
-    engine = engine_for(case.system, wait=True)
+    engine = engine_for(case.system)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
     args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module, engine))

@@ -44,7 +44,7 @@ def check(name, samples, rng):
     except ModelError as err:
         why = str(err).splitlines()[0].split(": ", 1)[-1].split(";")[0]  # without the file's path
         return None, None, None, 0, 0, f"refused by mbsynth: {why}"
-    engine = engine_for(system, wait=True)
+    engine = engine_for(system)
     twin = Twin(system)
     worst = worst_ref = 0.0
     compared = declined = 0

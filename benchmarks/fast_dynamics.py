@@ -175,7 +175,7 @@ class Case:
     def run(self, rng, dense=True):
         system = self.system
         started = time.perf_counter()
-        engine = engine_for(system, wait=True)
+        engine = engine_for(system)
         build_s = time.perf_counter() - started
         q, v = self.draw(rng)
         qm, qdm = self.to_maximal(q, v)
@@ -267,7 +267,7 @@ def compile_times(cache):
     """Seconds to build a first Engine (double pendulum) in a fresh process: (cold, warm)."""
     code = ("import time, mbsynth as mb\nfrom mbsynth.compiled import engine_for\n"
             "s = mb.load('models/rigid/double_pendulum_spatial.yaml')\nt = time.perf_counter()\n"
-            "engine_for(s, wait=True)\nprint(time.perf_counter() - t)\n")
+            "engine_for(s)\nprint(time.perf_counter() - t)\n")
     env = dict(os.environ, MBSYNTH_CACHE_DIR=str(cache))
     env.pop("NUMBA_CACHE_DIR", None)
     run = [sys.executable, "-c", code]

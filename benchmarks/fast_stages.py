@@ -98,7 +98,7 @@ def variant(span=None, called=None):
 
 def profile(label):
     case = chain_case(int(label)) if label.isdigit() else robot_case(label, label in ("talos", "solo12"))
-    engine = engine_for(case.system, wait=True)
+    engine = engine_for(case.system)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
     args = (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, kernel.CHECKED, engine.general)

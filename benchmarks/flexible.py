@@ -97,7 +97,7 @@ TARGET = 1e-6  # m: integration error for the "matched accuracy" line
 
 def mbsynth_pendulum(modes=MODES):
     system = mb.loads(pendulum_yaml(modes), name="flexible_pendulum")
-    engine_for(system, wait=True)  # compile (or load) the kernels before anything is timed
+    engine_for(system)  # compile (or load) the kernels before anything is timed
     return system
 
 

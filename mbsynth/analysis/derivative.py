@@ -57,14 +57,14 @@ class StateDerivative:
     velocity_form.VelocityForm), with ``baumgarte`` (α, β) or None."""
 
     def __init__(self, data, baumgarte, form):
-        self.data, self.n, self.baumgarte, self.form = data, data.n, baumgarte, form
+        self.data, self.n, self.baumgarte, self.form = data, data.model.n, baumgarte, form
         self.evaluations = 0
         self.t_failed = float("nan")  # where the run was when it failed: its last stage or state looked at
         self.non_unique = False
         self.singular = []  # (t, rows) of the interval's stages near a singular position
         self.singular_positions = []  # per interval with such stages: {t_from, t_to, rows}
         self.on_manifold = None  # (q, q̇) -> the state on the constraints or None: a step across a singular position
-        self.angles = AngleParts(data)  # the parts that turn by angles, watched for their singular position
+        self.angles = AngleParts(data.model)  # the parts that turn by angles, watched for their singular position
         self.use(None)
         self.begin(0.0, 0.0)
 
@@ -176,7 +176,7 @@ class StateDerivative:
         self.t_failed = t
         data = self.data
         qdd = np.abs(data.motion(t, *self.form.to_state(y), baumgarte=self.baumgarte, drift=True).qdd)
-        fastest = [(c, a) for c, a in zip(data.coordinates, qdd) if a >= qdd.max() / 10]
+        fastest = [(c, a) for c, a in zip(data.model.coordinates, qdd) if a >= qdd.max() / 10]
         return SolveError(f"step-size collapse, the integrator gave up ({why}); fastest changing: "
                           f"{', '.join(f'{c} (q̈ = {a:.3g})' for c, a in fastest)}{self._angles_note(y[:self.n])}",
                           coordinates=[c for c, _ in fastest])
@@ -188,7 +188,7 @@ class StateDerivative:
             return
         self.t_failed = t
         y = np.concatenate([q, qd])
-        names = [*self.data.coordinates, *(c + "_dot" for c in self.data.coordinates)]
+        names = [*self.data.model.coordinates, *(c + "_dot" for c in self.data.model.coordinates)]
         culprits = [names[i] for i in np.flatnonzero(~np.isfinite(y) | (np.abs(y) > MAX_STATE))]
         raise SolveError(f"the state is not finite or exploded (|value| > {MAX_STATE:g}) in "
                          f"{', '.join(culprits[:6])}{self._angles_note(np.nan_to_num(q))}", coordinates=culprits)

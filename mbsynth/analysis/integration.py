@@ -37,8 +37,8 @@ class Integration:
 
     def __init__(self, data, method, rtol, atol, stabilization, baumgarte, schedule):
         self.data, self.method, self.rtol, self.atol = data, method, rtol, atol
-        self.stabilization, self.schedule, self.n = stabilization, schedule, data.n
-        self.form = VelocityForm(data)  # the integrator's y = (q, v) and (q, q̇)
+        self.stabilization, self.schedule, self.n = stabilization, schedule, data.model.n
+        self.form = VelocityForm(data.model)  # the integrator's y = (q, v) and (q, q̇)
         self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None, self.form)
         self.steps = 0
         self.solver = None  # the integrator, kept from interval to interval (``resumed``)
@@ -48,7 +48,7 @@ class Integration:
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
         self.corrected = None  # the kernel's correction.Corrected there, if at hand
         self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
-        self.potential_free = all(f.V == 0 for f in data.forces)  # no force element with a potential
+        self.potential_free = all(f.V == 0 for f in data.model.forces)  # no force element with a potential
         self.restart()
 
     @property

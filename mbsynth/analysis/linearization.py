@@ -72,24 +72,23 @@ dependent here whose dependency does not persist along the tangent directions, d
 by the rows' second derivatives).
 """
 
-import functools
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 import scipy.sparse
+from ..core.memo import MEMO
 import scipy.sparse.csgraph
 import sympy as sp
 
 from ..core.errors import SolveError
+from ..model.data import shared
 from .projection import relative_drift
 from ..symbolic.derive import T_SYMBOL, compile_function, jacobian
 from ..core.tolerances import (CHANGE_POINT_RTOL, NAME_RTOL, NEAR_SINGULAR, ON_MANIFOLD_RTOL, RANK_RTOL,
                                STRUCTURAL_ZERO_RTOL)
 
 _CACHE_SIZE = 8
-_cache = OrderedDict()  # (ids of the parts, rows and forces) -> (those tuples, Derivatives)
 
 
 @dataclass(frozen=True)
@@ -316,7 +315,7 @@ def time_rows(system):
     return _time_rows(system.connectors)
 
 
-@functools.lru_cache(maxsize=_CACHE_SIZE)
+@MEMO.function(_CACHE_SIZE)
 def _time_rows(connectors):
     found = []
     for con in connectors:
@@ -577,15 +576,9 @@ def _dummies(prefix, count):
 
 
 def derivatives_of(system):
-    """The ``Derivatives`` of ``system``, shared by the Systems that differ only in their
-    parameter values (they share their parts, rows and forces)."""
-    held = (system.parts, system.connectors, system.forces, tuple(system.parameters))
-    key = tuple(id(x) for x in held[:3]) + held[3:]
-    found = _cache.get(key)
-    if found is None or any(a is not b for a, b in zip(found[0][:3], held[:3])):
-        found = (held, Derivatives(system))
-        _cache[key] = found
-        while len(_cache) > _CACHE_SIZE:
-            _cache.popitem(last=False)
-    _cache.move_to_end(key)
-    return found[1]
+    """The ``Derivatives`` of ``system``, shared by the models of one structure (they
+    differ only in parameter values: data.Shared, in the one cache)."""
+    held = shared(system)
+    if held.derivatives is None:
+        held.derivatives = Derivatives(system)
+    return held.derivatives

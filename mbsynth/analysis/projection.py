@@ -15,16 +15,16 @@ row's residual is judged against the size of its terms, estimated from the row o
 ``PROJECTION_RTOL``.
 """
 
-import functools
-
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
 
 from ..core.equations import term_scales
+from ..model.data import workspace
 from ..model.evaluation import DENSE_ENTRIES
 from ..core.errors import SolveError
 from ..core.tolerances import DRIFT_FLOOR, NEAR_SINGULAR, PROJECTION_RTOL
+from ..core.memo import MEMO
 
 MAX_ITERATIONS = 50
 DIVERGED = 1e6  # a last pass stops where its largest residual exceeds this times its smallest so far
@@ -110,7 +110,7 @@ def _grouped(squares, groups):
     return np.sqrt(np.bincount(inverse, weights=squares, minlength=labels)[inverse] / counts[inverse])
 
 
-@functools.lru_cache(maxsize=64)
+@MEMO.function(64)
 def _labelled(groups, dtype):
     """(number of groups, each column's group index, each group's size) of the group labels
     (as bytes: a System's labels are the same at every projection of a run)."""
@@ -132,7 +132,7 @@ def _accepted(z, G, norm_G, r, size):
     return bool(np.all(np.isfinite(z)) and well_posed and np.linalg.norm(G @ z - r) <= SPARSE_ACCEPT * size)
 
 
-def project_positions(system, t, q, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
+def project_positions(data, t, q, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
     """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices);
     ``arrays``: the ConstraintArrays at q (any q̇), if at hand.
 
@@ -142,14 +142,15 @@ def project_positions(system, t, q, fixed=None, tolerance=PROJECTION_RTOL, array
     ∂(|u|² − 1)/∂u_z = 2u_z) counts in that metric as nearly free to move: the step moves
     it by about r/c_j, whose second-order effect (r/c_j)² exceeds r, and Newton diverges
     even from a state on the manifold to rounding."""
+    data = workspace(data)
     start = np.array(q, dtype=float)
     free = _free_columns(start.size, fixed)
-    q = _newton(system, t, start, free, tolerance, floor=0.0, arrays=arrays)
-    return q if q is not None else _newton(system, t, start, free, tolerance, floor=COLUMN_FLOOR, last=True,
+    q = _newton(data, t, start, free, tolerance, floor=0.0, arrays=arrays)
+    return q if q is not None else _newton(data, t, start, free, tolerance, floor=COLUMN_FLOOR, last=True,
                                            arrays=arrays)
 
 
-def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
+def _newton(data, t, q, free, tolerance, floor, last=False, arrays=None):
     """Gauss–Newton steps from q (a copy is changed) until every position row is met; None
     when the residual grows (unless ``last``: then a SolveError names the rows unmet,
     ``_unmet_positions``). ``arrays``: the ConstraintArrays at q, if at hand (φ and A do
@@ -158,7 +159,7 @@ def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
     previous, best = np.inf, (np.inf, q.copy())
     for _ in range(MAX_ITERATIONS):
         if arrays is None:
-            arrays = system.constraint_arrays(t, q, qd, sparse=None)
+            arrays = data.constraint_arrays(t, q, qd, sparse=None)
         phi = arrays.phi
         rows = np.isfinite(phi)
         unmet = np.abs(phi[rows]) > tolerance * term_scales(arrays.A, q)[rows]
@@ -172,45 +173,47 @@ def _newton(system, t, q, free, tolerance, floor, last=False, arrays=None):
         elif size > DIVERGED * best[0]:  # the last pass gives up once it runs away from its best
             break
         previous = size
-        q[free] -= _correction(arrays.A[rows][:, free], phi[rows], system.coordinate_groups[free], floor)
+        q[free] -= _correction(arrays.A[rows][:, free], phi[rows], data.model.coordinate_groups[free], floor)
         arrays = None
         if not np.all(np.isfinite(q)):
             break
     if not last:
         return None
-    raise _unmet_positions(system, t, start, best[1], free, tolerance)
+    raise _unmet_positions(data, t, start, best[1], free, tolerance)
 
 
-def project_velocities(system, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
+def project_velocities(data, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, arrays=None):
     """q̇ on the velocity-level rows (φ̇ = 0, ψ = 0), changing only free velocities;
     ``arrays``: the ConstraintArrays at (q, q̇), if at hand."""
+    data = workspace(data)
     qd = np.array(qd, dtype=float)
     free = _free_columns(qd.size, fixed)
     if arrays is None:
-        arrays = system.constraint_arrays(t, q, qd, sparse=None)
+        arrays = data.constraint_arrays(t, q, qd, sparse=None)
     psi = arrays.psi
     rows = np.isfinite(psi)
     if not (np.abs(psi[rows]) > tolerance * term_scales(arrays.A, qd)[rows]).any():
         return qd
     A = arrays.A[rows]
-    qd[free] -= _correction(A[:, free], psi[rows], system.coordinate_groups[free])  # ψ is affine in q̇, slope A
-    _, psi = system.constraint_residuals(t, q, qd)
+    qd[free] -= _correction(A[:, free], psi[rows], data.model.coordinate_groups[free])  # ψ is affine in q̇, slope A
+    _, psi = data.constraint_residuals(t, q, qd)
     unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
     if unmet.any():
-        raise SolveError(_unmet(system, psi, "velocities", free),
-                         constraints=[n for n, u in zip(np.array(system.constraint_names)[rows], unmet) if u])
+        raise SolveError(_unmet(data, psi, "velocities", free),
+                         constraints=[n for n, u in zip(np.array(data.model.constraint_names)[rows], unmet) if u])
     return qd
 
 
 
 
-def relative_drift(system, t, q, qd, arrays=None):
+def relative_drift(data, t, q, qd, arrays=None):
     """The largest residual of φ or ψ relative to its row's terms (module docstring), at
     least DRIFT_FLOOR of the row's norm times the largest coordinate (or rate): how far
     the state lies off the manifold, alike at every scale. ``arrays``: the
     ConstraintArrays at (q, q̇), if at hand."""
+    data = workspace(data)
     if arrays is None:
-        arrays = system.constraint_arrays(t, q, qd, sparse=None)
+        arrays = data.constraint_arrays(t, q, qd, sparse=None)
     worst = 0.0
     for residual, x in ((arrays.phi, q), (arrays.psi, qd)):
         rows = np.isfinite(residual)
@@ -220,15 +223,16 @@ def relative_drift(system, t, q, qd, arrays=None):
     return worst
 
 
-def project(system, t, q, qd, fixed_q=None, fixed_qd=None, arrays=None):
+def project(data, t, q, qd, fixed_q=None, fixed_qd=None, arrays=None):
     """(q, q̇) on the constraint manifold: positions first, then velocities. ``arrays``:
     the ConstraintArrays at (q, q̇), if at hand (used while q is unchanged)."""
-    moved = project_positions(system, t, q, fixed_q, arrays=arrays)
+    data = workspace(data)
+    moved = project_positions(data, t, q, fixed_q, arrays=arrays)
     same = arrays is not None and np.array_equal(moved, q)
-    return moved, project_velocities(system, t, moved, qd, fixed_qd, arrays=arrays if same else None)
+    return moved, project_velocities(data, t, moved, qd, fixed_qd, arrays=arrays if same else None)
 
 
-def consistent_initial_state(system, t=0.0):
+def consistent_initial_state(data, t=0.0):
     """The model's initial state made consistent with the constraints.
 
     First every value the model sets is kept and only the others are completed (a
@@ -236,18 +240,19 @@ def consistent_initial_state(system, t=0.0):
     listed in ``initial_fixed`` are kept and the rest change as little as possible.
     Returns (q, q̇, changes) with changes = {name: (given, new)} for the values that
     moved. Raises SolveError when no consistent state keeps the fixed values."""
-    q0, qd0 = system.initial_state()
+    data = workspace(data)
+    q0, qd0 = data.model.initial_state()
     try:
-        q, qd = _project_keeping(system, t, q0, qd0, system.initial_given)
+        q, qd = _project_keeping(data, t, q0, qd0, data.model.initial_given)
     except SolveError:
         try:
-            q, qd = _project_keeping(system, t, q0, qd0, system.initial_fixed)
+            q, qd = _project_keeping(data, t, q0, qd0, data.model.initial_fixed)
         except SolveError as err:
-            kept = ", ".join(sorted(system.initial_fixed)) or "nothing"
+            kept = ", ".join(sorted(data.model.initial_fixed)) or "nothing"
             raise SolveError(f"no consistent initial state exists (keeping {kept}): {err}",
                              constraints=err.constraints) from None
-    system.check_branches(q, t)  # a joint's rows met on a branch it does not mean: a fixed joint flipped
-    names = list(system.coordinates)
+    data.check_branches(q, t)  # a joint's rows met on a branch it does not mean: a fixed joint flipped
+    names = list(data.model.coordinates)
     changes = {}
     q_size, qd_size = np.abs(q).max(initial=0.0), np.abs(qd).max(initial=0.0)
     for i, c in enumerate(names):
@@ -258,30 +263,30 @@ def consistent_initial_state(system, t=0.0):
     return q, qd, changes
 
 
-def _project_keeping(system, t, q, qd, keep):
-    names = list(system.coordinates)
-    return project(system, t, q, qd, [i for i, c in enumerate(names) if c in keep],
+def _project_keeping(data, t, q, qd, keep):
+    names = list(data.model.coordinates)
+    return project(data, t, q, qd, [i for i, c in enumerate(names) if c in keep],
                    [i for i, c in enumerate(names) if c + "_dot" in keep])
 
 
-def _unmet(system, residual, level, free):
+def _unmet(data, residual, level, free):
     worst = np.nanargmax(np.abs(residual))
-    return (f"the constraints cannot be met by adjusting the {level} of {_listed(system, free)}; "
-            f"largest residual {abs(residual[worst]):.3g} in {system.constraint_names[worst]}")
+    return (f"the constraints cannot be met by adjusting the {level} of {_listed(data, free)}; "
+            f"largest residual {abs(residual[worst]):.3g} in {data.model.constraint_names[worst]}")
 
 
 LISTED = 8  # coordinates named in an error before "… (n in all)"
 
 
-def _listed(system, free):
+def _listed(data, free):
     """The free coordinates, the first LISTED of them named."""
-    names = [c for c, f in zip(system.coordinates, free) if f]
+    names = [c for c, f in zip(data.model.coordinates, free) if f]
     if not names:
         return "no coordinate (all are fixed)"
     return ", ".join(names) if len(names) <= LISTED else f"{', '.join(names[:LISTED])}, … ({len(names)} in all)"
 
 
-def _unmet_positions(system, t, start, best, free, tolerance):
+def _unmet_positions(data, t, start, best, free, tolerance):
     """The SolveError of a projection that could not meet the position rows: the rows
     unmet at ``start``, largest residual relative to its row's terms first (a row no
     configuration meets, such as a servo beyond a joint's range, is one of them; the rows
@@ -289,22 +294,22 @@ def _unmet_positions(system, t, start, best, free, tolerance):
     the iterate that came closest. Where the residual at ``best`` lies along a dependency
     of the rows (dependent at this configuration only: a singular position, where no
     first-order change moves it), that dependency's rows are named instead."""
-    unmet = _unmet_rows(system, t, start, tolerance)
-    arrays = system.constraint_arrays(t, best, np.zeros_like(best), sparse=None)
+    unmet = _unmet_rows(data, t, start, tolerance)
+    arrays = data.constraint_arrays(t, best, np.zeros_like(best), sparse=None)
     phi = np.where(np.isfinite(arrays.phi), arrays.phi, 0.0)
     worst = int(np.argmax(np.abs(phi)))
-    closest = f"{abs(phi[worst]):.3g} in {system.constraint_names[worst]}"
+    closest = f"{abs(phi[worst]):.3g} in {data.model.constraint_names[worst]}"
     listed = ", ".join(f"{name} ({residual:.3g})" for name, residual in unmet[:LISTED])
     if len(unmet) > LISTED:
         listed += f", … ({len(unmet)} rows in all)"
-    dependency = _dependency(system, t, best, arrays.A, phi, free)
+    dependency = _dependency(data, t, best, arrays.A, phi, free)
     if dependency is None:
-        return SolveError(f"the constraints cannot be met by adjusting the positions of {_listed(system, free)}: "
+        return SolveError(f"the constraints cannot be met by adjusting the positions of {_listed(data, free)}: "
                           f"unmet {listed}; Newton's steps left at best a residual of {closest}",
                           constraints=[name for name, _ in unmet])
     rows, distance = dependency
     if distance is None:
-        return SolveError(f"the constraints cannot be met by adjusting the positions of {_listed(system, free)}: "
+        return SolveError(f"the constraints cannot be met by adjusting the positions of {_listed(data, free)}: "
                           f"unmet {listed}; the residual left ({closest}) is the least the rows {_names(rows)} "
                           "reach near here (no change of the positions lowers it, to first or second order)",
                           constraints=rows)
@@ -315,13 +320,13 @@ def _unmet_positions(system, t, start, best, free, tolerance):
                       "singular position", constraints=rows)
 
 
-def _unmet_rows(system, t, q, tolerance):
+def _unmet_rows(data, t, q, tolerance):
     """[(row name, |φ|)] of the position rows unmet at q, largest relative residual first."""
-    arrays = system.constraint_arrays(t, q, np.zeros_like(q), sparse=None)
+    arrays = data.constraint_arrays(t, q, np.zeros_like(q), sparse=None)
     phi = np.where(np.isfinite(arrays.phi), arrays.phi, 0.0)
     scales = term_scales(arrays.A, q)
     order = np.argsort(-np.abs(phi) / np.maximum(scales, np.finfo(float).tiny))
-    return [(system.constraint_names[i], float(abs(phi[i]))) for i in order if abs(phi[i]) > tolerance * scales[i]]
+    return [(data.model.constraint_names[i], float(abs(phi[i]))) for i in order if abs(phi[i]) > tolerance * scales[i]]
 
 
 def _names(rows):
@@ -332,7 +337,7 @@ def _names(rows):
 DIAGNOSED_ENTRIES = 4_000_000  # a dense SVD of the rows is taken for a diagnosis up to this size
 
 
-def _dependency(system, t, q, A, phi, free):
+def _dependency(data, t, q, A, phi, free):
     """None where φ lies mostly in the range of A's free columns (rows scaled to unit norm);
     else (the rows of the dependency wᵀA = 0 along which it lies — singular values below
     NEAR_SINGULAR of the largest —, the distance to a configuration that meets it or None).
@@ -353,7 +358,7 @@ def _dependency(system, t, q, A, phi, free):
         return None
     w = U[:, rank:] @ along / np.linalg.norm(along)  # the dependency that carries φ
     weights = np.abs(w)
-    rows = [n for n, x in zip(system.constraint_names, weights) if x > DEPENDENCY_SHARE * weights.max()]
+    rows = [n for n, x in zip(data.model.constraint_names, weights) if x > DEPENDENCY_SHARE * weights.max()]
     N = Vt[rank:].T  # the free coordinates' directions the rows do not move (to first order)
     if not N.shape[1] or N.shape[1] > DIAGNOSED_DIRECTIONS:
         return rows, None
@@ -362,7 +367,7 @@ def _dependency(system, t, q, A, phi, free):
     for n in N.T:
         step = np.zeros_like(q)
         step[free] = h * n
-        ends = [system.constraint_arrays(t, q + sign * step, np.zeros_like(q), sparse=False).A[:, free]
+        ends = [data.constraint_arrays(t, q + sign * step, np.zeros_like(q), sparse=False).A[:, free]
                 for sign in (1, -1)]
         slopes.append(((w / norms) @ (ends[0] - ends[1])) / (2 * h))
     C = np.array(slopes) @ N

@@ -25,7 +25,7 @@ class Recorder:
         self.run = run_of(data)
         self.powered = bool(data.system.working_forces())  # else every row's power is 0: none evaluated
         self.outputs = OutputEvaluator(data)
-        n, m = len(data.coordinates), len(self.outputs.names)
+        n, m = len(data.model.coordinates), len(self.outputs.names)
         _check_fits(rows, row_bytes(n, m), out)
         self.count = 0
         self.columns = dict(t=np.empty(rows), q=np.empty((rows, n)), qd=np.empty((rows, n)), energy=np.empty(rows),
@@ -36,7 +36,7 @@ class Recorder:
     def open(self):
         """Start the file, if one was asked for (a path that cannot be written fails here)."""
         if self.out is not None:
-            self.writer = TrajectoryWriter(self.out, self.data.coordinates, self.outputs.names, rows=self.trajectory,
+            self.writer = TrajectoryWriter(self.out, self.data.model.coordinates, self.outputs.names, rows=self.trajectory,
                                            run=self.run)
 
     @property
@@ -100,7 +100,7 @@ class Recorder:
         arrays are views of the recorder's."""
         rows = slice(0, self.count) if rows is None else rows
         c = {name: column[rows] for name, column in self.columns.items()}
-        return Trajectory(tuple(self.data.coordinates), c["t"], c["q"], c["qd"], c["energy"], c["kinetic"],
+        return Trajectory(tuple(self.data.model.coordinates), c["t"], c["q"], c["qd"], c["energy"], c["kinetic"],
                           c["residual_position"], c["residual_velocity"], status, outputs=c["outputs"],
                           output_names=tuple(self.outputs.names), power=c["power"], **self.run)
 

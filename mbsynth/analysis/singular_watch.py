@@ -30,7 +30,7 @@ class SingularWatch:
     @staticmethod
     def fits(data):
         """Whether the model's A is worth watching: some rows, at most WATCH_ENTRIES entries."""
-        entries = len(data.system.constraint_names) * data.n
+        entries = len(data.system.constraint_names) * data.model.n
         return 0 < entries <= WATCH_ENTRIES
 
     def __init__(self, data, t, q, qd):

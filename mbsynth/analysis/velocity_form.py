@@ -32,11 +32,11 @@ from numba import njit
 
 class VelocityForm:
     """The conversions between a run's state (q, q̇) and the integrator's y = (q, v) of
-    ``data`` (its Data or System): ``size`` entries, 2n less one per rigid body."""
+    ``model``: ``size`` entries, 2n less one per rigid body."""
 
-    def __init__(self, data):
+    def __init__(self, model):
         starts, start = [], 0
-        for part in data.parts:
+        for part in model.parts:
             if part.kind == "rigid_body":
                 starts.append(start + 3)  # its quaternion (qw, qx, qy, qz) after its position
             start += len(part.coordinates)

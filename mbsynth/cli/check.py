@@ -5,14 +5,14 @@ import os
 import re
 
 from ..analysis.diagnose import diagnose
-from ..compiled.background import default_mode
+from ..compiled.background import default_path_as
 from .parsers import model_of
 
 
 def run(args):
-    # a handful of evaluations at one state: compiling kernels (numba) in the background
-    # would only compete with them (MBSYNTH_FAST set by the user is kept)
-    with default_mode("off"):
+    # a handful of evaluations at one state: the KKT path, no kernels to compile (a path the
+    # user set with MBSYNTH_FAST is kept)
+    with default_path_as("kkt"):
         system = model_of(args)
         report = diagnose(system)
     if args.json:

@@ -1,24 +1,24 @@
-"""Compiled Templates built off the caller's thread; MBSYNTH_FAST.
+"""Compiled Templates built on the worker thread; MBSYNTH_FAST; the default path.
 
 numba compiles the kernels once per machine and keeps them on disk (cache.py); a cold
-compile takes tens of seconds, loading a warm cache well under a second. So that no call
-waits for it, ``template(system)`` starts building the Template of the System's structure
-(layout, generated function, compilation: engine.py) on a background thread the first
-time it is asked, and answers None — use the KKT path — until it is ready.
-``MBSYNTH_FAST`` changes this: "background" (the default), "wait" (build on first use,
-blocking) or "off" (never use the compiled path). ``python -m mbsynth.compiled`` (run by
-``make install``) compiles ahead.
+compile takes minutes, loading a warm cache well under a second. ``python -m
+mbsynth.compiled`` compiles ahead (``make install`` runs it).
 
-A Template is kept in the ``TemplateSlot`` of the System's structure (``System.shared``:
-the Systems that differ only in parameter values share it), built at most once for all
-of them. A Data (data.py) decides with ``compiled()`` whether a run waits for it.
+A model's path is chosen when its Data is made (model/data.py): "compiled" or "kkt",
+by default ``default_path()`` — "compiled", or "kkt" where ``MBSYNTH_FAST=off`` (the
+environment's choice) or inside ``default_path_as("kkt")`` (a command that evaluates a
+handful of states). On the compiled path ``template`` builds the Template of the model's
+structure (layout, generated function, compilation: engine.py) on the worker thread and
+waits for it, once per structure (``TemplateSlot``, kept in the one cache, core/memo.py),
+so the path never depends on what a background build happens to have finished.
 
 The worker is a daemon thread (worker.py): leaving Python waits only for the numba
-compilation in progress (one interrupted would abort the process); a build not finished
-starts again next time, and one asked for while Python exits is refused (the KKT path).
+compilation in progress (one interrupted would abort the process); a build asked for
+while Python exits is refused (the KKT path serves).
 """
 
 import contextlib
+import contextvars
 import logging
 import os
 import threading
@@ -28,7 +28,8 @@ from . import ahead, cache
 from .worker import Worker
 
 log = logging.getLogger(__name__)
-MODES = ("background", "wait", "off")
+MODES = ("on", "off")  # MBSYNTH_FAST: the compiled path where it covers a model, or never
+LEGACY_MODES = {"wait": "on", "background": "on"}  # earlier names of "on", still accepted
 
 
 class TemplateSlot:
@@ -39,48 +40,55 @@ class TemplateSlot:
 
 
 _lock = threading.Lock()
-_compiled = False  # an Engine has been warmed in this process: the kernels are compiled
-_default_mode = "background"  # MBSYNTH_FAST when it is not set (``default_mode``)
+_default_path = contextvars.ContextVar("default_path", default=None)  # ``default_path_as``
 
 
 @contextlib.contextmanager
-def default_mode(value):
-    """MBSYNTH_FAST taken as ``value`` inside the block where the user has not set it (a
+def default_path_as(path):
+    """``default_path()`` is ``path`` inside the block where MBSYNTH_FAST is not set (a
     command that evaluates a handful of states has no use for compiling kernels)."""
-    global _default_mode
-    before, _default_mode = _default_mode, value
+    token = _default_path.set(path)
     try:
         yield
     finally:
-        _default_mode = before
+        _default_path.reset(token)
 
 
 def mode():
-    value = os.environ.get("MBSYNTH_FAST", _default_mode)
+    """MBSYNTH_FAST: "on" (unset: the default) or "off"."""
+    value = os.environ.get("MBSYNTH_FAST", "on")
+    value = LEGACY_MODES.get(value, value)
     if value not in MODES:
         raise ValueError(f"MBSYNTH_FAST must be one of {MODES}, got {value!r}")
     return value
 
 
-def template(system, wait=False):
-    """The compiled Template of ``system``'s structure when it is ready (``wait``: build it
-    now), else None: not ready, MBSYNTH_FAST=off, its build failed, or the kernels cover
-    no part of the model."""
+def default_path():
+    """The path of a Data made without one: "kkt" where MBSYNTH_FAST=off, else the
+    ``default_path_as`` block's where MBSYNTH_FAST is unset, else "compiled"."""
+    if mode() == "off":
+        return "kkt"
+    if "MBSYNTH_FAST" not in os.environ and _default_path.get() is not None:
+        return _default_path.get()
+    return "compiled"
+
+
+def template(system, slot):
+    """The compiled Template of ``system``'s structure, built now if it is not yet (in
+    ``slot``, its TemplateSlot); None where MBSYNTH_FAST=off, its build failed, or the
+    kernels cover no part of the model."""
     if mode() == "off":
         return None
-    future = _submit(system, system.shared.compiled)
-    if not (wait or mode() == "wait" or future.done()):
-        return None
-    if future.exception() is not None:  # logged by the worker; the exact path serves (the error is not
+    future = _submit(system, slot)
+    if future.exception() is not None:  # logged by the worker; the KKT path serves (the error is not
         return None  # raised here: its traceback would keep this frame, and the System, with the future)
     return future.result()
 
 
-def engine_for(system, wait=False):
-    """The compiled Engine of ``system`` at its parameter values, when its Template is ready
-    (``wait``: build it now), else None (``template``)."""
-    found = template(system, wait)
-    return None if found is None else found.engine(system.parameter_values)
+def engine_for(system):
+    """The compiled Engine of ``system`` at its parameter values (its structure's Template
+    built now if it is not yet), or None (``template``): a compiled-path Data's engine."""
+    return system.data(path="compiled").engine
 
 
 def compile_ahead(variant):
@@ -93,8 +101,9 @@ def compile_ahead(variant):
 
 
 def compiled():
-    """Whether the kernels are compiled: in this process, or in the cache on disk."""
-    return _compiled or cache.compiled_mark().exists()
+    """Whether the kernels are compiled: the cache on disk says so (a speed matter alone:
+    ``ahead.start`` compiles their largest parts in helper processes when they are not)."""
+    return cache.compiled_mark().exists()
 
 
 def _submit(system, slot):
@@ -133,7 +142,6 @@ def _refuse(system, slot):
 def _build(system):
     """The Template of ``system``, its first Engine warmed at the initial state, or None when
     the kernels cover none of its parts."""
-    global _compiled
     from .engine import Template
     built = Template.build(system)
     if built is None:
@@ -141,11 +149,10 @@ def _build(system):
     if not compiled():
         ahead.start(built.general)  # the kernel's largest parts, alongside (none if started already)
     built.engine(system.parameter_values).warm(*system.initial_state())
-    if not _compiled:
-        _compiled = True
+    if not compiled():
         try:
             cache.compiled_mark().touch()
-        except OSError:  # a cache that cannot be written: runs on this machine start on KKT
+        except OSError:  # a cache that cannot be written: the next process compiles ahead again
             pass
     return built
 

@@ -13,6 +13,7 @@ import os
 from pathlib import Path
 
 from ..core.files import cache_dir, mark_and_prune, sources_hash
+from ..core.memo import MEMO
 
 HERE = Path(__file__).resolve().parent  # the compiled path's sources: the kernels and all they call
 # constants the kernels compile in: the tolerances and the joint kinds' row programs
@@ -42,13 +43,14 @@ def configure():
 def compiled_mark():
     """The file whose presence says that numba's cache holds the kernels of these sources
     (background.py writes it when an Engine has been warmed): ``<numba cache>/.compiled-<digest()>``."""
-    global _sources
-    if _sources is None:
-        _sources = digest()
-    return Path(os.environ.get("NUMBA_CACHE_DIR") or cache_dir() / "numba" / _sources) / f".compiled-{_sources}"
+    sources = _sources_digest()
+    return Path(os.environ.get("NUMBA_CACHE_DIR") or cache_dir() / "numba" / sources) / f".compiled-{sources}"
 
 
-_sources = None  # digest(), once computed
+@MEMO.function(1)
+def _sources_digest():
+    """``digest()``, once per process."""
+    return digest()
 
 
 def generated_dir():

@@ -23,19 +23,15 @@ class Batch:
     """``functions[i](t, q[indices[i]], qd[indices[i]], p)`` for all i at once; each
     returns a tuple of arrays (one per *slot*: a, b, C, φ, ψ of a connector; M, Q or T, V
     of a part). A call returns, per slot, the raveled outputs of all functions
-    concatenated in order (``slots`` of them). The layout is fixed at the first call."""
+    concatenated in order (``slots`` of them). The layout is fixed at the first call.
+    ``compiled``: each group of a shared structure is evaluated by its numba kernel, built
+    at its first call (compiled/structures.py), else by numpy throughout."""
 
-    def __init__(self, functions, indices, slots):
+    def __init__(self, functions, indices, slots, compiled):
         self.functions, self.slots = list(functions), slots
         self.indices = [np.asarray(i, dtype=int) for i in indices]
         self.layout = None
-        self.kernels = "when ready"  # or "wait" / "never": decided at the first call, for good (fix_kernels)
-
-    def fix_kernels(self, wait):
-        """From now on each group's path is decided at its first call and kept: its numba
-        kernel, built then if need be (``wait``), or numpy throughout (not ``wait``) — so
-        that results do not depend on when a background compilation finishes."""
-        self.kernels = "wait" if wait else "never"
+        self.kernels = "wait" if compiled else "never"
 
     def __call__(self, t, q, qd, p):
         t = np.float64(t)
@@ -96,11 +92,11 @@ def _values_key(values):
 
 class _Group:
     """Functions sharing one raw function: evaluated by its numba kernel
-    (compiled/structures.py) once that is ready, else by one stacked numpy call when there are
-    at least STACK_MIN of them, else one by one. ``dest`` (outputs × members): where each
-    output of each member goes in the flat result."""
+    (compiled/structures.py, built at the first call) where ``kernels`` is "wait", else by one
+    stacked numpy call when there are at least STACK_MIN of them, else one by one. ``dest``
+    (outputs × members): where each output of each member goes in the flat result."""
 
-    def __init__(self, functions, indices, dest, kernels="when ready"):
+    def __init__(self, functions, indices, dest, kernels):
         first = functions[0]
         self.raw, self.dest = first.raw, dest
         self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
@@ -116,7 +112,6 @@ class _Group:
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
         self.kernel = None  # the numba kernel once it is ready and checked
         self.refused = kernels == "never"  # numpy for good (also when the kernel disagreed with numpy)
-        self.wait = kernels == "wait"
 
     def __call__(self, t, q, qd, p):
         if self.picks is None:
@@ -147,10 +142,10 @@ class _Group:
         return values
 
     def _take_kernel(self, t, q, qd, p, values):
-        """Use the kernel from now on if it is ready and agrees with numpy at this state."""
-        found = structures.kernel(self.raw, wait=self.wait)
+        """Use the kernel from now on (built now if need be) if it agrees with numpy at this state."""
+        found = structures.kernel(self.raw)
         if found is None:
-            self.refused = self.wait  # waited for, and none: numpy for good
+            self.refused = True  # none: numpy for good
             return
         result = np.empty(self.dest.shape)
         try:

@@ -10,10 +10,9 @@ one structure together. ``kernel(raw)`` turns that structure into
         values[:, m] and numbers from fixed[:, m]
 
 written into the cache under the hash of its text and compiled by numba (``cache=True``:
-a structure seen before, by any model, loads its machine code from disk). Like the
-Template (background.py), the kernel is built off the caller's thread unless
-``MBSYNTH_FAST`` is "wait"; "off" never builds it; until it is ready, ``kernel`` answers
-None and grouped.py uses numpy.
+a structure seen before, by any model, loads its machine code from disk). A Data on the
+compiled path (grouped.Batch with ``compiled``) builds it at its first call, waiting;
+``MBSYNTH_FAST=off`` never builds it (grouped.py then uses numpy).
 """
 
 import logging
@@ -22,7 +21,6 @@ import threading
 from ..symbolic.derive import beyond_double_as_inf
 from .background import mode
 from .codegen import assignments, load
-from .worker import Worker
 
 log = logging.getLogger(__name__)
 
@@ -40,45 +38,29 @@ def evaluate(t, q, qd, p, columns, values, fixed, out):
 SIGNATURE = ("(float64, float64[::1], float64[::1], float64[::1], int64[:, ::1], float64[:, ::1], "
              "float64[:, ::1], float64[:, ::1])")
 _lock = threading.Lock()
-UNSET = "unset"  # a raw function's ``kernel`` before its build was asked for
+UNSET = "unset"  # a raw function's ``kernel`` before its build
 
 
-def kernel(raw, wait=False):
+def kernel(raw):
     """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
-    symbolic.derive._lambdified), or None: not ready yet, MBSYNTH_FAST=off, or not compilable.
-    ``wait``: build it now if it is not ready (as MBSYNTH_FAST=wait does). The kernel is
-    kept on ``raw`` itself (its attribute ``kernel``: None while building or failed)."""
-    found = getattr(raw, "kernel", UNSET)
-    if found is not None and found is not UNSET:
-        return found
-    if found is None and not wait:
+    symbolic.derive._lambdified), built now if it is not yet, or None: MBSYNTH_FAST=off,
+    or not compilable. Kept on ``raw`` itself (its attribute ``kernel``)."""
+    if mode() == "off" or not hasattr(raw, "structure"):
         return None
-    setting = mode()
-    if setting == "off" or not hasattr(raw, "structure"):
-        return None
-    with _lock:
-        building = getattr(raw, "kernel", UNSET) is not UNSET
-        if not building:
-            raw.kernel = None
-    if setting == "wait" or wait:
-        _build(raw)  # a background build of the same structure may run too: either result serves
-    elif not building:
-        _worker.submit(raw)
+    with _lock:  # one build per structure; another thread asking meanwhile waits for it
+        if getattr(raw, "kernel", UNSET) is UNSET:
+            raw.kernel = _build(raw)
     return raw.kernel
 
 
 def _build(raw):
     try:
         evaluate = load(source(*raw.structure()), prefix="mbsynth_structure").evaluate
-        evaluate.compile(SIGNATURE)  # here, not at the first call (which may be on the caller's thread)
+        evaluate.compile(SIGNATURE)  # here, not at the first call
     except Exception as err:  # noqa: BLE001 - numpy serves
-        if not _worker.closed:  # else Python is exiting: what failed is the exit's doing
-            log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
-        return
-    raw.kernel = evaluate
-
-
-_worker = Worker("mbsynth-structures", _build)
+        log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
+        return None
+    return evaluate
 
 
 def source(args, forms):

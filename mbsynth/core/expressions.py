@@ -14,11 +14,11 @@ holds no number beyond the double range, no division by zero and nothing complex
 """
 
 import ast
-import functools
 import re
 
 import numpy as np
 import sympy as sp
+from .memo import MEMO
 
 FUNCTIONS = {
     "sin": sp.sin, "cos": sp.cos, "tan": sp.tan,
@@ -104,17 +104,17 @@ def _from_form(text, symbols):
         expr = _parsed_form(form, len(names))
     except (ValueError, SyntaxError, RecursionError, MemoryError):  # ExpressionError among them
         return None
-    return expr.xreplace({_FORM_SLOTS[j]: symbols[name] for j, name in enumerate(names)}) if names else expr
+    return expr.xreplace({_form_slot(j): symbols[name] for j, name in enumerate(names)}) if names else expr
 
 
-_FORM_SLOTS = [sp.Symbol(f"\0v{j}") for j in range(64)]  # names no model symbol has
+def _form_slot(j):
+    """The symbol standing for a form's j-th name: a name no model symbol has."""
+    return sp.Symbol(f"\0v{j}")
 
 
-@functools.lru_cache(maxsize=4096)
+@MEMO.function(4096)
 def _parsed_form(form, count):
-    if count > len(_FORM_SLOTS):
-        _FORM_SLOTS.extend(sp.Symbol(f"\0v{j}") for j in range(len(_FORM_SLOTS), count))
-    slots = {f"_v{j}": _FORM_SLOTS[j] for j in range(count)}
+    slots = {f"_v{j}": _form_slot(j) for j in range(count)}
     return _check_value(_Translator(slots, form).visit(ast.parse(form, mode="eval").body), form)
 
 

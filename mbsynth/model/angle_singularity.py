@@ -75,7 +75,7 @@ def explain(singularities, where="at"):
 
 
 class AngleParts:
-    """The parts of ``system`` (a System or Data) that turn by angles, their angles' places in q."""
+    """The parts of the model ``system`` that turn by angles, their angles' places in q."""
 
     def __init__(self, system):
         self.coordinates = list(system.coordinates)

@@ -1,26 +1,27 @@
-"""A System's workspace: ``data = system.data()``, as Pinocchio's Data beside its Model.
+"""A model's workspace: ``data = system.data(path=)``, as Pinocchio's Data beside its Model.
 
-A System (system.py) is the model, a value: parts, connectors, forces, the coordinate
+A System (system.py) is the model, a value: parts, constraints, forces, the coordinate
 layout, parameter names and default values. What a computation keeps between calls lives
-in a Data made from it:
+in a Data made from it (``data.model`` is that System):
 
 - the parameter values, an array ``p`` in the model's parameter order (a controller writes
   them: ``set_parameters``; parameters defined by expressions of others follow);
-- the Evaluator of the connectors and parts (evaluation.py, the KKT path's arrays);
-- the compiled Engine (mbsynth.compiled) at those values, or None: the path ``motion`` takes.
+- its path, chosen when it is made: "compiled" (the kernels of mbsynth.compiled where they
+  cover the model, built at the first use and waited for) or "kkt" ((2.14) in its KKT form
+  throughout); by default ``mbsynth.compiled.background.default_path()`` ("compiled";
+  "kkt" where MBSYNTH_FAST=off). The path never depends on what a background build or a
+  file on disk happens to have finished, so equal models give equal results;
+- the Evaluator of the constraints and parts (evaluation.py) and the compiled Engine at
+  its parameter values.
 
-A Data's path is fixed when it is made — the compiled Engine when the kernels are compiled
-(in this process or on disk; its Template is waited for), else the KKT path throughout —
-so a result never depends on when a background compilation finishes: ``system.data()``
-(a run's) and the Data behind a System's own methods (``System.motion``, …) alike.
+The algorithms compute with a Data (``data.motion``, ``data.reactions``, …; the run loop,
+projection.py, outputs.py): they read the model's description from ``data.model`` and the
+parameter values from the Data, never from the model. ``workspace`` gives a model's
+default-path Data where a function is handed a model.
 
-A Data reads as its System for the model's description (coordinates, parts, names,
-``initial_state``): an algorithm written for a System takes a Data as well, and computes
-at the Data's parameter values.
-
-What Systems of one structure share (the System's ``shared``: the compiled Template, the
-Evaluators of the runs) is a cache of derived values: it changes how fast a Data is made,
-never what it computes.
+What models of one structure share (``Shared``: the compiled Template, the Evaluators, the
+joint kinematics, linearize's derivatives) is kept in the one cache (core/memo.py): it
+changes how fast a Data is made, never what it computes.
 """
 
 from dataclasses import dataclass
@@ -29,12 +30,15 @@ import numpy as np
 
 from ..compiled import background
 from ..core import equations, solvers
+from ..core.memo import MEMO
 from ..core.errors import SolveError
 from . import friction, reactions
 from .evaluation import Evaluator
 from .joint_values import JointValuesBatch
 
 UNSET = object()  # a Data's engine before its first use
+PATHS = ("compiled", "kkt")  # the compiled kernels (mbsynth.compiled) where they cover the model, or (2.14)'s KKT form
+STRUCTURES_KEPT = 16  # model structures whose compiled Template and evaluators MEMO keeps
 METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
 
 
@@ -50,53 +54,58 @@ class Assembly:
 
 
 class Shared:
-    """What the Systems of one structure (the same parts, connectors and forces; any
-    parameter values) share: the compiled Template's slot and the Evaluators made for them,
-    one per kernel setting ("wait" or "never": ``Data``)."""
-
-    def __init__(self, system):
-        self.structure = _structure(system)
-        self.compiled = background.TemplateSlot()
-        self.evaluators = {}
-
-    def fits(self, system):
-        """Whether ``system`` has the structure this was made for (the same parts,
-        connectors and forces, the same parameter names)."""
-        mine, theirs = self.structure, _structure(system)
-        return mine[3] == theirs[3] and all(len(a) == len(b) and all(x is y for x, y in zip(a, b))
-                                            for a, b in zip(mine[:3], theirs[:3]))
-
-    def evaluator(self, system, kernels):
-        found = self.evaluators.get(kernels)
-        if found is None:
-            found = Evaluator(system).fix_kernels(kernels == "wait")
-            self.evaluators[kernels] = found
-        return found
-
-
-def _structure(system):
-    return system.parts, system.connectors, system.forces, tuple(system.parameters)
-
-
-class Data:
-    """The workspace of computations on ``system`` at parameter values ``p``."""
+    """What the models of one structure (equal parts, constraints and forces, the same
+    parameter names; any parameter values) share, kept in ``MEMO``: the compiled Template's
+    slot, the Evaluators (one per path), the joint kinematics and the derivatives of
+    linearize. Made from the first model of the structure asked for."""
 
     def __init__(self, system):
         self.system = system
-        self.p = system.parameter_values
-        self._kernels = "wait" if background.compiled() else "never"
+        self.compiled = background.TemplateSlot()
+        self.evaluators = {}
+        self.joint_kinematics = None
+        self.derivatives = None
+
+    def evaluator(self, compiled):
+        found = self.evaluators.get(compiled)
+        if found is None:
+            found = Evaluator(self.system, compiled)
+            self.evaluators[compiled] = found
+        return found
+
+
+def workspace(model_or_data):
+    """The Data an algorithm computes with: ``model_or_data`` itself when it is a Data, a
+    model's Data of the default path otherwise (its parameter values, ``System._data``)."""
+    return model_or_data if isinstance(model_or_data, Data) else model_or_data._data
+
+
+def shared(system):
+    """The Shared of ``system``'s structure (``System.structure``), from ``MEMO``."""
+    return _STRUCTURES.get(system.structure, lambda: Shared(system))
+
+
+_STRUCTURES = MEMO.table("model structures", STRUCTURES_KEPT)
+
+
+class Data:
+    """The workspace of computations on ``system`` at parameter values ``p``, on the
+    ``path`` "compiled" or "kkt" (``PATHS``; None: ``background.default_path()``)."""
+
+    def __init__(self, system, path=None):
+        path = background.default_path() if path is None else path
+        if path not in PATHS:
+            raise ValueError(f"path must be one of {PATHS}, got {path!r}")
+        self.system = self.model = system
+        self.path = path
+        self.p = system.parameter_values.copy()
+        self._shared = shared(system)
         self._evaluator = None  # made on first use: a compiled run may never need it
         self._joint_values = None  # joint_values.JointValuesBatch, made on first use
-        self._engine = UNSET  # the compiled Engine, made on first use where the kernels are compiled
-
-    def __getattr__(self, name):
-        """The System's attribute: the model's description (coordinates, parts, names, …)."""
-        if name.startswith("__"):
-            raise AttributeError(name)
-        return getattr(self.system, name)
+        self._engine = UNSET  # the compiled Engine, made on first use on the compiled path
 
     def __repr__(self):
-        return f"Data({self.system.name!r}, path={'compiled' if self.engine else 'KKT'})"
+        return f"Data({self.system.name!r}, path={self.path!r})"
 
     @property
     def parameters(self):
@@ -110,16 +119,17 @@ class Data:
     @property
     def evaluator(self):
         if self._evaluator is None:
-            self._evaluator = self.system.shared.evaluator(self.system, self._kernels)
+            self._evaluator = self._shared.evaluator(self.path == "compiled")
         return self._evaluator
 
     @property
     def engine(self):
-        """The compiled Engine that serves ``motion``, or None (the KKT path): the path fixed
-        when this Data was made (its Template waited for at the first use)."""
+        """The compiled Engine that serves ``motion`` on the compiled path (its Template built
+        at the first use, waited for), or None: the KKT path, or a model the kernels do not
+        cover."""
         if self._engine is UNSET:
-            template = background.template(self.system, wait=self._kernels == "wait")  # else its build starts
-            self._engine = None if template is None or self._kernels == "never" else template.engine(self.p)
+            template = None if self.path == "kkt" else background.template(self.system, self._shared.compiled)
+            self._engine = None if template is None else template.engine(self.p)
         return self._engine
 
     def set_parameters(self, values):
@@ -171,7 +181,12 @@ class Data:
         return self.evaluator.power(t, q, qd, self.p)
 
     def branch_problems(self, q=None, t=0.0):
+        """``System.branch_problems`` at this Data's parameter values."""
         return self.system.branch_problems(q, t, self.p)
+
+    def part_problems(self, parameters=None):
+        """``System.part_problems`` at this Data's parameter values."""
+        return self.system.part_problems(parameters, self.p)
 
     def check_branches(self, q, t=0.0):
         """Raise SolveError naming the first joint whose frames, at the state q, are in a
@@ -280,8 +295,8 @@ class Data:
         q, qd = self._state(q, qd)
         qdd = None if qdd is None else np.asarray(qdd, dtype=float).ravel()
         if self._joint_values is None:
-            self._joint_values = JointValuesBatch(k for k in self.system.joint_kinematics().values()
-                                                  if k.position_names)
+            self._joint_values = JointValuesBatch((k for k in self.system.joint_kinematics().values()
+                                                   if k.position_names), self.path == "compiled")
         return self._joint_values(t, q, qd, qdd, self.p)
 
     def reactions(self, t, q, qd, motion=None):

@@ -1,6 +1,7 @@
 """A System's arrays at one state, evaluated a structure at a time (grouped.Batch).
 
-An ``Evaluator(system)`` (a Data's, data.py) gives
+An ``Evaluator(system, compiled)`` (a Data's, data.py; ``compiled``: the shared structures
+evaluated by their numba kernels, else by numpy) gives
 
 - ``constraints(t, q, qd)``: one evaluation of every connector's rows: A (sparse CSR), b,
   C, and the residuals φ, φ̇ (NaN on rows without that level) — drift control and
@@ -38,11 +39,11 @@ class ConstraintArrays(NamedTuple):
 class Evaluator:
     """The layout of a System's connectors and parts for evaluation in batches."""
 
-    def __init__(self, system):
+    def __init__(self, system, compiled):
         constraints, n = system.connectors, system.n
         self.n = n
         self.m = sum(c.size for c in constraints)
-        self.rows = Batch([c._rows for c in constraints], [c.indices for c in constraints], 5)
+        self.rows = Batch([c._rows for c in constraints], [c.indices for c in constraints], 5, compiled)
         starts = np.cumsum([0] + [c.size for c in constraints])
         pattern = [np.meshgrid(np.arange(s, s + c.size), c.indices, indexing="ij")
                    for s, c in zip(starts, constraints)]
@@ -61,11 +62,11 @@ class Evaluator:
         stops = np.cumsum([len(s.coordinates) for s in system.parts])
         ranges = [np.arange(stop - len(s.coordinates), stop) for s, stop in zip(system.parts, stops)]
         grouped = [type(s).evaluate is Part.evaluate and isinstance(s._evaluate, Compiled) for s in system.parts]
-        self.blocks = Batch([s._evaluate if g else s.evaluate for s, g in zip(system.parts, grouped)], ranges, 2)
+        self.blocks = Batch([s._evaluate if g else s.evaluate for s, g in zip(system.parts, grouped)], ranges, 2, compiled)
         self.energy = Batch([s._energy if type(s).energy is Part.energy and isinstance(s._energy, Compiled)
-                             else s.energy for s in system.parts], ranges, 2)
+                             else s.energy for s in system.parts], ranges, 2, compiled)
         forces = system.forces
-        self.forces = Batch([f._evaluate for f in forces], [f.indices for f in forces], 2)
+        self.forces = Batch([f._evaluate for f in forces], [f.indices for f in forces], 2, compiled)
         self.f_cols = np.concatenate([np.zeros(0, int)] + [f.indices for f in forces])
         self.working = ([(part, r) for part, r in zip(system.parts, ranges) if part.working],
                         [f for f in forces if not f.conservative],
@@ -73,14 +74,6 @@ class Evaluator:
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
-        self.fixed = False  # every group's path decided at its first call, for good (fix_kernels)
-
-    def fix_kernels(self, wait):
-        """Fix every group's path at its first evaluation (grouped.Batch.fix_kernels); returns self."""
-        for batch in (self.rows, self.blocks, self.energy, self.forces):
-            batch.fix_kernels(wait)
-        self.fixed = True
-        return self
 
     def constraints(self, t, q, qd, p, sparse=True):
         """ConstraintArrays at (t, q, q̇) with parameter values p; A sparse (CSR) or dense

@@ -14,26 +14,27 @@ Builders: ``point_spring`` (a linear spring and damper between two points),
 ``applied_force`` (a force at a point), ``applied_torque`` (a torque on a body).
 """
 
-import functools
-
 import numpy as np
 import sympy as sp
 
 from .parts.base import Frame, frame_velocity
 from .parts.spring import quiet_at_zero_length, spring_damper
+from ..core.values import Keyed, freeze
 from ..symbolic.cache import placeholder
 from ..symbolic.derive import T_SYMBOL, compile_function, generalized_force, placed_values
+from ..core.memo import MEMO
 
 AXES = ("world", "body")
 
 
-class ForceElement:
+class ForceElement(Keyed):
     """A named force element: ``Q`` (sympy, over all the model's coordinates) and its
     potential energy ``V`` (0 for non-conservative elements). ``joint``: the name of the
     joint it acts across (joint_forces.py), whose reaction includes it; None otherwise."""
 
     def __init__(self, name, V, efforts, q, qd, params, joint=None):
         self.name, self.joint = name, joint
+        self._defined_by = (sp.sympify(V), freeze(efforts), tuple(q), tuple(qd))
         self.conservative = all(sp.sympify(effort) == 0 for effort, _ in efforts)  # all of Q from V
         self.V = sp.sympify(V)
         self._Q = Q = generalized_force(self.V, efforts, q, qd)
@@ -63,11 +64,17 @@ class ForceElement:
         element._power = element._power_terms = None
         constants = {**constants, **dict(zip(marks, efforts))}
         element._Q, element._placed = None, (column, slots, coordinates, constants, q, qd)
+        element._defined_by = element._placed
         element.indices = np.array([coordinates[j] for j in local], dtype=int)
         element._evaluate = compile_function(
             (T_SYMBOL, [slots[0][j] for j in local], [slots[1][j] for j in local], list(params)),
             [sp.Matrix([column[j] for j in local]), sp.S.Zero], constants=list(constants.items()))
         return element
+
+    def content(self):
+        """What defines the element (its equality, ``core.values``): its name, joint and the
+        potential and efforts (or the template and values) it was given."""
+        return self.name, self.joint, self._defined_by
 
     @property
     def Q(self):
@@ -110,7 +117,7 @@ def _power_function(Q, V, q, qd, params):
     return compile_function((T_SYMBOL, q, qd, params), [power])
 
 
-@functools.lru_cache(maxsize=256)
+@MEMO.function(256)
 def _column(gradients, marks, slots):
     """(Σ_k mark_k ∂rate_k/∂q̇ per velocity slot, the slots whose coordinate or velocity it
     involves): once per template."""

@@ -108,9 +108,10 @@ class JointValuesBatch:
 
     SLOTS = 9  # the outputs of a JointKinematics' function (``_expressions``)
 
-    def __init__(self, kinematics):
+    def __init__(self, kinematics, compiled):
         self.kinematics = list(kinematics)
-        self.batch = Batch([k._evaluate for k in self.kinematics], [k.indices for k in self.kinematics], self.SLOTS)
+        self.batch = Batch([k._evaluate for k in self.kinematics], [k.indices for k in self.kinematics], self.SLOTS,
+                           compiled)
         self.shapes = None  # per joint, where each output lies in its slot (``_layout``, at the first call)
 
     def __call__(self, t, q, qd, qdd, p):

@@ -24,6 +24,7 @@ import sympy as sp
 
 from ..core.errors import ModelError
 from ..symbolic.derive import T_SYMBOL, compile_function, time_derivative
+from .data import workspace
 
 AXES = ("x", "y", "z")
 BUILT_IN_COLUMNS = ("t", "energy")  # a trajectory file's columns besides the coordinates and velocities
@@ -85,10 +86,12 @@ def energy_output(name, which):
 
 
 class OutputEvaluator:
-    """The columns of a System's outputs at states of a run."""
+    """The columns of a model's outputs at states of a run, computed with ``data`` (a Data,
+    data.py: its parameter values; or a model: its default-path Data)."""
 
-    def __init__(self, system):
-        self.system = system
+    def __init__(self, data):
+        self.data = data = workspace(data)
+        system = data.model
         self.outputs = tuple(system.outputs)
         self.names = [c for o in self.outputs for c in o.columns]
         exprs = [e for o in self.outputs for e in o.expressions]
@@ -103,18 +106,18 @@ class OutputEvaluator:
     def evaluate(self, t, q, qd, motion=None):
         """One row: every output's columns at (t, q, q̇); ``motion`` (System.motion at that
         state) for reactions, computed when not given."""
-        system, p = self.system, self.system.parameter_values
+        data, p = self.data, self.data.p
         compiled = iter(self._compiled(t, q, qd, p)[0].ravel()) if self._compiled else iter(())
         reactions = None
         if self.needs_reactions:
-            reactions = system.reactions(t, q, qd, motion)
+            reactions = data.reactions(t, q, qd, motion)
         energies = None
         row = []
         for output in self.outputs:
             if output.kind == "reaction":
                 row += list(getattr(reactions[output.connector], output.part))
             elif output.kind == "energy":
-                energies = system.energy(t, q, qd) if energies is None else energies
+                energies = data.energy(t, q, qd) if energies is None else energies
                 kinetic, potential = energies
                 row.append({"kinetic": kinetic, "potential": potential, "total": kinetic + potential}[output.part])
             else:

@@ -1,26 +1,30 @@
 """A System: the model — parts, their coordinate layout, the constraints joining them,
 the force elements, parameter names and default values.
 
-A System is a value: built once, never changed, two equal Systems behave the same.
-What a computation keeps between calls (parameter values as an array, evaluators, the
-compiled engine and the path it takes) lives in a Data made from it (``system.data()``,
-data.py). The System's own methods (``evaluate``, ``motion``, ``reactions``, …) compute at
-its parameter values through a Data it makes on first use: ``evaluate(t, q, qd)``
-assembles the block-diagonal M, the stacked Q and the constraint rows A, b, C;
-``motion(t, q, qd)`` solves them with the singular-mass equation (2.14).
+A System is a value: immutable (tuples, read-only arrays and mappings), equal to another
+with the same content (``==`` and ``hash``: two loads of one file are equal), holding no
+cache and no work. What a computation keeps between calls (parameter values as an array,
+evaluators, the compiled engine and its path) lives in a Data made from it
+(``system.data(path=)``, data.py); what models of one structure share, in the one cache
+(core/memo.py). The algorithms are functions of the Data (``data.motion(t, q, q̇)``, …);
+the System's own methods (``evaluate``, ``motion``, ``reactions``, …) compute at its
+parameter values, each through the Data of the default path.
 """
 
 import functools
 import math
 import numbers
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 import sympy as sp
 
 from .connectors.joints import Joint
-from .data import Data, Shared
+from ..compiled.background import default_path
+from .data import Data, shared
 from ..core.errors import ModelError
+from ..core.memo import MEMO
+from ..core.values import freeze, frozen_mapping, read_only
 from .joint_values import JointKinematics, value_expressions
 from .parts import LINK_FRAME, Frame
 from ..symbolic.derive import T_SYMBOL
@@ -48,7 +52,32 @@ class Substructure:
     children: tuple = ()
 
 
-@dataclass(frozen=True)
+DEFAULT_DATA_KEPT = 16  # models whose default-path Data (``System._data``) the one cache keeps
+
+
+class Structure:
+    """What models that differ only in parameter values share: their parts, constraints,
+    force elements and parameter names, equal by content (``core.values``); the key of
+    the one cache's ``model structures`` table (data.py)."""
+
+    __slots__ = ("parts", "connectors", "forces", "names", "_hash")
+
+    def __init__(self, parts, connectors, forces, names):
+        self.parts, self.connectors, self.forces, self.names = parts, connectors, forces, names
+        self._hash = None
+
+    def __eq__(self, other):
+        return self is other or (isinstance(other, Structure) and hash(self) == hash(other) and
+                                 (self.parts, self.connectors, self.forces, self.names) ==
+                                 (other.parts, other.connectors, other.forces, other.names))
+
+    def __hash__(self):
+        if self._hash is None:  # a hash of immutable content, kept as str keeps its own
+            self._hash = hash((self.parts, self.connectors, self.forces, self.names))
+        return self._hash
+
+
+@dataclass(frozen=True, eq=False)
 class System:
     """An assembled model. Build it with ``mbsynth.load`` or ``System.build``."""
 
@@ -76,13 +105,48 @@ class System:
     fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load
     load_parameters: dict = None  # the values given to ``load`` (``parameters=``), built in at load
     built_parameters: dict = None  # every parameter's value as the model was built at load
-    # what Systems of this structure share (data.Shared: the compiled Template, evaluators): a
-    # cache of derived values, handed on by ``with_parameters``, no part of the System's value
-    shared: Shared = field(default=None, compare=False, repr=False)
+    # derived from the fields above as the System is made (no part of its value)
+    structure: "Structure" = field(init=False, repr=False)
+    coordinate_groups: np.ndarray = field(init=False, repr=False)
+    constraint_names: tuple = field(init=False, repr=False)
+    parameter_index: dict = field(init=False, repr=False)
+    parameter_symbols: tuple = field(init=False, repr=False)
+    coulomb: bool = field(init=False, repr=False)
 
     def __post_init__(self):
-        if self.shared is None or not self.shared.fits(self):  # built anew, or its structure replaced
-            object.__setattr__(self, "shared", Shared(self))
+        """Freeze what was given (read-only arrays and mappings) and derive the rest."""
+        put = functools.partial(object.__setattr__, self)
+        put("parameters", frozen_mapping(self.parameters))
+        for name in ("definitions", "initial_definitions", "fixed_parameters", "load_parameters", "built_parameters"):
+            put(name, frozen_mapping(getattr(self, name)))
+        put("initial_q", read_only(self.initial_q))
+        put("initial_qd", read_only(self.initial_qd))
+        put("structure", Structure(self.parts, self.connectors, self.forces, tuple(self.parameters)))
+        put("coordinate_groups", read_only(_coordinate_groups(self.parts)))
+        # one name per row of A (a joint with k rows names them ``joint[label]``)
+        put("constraint_names", tuple(row for c in self.connectors for row in c.row_names))
+        put("parameter_index", frozen_mapping({name: i for i, name in enumerate(self.parameters)}))
+        put("parameter_symbols", tuple(sp.Symbol(name) for name in self.parameters))
+        # whether a constraint has Coulomb friction (its C depends on q̈)
+        put("coulomb", any(getattr(con, "coulomb", None) for con in self.connectors))
+
+    def _content(self):
+        return tuple(getattr(self, f.name) for f in fields(self) if f.init)
+
+    def __eq__(self, other):
+        if self is other:
+            return True
+        if type(other) is not type(self):
+            return NotImplemented
+        return hash(self) == hash(other) and freeze(self._content()) == freeze(other._content())
+
+    def __hash__(self):
+        found = self.__dict__.get("_hash")  # a hash of immutable content, kept as str keeps its own
+        if found is None:
+            found = hash((self.name, self.structure, self.coordinates, tuple(self.parameters.values()),
+                          self.initial_q.tobytes(), self.initial_qd.tobytes()))
+            self.__dict__["_hash"] = found
+        return found
 
     @classmethod
     def build(cls, name, parts, connectors, q_symbols, qd_symbols, parameters, initial=None, forces=(),
@@ -116,49 +180,12 @@ class System:
                    initial_given=frozenset(initial or ()), initial_fixed=frozenset(initial_fixed))
 
     @property
-    def subsystems(self):
-        """The parts, by the model file's name for them (``subsystems:``)."""
-        return self.parts
-
-    @property
-    def constraints(self):
-        """The connectors, by the model file's name for them (``constraints:``)."""
-        return self.connectors
-
-    @property
     def n(self):
         return len(self.coordinates)
-
-    @functools.cached_property
-    def coordinate_groups(self):
-        """One label per coordinate, equal for the coordinates that move together (a part's
-        ``groups``: a point's x, y, z, a quaternion's four numbers), for projection.py's metric."""
-        labels, start = [], 0
-        for part in self.parts:
-            group = {c: start + k for k, members in enumerate(part.groups) for c in members}
-            labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
-            start += len(part.groups) + len(part.coordinates)
-        return np.array(labels)
-
-    @functools.cached_property
-    def constraint_names(self):
-        """One name per row of A (a joint with k rows names them ``joint[label]``): a tuple,
-        made once (every KKT evaluation hands it on)."""
-        return tuple(row for c in self.connectors for row in c.row_names)
 
     @property
     def parameter_values(self):
         return np.array(list(self.parameters.values()), dtype=float)
-
-    @functools.cached_property
-    def parameter_index(self):
-        """{parameter name: its place in the model's order}."""
-        return {name: i for i, name in enumerate(self.parameters)}
-
-    @functools.cached_property
-    def parameter_symbols(self):
-        """The parameters' sympy symbols, in the model's order."""
-        return tuple(sp.Symbol(p) for p in self.parameters)
 
     def initial_state(self):
         """(q, q̇) from the model's ``initial:`` mapping (copies)."""
@@ -251,16 +278,18 @@ class System:
         raise ModelError(f"model '{self.name}': parameter '{name}' takes a real number (or a real array of one "
                          f"element), got {got}")
 
-    def data(self):
-        """A new workspace for a run on this System (data.Data): its parameter values, its
-        evaluators and the compiled engine, the path fixed as it is made."""
-        return Data(self)
+    def data(self, path=None):
+        """A new workspace for computations on this System (data.Data): its parameter
+        values, evaluators and compiled engine. ``path``: "compiled" or "kkt" (data.PATHS);
+        None: the default (``mbsynth.compiled.background.default_path``)."""
+        return Data(self, path)
 
-    @functools.cached_property
+    @property
     def _data(self):
-        """The Data of this System's own methods, made on first use (data.Data: its path
-        fixed as it is made, as a run's)."""
-        return Data(self)
+        """The Data of the default path behind this System's own methods, kept in the one
+        cache (core/memo.py) so that repeated calls share its evaluators and engine."""
+        path = default_path()
+        return _DEFAULT_DATA.get((self, path), lambda: Data(self, path))
 
     def part_problems(self, parameters=None, p=None):
         """[(part name, message)] for each part whose M or Q is not finite, or whose M is not
@@ -334,10 +363,9 @@ class System:
     def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
         Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
-        (2.14)). "fast" is the linear-time compiled path (``mbsynth.compiled``) once its kernels
-        are ready (they build in the background on first use; a run's Data fixes the
-        choice for the run: data.py) and where its checks pass, else the KKT path; both
-        fall back to the exact treatment when the problem is not well posed.
+        (2.14)). "fast" is the Data's path (data.py: by default the linear-time compiled path of
+        ``mbsynth.compiled`` where it covers the model and its checks pass, else the KKT
+        path); both fall back to the exact treatment when the problem is not well posed.
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
         residuals (drift control during integration; b itself when they are zero).
         Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``
@@ -348,11 +376,6 @@ class System:
         aside) instead of raising SolveError for contradictory constraints.
         The Motion's ``lam`` (the multipliers, reactions.py) is computed when first read."""
         return self._data.motion(t, q, qd, method, baumgarte, drift)
-
-    @functools.cached_property
-    def coulomb(self):
-        """Whether a constraint has Coulomb friction (its C depends on q̈), found once."""
-        return any(getattr(con, "coulomb", None) for con in self.connectors)
 
     def motion_batch(self, t, q_batch, qd_batch):
         """q̈ at many states, one per row of ``q_batch`` and ``qd_batch`` (t: a number or one
@@ -381,23 +404,12 @@ class System:
     def joint_kinematics(self):
         """{name: joint_values.JointKinematics} of every joint (reaction frames; fixed and
         distance joints have no values) and of each floating robot's root link
-        (``<prefix>root_joint``, a free joint, as Pinocchio names it), compiled on first use."""
-        return self._joint_kinematics
-
-    @functools.cached_property
-    def _joint_kinematics(self):
-        found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
-                                         c.report_frame, self)
-                 for c in self.connectors if isinstance(c, Joint)}
-        parts = {p.name: p for p in self.parts}
-        for robot in self.robots:
-            if robot.floating:
-                root = parts[robot.parts[robot.description.root]]
-                frame = root.frames[LINK_FRAME]
-                world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
-                name = f"{robot.prefix}root_joint"
-                found[name] = JointKinematics(name, "free", None, world, root, frame, frame, self)
-        return found
+        (``<prefix>root_joint``, a free joint, as Pinocchio names it), compiled on first use
+        and shared by the models of one structure (data.Shared)."""
+        held = shared(self)
+        if held.joint_kinematics is None:
+            held.joint_kinematics = _joint_kinematics(self)
+        return held.joint_kinematics
 
     def joint_values(self, t, q, qd, qdd=None):
         """{joint name: JointValues(position, rate, acceleration)} of every joint that has
@@ -445,6 +457,36 @@ class System:
         found += [part.name for part in self.parts if _time_in_part(part)]
         found += [con.name for con in self.connectors if getattr(con, "coulomb", None) or _time_in_rows(con)]
         return found
+
+
+_DEFAULT_DATA = MEMO.table("default data", DEFAULT_DATA_KEPT)
+
+
+def _joint_kinematics(system):
+    """``System.joint_kinematics`` made anew."""
+    found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
+                                     c.report_frame, system)
+             for c in system.connectors if isinstance(c, Joint)}
+    parts = {p.name: p for p in system.parts}
+    for robot in system.robots:
+        if robot.floating:
+            root = parts[robot.parts[robot.description.root]]
+            frame = root.frames[LINK_FRAME]
+            world = Frame("world", "origin", sp.zeros(3, 1), sp.eye(3))
+            name = f"{robot.prefix}root_joint"
+            found[name] = JointKinematics(name, "free", None, world, root, frame, frame, system)
+    return found
+
+
+def _coordinate_groups(parts):
+    """One label per coordinate, equal for the coordinates that move together (a part's
+    ``groups``: a point's x, y, z, a quaternion's four numbers), for projection.py's metric."""
+    labels, start = [], 0
+    for part in parts:
+        group = {c: start + k for k, members in enumerate(part.groups) for c in members}
+        labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
+        start += len(part.groups) + len(part.coordinates)
+    return np.array(labels)
 
 
 def _time_in_part(part):

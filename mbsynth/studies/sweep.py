@@ -37,6 +37,7 @@ import sympy as sp
 from ..core.errors import ModelError, SolveError
 from ..core.expressions import ExpressionError, parse
 from ..core.files import file_format, write_atomically
+from ..core.memo import MEMO
 from ..io import load, loads
 from ..analysis.simulate import simulate
 from ..symbolic.derive import T_SYMBOL
@@ -174,14 +175,14 @@ class ModelText:
 
     def system(self):
         """The System as the sweep was given it, the file built once per process."""
-        key = (self.source, self.folder, self.load_parameters, self.changed)
-        if key not in _SYSTEMS:
+        def build():
             system = loads(self.source, name=self.name, folder=self.folder or None, parameters=dict(self.load_parameters))
-            _SYSTEMS[key] = system.with_parameters(**dict(self.changed))
-        return _SYSTEMS[key]
+            return system.with_parameters(**dict(self.changed))
+        return _SYSTEMS.get((self.source, self.folder, self.load_parameters, self.changed), build)
 
 
-_SYSTEMS = {}  # per worker process: (model text, folder, load values, changed values) -> System
+SYSTEMS_KEPT = 8  # models a sweep's worker process keeps built (one per model file and load values swept)
+_SYSTEMS = MEMO.table("sweep models", SYSTEMS_KEPT)  # (model text, folder, load values, changed values) -> System
 
 
 def changed_parameters(system):

@@ -34,8 +34,8 @@ import sympy as sp
 from sympy.core.parameters import evaluate
 
 from ..core.files import cache_dir, mark_and_prune, sources_hash, write_atomically
+from ..core.memo import MEMO
 
-_folder = None
 
 
 def placeholder(tag):
@@ -178,20 +178,18 @@ def fingerprint(value, seen=None):
     return digest
 
 
+@MEMO.function(1)
 def _cache_folder():
     """``<cache>/derivations/<digest of this package's sources and sympy's version>``,
-    created; None when off or not writable."""
-    global _folder
-    if _folder is None:
-        _folder = False
-        if os.environ.get("MBSYNTH_DERIVATION_CACHE", "").lower() not in ("off", "0", "no"):
-            try:
-                salt = sp.__version__ + MAGIC_NUMBER.hex()
-                digest = sources_hash(Path(__file__).resolve().parents[1], "**/*.py", salt=salt)
-                folder = cache_dir() / "derivations" / digest
-                folder.mkdir(parents=True, exist_ok=True)
-                mark_and_prune(folder)  # and the entries of older sources removed
-                _folder = folder
-            except OSError:
-                pass
-    return _folder or None
+    created (once per process); None when off or not writable."""
+    if os.environ.get("MBSYNTH_DERIVATION_CACHE", "").lower() in ("off", "0", "no"):
+        return None
+    try:
+        salt = sp.__version__ + MAGIC_NUMBER.hex()
+        digest = sources_hash(Path(__file__).resolve().parents[1], "**/*.py", salt=salt)
+        folder = cache_dir() / "derivations" / digest
+        folder.mkdir(parents=True, exist_ok=True)
+        mark_and_prune(folder)  # and the entries of older sources removed
+    except OSError:
+        return None
+    return folder

@@ -14,14 +14,14 @@ names of their coordinates and the numbers of their frames, so their rows are
 differentiated and compiled a handful of times, not fifty.
 """
 
-import functools
-
 import numpy as np
 import sympy as sp
 
 from .cache import Unstable, fingerprint, placeholder, remembered, remembered_function
+from ..core.memo import MEMO
 
 T_SYMBOL = sp.Symbol("t")
+LAMBDIFIED_KEPT = 65536  # structures whose numpy function the one cache keeps (far above a model's count)
 PARAMETERS = 3  # the position of the model's parameters among a part's or connector's arguments (t, q, q̇, p)
 _LARGEST = sp.Float(np.finfo(float).max)
 # pi and e as numpy floats, so that all arithmetic of a compiled expression is numpy's:
@@ -80,7 +80,7 @@ def _plain(symbol):
     return type(symbol) is sp.Symbol and symbol.assumptions0 == _PLAIN
 
 
-@functools.lru_cache(maxsize=1024)
+@MEMO.function(1024)
 def _lagrange(T, V, F, q, qd, t):
     """``lagrange`` of these T, V, F in these q, q̇: once per process, and kept on disk (cache.py)."""
     def derive():
@@ -270,22 +270,24 @@ def placed_values(slots, coordinates, constants, q, qd):
     return put
 
 
-_last_positions = ((), (), {})
+_POSITIONS = MEMO.table("coordinate positions", 1)  # the last pair asked: every constraint of a model asks for it
 
 
 def positions(q, qd):
-    """{symbol: index} of the coordinates q and velocities q̇, kept for the last pair
-    asked (every constraint of a model asks for the same two)."""
-    global _last_positions
-    q, qd = tuple(q), tuple(qd)
-    if _last_positions[:2] != (q, qd):  # tuples of the same symbols compare by identity first: fast
-        where = {s: i for i, s in enumerate(q)}
-        where.update({s: i for i, s in enumerate(qd)})
-        _last_positions = (q, qd, where)
-    return _last_positions[2]
+    """{symbol: index} of the coordinates q and velocities q̇, kept for the last pair asked."""
+    key = (tuple(q), tuple(qd))
+    last = _POSITIONS.last()
+    if last is not None and last[0] == key:  # tuples of the same symbols compare by identity first: fast
+        return last[1]
+
+    def make():
+        where = {s: i for i, s in enumerate(key[0])}
+        where.update({s: i for i, s in enumerate(key[1])})
+        return where
+    return _POSITIONS.get(key, make)
 
 
-@functools.lru_cache(maxsize=4096)
+@MEMO.function(4096)
 def _differentiated(forms, count, t):
     """``differentiate`` of each placeholder form in the coordinates a_0 … a_{count−1}
     and velocities a_count …: (rows of a over the involved coordinates, b, ψ)."""
@@ -383,17 +385,16 @@ def _picking(args, position, flat, constants):
             tuple((v, (position, index[v])) for _, v in constants if v in index))
 
 
-_last_index = ((), {})
+_INDEX = MEMO.table("symbol positions", 1)  # the last list asked: every part and constraint asks for the parameters
 
 
 def _index_of(symbols):
-    """{symbol: its position in ``symbols``}, kept for the last list asked (every part and
-    connector of a model asks for its parameters)."""
-    global _last_index
-    symbols, found = tuple(symbols), _last_index  # one read: another thread may replace it
-    if found[0] != symbols:  # tuples of the same symbols compare by identity first: fast
-        found = _last_index = (symbols, {s: i for i, s in enumerate(symbols)})
-    return found[1]
+    """{symbol: its position in ``symbols``}, kept for the last list asked."""
+    symbols = tuple(symbols)
+    last = _INDEX.last()
+    if last is not None and last[0] == symbols:  # tuples of the same symbols compare by identity first: fast
+        return last[1]
+    return _INDEX.get(symbols, lambda: {s: i for i, s in enumerate(symbols)})
 
 
 class Compiled:
@@ -413,7 +414,7 @@ class Compiled:
         return tuple(part.reshape(shape) for part, shape in zip(np.split(out, self.splits), self.shapes))
 
 
-@functools.lru_cache(maxsize=4096)
+@MEMO.function(4096)
 def _compiled(args, flat, placeholders):
     """(numpy function of (args, placeholder values, numbers), the numbers): the
     expressions in ``canonical`` form, compiled once per structure. Both the canonical
@@ -441,33 +442,29 @@ def _compiled(args, flat, placeholders):
     return _lambdified(digest, structure), numbers
 
 
-@functools.lru_cache(maxsize=4096)
+@MEMO.function(4096)
 def _structure_digest(structure):
     """``fingerprint`` of a structure (argument slots, count of numbers, canonical forms):
     once per structure in a process, however many instances have it."""
     return fingerprint(structure)
 
 
-_by_structure = {}  # structure digest -> its numpy function, one per structure in this process
+_LAMBDIFIED = MEMO.table("lambdified structures", LAMBDIFIED_KEPT)  # structure digest -> its numpy function
 
 
 def _lambdified(digest, structure):
     """The numpy function of the structure ``digest`` (``structure()``: its argument slots
     and forms), made once per structure: joints alike, and models loaded again (a sweep's
     workers, a file checked then simulated) reuse it."""
-    raw = _by_structure.get(digest)
-    if raw is None:
-        def derive():
-            args, forms = _positional(*structure())
-            return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"],
-                               cse=True)
+    def derive():
+        args, forms = _positional(*structure())
+        return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True)
 
-        if digest is None:
-            raw = derive()
-        else:
-            raw = _by_structure[digest] = remembered_function("lambdified", digest, derive)
+    def make():
+        raw = derive() if digest is None else remembered_function("lambdified", digest, derive)
         raw.structure = _kernel_view(structure)  # for compiled/structures.py, which compiles it with numba
-    return raw
+        return raw
+    return make() if digest is None else _LAMBDIFIED.get(digest, make)
 
 
 def _kernel_view(structure):
@@ -495,7 +492,7 @@ def _positions_in(args, picks=()):
     return where
 
 
-@functools.lru_cache(maxsize=4096)
+@MEMO.function(4096)
 def _values(args, values, picks=()):
     """A function of ``args`` giving the array of ``values``: gathered from numbers and picks
     (k, argument a, position i or None) of the arguments (``picks``: where symbols read from

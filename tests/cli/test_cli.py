@@ -38,20 +38,20 @@ def test_unique_models(capsys, name, n, m, rank_M, rank_A):
     assert report["consistent"]
 
 
-def test_check_compiles_nothing_and_leaves_the_fast_mode_as_it_was(capsys, monkeypatch):
-    """``check`` runs with MBSYNTH_FAST taken as "off" where the user left it unset, and
-    only while it runs: the models simulated after it in the same process (as in this test
+def test_check_compiles_nothing_and_leaves_the_default_path_as_it_was(capsys, monkeypatch):
+    """``check`` computes on the KKT path where the user left MBSYNTH_FAST unset, and only
+    while it runs: the models simulated after it in the same process (as in this test
     session) still get the compiled path; a value the user set is kept."""
-    from mbsynth.compiled import background, structures
+    from mbsynth.compiled import background
     monkeypatch.delenv("MBSYNTH_FAST", raising=False)
-    seen = []  # kernels put to build (the UR5's joints alike are evaluated stacked: grouped.py)
+    seen = []  # Templates put to build
     monkeypatch.setattr(background, "_submit", lambda *args: seen.append("engine"))
-    monkeypatch.setattr(structures._worker, "submit", lambda *args: seen.append("structure"))
     assert main(["check", str(MODELS.parent / "robots" / "ur5_payload.yaml")]) == 0
-    assert "MBSYNTH_FAST" not in os.environ and background.mode() == "background" and seen == []
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
-    with background.default_mode("off"):
-        assert background.mode() == "wait"
+    assert "MBSYNTH_FAST" not in os.environ and background.default_path() == "compiled" and seen == []
+    with background.default_path_as("kkt"):
+        assert background.default_path() == "kkt"
+        monkeypatch.setenv("MBSYNTH_FAST", "on")
+        assert background.default_path() == "compiled"
 
 
 def test_massless_particle_is_a_free_direction(capsys):

@@ -79,7 +79,7 @@ def assert_layout_as_built(system, engine):
 
 
 def test_with_parameters_shares_the_compiled_code(model, background_mode):
-    engine = engine_for(model, wait=True)
+    engine = engine_for(model)
     heavier = model.with_parameters(m=2.1, L=0.55, R=0.7, g=3.0, k=-1.0, Ib=0.05)
     derived = engine_for(heavier)  # no wait: nothing to compile
     assert derived is not None and derived is not engine
@@ -99,7 +99,7 @@ def test_a_force_parameter_keeps_the_layout_and_moves_the_motion(model, backgrou
     Layout's numbers (masses, inertias, frames, lengths, gravity: m, L, mb, Ib, R, g): a
     System differing only in k shares its parent's Layout as it is (a controller's torques
     at every sample), and its motion is the literal (2.14)'s with the new k."""
-    engine = engine_for(model, wait=True)
+    engine = engine_for(model)
     pushed = model.with_parameters(k=-7.0)
     derived = engine_for(pushed)
     assert {list(model.parameters)[i] for i in engine.template.number_parameters} == {"m", "L", "mb", "Ib", "R", "g"}
@@ -178,7 +178,7 @@ def test_a_structural_replace_gets_a_cache_of_its_own(model):
 def test_a_massless_body_from_a_parameter(model, background_mode):
     """b1 welded to b0 loses its mass and inertia: M gets a zero block (a structural change
     of (2.14)'s problem), which the reused Engine meets with the numbers a fresh build has."""
-    engine_for(model, wait=True)
+    engine_for(model)
     massless = model.with_parameters(mb=0.0, Ib=0.0)
     derived = engine_for(massless)
     assert derived is not None
@@ -196,7 +196,7 @@ def test_a_massless_body_from_a_parameter(model, background_mode):
 def test_engines_die_with_their_systems(background_mode):
     system = mb.loads(MODEL, "reuse")
     child = system.with_parameters(m=3.0)
-    engines = [engine_for(system, wait=True), engine_for(child)]
+    engines = [engine_for(system), engine_for(child)]
     assert None not in engines
     refs = [weakref.ref(x) for x in (system, child, *engines, engines[0].template)]
     del system, child, engines
@@ -212,7 +212,7 @@ def test_a_failed_build_leaves_the_kkt_path_and_holds_no_system(monkeypatch, bac
     monkeypatch.setattr(background, "_build", broken)
     system = mb.loads(MODEL, "broken_build")
     with caplog.at_level("WARNING", logger=background.__name__):
-        assert engine_for(system, wait=True) is None
+        assert engine_for(system) is None
     assert "no kernel today" in caplog.text and "using the KKT path" in caplog.text
     q, qd = a_state(system)
     assert system.motion(0.0, q, qd).method != "tree (Baraff)"
@@ -226,14 +226,14 @@ def test_equal_systems_behave_the_same(model, background_mode):
     """A second load of the same text builds its own Template and takes the same path,
     with bit-identical motions; a copy with other numbers shares the Template (parameters
     are arguments of its code) with its own numbers."""
-    engine = engine_for(model, wait=True)
+    engine = engine_for(model)
     again = mb.loads(MODEL, "reuse")
-    theirs = engine_for(again, wait=True)
+    theirs = engine_for(again)
     assert theirs is not engine and theirs.template is not engine.template
     q, qd = a_state(model)
     ours, other = model.data().motion(0.3, q, qd), again.data().motion(0.3, q, qd)
     assert ours.method == other.method == "tree (Baraff)" and np.array_equal(ours.qdd, other.qdd)
-    heavier = engine_for(replace(model, parameters={**model.parameters, "m": 5.0}), wait=True)
+    heavier = engine_for(replace(model, parameters={**model.parameters, "m": 5.0}))
     assert heavier.template is engine.template
     assert heavier.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
 
@@ -249,7 +249,7 @@ def test_a_run_keeps_the_path_it_started_with(monkeypatch, background_mode):
     assert run.engine is None
     monkeypatch.undo()
     monkeypatch.setenv("MBSYNTH_FAST", "background")
-    assert engine_for(system, wait=True) is not None
+    assert engine_for(system) is not None
     assert run.engine is None and run.engine is None
     assert background.compiled()  # an Engine was warmed in this process
     assert system.data().engine is not None

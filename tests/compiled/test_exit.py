@@ -69,7 +69,7 @@ def test_a_build_asked_for_while_python_exits_is_refused():
 
         def late():
             from mbsynth.compiled import background
-            print(background.template(system, wait=True))
+            print(background.template(system, background.TemplateSlot()))
 
         atexit.register(late)
         import mbsynth as mb

@@ -2,7 +2,7 @@
 sympy-compiled ones, its accelerations against the reference (2.14) on every model file and
 on random chains, trees and loops, its fallback to the exact treatment, and the batch.
 
-The kernels compile once per machine (numba's cache); ``engine_for(..., wait=True)``
+The kernels compile once per machine (numba's cache); ``engine_for(...)``
 builds an Engine synchronously, so each test knows the tree path answered.
 """
 
@@ -225,7 +225,7 @@ def test_body_blocks_equal_the_sympy_blocks(all_joints):
 
 def assert_same_motion(system, t, q, qd, *, rtol=1e-10):
     """The fast path answers, and as (2.15) does."""
-    engine = engine_for(system, wait=True)
+    engine = engine_for(system)
     assert engine is not None
     fast = engine.motion(t, q, qd)
     ref = system.motion(t, q, qd, method="reference")
@@ -241,7 +241,7 @@ def test_rigid_transport_carries_the_parent_rows(all_joints):
     """For a body on a rigid parent, X = [[I, [ζ]×], [0, I]] (assembly.transports) satisfies
     J X = −P for its joint rows at any state, on or off the constraint manifold (tree.py
     relies on it): random states of the model with every joint kind."""
-    engine = engine_for(all_joints, wait=True)
+    engine = engine_for(all_joints)
     L, W = engine.L, engine.W
     rng = np.random.default_rng(5)
     checked = set()
@@ -271,7 +271,7 @@ def test_every_model_file(path):
     """Wherever the kernels cover a model: at its initial state and nearby states, the same
     acceleration as (2.15) when that is unique, the same verdict or error when not."""
     system = mb.load(path)
-    engine = engine_for(system, wait=True)
+    engine = engine_for(system)
     if engine is None:
         assert build_layout(system) is None
         return
@@ -428,7 +428,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
     q[7:10] = tip
     qd[3:7] = np.concatenate([[0.0], omega / 2])  # at u = (1, 0, 0, 0)
     qd[7:10] = np.cross(omega, tip)
-    assert engine_for(free, wait=True).motion(0.0, q, qd) is None
+    assert engine_for(free).motion(0.0, q, qd) is None
     motion = free.motion(0.0, q, qd)
     expected = np.zeros(14)
     expected[3:7] = -omega @ omega / 4 * q[3:7]
@@ -457,7 +457,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
                 (pushed, "no mass resists: wᵀ(Q + C) = 1 ≠ 0", (), ("dot.x",))]
     for system, words, constraints, coordinates in expected:
         q, qd = system.initial_state()
-        assert engine_for(system, wait=True).motion(0.0, q, qd) is None
+        assert engine_for(system).motion(0.0, q, qd) is None
         with pytest.raises(SolveError) as fast:
             system.motion(0.0, q, qd)
         assert words in str(fast.value), str(fast.value)
@@ -493,7 +493,7 @@ def test_an_integrators_stage_equals_the_motion(all_joints):
     """Engine.derivative, what simulate's stages call, gives (q̇, q̈) with q̈ that of
     System.motion bit for bit, and (2.14)'s to 1e-10, also on a state in a strided array;
     None where the kernel hands the problem back (a NaN)."""
-    engine = engine_for(all_joints, wait=True)
+    engine = engine_for(all_joints)
     q, qd = random_state(all_joints, np.random.default_rng(11))
     y = np.concatenate([q, qd])
     found = engine.derivative(0.7, y)
@@ -511,7 +511,7 @@ def test_baumgarte_and_parameters(all_joints):
     """Baumgarte's shifted b and changed parameters reach the kernels."""
     rng = np.random.default_rng(9)
     q, qd = random_state(all_joints, rng)
-    engine = engine_for(all_joints, wait=True)
+    engine = engine_for(all_joints)
     phi, psi = all_joints.constraint_residuals(0.0, q, qd)
     shift = -2 * 3.0 * np.nan_to_num(psi) - 4.0**2 * np.nan_to_num(phi)
     fast = engine.motion(0.0, q, qd, shift)
@@ -605,7 +605,7 @@ def test_helpers_compile_the_argument_types_motion_passes(name, all_joints):
     system = mb.load(MODELS[0].parent.parent / "rigid" / "double_pendulum_3d.yaml") if name == "rigid tree" \
         else all_joints
     assert ahead.VARIANTS == {"rigid_tree": kernel.RIGID_TREE, "general": kernel.GENERAL}  # the helpers' names
-    engine = engine_for(system, wait=True)
+    engine = engine_for(system)
     assert engine.general is (kernel.RIGID_TREE if name == "rigid tree" else kernel.GENERAL)
     fresh = njit(error_model="numpy")(kernel.motion.py_func)  # not cached: compiled here
     q, qd = random_state(system, np.random.default_rng(3))

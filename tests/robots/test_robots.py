@@ -63,7 +63,7 @@ def test_tree_path_equals_pinocchio_aba(name, request):
     system = request.getfixturevalue(name)
     rng = np.random.default_rng(7)
     for variant in (system, fix_base(system)):
-        engine, twin = engine_for(variant, wait=True), Twin(variant)
+        engine, twin = engine_for(variant), Twin(variant)
         for _ in range(SAMPLES):
             q, v = sample_pinocchio_state(twin, rng)
             qm, qdm = twin.to_maximal(q, v)

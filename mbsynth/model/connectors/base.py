@@ -1,15 +1,15 @@
 """Constraints as sympy expressions of the model's coordinates: the rows of A q̈ = b (2.4)."""
 
-import functools
-
 import numpy as np
 import sympy as sp
 
+from ...core.values import Keyed
 from ...symbolic.derive import (PARAMETERS, T_SYMBOL, compile_function, differentiated, differentiated_template,
     expand_joint_values, joint_values_in, placed_values, positions, symbols_in)
 
+from ...core.memo import MEMO
 
-class Connector:
+class Connector(Keyed):
     """k rows ``a q̈ = b`` of (2.4), an optional non-ideal force C (2.6), and the
     position- and velocity-level residuals φ, φ̇ used for drift control.
 
@@ -26,6 +26,7 @@ class Connector:
         a = sp.SparseMatrix(a if isinstance(a, sp.SparseMatrix) else sp.Matrix(a).reshape(len(b), n))
         self._symbolic = (a, sp.Matrix(b), sp.SparseMatrix(C), None if phi is None else sp.Matrix(phi),
                           None if psi is None else sp.Matrix(psi))
+        self._defined_by = self._symbolic
         self._name_rows(name, kind, len(b), row_labels)
         self._levels = (phi is not None, psi is not None)  # which residuals the rows have
         exprs = [e for e in self._symbolic if e is not None]
@@ -61,6 +62,7 @@ class Connector:
         self._symbolic = None
         self._levels = (True, True)
         self._placed = (rows, slots, coordinates, dict(constants), q, qd)
+        self._defined_by = self._placed
         self._zero_C = sp.SparseMatrix(len(q), 1, {})
         self._rows = compile_function(
             (T_SYMBOL, [q_slots[j] for j in local], [qd_slots[j] for j in local], list(params)),
@@ -72,6 +74,16 @@ class Connector:
         connector = cls.__new__(cls)
         connector._place(name, kind, rows, slots, coordinates, constants, q, qd, params, row_labels)
         return connector
+
+    # attributes beyond the base's that define a connector of a subclass (``content``)
+    content_fields = ()
+
+    def content(self):
+        """What defines the connector (its equality, ``core.values``): its name, kind, row
+        names and the rows it was given (sympy, or a template with its values), and the
+        subclass's ``content_fields``."""
+        base = (self.name, self.kind, tuple(self.row_names), self._levels, self._defined_by)
+        return base + tuple(getattr(self, name) for name in self.content_fields)
 
     def _materialized(self):
         """(a, b, C, φ, ψ) as sympy expressions of the model's symbols."""
@@ -134,7 +146,7 @@ class Connector:
         return (phi.ravel() if self._levels[0] else nan, psi.ravel() if self._levels[1] else nan)
 
 
-@functools.lru_cache(maxsize=256)
+@MEMO.function(256)
 def _slots_in(rows, slots):
     """The positions j whose coordinate slot or velocity slot the rows (a, b, φ, ψ) hold:
     once per template (connectors alike share their rows)."""
@@ -143,7 +155,7 @@ def _slots_in(rows, slots):
     return [j for j, (s, sd) in enumerate(zip(*slots)) if s in free or sd in free]
 
 
-@functools.lru_cache(maxsize=256)
+@MEMO.function(256)
 def _placed_rows(rows, local):
     """[a, b, C, φ, ψ] of ``Connector._rows`` for rows (a, b, φ, ψ) over the slots at
     ``local``: once per template and selection (connectors alike share it)."""

@@ -24,7 +24,6 @@ when asked. Joints on parts whose frames move with their coordinates, or with fr
 derived directly. The rows of each kind are those of its record in core/joint_kinds.py.
 """
 
-import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -39,6 +38,7 @@ from ...symbolic.cache import placeholder
 from ...symbolic.derive import (compile_function, differentiate, differentiated, jacobian, placed_values, positions,
     time_derivative)
 
+from ...core.memo import MEMO
 
 def joint_equations(kind, pA, RA, pB, RB, length=None):
     """(φ rows, row labels) of a joint of ``kind`` between poses (pA, RA) and (pB, RB): the
@@ -66,6 +66,8 @@ class Joint(Connector):
     cylindrical), and ``displacement`` z_A·(p_B − p_A) along z_A with its rate
     (prismatic, cylindrical) — what actuation, joint springs and friction act on."""
 
+    content_fields = ("joint_kind", "frames", "part_names", "report_frame", "length", "friction")
+
     def __init__(self, name, kind, parent, frame_a, child, frame_b, q, qd, params, length=None, friction=None,
                  report_frame=None):
         """``friction`` (a ``friction.Friction``) puts viscous friction into the joint's C
@@ -75,6 +77,7 @@ class Joint(Connector):
         self.joint_kind, self.frames, self.parts = kind, (frame_a, frame_b), (parent, child)
         self.report_frame = frame_b if report_frame is None else report_frame
         self.length = length  # a distance joint's L (sympy), None for the other kinds
+        self.friction = friction
         values = TEMPLATES.constants((frame_a, frame_b), positions(q, qd))
         if friction is None and values is not None and shared(parent, child):
             self._place_shared(name, kind, parent, child, values, q, qd, params, length)
@@ -107,6 +110,9 @@ class Joint(Connector):
         self.coulomb = None
         self._place(name, "holonomic", rows, template.slots, coordinates, list(constants.items()), q, qd, params,
                     [template.labels[i] for i in kept])
+
+    part_names = property(lambda self: tuple(None if p is None else p.name for p in self.parts),
+                          doc="the names of the parent (None: the world) and the child")
 
     def rate_gradient(self, rate):
         """∂rate/∂q̇ over the velocity slots of the joint's template (``placed``) of ``rate``
@@ -243,7 +249,7 @@ def _kept_rows(template, constants):
 _PROBE = np.random.default_rng(2006).uniform(0.1, 0.9, 64)  # the random state of _kept_rows
 
 
-@functools.lru_cache(maxsize=64)
+@MEMO.function(64)
 def _phi_function(phis, slots, symbols):
     return compile_function((list(slots), list(symbols)), [sp.Matrix(phis)])
 

@@ -35,6 +35,8 @@ class RollingDisk(Connector):
     rows ``height``, ``slip_x``, ``slip_y``. Keeps ``part``, ``frame`` and ``radius``
     (the viewer draws the wheel)."""
 
+    content_fields = ("frame", "radius")
+
     def __init__(self, name, part, frame, radius, height, q, qd, params):
         self.part, self.frame, self.radius = part, frame, radius
         p, R = part.pose(frame)
@@ -50,6 +52,8 @@ class RollingDisk(Connector):
 class KnifeEdge(Connector):
     """A blade along the x axis of ``frame`` on ``part``: y_f · v_p = 0. Keeps ``part``
     and ``frame``."""
+
+    content_fields = ("frame",)
 
     def __init__(self, name, part, frame, q, qd, params):
         self.part, self.frame = part, frame

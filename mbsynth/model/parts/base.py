@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from ...core.values import Keyed
 from ...symbolic.derive import PARAMETERS, T_SYMBOL, compile_function, placed_values
 
 LINK_FRAME = "link"  # the frame a robot link's body carries at the URDF link frame (robots/build.py)
@@ -37,7 +38,7 @@ class Frame:
             return None
 
 
-class Part:
+class Part(Keyed):
     """A subsystem given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
     and the model's parameter symbols ``params``.
 
@@ -54,6 +55,8 @@ class Part:
     # q̇ᵀ Q_nc in the part's symbols: the power of its forces that derive from neither T nor V
     # (dampers, generalized forces); a subclass with such forces sets it before Part.__init__
     power_expression = sp.S.Zero
+    # attributes beyond the base's that define a part of a subclass (``content``)
+    content_fields = ()
 
     def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None,
                  shared=None):
@@ -70,11 +73,19 @@ class Part:
         q_slots, qd_slots, constants = shared or (self.q, self.qd, ())
         self._symbolic = None if shared else template
         self._shared = shared and (template, (q_slots, qd_slots), constants)
+        self._defined_by = (template, (q_slots, qd_slots), constants)
         args = (T_SYMBOL, list(q_slots), list(qd_slots), list(params))
         self._evaluate = compile_function(args, template[:2], constants, picked=PARAMETERS)
         self._energy = compile_function(args, template[2:], constants, picked=PARAMETERS)
         self._power, self._power_args = None, (args, constants)  # compiled when first asked (``power``)
         self._reads = None  # the symbols M and Q are written in (``reads``), once asked
+
+    def content(self):
+        """What defines the part (its equality, ``core.values``): its names, symbols, frames,
+        the expressions of (2.1) it was given and the subclass's ``content_fields``."""
+        base = (self.name, self.coordinates, self.q, self.qd, self.frames, self.geometry, self.initial,
+                self.groups, self.power_expression, self._defined_by)
+        return base + tuple(getattr(self, name) for name in self.content_fields)
 
     def _materialized(self):
         if self._symbolic is None:

@@ -10,7 +10,6 @@ are singular where H below loses rank: the middle turn at ±90° (Tait–Bryan) 
 180° (proper Euler: zxz for a disk whose axis is its z axis, singular only when it lies
 flat)."""
 
-import functools
 import warnings
 
 import numpy as np
@@ -20,6 +19,7 @@ from ...core.kinematics import euler_rate_matrix, euler_rotation
 from ...core.tolerances import NEAR_SINGULAR
 from ...symbolic.cache import placeholder, remembered
 from .base import Part
+from ...core.memo import MEMO
 
 SEQUENCES = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx",  # Tait–Bryan: three different axes
              "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")  # proper Euler: the first axis again last
@@ -30,6 +30,8 @@ class EulerBody(Part):
     body-axes angular velocity (``euler_rate_matrix``): Euler's equations J ω̇ + ω × Jω = τ
     premultiplied by Hᵀ, as virtual turns are H δα. M is regular away from the angles'
     singular position; the body adds no constraint of its own."""
+
+    content_fields = ("sequence", "mass", "inertia", "gravity")
 
     kind = "euler_body"
     groups = (("x", "y", "z"),)
@@ -100,7 +102,7 @@ def angle_rates_of(sequence, angles, omega_world):
     return np.linalg.solve(H, R.T @ np.asarray(omega_world, dtype=float))
 
 
-@functools.lru_cache(maxsize=len(SEQUENCES))
+@MEMO.function(len(SEQUENCES))
 def _template(sequence):
     """(coordinate slots, placeholders (m, J row by row, g), (M, Q, T, V)) of a body whose
     angles follow ``sequence``, derived once (base.Part's ``shared``)."""

@@ -48,6 +48,8 @@ class FlexibleBody(Part):
     ``centrifugal_stiffening``, default none. ``frame_nodes``: {frame name: FE node};
     ``elastic``: the slice of the part's coordinates that are η."""
 
+    content_fields = ("reduction", "gravity", "damping", "stiffening", "frame_nodes")
+
     kind = "flexible_body"
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}

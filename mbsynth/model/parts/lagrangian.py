@@ -17,6 +17,8 @@ class LagrangianPart(Part):
     Its frames are points whose world position is an expression of its coordinates.
     """
 
+    content_fields = ("forces",)
+
     kind = "lagrangian"
 
     def __init__(self, name, coordinates, q, qd, T, V, forces, params, frames=(), geometry=()):

@@ -1,8 +1,6 @@
 """A rigid body in 7 coordinates: its centre of mass r in the world and a unit
 quaternion u (scalar-first) for its orientation."""
 
-import functools
-
 import numpy as np
 import sympy as sp
 
@@ -11,6 +9,7 @@ from ...symbolic.cache import placeholder, remembered
 from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import differentiate, positions
 from .base import Part
+from ...core.memo import MEMO
 
 COORDINATES = ("x", "y", "z", "qw", "qx", "qy", "qz")
 
@@ -23,6 +22,8 @@ class RigidBody(Part):
     with T = ½ m ṙᵀṙ + 2 u̇ᵀ Eᵀ J E u̇ (ω_body = 2 E u̇). ``mass`` (≥ 0) and ``inertia``
     (3 × 3, about the centre of mass, body axes) are sympy expressions of parameters.
     """
+
+    content_fields = ("mass", "inertia", "gravity")
 
     kind = "rigid_body"
     COORDINATES = COORDINATES
@@ -60,14 +61,14 @@ class RigidBody(Part):
 
 
 
-@functools.lru_cache(maxsize=1)
+@MEMO.function(1)
 def _template():
     """(coordinate slots (q, q̇), placeholders (m, J row by row, g), (M, Q, T, V)): the
     body's equations derived once, for every body (base.Part's ``shared``)."""
     return remembered("rigid-body", (), _derive_template)
 
 
-@functools.lru_cache(maxsize=1)
+@MEMO.function(1)
 def _unit_norm_rows():
     """((a over the slots, b, φ, φ̇), slots) of φ = (uᵀu − 1)/2 in four quaternion slots
     (symbolic.differentiate), derived once and kept on disk (symbolic/cache.py)."""

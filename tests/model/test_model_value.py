@@ -1,0 +1,127 @@
+"""A model is a value; its workspace is a Data; what is kept between calls is in one cache.
+
+Two loads of one file give equal models (``==``, equal hashes, byte-identical motions);
+a model cannot be changed after it is made; a Data has its own parameter values and an
+explicit path and does not pass for its model; module state lives in ``MEMO`` alone."""
+
+import ast
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbsynth as mb
+from mbsynth.core.memo import MEMO
+
+ROOT = Path(__file__).resolve().parents[2]
+FOUR_BAR = ROOT / "models" / "mechanisms" / "four_bar.yaml"
+CANTILEVER = ROOT / "models" / "flexible" / "cantilever.yaml"
+
+
+@pytest.mark.parametrize("path", [FOUR_BAR, CANTILEVER], ids=lambda p: p.stem)
+def test_two_loads_of_one_file_are_equal_and_move_alike(path):
+    first, second = mb.load(path), mb.load(path)
+    assert first is not second and first.parts[0] is not second.parts[0]
+    assert first == second and hash(first) == hash(second)
+    assert {first: "model"}[second] == "model"
+    q, qd = first.initial_state()
+    qd = qd + 0.1
+    assert first.motion(0.2, q, qd).qdd.tobytes() == second.motion(0.2, q, qd).qdd.tobytes()
+
+
+def test_a_changed_parameter_makes_another_model_and_changing_it_back_the_same():
+    model = mb.load(FOUR_BAR)
+    name = next(iter(model.parameters))
+    heavier = model.with_parameters(**{name: 2 * model.parameters[name] + 1})
+    assert heavier != model and heavier.structure == model.structure
+    assert heavier.with_parameters(**{name: model.parameters[name]}) == model
+
+
+def test_another_model_file_is_another_model():
+    assert mb.load(FOUR_BAR) != mb.load(ROOT / "models" / "mechanisms" / "slider_crank.yaml")
+
+
+def test_a_model_cannot_be_changed():
+    model = mb.load(FOUR_BAR)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        model.name = "other"
+    with pytest.raises(ValueError, match="read-only"):
+        model.initial_q[0] = 1.0
+    with pytest.raises(TypeError):
+        model.parameters[next(iter(model.parameters))] = 1.0
+
+
+def test_a_data_does_not_pass_for_its_model_and_computes_at_its_own_parameters():
+    model = mb.load(FOUR_BAR)
+    data = model.data()
+    assert data.model is model and not hasattr(data, "coordinates") and not hasattr(data, "parts")
+    name = next(iter(model.parameters))
+    data.set_parameters({name: 3 * model.parameters[name] + 1})
+    q, qd = model.initial_state()
+    heavier = model.with_parameters(**{name: 3 * model.parameters[name] + 1})
+    np.testing.assert_array_equal(data.motion(0.0, q, qd).qdd, heavier.data().motion(0.0, q, qd).qdd)
+    assert data.p[model.parameter_index[name]] != model.parameter_values[model.parameter_index[name]]
+
+
+def test_the_path_is_chosen_explicitly_and_both_give_the_motion():
+    """The compiled path and the KKT path of (2.14) agree (an independent solve); the path
+    is the one asked for, whatever has been compiled."""
+    model = mb.load(FOUR_BAR)
+    kkt, compiled = model.data(path="kkt"), model.data(path="compiled")
+    assert (kkt.path, kkt.engine) == ("kkt", None) and compiled.engine is not None
+    q, qd = model.initial_state()
+    qd = qd + 0.3
+    np.testing.assert_allclose(compiled.motion(0.1, q, qd).qdd, kkt.motion(0.1, q, qd).qdd, rtol=1e-9, atol=1e-9)
+    with pytest.raises(ValueError, match="path must be one of"):
+        model.data(path="fast")
+
+
+def test_the_one_cache_can_be_emptied_without_changing_an_answer():
+    model = mb.load(FOUR_BAR)
+    q, qd = model.initial_state()
+    before = model.motion(0.0, q, qd).qdd
+    assert MEMO.sizes()["model structures"] >= 1
+    MEMO.clear()
+    assert MEMO.sizes()["model structures"] == 0
+    np.testing.assert_array_equal(model.motion(0.0, q, qd).qdd, before)
+
+
+# Module-level state outside MEMO that the package keeps on purpose: the thread pools and
+# helper processes (compiled/threads.py, worker.py, ahead.py) and the locks that guard them.
+POOLS = {("compiled/threads.py", "_threads"), ("compiled/threads.py", "_owner"),
+         ("compiled/worker.py", "_workers"), ("compiled/ahead.py", "_started"), ("compiled/ahead.py", "_running")}
+MUTATORS = {"append", "extend", "update", "setdefault", "pop", "popitem", "clear", "add", "insert", "remove",
+            "discard", "__setitem__"}
+
+
+def test_no_module_keeps_state_outside_the_one_cache_and_the_pools():
+    """No ``global`` statement, and no module-level container written after import, but in
+    the pools; what is kept between calls goes in ``MEMO`` (core/memo.py)."""
+    found = []
+    for path in sorted((ROOT / "mbsynth").rglob("*.py")):
+        where = path.relative_to(ROOT / "mbsynth").as_posix()
+        tree = ast.parse(path.read_text())
+        module_names = {t.id for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
+                        for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                        if isinstance(t, ast.Name)}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Global):
+                found += [(where, name) for name in node.names if (where, name) not in POOLS]
+            elif isinstance(node, (ast.Assign, ast.AugAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                found += [(where, t.value.id) for t in targets if isinstance(t, ast.Subscript)
+                          and isinstance(t.value, ast.Name) and t.value.id in module_names
+                          and (where, t.value.id) not in POOLS and _inside_function(tree, node)]
+            elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in MUTATORS:
+                target = node.func.value
+                if isinstance(target, ast.Name) and target.id in module_names and (where, target.id) not in POOLS \
+                        and _inside_function(tree, node):
+                    found.append((where, target.id))
+    assert found == []
+
+
+def _inside_function(tree, node):
+    """Whether ``node`` sits in a function (module-level code builds its tables at import)."""
+    return not any(node is inner for top in tree.body if not isinstance(top, (ast.FunctionDef, ast.ClassDef))
+                   for inner in ast.walk(top))
