@@ -8,7 +8,6 @@ them (tests/model/test_joint_values.py)."""
 import numpy as np
 import pytest
 
-from mbsynth.compiled import joints as compiled_joints, rate_rows, rows as compiled_rows
 from mbsynth.core import joint_kinds
 from mbsynth.core.joint_kinds import (COINCIDENT, COMPONENT, D, DISTANCE, DOT, EFFORTS, FRICTION_KINDS, JOINT_KINDS,
                                       KINDS, MAX_ROWS, OPERATIONS, URDF_KINDS, ZB, FrictionRate, JointKind,
@@ -84,12 +83,6 @@ def test_an_operations_rate_is_the_derivative_of_its_phi(code):
         w, w_rate = (k, None) if k is not None else (x0, xd) if code == DISTANCE else (w0, wd)
         difference = (phi(h) - phi(-h)) / (2 * h)
         assert spec.rate(x0, xd, w, w_rate, length) == pytest.approx(difference, rel=1e-9, abs=1e-12)
-
-
-def test_every_interpreter_evaluates_every_operation():
-    """The compiled interpreters state their branches, one per operation of the spec."""
-    for module in (compiled_joints, compiled_rows, rate_rows):
-        assert sorted(module.EVALUATED) == list(range(len(OPERATIONS))), module.__name__
 
 
 def test_an_interpreter_lacking_an_operation_is_refused():
