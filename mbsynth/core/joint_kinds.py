@@ -59,9 +59,11 @@ class Operation(NamedTuple):
 OPERATIONS = (  # indexed by the codes below
     Operation("component", "component", lambda x, k, L: x[k], lambda x, xd, k, kd, L: xd[k]),
     Operation("dot", "vector", lambda x, w, L: _dot(x, w), lambda x, xd, w, wd, L: _dot(xd, w) + _dot(x, wd)),
-    Operation("distance", "vector", lambda x, w, L: (_dot(x, x) - L**2) / (2 * L), lambda x, xd, w, wd, L: _dot(x, xd) / L),
+    Operation("distance", "vector", lambda x, w, L: (_dot(x, x) - L**2) / (2 * L),
+              lambda x, xd, w, wd, L: _dot(x, xd) / L),
 )
-COMPONENT, DOT, DISTANCE = 0, 1, 2  # a row's operation: its index in OPERATIONS
+# a row's operation: its index in OPERATIONS
+COMPONENT, DOT, DISTANCE = ([op.name for op in OPERATIONS].index(name) for name in ("component", "dot", "distance"))
 D, XA, YA, ZA, XB, YB, ZB = range(7)  # the vectors a row reads (compiled/joints.py adds 7, 8: the origins)
 
 
@@ -72,6 +74,9 @@ def check_operations(interpreter, covered, operations=OPERATIONS):
     if missing:
         raise KindTableError(f"{interpreter} does not evaluate the row operation(s) "
                              f"{', '.join(operations[op].name for op in missing)} (core/joint_kinds.OPERATIONS)")
+    unknown = sorted(set(covered) - set(range(len(operations))))
+    if unknown:
+        raise KindTableError(f"{interpreter} names row operation code(s) {unknown}, which OPERATIONS lacks")
 
 
 class Row(NamedTuple):

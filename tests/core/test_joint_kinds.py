@@ -88,6 +88,8 @@ def test_an_operations_rate_is_the_derivative_of_its_phi(code):
 def test_an_interpreter_lacking_an_operation_is_refused():
     with pytest.raises(KindTableError, match=r"^new interpreter does not evaluate the row operation\(s\) distance "):
         check_operations("new interpreter", (COMPONENT, DOT))
+    with pytest.raises(KindTableError, match=r"^stale interpreter names row operation code\(s\) \[3\]"):
+        check_operations("stale interpreter", (COMPONENT, DOT, DISTANCE, 3))
     check_operations("complete interpreter", (DISTANCE, DOT, COMPONENT))  # any order
 
 
