@@ -19,14 +19,18 @@ A row's A and b then follow from φ̈ = a q̈ − b:
 
 A joint's program is its kind's rows (core/joint_kinds.py: operation, vector, vector or
 component), the rows ``connectors.joints.joint_equations`` reads too; the tests compare the
-two for every kind.
+two for every kind. ``EVALUATED``: the operations ``joint_rows`` has a branch for, all of
+core/joint_kinds.OPERATIONS (checked at import).
 """
 
 import numpy as np
 from numba import njit
 
-from ..core.joint_kinds import COMPONENT, D, DOT, XA, XB, ZA, ZB
+from ..core.joint_kinds import COMPONENT, D, DISTANCE, DOT, XA, XB, ZA, ZB, check_operations
 from .bodies import OPTIONS, rotation, rotation_jacobian
+
+EVALUATED = (COMPONENT, DOT, DISTANCE)  # joint_rows' branches, in order
+check_operations("compiled/joints.joint_rows", EVALUATED)
 
 WORLD, RIGID, PARTICLE = 0, 1, 2  # what a joint's end sits on; vectors 7, 8: the two origins
 VALUE, VELOCITY, BIAS, JAC = 0, 1, 2, 3  # columns of a vector's record: 3 values each, then 14 Jacobian columns
@@ -116,7 +120,7 @@ def joint_rows(program, k, kinds, starts, s, Rf, length, q, qd, V, R, Jt, A, b):
             for i in range(3):
                 total += Y[i, VALUE] * X[i, BIAS] + X[i, VALUE] * Y[i, BIAS] + 2 * X[i, VELOCITY] * Y[i, VELOCITY]
             b[r] = -total
-        else:
+        else:  # DISTANCE
             for col in range(14):
                 A[r, col] = (X[0, VALUE] * X[0, JAC + col] + X[1, VALUE] * X[1, JAC + col]
                              + X[2, VALUE] * X[2, JAC + col]) / length

@@ -1,8 +1,8 @@
 """What the fast path computes where: a System turned, once, into index and number arrays.
 
 Kernel nodes are the rigid bodies (with their own ``<body>.unit_quaternion`` row) and the
-particles (their ``kind``); kernel joints are the holonomic joints (a ``joint_kind`` the
-that has rows, core/joint_kinds.py) whose ends are nodes or the world and
+particles (their ``kind``); kernel joints are the holonomic joints (of a kind whose record
+says ``compiled``, core/joint_kinds.py) whose ends are nodes or the world and
 whose frames are constant. A breadth-first search from the world (then from each body no
 joint path reaches) picks each node's parent joint: those joints form the tree
 (tree.py); the other kernel joints close loops, and their rows join the *extra rows*.
@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from ..core.joint_kinds import COMPONENT, JOINT_KINDS, KINDS, MAX_ROWS
+from ..core.joint_kinds import COMPONENT, KINDS, MAX_ROWS
 from .banded import band_order
 from .joints import PARTICLE, RIGID, WORLD
 from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
@@ -178,7 +178,8 @@ def build(system):
 
 
 def _kernel_joint(con, node_of, number):
-    if getattr(con, "joint_kind", None) not in JOINT_KINDS:
+    kind = KINDS.get(getattr(con, "joint_kind", None))
+    if kind is None or not kind.compiled:
         return False
     if any(part is not None and part.name not in node_of for part in con.parts):
         return False
@@ -271,7 +272,7 @@ def _numbers(parts, joints, number):
         for part, frame in zip(con.parts, con.frames):
             offsets.append(np.zeros(3) if _kind(part) == PARTICLE_PART else number(frame.position).ravel())
             rotations.append(number(frame.rotation))
-        lengths.append(number(con.length)[0, 0] if con.joint_kind == "distance" else 1.0)
+        lengths.append(number(con.length)[0, 0] if KINDS[con.joint_kind].has_length else 1.0)
     N = len(parts)
     return dict(node_mass=np.array(masses, dtype=float), node_mg=np.array(mg, dtype=float).reshape(N, 3),
                 node_J=np.array(inertia, dtype=float).reshape(N, 3, 3),

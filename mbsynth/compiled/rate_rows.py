@@ -18,7 +18,8 @@ a kind's program (core/joint_kinds.py), each row's coefficients on (r̈_A, α_A,
 and b = −(the bias terms + 2 ẋ·ẇ) as in joints.py. A world end has no unknowns: its
 coefficients are dropped.
 
-Each row is computed on its own, its vectors as 3-tuples (``_row``), so that they stay in
+``EVALUATED``: the operations ``_row`` has a branch for, all of core/joint_kinds.OPERATIONS
+(checked at import). Each row is computed on its own, its vectors as 3-tuples (``_row``), so that they stay in
 registers, not in a table of the joint's vectors filled first.
 """
 
@@ -26,11 +27,13 @@ import math
 
 from numba import njit
 
-from ..core.joint_kinds import COMPONENT, D, DOT
+from ..core.joint_kinds import COMPONENT, D, DISTANCE, DOT, check_operations
 from .bodies import INLINE, cross3, dot3, times3
 from .joints import WORLD
 
 ZERO = (0.0, 0.0, 0.0)
+EVALUATED = (COMPONENT, DOT, DISTANCE)  # _row's branches: a component; a dot of two axes or of d, and the distance
+check_operations("compiled/rate_rows._row", EVALUATED)
 
 
 @njit(**INLINE)

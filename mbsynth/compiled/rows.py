@@ -6,19 +6,23 @@ The rows are those of kernel.py: each rigid body's unit-norm row φ = (uᵀu −
 component φ = d_k, φ̇ = ḋ_k; dot φ = v·w, φ̇ = v̇·w + v·ẇ; distance φ = (d·d − L²)/2L,
 φ̇ = d·ḋ/L. Energies: T = ½ m ṙᵀṙ + 2 u̇ᵀEᵀJEu̇, V = −m gᵀr (rigid_body.py). Only values
 and velocities: R(u) and Ṙ(u, u̇) once per body, then a frame's vector R c moves at Ṙ c
-(no Jacobians, unlike joints.py), each row's vectors 3-tuples (as in rate_rows.py).
+(no Jacobians, unlike joints.py), each row's vectors 3-tuples (as in rate_rows.py). These
+are the φ and φ̇ of core/joint_kinds.OPERATIONS; ``EVALUATED``: the operations the row loop
+has a branch for, all of them (checked at import).
 """
 
 import numpy as np
 from numba import njit
 
-from ..core.joint_kinds import COMPONENT, D, DOT
+from ..core.joint_kinds import COMPONENT, D, DISTANCE, DOT, check_operations
 from .bodies import OPTIONS, INLINE, dot3, rotation, rotation_rate, times3
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
 from .joints import PARTICLE, RIGID, WORLD
 
 LAYOUT = fields(Layout)
+EVALUATED = (COMPONENT, DOT, DISTANCE)  # residuals_energy's row branches, in order
+check_operations("compiled/rows.residuals_energy", EVALUATED)
 
 
 @njit(**OPTIONS)
@@ -83,7 +87,7 @@ def residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs, rates=True):
                 else:
                     xv, xd = _axis(x, nodes, Rf, Rs)
                     value, rate = dot3(xv, wv), dot3(xd, wv) + dot3(xv, wd)
-            else:
+            else:  # DISTANCE
                 L = joint_length[k]
                 value, rate = (dot3(d, d) - L * L) / (2 * L), dot3(d, dd) / L
             phi[row + r] = value

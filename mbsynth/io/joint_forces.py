@@ -13,7 +13,7 @@ springs become force elements (mbsynth.model.joint_forces), friction the joint's
 
 import sympy as sp
 
-from ..core.joint_kinds import FRICTION_KINDS
+from ..core.joint_kinds import FRICTION_KINDS, KINDS
 from ..model.friction import Friction
 from ..model.joint_forces import MOTIONS, actuation, joint_motion, joint_spring
 from .parts import read_nonnegative
@@ -32,10 +32,11 @@ def read_friction(builder, spec, path, kind):
         builder.fail(path, "give 'viscous:' and/or 'coulomb:'")
     viscous, coulomb = (read_nonnegative(builder, node, key, path, default=0) for key in ("viscous", "coulomb"))
     radius = sp.S.One
-    if "radius" in node and (kind != "revolute" or "coulomb" not in node):
+    turning = KINDS[kind].friction.rate == "angle_rate"  # its Coulomb torque is μ r N
+    if "radius" in node and (not turning or "coulomb" not in node):
         builder.fail(path + ("radius",), "radius is the pin radius of Coulomb friction at a revolute joint "
                                          "(friction torque μ r N)")
-    if kind == "revolute" and "coulomb" in node:
+    if turning and "coulomb" in node:
         if "radius" not in node:
             builder.fail(path, "Coulomb friction at a revolute joint needs 'radius', the pin radius "
                                "(friction torque μ r N)")
@@ -82,7 +83,7 @@ def read_spring(builder, node, path, joint, args):
     node = builder.section(node, path, "joint_spring")
     stiffness, damping = (read_nonnegative(builder, node, key, path, default=0) for key in ("stiffness", "damping"))
     rest = builder.constant(node.get("rest", 0), path + ("rest",))
-    if joint.joint_kind == "revolute" and abs(builder.value(rest)) > float(sp.pi):
+    if MOTIONS[joint_motion(joint)][0] == "angle" and abs(builder.value(rest)) > float(sp.pi):
         builder.fail(path + ("rest",), "the rest angle must lie in [−π, π] (the joint angle is atan2 of the "
                                        "frames' x axes)")
     return joint_spring(f"{joint.name}.spring", joint, stiffness, damping, rest, *args)

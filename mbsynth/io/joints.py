@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import sympy as sp
 
-from ..core.joint_kinds import JOINT_KINDS
+from ..core.joint_kinds import JOINT_KINDS, KINDS
 from ..model.connectors.joints import Joint
 from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
@@ -148,7 +148,7 @@ def _read_joint(builder, spec, path, names, suffix):
     if child is None or child is parent:
         builder.fail(path + ("child",), "the child of a joint must be a part other than its parent")
     length = None
-    if kind == "distance":
+    if KINDS[kind].has_length:
         if "length" not in spec:
             builder.fail(path, "a distance joint needs 'length'")
         length = builder.constant(spec["length"], path + ("length",))

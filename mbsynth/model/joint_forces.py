@@ -13,11 +13,11 @@ a turn from θ = 0 (its potential jumps where θ wraps).
 
 import sympy as sp
 
-from ..core.joint_kinds import KINDS
+from ..core.joint_kinds import EFFORTS, KINDS
 from .forces import ForceElement
 
-# the joint's (position, rate) attribute for each kind of motion
-MOTIONS = {"torque": ("angle", "angle_rate"), "force": ("displacement", "displacement_rate")}
+# the joint's (position, rate) attribute along which each effort acts (core/joint_kinds.EFFORTS)
+MOTIONS = {effort: (motion, f"{motion}_rate") for motion, effort in EFFORTS.items()}
 
 
 def joint_motion(joint):

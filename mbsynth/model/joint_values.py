@@ -18,7 +18,9 @@ spatial velocity in its own axes and v̇ its derivative, Rᵀp̈ − ω × Rᵀ�
 acceleration); Pinocchio's quaternion is (x, y, z, w), mbsynth's (w, x, y, z). Angles
 are atan2 in (−π, π] at one state; ``unwrap`` makes them continuous along a trajectory.
 Fixed and distance joints have no values. The names per kind are those of its record in
-core/joint_kinds.py.
+core/joint_kinds.py, the formulas its entry of ``VALUES``, a table that must name every kind
+(``NO_VALUES`` for one without values) and agree with its record, or this module is
+refused at import.
 
 The same compiled function gives the pose of the joint's reaction frame (the child frame
 B, or a robot's child link frame) and its Jacobian, which turn the generalized force a
@@ -31,7 +33,7 @@ import numpy as np
 import sympy as sp
 
 from ..compiled.grouped import Batch
-from ..core.joint_kinds import KINDS
+from ..core.joint_kinds import KINDS, check_table
 from ..core.kinematics import matrix_quaternion
 from .joint_templates import Templates, joint_coordinates, pose, shared
 from ..symbolic.derive import T_SYMBOL, JointValue, compile_function, jacobian, time_derivative
@@ -210,39 +212,129 @@ def constraint_symbols(joint):
     return exprs
 
 
+class _Frames(NamedTuple):
+    """What a kind's value formulas read: the two frames' poses (pA, RA), (pB, RB) on
+    ``parent`` (None: the world) and ``child``, the ``frames`` (A, B) and the coordinates."""
+
+    parent: object
+    child: object
+    frames: tuple
+    pA: sp.Matrix
+    RA: sp.Matrix
+    pB: sp.Matrix
+    RB: sp.Matrix
+    q: list
+    qd: list
+
+    def axis(self, end, k):
+        return (self.RA, self.RB)[end][:, k]
+
+    @property
+    def omega(self):
+        """ω_B − ω_A."""
+        parent = self.parent
+        omega_a = parent.frame_angular_velocity(self.frames[0]) if parent is not None else sp.zeros(3, 1)
+        return self.child.frame_angular_velocity(self.frames[1]) - omega_a
+
+    @property
+    def angle(self):
+        """The turn about z_A: atan2((x_A × x_B)·z_A, x_A·x_B)."""
+        xa, xb, za = self.axis(0, 0), self.axis(1, 0), self.axis(0, 2)
+        return sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
+
+    @property
+    def displacement(self):
+        return self.axis(0, 2).dot(self.pB - self.pA)
+
+    def rate_of(self, position):
+        return time_derivative(position, self.q, self.qd)
+
+
+def _turns(f):
+    return [f.angle], [f.axis(0, 2).dot(f.omega)]
+
+
+def _slides(f):
+    return [f.displacement], [f.rate_of(f.displacement)]
+
+
+def _turns_and_slides(f):
+    (angle,), (angle_rate,) = _turns(f)
+    (displacement,), (displacement_rate,) = _slides(f)
+    return [angle, displacement], [angle_rate, displacement_rate]
+
+
+def _crosses(f):
+    xa, ya, za, xb, yb, zb = (f.axis(end, k) for end in range(2) for k in range(3))
+    omega = f.omega
+    return [sp.atan2(zb.dot(ya), zb.dot(xa)), sp.atan2(-za.dot(yb), za.dot(xb))], [za.dot(omega), zb.dot(omega)]
+
+
+def _rotates(f):
+    return [], list(f.RB.T * f.omega)
+
+
+def _floats(f):
+    velocity = sp.Matrix([f.rate_of(x) for x in f.pB])
+    return [], list(f.RB.T * velocity) + list(f.RB.T * f.child.frame_angular_velocity(f.frames[1]))
+
+
+def _rotation_vector(RA, RB, origin):
+    from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
+    return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
+
+
+def _pose(RA, RB, origin):
+    return np.concatenate([origin, matrix_quaternion(RB)])
+
+
+class KindValues(NamedTuple):
+    """How a kind's joint values are computed: ``expressions`` (a ``_Frames``) -> (scalar
+    position expressions, rate expressions), and for a kind whose record says
+    ``matrix_positions``, ``from_matrices`` (R_A, R_B, p_B as floats) -> its positions."""
+
+    expressions: object
+    from_matrices: object = None
+
+
+NO_VALUES = KindValues(None)  # a kind without joint values (its record names none)
+
+VALUES = {  # per kind of core/joint_kinds.KINDS (module docstring)
+    "fixed": NO_VALUES,
+    "revolute": KindValues(_turns),
+    "prismatic": KindValues(_slides),
+    "cylindrical": KindValues(_turns_and_slides),
+    "spherical": KindValues(_rotates, _rotation_vector),
+    "universal": KindValues(_crosses),
+    "distance": NO_VALUES,
+    "free": KindValues(_floats, _pose),
+}
+
+
+def values_agree(record, values):
+    """Whether ``values`` (a ``VALUES`` entry) are what ``record`` names: formulas exactly for
+    a kind with joint values, positions from the matrices exactly for ``matrix_positions``."""
+    if (values.expressions is None) == bool(record.rates):
+        return "joint values where the record names none, or none where it names some"
+    if (values.from_matrices is None) == record.matrix_positions:
+        return "positions from the frames' rotations exactly when the record says matrix_positions"
+    return None
+
+
+check_table("model/joint_values.VALUES", VALUES, agrees=values_agree)
+
+
 def _relative(kind, parent, child, frames, pA, RA, pB, RB, q, qd):
     """(scalar position expressions, rate expressions) of a joint of ``kind`` between ``frames``
-    (A, B) at (pA, RA), (pB, RB)."""
-    xa, ya, za = RA[:, 0], RA[:, 1], RA[:, 2]
-    xb, yb, zb = RB[:, 0], RB[:, 1], RB[:, 2]
-    omega = child.frame_angular_velocity(frames[1]) - (parent.frame_angular_velocity(frames[0]) if parent is not None
-                                                       else sp.zeros(3, 1))
-    angle = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
-    displacement = za.dot(pB - pA)
-    if kind == "revolute":
-        return [angle], [za.dot(omega)]
-    if kind == "prismatic":
-        return [displacement], [time_derivative(displacement, q, qd)]
-    if kind == "cylindrical":
-        return [angle, displacement], [za.dot(omega), time_derivative(displacement, q, qd)]
-    if kind == "universal":
-        return [sp.atan2(zb.dot(ya), zb.dot(xa)), sp.atan2(-za.dot(yb), za.dot(xb))], [za.dot(omega), zb.dot(omega)]
-    if kind == "spherical":
-        return [], list(RB.T * omega)
-    if kind == "free":
-        velocity = sp.Matrix([time_derivative(x, q, qd) for x in pB])
-        return [], list(RB.T * velocity) + list(RB.T * child.frame_angular_velocity(frames[1]))
-    return [], []
+    (A, B) at (pA, RA), (pB, RB): its ``VALUES`` entry's, none for a kind without values."""
+    expressions = VALUES[kind].expressions
+    return ([], []) if expressions is None else expressions(_Frames(parent, child, frames, pA, RA, pB, RB, q, qd))
 
 
 def _positions(kind, scalars, RA, RB, origin):
-    """The position entries: compiled scalars, or from the frames' rotations."""
-    if kind == "spherical":
-        from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
-        return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
-    if kind == "free":
-        return np.concatenate([origin, matrix_quaternion(RB)])
-    return scalars
+    """The position entries: compiled scalars, or from the frames' rotations (``VALUES``)."""
+    from_matrices = VALUES[kind].from_matrices
+    return scalars if from_matrices is None else from_matrices(RA, RB, origin)
 
 
 def _orthonormal(R):

@@ -35,15 +35,18 @@ import sympy as sp
 
 from ..model.connectors.joints import Joint
 from ..core.errors import ModelError
+from ..core.joint_kinds import KINDS, WELD
 from ..core.kinematics import body_rate_matrix, rotation
 from ..model.parts import LINK_FRAME, Frame, RigidBody
 from ..model.parts.base import frame_velocity
 from ..symbolic.derive import compile_function, jacobian
 
-# loop-closing joints: Pinocchio's rigid constraints (type, point offsets along the frame's z)
-LOOPS = {"fixed": (pin.ContactType.CONTACT_6D, (0.0,)), "spherical": (pin.ContactType.CONTACT_3D, (0.0,)),
-         "revolute": (pin.ContactType.CONTACT_3D, (0.0, 1.0))}
-TREE_JOINTS = {"revolute": pin.JointModelRZ, "prismatic": pin.JointModelPZ}
+# per kind its Pinocchio counterparts (core/joint_kinds.py: a kind's ``pinocchio``): the joint
+# models that hang a body (WELD: on its parent's joint) and the rigid constraints that close a
+# loop (type, point offsets along the frame's z)
+TREE_JOINTS = {name: kind.pinocchio.tree for name, kind in KINDS.items() if kind.pinocchio.tree}
+LOOPS = {name: (getattr(pin.ContactType, kind.pinocchio.loop[0]), kind.pinocchio.loop[1])
+         for name, kind in KINDS.items() if kind.pinocchio.loop}
 PROXIMAL = (1e-13, 1e-10, 200)  # constraintDynamics: accuracy, μ, iterations (redundant loop rows allowed)
 
 
@@ -200,7 +203,7 @@ class Twin:
         spherical joints then close loops)."""
         self.bodies.setdefault(None, Placed(0, pin.SE3.Identity()))  # the world
         while len(self.bodies) <= len(parts):
-            edges = [(j, side) for j in joints if j.name not in used and j.joint_kind in (*TREE_JOINTS, "fixed")
+            edges = [(j, side) for j in joints if j.name not in used and j.joint_kind in TREE_JOINTS
                      for side in (0, 1)
                      if _name(j.parts[side]) in self.bodies and _name(j.parts[1 - side]) not in self.bodies]
             edge = edges[0] if edges else None
@@ -222,11 +225,11 @@ class Twin:
         at = placed.placement * self._se3(joint.frames[side])  # the joint frame on the placed side, in its joint
         part = joint.parts[1 - side]
         body = self._se3(joint.frames[1 - side]).inverse()  # the new body's frame in the joint frame
-        if joint.joint_kind == "fixed":
+        if TREE_JOINTS[joint.joint_kind] == WELD:
             self.bodies[part.name] = Placed(placed.joint, at * body)
             self.model.appendBodyToJoint(placed.joint, self._inertia(part, at * body), pin.SE3.Identity())
             return
-        jid = self.model.addJoint(placed.joint, TREE_JOINTS[joint.joint_kind](), at, joint.name)
+        jid = self.model.addJoint(placed.joint, getattr(pin, TREE_JOINTS[joint.joint_kind])(), at, joint.name)
         self.model.appendBodyToJoint(jid, self._inertia(part, body), pin.SE3.Identity())
         self.bodies[part.name] = Placed(jid, body)
         self.coordinates.append(_joint_coordinate(joint.name, jid, self.model, joint, 1 if side == 0 else -1,
@@ -236,7 +239,7 @@ class Twin:
         for joint in joints:
             if joint.joint_kind not in LOOPS:
                 raise no_twin(self.system, f"joint '{joint.name}' ({joint.joint_kind}) is neither a tree joint "
-                                           f"({', '.join(TREE_JOINTS)}, fixed) nor one that Pinocchio's rigid "
+                                           f"({', '.join(TREE_JOINTS)}) nor one that Pinocchio's rigid "
                                            f"constraints close ({', '.join(LOOPS)})")
             kind, offsets = LOOPS[joint.joint_kind]
             ends = [self.bodies[_name(part)] for part in joint.parts]
@@ -322,8 +325,8 @@ class Twin:
 
 def _joint_coordinate(name, joint_id, model, joint, sign, system, kind, limits=None, torque=None):
     """A revolute, continuous or prismatic Pinocchio joint read off an mbsynth Joint."""
-    position, rate = ((joint.angle, joint.angle_rate) if joint.joint_kind == "revolute"
-                      else (joint.displacement, joint.displacement_rate))
+    motion, = KINDS[joint.joint_kind].motions  # a tree joint's one free motion: angle or displacement
+    position, rate = getattr(joint, motion), getattr(joint, f"{motion}_rate")
     positions = [sp.cos(position), sp.sin(position)] if kind == "continuous" else [sign * position]
     return Coordinate(name, joint_id, model, kind, positions, [sign * rate], system, limits, torque, sign)
 

@@ -42,6 +42,7 @@ import numpy as np
 import sympy as sp
 
 from ..core.errors import ModelError
+from ..core.joint_kinds import KINDS
 from ..io.parts import COLORS
 from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
@@ -280,7 +281,7 @@ def _joint_items(system, poses, markers):
         if getattr(con, "joint_kind", None) is None:
             continue
         ends = [poses.add(part, frame) for part, frame in zip(con.parts, con.frames)]
-        if con.joint_kind == "distance":
+        if KINDS[con.joint_kind].has_length:  # a massless rod
             lines.append((f"lines/{con.name}", *ends, ROD_COLOR, LINE_RADIUS))
         elif markers:
             specs += [_Spec(f"joints/{con.name}.{end}", key, [], "marker", ROD_COLOR) for end, key in zip("AB", ends)]

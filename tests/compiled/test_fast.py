@@ -19,7 +19,7 @@ import pytest
 import mbsynth as mb
 from mbsynth.model.connectors.joints import Joint
 from mbsynth.core.equations import constrained_acceleration, equilibrate_rows
-from mbsynth.core.joint_kinds import JOINT_KINDS
+from mbsynth.core.joint_kinds import JOINT_KINDS, KINDS
 from mbsynth.core.tolerances import RANK_RTOL
 from mbsynth.core.errors import SolveError
 from mbsynth.compiled import engine_for
@@ -28,7 +28,9 @@ from mbsynth.compiled.joints import vector_work
 from mbsynth.compiled.joints import joint_rows as kernel_rows
 from mbsynth.compiled.assembly import make_work, nodes
 from mbsynth.compiled.layout import build as build_layout
+from mbsynth.compiled.packing import pack
 from mbsynth.compiled.rate_rows import rate_rows
+from mbsynth.compiled.rows import Rows
 from mbsynth.compiled.tree import _components_closed, _null_space_components
 from mbsynth.core import kinematics
 from mbsynth.core.kinematics import body_rate_matrix
@@ -169,6 +171,34 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
                 assert np.abs(A[:k, 6 * e + 3:6 * e + 6] - expected_a).max() <= 1e-12, con.joint_kind
                 expected_b -= c_u @ u * (-(ud @ ud) / nu) / nu
             assert np.abs(b[:k] - expected_b).max() <= 1e-12 * max(1.0, np.abs(expected_b).max()), con.joint_kind
+
+
+def test_every_kind_agrees_in_every_interpreter(all_joints):
+    """Per kind of the table (core/joint_kinds.py), at seeded states with quaternions of any
+    length: the compiled φ, φ̇ (rows.residuals_energy) equal the sympy rows' (whose φ is the
+    spec's, OPERATIONS); the joint has exactly its kind's free motions (what its efforts act
+    along) and its joint values, one entry per position and rate its record names."""
+    system = all_joints
+    L = build_layout(system)[0]
+    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    assert sorted({c.joint_kind for c in kernel_joints}) == sorted(JOINT_KINDS)  # a new kind joins ALL_JOINTS
+    rows = Rows(L, pack(L), int(L.sizes[1]))
+    rng = np.random.default_rng(61)
+    for trial in range(4):
+        q, qd = random_state(system, rng, unit=trial % 2 == 0)
+        phi, psi = (x.copy() for x in rows(q, qd)[:2])
+        values = system.joint_values(0.0, q, qd)
+        for j, con in enumerate(kernel_joints):
+            kind, at = KINDS[con.joint_kind], slice(L.joint_row[j], L.joint_row[j] + L.joint_k[j])
+            phi_ref, psi_ref = con.residuals(0.0, q, qd, system.parameter_values)
+            assert np.abs(phi[at] - phi_ref).max() <= 1e-12 * max(1.0, np.abs(phi_ref).max()), kind.name
+            assert np.abs(psi[at] - psi_ref).max() <= 1e-12 * max(1.0, np.abs(psi_ref).max()), kind.name
+            assert [m for m in ("angle", "displacement") if getattr(con, m) is not None] == list(kind.motions)
+            if kind.rates:
+                assert values[con.name].position.shape == (len(kind.positions),), kind.name
+                assert values[con.name].rate.shape == (len(kind.rates),), kind.name
+            else:
+                assert con.name not in values
 
 
 def test_closed_form_null_spaces_of_revolute_and_fixed_rows():

@@ -30,7 +30,7 @@ import numpy as np
 import sympy as sp
 
 from .base import Connector
-from ...core.joint_kinds import ALIGNED_AXIS, COMPONENT, DOT, JOINT_KINDS, KINDS, ORIENTATION_LOCK
+from ...core.joint_kinds import ALIGNED_AXIS, JOINT_KINDS, KINDS, OPERATIONS, ORIENTATION_LOCK
 from ...core.kinematics import quaternion_rotation
 from ..joint_templates import SHARED_PARTS, Templates, joint_coordinates, pose, shared
 from ..parts import Particle, PlanarBody
@@ -42,19 +42,15 @@ from ...core.memo import MEMO
 
 def joint_equations(kind, pA, RA, pB, RB, length=None):
     """(φ rows, row labels) of a joint of ``kind`` between poses (pA, RA) and (pB, RB): the
-    rows of its record in core/joint_kinds.py, on d = pB − pA and the axes of RA and RB."""
+    rows of its record in core/joint_kinds.py, on d = pB − pA and the axes of RA and RB, each
+    its operation's φ (``OPERATIONS``)."""
     if kind not in JOINT_KINDS:
         raise ValueError(f"unknown joint kind {kind!r}; known: {', '.join(JOINT_KINDS)}")
-    d = pB - pA
-    vectors = (d, RA[:, 0], RA[:, 1], RA[:, 2], RB[:, 0], RB[:, 1], RB[:, 2])
+    vectors = (pB - pA, RA[:, 0], RA[:, 1], RA[:, 2], RB[:, 0], RB[:, 1], RB[:, 2])
     phis = []
     for _, operation, first, second in KINDS[kind].rows:
-        if operation == COMPONENT:
-            phis.append(vectors[first][second])
-        elif operation == DOT:
-            phis.append(vectors[first].dot(vectors[second]))
-        else:
-            phis.append((d.dot(d) - length**2) / (2 * length))
+        spec = OPERATIONS[operation]
+        phis.append(spec.phi(vectors[first], second if spec.second == "component" else vectors[second], length))
     return phis, list(KINDS[kind].labels)
 
 
