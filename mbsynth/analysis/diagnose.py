@@ -15,6 +15,7 @@ import numpy as np
 
 from ..model.angle_singularity import AngleParts
 from ..model.balances import balances
+from ..model.data import workspace
 from ..core.equations import rank_report
 from ..core.errors import SolveError
 from ..core.kinematics import body_rate_matrix, quaternion_matrix, rotation_z
@@ -60,19 +61,22 @@ class Diagnosis:
         return dict(asdict(self), consistent=self.consistent)
 
 
-def diagnose(system, t=0.0, q=None, qd=None):
-    """Result 3 and the closure balances of ``system`` at (t, q, q̇), by default its initial state."""
+def diagnose(data, t=0.0, q=None, qd=None):
+    """Result 3 and the closure balances of the model of ``data`` (a Data, or a model: its
+    default-path Data) at (t, q, q̇), by default its initial state."""
+    data = workspace(data)
+    system = data.model
     q0, qd0 = system.initial_state()
     q = q0 if q is None else np.asarray(q, dtype=float)
     qd = qd0 if qd is None else np.asarray(qd, dtype=float)
-    arrays = system.evaluate(t, q, qd)
+    arrays = data.evaluate(t, q, qd)
     report = rank_report(arrays.M, arrays.A)
-    found = balances(system, t, q, qd)
-    phi, phidot = system.constraint_residuals(t, q, qd)
+    found = balances(data, t, q, qd)
+    phi, phidot = data.constraint_residuals(t, q, qd)
     residuals = {name: {"phi": _number(a), "phi_dot": _number(b)}
                  for name, a, b in zip(system.constraint_names, phi, phidot)}
     try:
-        motion = system.motion(t, q, qd, method="reference")
+        motion = data.motion(t, q, qd, method="reference")
         qdd, error = dict(zip(system.coordinates, map(float, motion.qdd))), None
     except SolveError as err:
         motion, qdd, error = None, {}, str(err)
@@ -87,16 +91,16 @@ def diagnose(system, t=0.0, q=None, qd=None):
                    "state_dependent": c.state_dependent} for c in system.closures],
         constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
         rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report),
-        joints=_joints(system, t, q, qd, motion), free_joints=_moved_joints(system, t, q, report.nullspace),
+        joints=_joints(data, t, q, qd, motion), free_joints=_moved_joints(data, t, q, report.nullspace),
         angle_singularities=[a.to_dict() for a in AngleParts(system).set_aside(q, report.nullspace)[0]],
         substructures=substructure_counts(system, arrays.M, arrays.A))
 
 
-def _joints(system, t, q, qd, motion):
+def _joints(data, t, q, qd, motion):
     """{joint: {coordinates, position, rate, acceleration names and values}} at the state
-    (accelerations None without a motion): System.joint_values."""
-    kinematics = system.joint_kinematics()
-    values = system.joint_values(t, q, qd, None if motion is None else motion.qdd)
+    (accelerations None without a motion): Data.joint_values."""
+    kinematics = data.model.joint_kinematics()
+    values = data.joint_values(t, q, qd, None if motion is None else motion.qdd)
     return {name: {"coordinates": list(kinematics[name].position_names),
                    "accelerations": list(kinematics[name].acceleration_names),
                    "position": v.position.tolist(), "rate": v.rate.tolist(),
@@ -104,15 +108,15 @@ def _joints(system, t, q, qd, motion):
             for name, v in values.items()}
 
 
-def _moved_joints(system, t, q, nullspace):
+def _moved_joints(data, t, q, nullspace):
     """Per indeterminate direction w (scaled as in ``indeterminate``), {joint: its rates
     when the state moves along w}: the joints the free direction turns or slides."""
-    if not nullspace.shape[1] or not system.joint_kinematics():
+    if not nullspace.shape[1] or not data.model.joint_kinematics():
         return [{} for _ in nullspace.T]
-    rest = system.joint_values(t, q, np.zeros(system.n))
+    rest = data.joint_values(t, q, np.zeros(data.model.n))
     found = []
     for w in nullspace.T:
-        moving = system.joint_values(t, q, w / w[np.argmax(np.abs(w))])
+        moving = data.joint_values(t, q, w / w[np.argmax(np.abs(w))])
         rates = {name: (v.rate - rest[name].rate) for name, v in moving.items()}
         scale = max((np.abs(r).max(initial=0.0) for r in rates.values()), default=0.0)
         found.append({name: r.tolist() for name, r in rates.items() if np.abs(r).max(initial=0.0) > COMPONENT_TOL

@@ -51,7 +51,7 @@ DEFAULT_OUTPUTS = 500
 
 def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
              stabilization="projection", baumgarte=(10.0, 10.0), out=None, progress=None, controller=None,
-             control_dt=None):
+             control_dt=None, path=None):
     """Integrate ``system`` from t0 to t_end; returns a Trajectory with one row per output time
     (and the model's declared outputs: mbsynth.model.outputs).
 
@@ -64,6 +64,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     controller: ``f(t, joint_values) -> {parameter: value}``, called at t0 and every
     ``control_dt`` (default: the output interval), its values held in between (sampled
     control, mbsynth.analysis.control).
+    path: the run's path, "compiled" or "kkt" (``System.data``; None: the default).
     Raises SimulationError (with the partial trajectory) when the run cannot go on.
     """
     if stabilization not in STABILIZATIONS:
@@ -71,7 +72,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     method = _integrator(method)
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end > t0):
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0}), both finite")
-    data = system.data()  # the run's workspace: one motion path (compiled or KKT) for the whole run
+    data = system.data(path)  # the run's workspace: one motion path (compiled or KKT) for the whole run
     if q0 is None and qd0 is None:
         q, qd, changes = consistent_initial_state(data, t0)
         for name, (given, new) in changes.items():

@@ -17,6 +17,7 @@ import sympy as sp
 
 from .angle_singularity import AngleParts
 from .connectors.base import Connector
+from .data import workspace
 from ..core.equations import rank_report
 from ..core.errors import ModelError
 from ..symbolic.derive import T_SYMBOL, exceeds, tidy
@@ -64,8 +65,9 @@ class Balance:
                 f"{SYMBOLIC_SIZE_MAX} symbols and operations, is not written out)")
 
 
-def balances(system, t=0.0, q=None, qd=None):
-    """The balances of every indeterminate direction of ``system`` (none when unique), but
+def balances(data, t=0.0, q=None, qd=None):
+    """The balances of every indeterminate direction of the model of ``data`` (a Data, or a
+    model: its default-path Data) at its parameter values (none when unique), but
     those of a part's angles at their singular position (angle_singularity.py: the
     coordinates' fault, no balance closes them).
 
@@ -75,14 +77,16 @@ def balances(system, t=0.0, q=None, qd=None):
     are used and the balances are marked state dependent: they hold at this state and
     along the motion only while the null space keeps its form.
     """
+    data = workspace(data)
+    system = data.model
     q0, qd0 = system.initial_state()
     q = q0 if q is None else np.asarray(q, dtype=float)
     qd = qd0 if qd is None else np.asarray(qd, dtype=float)
-    arrays = system.evaluate(t, q, qd)
+    arrays = data.evaluate(t, q, qd)
     numeric = AngleParts(system).set_aside(q, rank_report(arrays.M, arrays.A).nullspace)[1]
     if numeric.shape[1] == 0:
         return []  # before the sympy form of the model: seconds on a robot
-    values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in system.parameters.items()}
+    values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in data.parameters.items()}
     M, Q, A, _, C = system.symbolic()
     force = Q + C
     state = {s: v for s, v in zip(system.q_symbols + system.qd_symbols, np.concatenate([q, qd]))}

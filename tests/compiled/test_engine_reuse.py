@@ -20,7 +20,9 @@ import pytest
 import sympy as sp
 
 import mbsynth as mb
+from mbsynth.core.memo import MEMO
 from mbsynth.compiled import background, engine_for
+from mbsynth.model.data import shared
 from mbsynth.model.system import System
 from mbsynth.compiled.layout import build as build_layout
 
@@ -51,11 +53,6 @@ def rel(x, y):
     return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
 
 
-@pytest.fixture
-def background_mode(monkeypatch):
-    monkeypatch.setenv("MBSYNTH_FAST", "background")
-
-
 @pytest.fixture(scope="module")
 def model():
     return mb.loads(MODEL, "reuse")
@@ -78,7 +75,7 @@ def assert_layout_as_built(system, engine):
         assert a.shape == b.shape and np.array_equal(a, b), field
 
 
-def test_with_parameters_shares_the_compiled_code(model, background_mode):
+def test_with_parameters_shares_the_compiled_code(model):
     engine = engine_for(model)
     heavier = model.with_parameters(m=2.1, L=0.55, R=0.7, g=3.0, k=-1.0, Ib=0.05)
     derived = engine_for(heavier)  # no wait: nothing to compile
@@ -94,7 +91,7 @@ def test_with_parameters_shares_the_compiled_code(model, background_mode):
     assert rel(engine.motion(0.5, q, qd).qdd, derived.motion(0.5, q, qd).qdd) > 1e-3  # the numbers differ
 
 
-def test_a_force_parameter_keeps_the_layout_and_moves_the_motion(model, background_mode):
+def test_a_force_parameter_keeps_the_layout_and_moves_the_motion(model):
     """k enters only the push on the bob (an argument of the generated code), not the
     Layout's numbers (masses, inertias, frames, lengths, gravity: m, L, mb, Ib, R, g): a
     System differing only in k shares its parent's Layout as it is (a controller's torques
@@ -141,10 +138,11 @@ def test_parameters_written_into_a_data_give_a_loaded_systems_arrays(model):
 
 
 @pytest.mark.implementation
-def test_the_runs_of_a_system_share_one_evaluation_layout(background_mode):
+def test_the_runs_of_a_system_share_one_evaluation_layout():
     """The Data of each run of a System, and of its ``with_parameters`` children, use one
     Evaluator (its groups laid out once, not once per simulate), each with its own
-    parameter values: the arrays equal a fresh load's. It dies with the Systems."""
+    parameter values: the arrays equal a fresh load's. The one cache holds it, and nothing
+    else once the Systems are gone (``MEMO.clear()`` frees it)."""
     system = mb.loads(MODEL, "reuse")
     first, second = system.data(), system.data()
     q, qd = a_state(system)
@@ -160,6 +158,9 @@ def test_the_runs_of_a_system_share_one_evaluation_layout(background_mode):
     made = weakref.ref(first.evaluator)
     del system, first, second, child, run
     gc.collect()
+    assert made() is not None  # kept for the next model of this structure
+    MEMO.clear()
+    gc.collect()
     assert made() is None
 
 
@@ -168,14 +169,14 @@ def test_a_structural_replace_gets_a_cache_of_its_own(model):
     """``dataclasses.replace`` with other parts or constraints (``with_constraints``) must not
     inherit the compiled Template or Evaluators of another structure; other parameter
     values keep them."""
-    assert replace(model, parameters={**model.parameters, "m": 2.0}).shared is model.shared
-    assert model.with_constraints([]).shared is model.shared  # nothing appended: the same structure
-    assert replace(model, connectors=model.connectors[:-1]).shared is not model.shared
+    assert shared(replace(model, parameters={**model.parameters, "m": 2.0})) is shared(model)
+    assert shared(model.with_constraints([])) is shared(model)  # nothing appended: the same structure
+    assert shared(replace(model, connectors=model.connectors[:-1])) is not shared(model)
     renamed = {("mass" if k == "m" else k): v for k, v in model.parameters.items()}
-    assert replace(model, parameters=renamed).shared is not model.shared
+    assert shared(replace(model, parameters=renamed)) is not shared(model)
 
 
-def test_a_massless_body_from_a_parameter(model, background_mode):
+def test_a_massless_body_from_a_parameter(model):
     """b1 welded to b0 loses its mass and inertia: M gets a zero block (a structural change
     of (2.14)'s problem), which the reused Engine meets with the numbers a fresh build has."""
     engine_for(model)
@@ -193,18 +194,19 @@ def test_a_massless_body_from_a_parameter(model, background_mode):
     assert rel(massless.motion(0.3, q, qd).qdd, ref.qdd) < 1e-10
 
 
-def test_engines_die_with_their_systems(background_mode):
+def test_nothing_but_the_one_cache_holds_systems_and_engines():
     system = mb.loads(MODEL, "reuse")
     child = system.with_parameters(m=3.0)
     engines = [engine_for(system), engine_for(child)]
     assert None not in engines
     refs = [weakref.ref(x) for x in (system, child, *engines, engines[0].template)]
     del system, child, engines
+    MEMO.clear()
     gc.collect()
     assert [r() for r in refs] == [None] * len(refs)
 
 
-def test_a_failed_build_leaves_the_kkt_path_and_holds_no_system(monkeypatch, background_mode, caplog):
+def test_a_failed_build_leaves_the_kkt_path_and_holds_no_system(monkeypatch, caplog):
     """A build that raises is logged, its System's motion is the KKT path's ((2.14), the
     reference) and the worker keeps no reference to the System."""
     def broken(system):
@@ -218,18 +220,19 @@ def test_a_failed_build_leaves_the_kkt_path_and_holds_no_system(monkeypatch, bac
     assert system.motion(0.0, q, qd).method != "tree (Baraff)"
     ref = weakref.ref(system)
     del system
+    MEMO.clear()
     gc.collect()
     assert ref() is None
 
 
-def test_equal_systems_behave_the_same(model, background_mode):
-    """A second load of the same text builds its own Template and takes the same path,
-    with bit-identical motions; a copy with other numbers shares the Template (parameters
-    are arguments of its code) with its own numbers."""
+def test_equal_systems_behave_the_same(model):
+    """A second load of the same text is an equal model: it shares the Template and takes
+    the same path, with bit-identical motions; a copy with other numbers shares the
+    Template (parameters are arguments of its code) with its own numbers."""
     engine = engine_for(model)
     again = mb.loads(MODEL, "reuse")
     theirs = engine_for(again)
-    assert theirs is not engine and theirs.template is not engine.template
+    assert again == model and theirs.template is engine.template
     q, qd = a_state(model)
     ours, other = model.data().motion(0.3, q, qd), again.data().motion(0.3, q, qd)
     assert ours.method == other.method == "tree (Baraff)" and np.array_equal(ours.qdd, other.qdd)
@@ -238,21 +241,18 @@ def test_equal_systems_behave_the_same(model, background_mode):
     assert heavier.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
 
 
-@pytest.mark.implementation
-def test_a_run_keeps_the_path_it_started_with(monkeypatch, background_mode):
-    """Kernels not compiled and the Template not ready: a run's Data takes the KKT path, and
-    keeps it after the Template becomes ready; with them compiled, a new Data waits for it."""
+def test_a_data_takes_the_path_it_was_made_with(monkeypatch):
+    """The path is the Data's, whatever the cache on disk says: the default path waits for
+    the Template though no kernels are marked compiled, a KKT Data never takes the engine,
+    and both give (2.14)'s motion."""
     system = mb.loads(MODEL, "reuse")
     monkeypatch.setattr(background, "compiled", lambda: False)
-    monkeypatch.setattr(background, "_submit", lambda system, slot: slot.future)  # nothing builds
-    run = system.data()
-    assert run.engine is None
-    monkeypatch.undo()
-    monkeypatch.setenv("MBSYNTH_FAST", "background")
-    assert engine_for(system) is not None
-    assert run.engine is None and run.engine is None
-    assert background.compiled()  # an Engine was warmed in this process
-    assert system.data().engine is not None
+    compiled, kkt = system.data(), system.data(path="kkt")
+    assert compiled.engine is not None and kkt.engine is None
+    q, qd = a_state(system)
+    fast, exact = compiled.motion(0.3, q, qd), kkt.motion(0.3, q, qd)
+    assert fast.method == "tree (Baraff)" and exact.method != fast.method
+    assert rel(fast.qdd, exact.qdd) < 1e-10
 
 
 def test_a_controlled_run_builds_no_system(monkeypatch, model):
