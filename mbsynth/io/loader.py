@@ -33,9 +33,9 @@ from .schema import SECTIONS
 from .placement import Placement, place_initial
 from .source import Document, LineDict, LineList, read_document
 from .substructures import Scoped, included_from, read_includes
+from ..core.tolerances import ASSEMBLED_TOL
 
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
-ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
 
 def load(path, parameters=None):
@@ -694,7 +694,7 @@ class _Builder:
         A joint whose rows do not hold yet is left to the state made consistent."""
         q, qd = system.initial_state()
         phi, _ = system.constraint_residuals(0.0, q, qd)
-        apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED}
+        apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED_TOL}
         for joint, problem in system.branch_problems(q):
             if joint not in apart:
                 builder, place = self.entry_named(joint)

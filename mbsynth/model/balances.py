@@ -21,7 +21,7 @@ from ..core.equations import rank_report
 from ..core.errors import ModelError
 from ..symbolic.derive import T_SYMBOL, exceeds, tidy
 from .system import Closure
-from ..core.tolerances import BALANCE_ZERO_RTOL
+from ..core.tolerances import BALANCE_ENTRY_ZERO, BALANCE_ZERO_RTOL, RATIONAL_TOL, READABLE_DROP
 
 SAMPLES = 8
 
@@ -104,8 +104,8 @@ def balances(system, t=0.0, q=None, qd=None):
             expression = sp.S.Zero if is_free else tidy((w.T * force)[0])  # tidy: bounded (derive.py)
             vector = np.array(w.subs(state).evalf(), dtype=float).ravel()
             vector /= vector[np.argmax(np.abs(vector))]
-            result.append(Balance({c: float(v) for c, v in zip(system.coordinates, vector) if abs(v) > 1e-12},
-                                  expression, state_dependent, float(vector @ (arrays.Q + arrays.C))))
+            entries = {c: float(v) for c, v in zip(system.coordinates, vector) if abs(v) > BALANCE_ENTRY_ZERO}
+            result.append(Balance(entries, expression, state_dependent, float(vector @ (arrays.Q + arrays.C))))
     return result
 
 
@@ -114,7 +114,6 @@ SYMBOLIC_SIZE_MAX = 400  # nodes of an expression (or of a matrix's non-numeric 
 
 
 READABLE_DIGITS = 6  # significant digits of the numbers in a printed balance
-READABLE_DROP = 1e-9  # a term of a sum below this times its largest coefficient is left out of a printed balance
 
 
 def readable(expression):
@@ -180,7 +179,7 @@ def _separate(W, system, q, qd, t):
 
 
 def _rational_rows(rows):
-    return [[sp.nsimplify(x, rational=True, tolerance=1e-12) for x in row] for row in rows]
+    return [[sp.nsimplify(x, rational=True, tolerance=RATIONAL_TOL) for x in row] for row in rows]
 
 
 def _canonical(D, state, dynamic):

@@ -39,12 +39,13 @@ from ..core.kinematics import body_rate_matrix, rotation
 from ..model.parts import LINK_FRAME, Frame, RigidBody
 from ..model.parts.base import frame_velocity
 from ..symbolic.derive import compile_function, jacobian
+from ..core.tolerances import PROXIMAL_ACCURACY, PROXIMAL_MU
 
 # loop-closing joints: Pinocchio's rigid constraints (type, point offsets along the frame's z)
 LOOPS = {"fixed": (pin.ContactType.CONTACT_6D, (0.0,)), "spherical": (pin.ContactType.CONTACT_3D, (0.0,)),
          "revolute": (pin.ContactType.CONTACT_3D, (0.0, 1.0))}
 TREE_JOINTS = {"revolute": pin.JointModelRZ, "prismatic": pin.JointModelPZ}
-PROXIMAL = (1e-13, 1e-10, 200)  # constraintDynamics: accuracy, μ, iterations (redundant loop rows allowed)
+PROXIMAL = (PROXIMAL_ACCURACY, PROXIMAL_MU, 200)  # constraintDynamics: accuracy, μ, iterations
 
 
 def no_twin(system, why):

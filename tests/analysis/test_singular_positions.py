@@ -14,7 +14,7 @@ from scipy.integrate import solve_ivp
 
 import mbsynth as mb
 from mbsynth.analysis import cut, derivative
-from mbsynth.analysis.cut import RELAXED_RTOL
+from mbsynth.core.tolerances import RELAXED_RTOL
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))

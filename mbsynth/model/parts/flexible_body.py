@@ -34,8 +34,8 @@ from ...symbolic.derive import positions
 from ..flexible.invariants import invariants
 from .base import Frame, Part
 from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
+from ...core.tolerances import GRAM_ZERO_RTOL
 
-GRAM_ZERO_RTOL = 1e-14  # invariant entries below this fraction of the largest are rounding: written as zero
 
 
 class FlexibleBody(Part):
