@@ -6,8 +6,8 @@ waits for it, ``template(system)`` starts building the Template of the System's 
 (layout, generated function, compilation: engine.py) on a background thread the first
 time it is asked, and answers None — use the KKT path — until it is ready.
 ``MBSYNTH_FAST`` changes this: "background" (the default), "wait" (build on first use,
-blocking) or "off" (never use the compiled path). ``python -m mbsynth.compiled`` (run by
-``make install``) compiles ahead.
+blocking) or "off" (never use the compiled path). ``python -m mbsynth.cli.compile_ahead``
+(run by ``make install``) compiles ahead.
 
 A Template is kept in the ``TemplateSlot`` of the System's structure (``System.shared``:
 the Systems that differ only in parameter values share it), built at most once for all
