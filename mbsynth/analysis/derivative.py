@@ -10,7 +10,7 @@ interval of integration (``begin``):
 
 - a step-size collapse: COLLAPSE_CALLS evaluations that advance t by less than COLLAPSE_SPAN
   of the interval (or than 1e4 ε |t|, steps near the resolution of t) raise SolveError
-  naming the fastest changing coordinates (scipy would crawl on for minutes first);
+  naming the fastest changing coordinates (where scipy would crawl on);
 - a crawl near a singular position: near one the stages' accelerations carry noise of about
   |q̇| ψ / σ² (ψ the velocity drift the projection leaves, σ the smallest singular value of
   A), which a tight tolerance chases with ever smaller steps; more than CRAWL_CALLS

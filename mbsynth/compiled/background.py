@@ -1,10 +1,10 @@
 """Compiled Templates built off the caller's thread; MBSYNTH_FAST.
 
 numba compiles the kernels once per machine and keeps them on disk (cache.py); a cold
-compile takes tens of seconds, loading a warm cache well under a second. So that no call
-waits for it, ``template(system)`` starts building the Template of the System's structure
-(layout, generated function, compilation: engine.py) on a background thread the first
-time it is asked, and answers None — use the KKT path — until it is ready.
+compile costs far more than loading a warm cache. So that no call waits for it,
+``template(system)`` starts building the Template of the System's structure (layout,
+generated function, compilation: engine.py) on a background thread the first time it is
+asked, and answers None — use the KKT path — until it is ready.
 ``MBSYNTH_FAST`` changes this: "background" (the default), "wait" (build on first use,
 blocking) or "off" (never use the compiled path). ``python -m mbsynth.cli.compile_ahead``
 (run by ``make install``) compiles ahead.

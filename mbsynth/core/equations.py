@@ -334,7 +334,7 @@ def term_scales(A, x, floor=TERM_FLOOR):
     (a thousandth unless given) of ‖A_i‖₁ ‖x‖∞ for rows whose coordinates are near zero.
     A dense or scipy.sparse A."""
     x = np.abs(np.asarray(x, dtype=float))
-    if hasattr(A, "tocsr"):  # scipy.sparse, from the CSR arrays (scipy's abs and sum build matrices: 10× slower)
+    if hasattr(A, "tocsr"):  # scipy.sparse, from the CSR arrays (scipy's abs and sum would build matrices)
         A = A.tocsr()
         return entry_term_scales(np.repeat(np.arange(A.shape[0]), np.diff(A.indptr)), A.indices, A.data, A.shape[0],
                                  x, floor)

@@ -590,7 +590,7 @@ class _Builder:
                           f"joint '{own}' has the name of {clash}: rename the joint")
             values = functools.cache(functools.partial(value_expressions, joint))
             symbols = functools.cache(functools.partial(constraint_symbols, joint))
-            for key in value_names(joint):  # derived when an expression uses them (sympy: tenths of a second)
+            for key in value_names(joint):  # derived only when an expression uses them (a sympy derivation)
                 model.global_symbols[f"{joint.name}.{key}"] = _Deferred(values, key)
                 model.constraint_symbols[f"{joint.name}.{key}"] = _Deferred(symbols, key)
 

@@ -81,7 +81,7 @@ def balances(system, t=0.0, q=None, qd=None):
     arrays = system.evaluate(t, q, qd)
     numeric = AngleParts(system).set_aside(q, rank_report(arrays.M, arrays.A).nullspace)[1]
     if numeric.shape[1] == 0:
-        return []  # before the sympy form of the model: seconds on a robot
+        return []  # before the sympy form of the model (costly on a robot)
     values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in system.parameters.items()}
     M, Q, A, _, C = system.symbolic()
     force = Q + C
@@ -110,7 +110,7 @@ def balances(system, t=0.0, q=None, qd=None):
 
 
 SYMBOLIC_SIZE_MAX = 400  # nodes of an expression (or of a matrix's non-numeric entries) beyond which it is not
-# factored, put through a simplifying nullspace or printed: minutes on a flexible body's balance (50,000 nodes)
+# factored, put through a simplifying nullspace or printed (a flexible body's balance has 50,000 nodes)
 
 
 READABLE_DIGITS = 6  # significant digits of the numbers in a printed balance

@@ -237,7 +237,7 @@ def _relative(kind, parent, child, frames, pA, RA, pB, RB, q, qd):
 def _positions(kind, scalars, RA, RB, origin):
     """The position entries: compiled scalars, or from the frames' rotations."""
     if kind == "spherical":
-        from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
+        from scipy.spatial.transform import Rotation  # scipy.spatial is imported only where used
         return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
     if kind == "free":
         return np.concatenate([origin, matrix_quaternion(RB)])

@@ -1,4 +1,4 @@
-"""The field's benchmark problems (issue 18) run to the end and meet independent references.
+"""The field's benchmark problems run to the end and meet independent references.
 
 IFToMM/LIM A01 (simple pendulum), A02 (N-four-bar through its singular positions), A03 /
 the IVP test set's `andrews`, A04 (Bricard's over-constrained loop), A05 (the stiff
@@ -13,7 +13,7 @@ written by hand, and the slider-crank library's published solution.
 
 They fail on a solver that stops at, or mis-steps through, a configuration where the
 dependent rows change (Bricard, the N-four-bar) or that judges consistency with an
-absolute tolerance (the 1 km pendulum), as mbsynth did before issue 18. Output intervals
+absolute tolerance (the 1 km pendulum). Output intervals
 are coarse to keep each run short (drift control projects between them as needed);
 accuracy is `simulate`'s default (DOP853, rtol = atol = 1e-10).
 """

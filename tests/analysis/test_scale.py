@@ -1,4 +1,4 @@
-"""Tolerances are relative (issue 18): the same mechanism in millimetres, metres or
+"""Tolerances are relative: the same mechanism in millimetres, metres or
 kilometres, with masses in grams or tonnes, completes and moves alike after rescaling time.
 
 Lengths ×s with g fixed scale time by √s (Froude similarity); masses scale no motion. The

@@ -1,4 +1,4 @@
-"""Motion through singular positions (issue 18): where the constraint rows become dependent
+"""Motion through singular positions: where the constraint rows become dependent
 for an instant (a parallelogram's change points, where the degrees of freedom jump from 1
 to 2) the motion keeps its velocity and its branch; where they stay independent (a
 slider-crank's dead centres) the motion passes with its energy. References: closed forms and

@@ -108,7 +108,7 @@ def test_text_complex_and_unphysical_mass_matrices_are_refused(tmp_path, mass, w
 def test_craig_bampton_of_a_solid_is_refused_with_the_right_advice(tmp_path, interface):
     """A solid (3 DOFs per node: a point-mass truss) reduced by Craig–Bampton: holding the
     reference node's translations at the frame leaves the rotation about it to the reduced
-    coordinates. Refused at once (not "add interface nodes", not minutes in sympy), and
+    coordinates. Refused at once (not "add interface nodes", not a long sympy derivation), and
     free-interface modes, the advice, give a model ``check`` finds unique."""
     write_fe(truss(), tmp_path / "rod.npz")
     refused(tmp_path, "fe: {bundle: rod.npz}", f"{{method: craig_bampton, interface: {interface}, modes: 2}}", 6,

@@ -395,7 +395,7 @@ def test_rank_tolerance_is_relative():
 
 def test_forces_that_cancel_are_judged_against_the_terms_not_their_sum():
     """Q + C = −2⁻⁵² Q on a massless coordinate is rounding of the forces involved (1e3), not
-    a load no mass resists: the consistency scale is ‖Q‖ + ‖C‖ + ‖M q̈‖ (issue 18); an
+    a load no mass resists: the consistency scale is ‖Q‖ + ‖C‖ + ‖M q̈‖; an
     imbalance of 1e-6 of them still is one."""
     Q = np.array([0.0, 1e3])
     motion = constrained_acceleration(np.diag([1.0, 0.0]), Q, np.zeros((0, 2)), np.zeros(0), C=-Q * (1 + 2**-52))

@@ -1,4 +1,4 @@
-"""One verdict on uniqueness (issue 18): every path — the KKT solve, the tree kernel, the
+"""One verdict on uniqueness: every path — the KKT solve, the tree kernel, the
 Udwadia–Kalaba form — says "unique" exactly where the reference (2.14) does, and gives its
 q̈, on random singular, redundant and near-singular problems. The fast paths defer to the
 reference near their own thresholds, so the reference's rank rule decides every close case.

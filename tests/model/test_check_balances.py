@@ -125,8 +125,8 @@ def test_readable_rounds_numbers_and_drops_negligible_terms(expression, text):
 def test_a_balance_too_large_to_write_is_reported_by_its_value_in_bounded_time():
     """A flexible part whose reduced coordinates repeat its frame's rotation (a solid, 3 DOFs
     per node, reduced by Craig–Bampton at three nodes and held at one: built through the API,
-    which the loader refuses): its balances are expressions of tens of thousands of nodes, which
-    sympy's factor, count_ops and printing took minutes over. ``diagnose`` ends in seconds and
+    which the loader refuses): its balances are expressions of tens of thousands of nodes, too
+    large for sympy's factor, count_ops and printing. ``diagnose`` ends in bounded time and
     gives each balance by its value at the state, the direction's w · (Q + C) of
     ``System.evaluate``: zero to rounding at the undeformed state, where each indeterminate
     direction is the frame's rotation undone by the constraint modes' rigid one (no node moves,
