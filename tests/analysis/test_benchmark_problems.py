@@ -20,7 +20,6 @@ accuracy is `simulate`'s default (DOP853, rtol = atol = 1e-10).
 
 import functools
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +30,7 @@ from mbsynth.analysis.diagnose import diagnose
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISMS = ROOT / "models" / "mechanisms"
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 load = functools.cache(lambda name: mb.load(MECHANISMS / name))
 

@@ -5,7 +5,6 @@ slider-crank's dead centres) the motion passes with its energy. References: clos
 conservation laws, no mbsynth."""
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,8 +16,7 @@ from mbsynth.analysis import cut, derivative
 from mbsynth.core.tolerances import RELAXED_RTOL
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 
 def test_a_parallelogram_turns_through_its_change_points_at_constant_rate():

@@ -4,7 +4,6 @@ fault is in one), never exit 3 with a raw numpy, zipfile or sympy exception."""
 
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,8 +11,7 @@ import pytest
 from mbsynth.model.flexible.beam import beam
 from mbsynth.model.flexible.files import write_fe
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "model" / "flexible"))
-from flexible_beams import truss  # noqa: E402  (a helper beside the FE tests)
+from tests.helpers.flexible_beams import truss
 
 BEAM = "{length: 1.0, elements: 4, area: 1e-4, Iy: 2e-9, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000}"
 CB = "{method: craig_bampton, interface: [0], modes: 1}"

@@ -24,6 +24,8 @@ from mbsynth.compiled import background, engine_for
 from mbsynth.model.system import System
 from mbsynth.compiled.layout import build as build_layout
 
+from tests.helpers.compare import rel
+
 # Parameters in a mass, an inertia, frame offsets, a rod's length, gravity and a force.
 MODEL = """
 name: reuse
@@ -45,10 +47,6 @@ joints:
 forces:
   - {name: push, type: force, at: bob, value: ["k*sin(t)", 0, 0]}
 """
-
-
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
 
 
 @pytest.fixture

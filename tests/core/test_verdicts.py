@@ -21,12 +21,10 @@ import mbsynth as mb
 from mbsynth.core.equations import RANK_RTOL, constrained_acceleration, equilibrate_rows, rank_report, udwadia_kalaba
 from mbsynth.core.solvers import SPARSE_SIZE, kkt_acceleration
 
+from tests.helpers.compare import rel
+
 ROOT = Path(__file__).resolve().parents[2]
 EPS = np.finfo(float).eps
-
-
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
 
 
 def agreement(M, A, F, qdd):

@@ -4,9 +4,7 @@ prints the equation with short decimals, not the rationals of a numeric null vec
 
 import json
 import re
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,8 +20,7 @@ from mbsynth.model.system import System
 from mbsynth.core.expressions import parse
 from mbsynth.core.kinematics import rpy_matrix
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "flexible"))
-from flexible_beams import truss  # noqa: E402  (the FE tests' point-mass truss: a solid)
+from tests.helpers.flexible_beams import truss  # the FE tests' point-mass truss: a solid
 
 L = 0.8
 TILT = rpy_matrix(0.4, 0.3, 0.0)  # the rod's axes: not the world's, so its null direction is numeric

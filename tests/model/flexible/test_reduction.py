@@ -14,7 +14,7 @@ import pytest
 import scipy.linalg
 import scipy.sparse
 
-from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
+from tests.helpers.flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
 from mbsynth.core.errors import ModelError
 from mbsynth.model.flexible.matrices import fe_model
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface, normal_modes
@@ -224,14 +224,15 @@ def test_an_unconnected_piece_is_refused():
 def test_a_round_beams_reductions_are_the_same_in_two_processes():
     """A pinned round strip's free-interface modes (pairs kept whole) and its Craig–Bampton
     reduction, on eigsh's side: byte for byte the same bases and frequencies in two processes."""
-    script = ("import hashlib, sys; sys.path.insert(0, sys.argv[1]); from flexible_beams import strip, STRIP; "
+    script = ("import hashlib; from tests.helpers.flexible_beams import strip, STRIP; "
               "from mbsynth.model.flexible.reduction import craig_bampton, free_interface; "
               "fe = strip(60, Iy=STRIP['Iz']); "
               "rs = [free_interface(fe, [0], count=4, rigid=False), craig_bampton(fe, [0, 60], count=6)]; "
               "print([(len(r.frequencies), hashlib.sha256(r.basis.tobytes() + r.frequencies.tobytes()).hexdigest()) "
               "for r in rs])")
-    here = str(Path(__file__).parent)
-    runs = [subprocess.Popen([sys.executable, "-c", script, here], stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    root = Path(__file__).resolve().parents[3]  # the repository: tests.helpers and this mbsynth
+    runs = [subprocess.Popen([sys.executable, "-c", script], cwd=root, stdout=subprocess.PIPE, text=True)
+            for _ in range(2)]
     outs = [run.communicate(timeout=120)[0] for run in runs]
     assert all(run.returncode == 0 for run in runs)
     assert outs[0] == outs[1] and "(4, " in outs[0] and "(6, " in outs[0]
