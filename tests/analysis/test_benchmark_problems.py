@@ -304,7 +304,7 @@ def test_slider_crank_3d_follows_the_crank_equation_and_the_published_solution()
 def test_only_merges_its_rows_into_an_existing_table(tmp_path):
     """--only with an existing results file: the problem run replaces its own row and
     note, every other row stays, and one line says which rows were run again."""
-    import iftomm
+    from benchmarks import iftomm
     out = tmp_path / "results.md"
     old = (ROOT / "benchmarks" / "iftomm_results.md").read_text()
     out.write_text(old)
@@ -325,7 +325,7 @@ def test_only_merges_its_rows_into_an_existing_table(tmp_path):
 def test_benchmark_script_quick_writes_its_table(tmp_path):
     """benchmarks/iftomm.py --quick on three problems: a table row each, a failure
     reported in its row rather than raised."""
-    import iftomm
+    from benchmarks import iftomm
     out = tmp_path / "results.md"
     results = iftomm.main(["--quick", "--only", "pendulum,andrews,pendulum_1km", "--out", str(out)])
     text = out.read_text()
