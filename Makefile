@@ -31,7 +31,7 @@ $(VENV)/bin/python:
 $(STAMP): pyproject.toml | $(VENV)/bin/python
 	@echo "installing mbsynth and its dependencies into $(VENV) (pip, from the network: about 2 minutes)"
 	$(PY) -m pip install --quiet -e .
-	$(PY) -m mbsynth.compiled
+	$(PY) -m mbsynth.cli.compile_ahead
 	touch $@
 
 $(TEST_STAMP): pyproject.toml $(STAMP)

@@ -8,7 +8,7 @@ of 1,000 elements.
     .venv/bin/python benchmarks/fe_reduction.py
 
 An Euler–Bernoulli beam's ω² spread grows as elements⁴: past about 4,000 elements its lowest
-modes sink below the rounding level of its stiffness (ZERO_RTOL · tr K / tr M), and the
+modes sink below the rounding level of its stiffness (FE_ZERO_RTOL · tr K / tr M), and the
 reduction refuses it with that reason (Rayleigh's estimate from the static deflection, before
 any eigen-solve). A Timoshenko beam's spread grows as elements²: 100,000 elements reduce.
 The row "trace-scaled shift" passes shift = 1e-8 · tr K / tr M, a shift far above the lowest

@@ -1,14 +1,9 @@
-"""Shared by every test folder (one per floor of the package): the helpers beside this file
-(literal.py: the literal pseudo-inverse form of (2.14); rotations.py: rotation matrices and
-quaternion rate matrices written out by hand) import by their names; ``scheduler``: a Dask
-scheduler with one in-process worker, for tests that run sweeps through ``--scheduler``."""
-
-import sys
-from pathlib import Path
+"""Shared by every test folder (one per floor of the package): ``scheduler``, a Dask
+scheduler with one in-process worker, for tests that run sweeps through ``--scheduler``.
+Helpers that tests import live in the package tests/helpers (``from tests.helpers.rotations
+import ...``: pyproject's ``pythonpath`` puts the repository root on the path)."""
 
 import pytest
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 @pytest.fixture(scope="module")

@@ -13,13 +13,11 @@ ROOF = ("mbsynth", "mbsynth.__main__")  # the package's lazy front door and the 
 
 
 def modules():
-    """{dotted name: (path, is a package)} of every module, ``__main__`` programs left out
-    (nothing imports them: they are entry points)."""
+    """{dotted name: (path, is a package)} of every module, ``__main__`` programs included
+    (a program lives on its package's floor)."""
     found = {}
     for path in sorted(PACKAGE.rglob("*.py")):
         parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
-        if parts[-1] == "__main__" and len(parts) > 2:
-            continue
         package = parts[-1] == "__init__"
         found[".".join(parts[:-1] if package else parts)] = (path, package)
     return found
@@ -108,3 +106,12 @@ def test_the_floor_reader_sees_what_it_must():
         path.unlink()
     assert found == {"mbsynth.model.system"}
     assert FLOORS.index(floor("mbsynth.model.system")) > FLOORS.index(floor("mbsynth.core.probe"))
+
+
+def test_programs_are_on_their_floor():
+    """Every ``__main__`` program is read like any module (``python -m mbsynth.cli`` on cli's
+    floor), so that a program imports uphill no more than its package may."""
+    programs = {".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+                for path in PACKAGE.rglob("__main__.py")}
+    assert "mbsynth.cli.__main__" in programs and programs <= set(modules())
+    assert all(name in ROOF or floor(name) is not None for name in programs)

@@ -1,6 +1,6 @@
 """Every module of mbsynth can be the first one imported: no import cycle hidden by the
 order in which ``mbsynth/__init__.py`` happens to import its submodules; and what is
-imported is only what is used (issue 20, a light import)."""
+imported is only what is used (a light import)."""
 
 import argparse
 import importlib
@@ -53,7 +53,7 @@ def test_every_submodule_imports_first_in_a_fresh_interpreter():
 
 
 
-# Libraries that load when their feature is used (issue 20, a light import), never before.
+# Libraries that load when their feature is used (a light import), never before.
 HEAVY = ("pandas", "dask", "matplotlib", "meshcat", "pinocchio", "numba")
 MODEL = PACKAGE.parent / "models" / "paper" / "example3_m1_zero.yaml"
 
@@ -108,8 +108,8 @@ def test_every_command_of_the_parser_has_its_module():
 def test_building_a_robot_loads_neither_scipy_nor_package_metadata():
     """``from_robot`` (the UR5 of example-robot-data, found beside the installed packages)
     builds with sympy and numpy alone: scipy loads with the first solve that needs it and
-    importlib.metadata only where the robots are not on sys.path (issue 20: 0.1 s of a
-    build of 0.3 s). Measured on a build whose derivations are cached (a first build, in
+    importlib.metadata only where the robots are not on sys.path (loading it is a large share
+    of a build). Checked on a build whose derivations are cached (a first build, in
     another process, keeps them): a cold derivation compiles with sympy's lambdify, which
     may load numpy.testing and through it importlib.metadata."""
     build = ("import mbsynth as mb\nsystem = mb.from_robot('ur5')\n"

@@ -30,11 +30,12 @@ from numba import njit
 from . import stepper
 from ..core.errors import SolveError
 from .crossing import NAMED_SHARE, Crossing
-from .cut import RELAXED_MAX, CutIntegration
-from .derivative import MAX_STATE, Crawl
+from .cut import CutIntegration
+from .derivative import Crawl
 from .drift import next_cap
 from .projection import project, relative_drift
 from .singular_watch import SingularWatch
+from ..core.tolerances import MAX_STATE, RELAXED_MAX
 
 
 class Passed(NamedTuple):

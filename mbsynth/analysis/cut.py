@@ -25,11 +25,10 @@ from .drift import next_cap
 from .integration import Integration
 from .projection import project, relative_drift
 from . import stepper
+from ..core.tolerances import RELAXED_MAX, RELAXED_RTOL
 
 log = logging.getLogger(__name__)
 
-RELAXED_RTOL = 1e-8
-RELAXED_MAX = 1e-7
 
 
 class CutIntegration(Integration):

@@ -10,7 +10,7 @@ interval of integration (``begin``):
 
 - a step-size collapse: COLLAPSE_CALLS evaluations that advance t by less than COLLAPSE_SPAN
   of the interval (or than 1e4 ε |t|, steps near the resolution of t) raise SolveError
-  naming the fastest changing coordinates (scipy would crawl on for minutes first);
+  naming the fastest changing coordinates (where scipy would crawl on);
 - a crawl near a singular position: near one the stages' accelerations carry noise of about
   |q̇| ψ / σ² (ψ the velocity drift the projection leaves, σ the smallest singular value of
   A), which a tight tolerance chases with ever smaller steps; more than CRAWL_CALLS
@@ -33,17 +33,14 @@ import numpy as np
 
 from ..core.errors import SolveError
 from ..model.angle_singularity import AngleParts, explain
+from ..core.tolerances import ANGLES_NEAR, COLLAPSE_SPAN, MAX_STATE, STEP_RESOLUTION
 
 log = logging.getLogger(__name__)
 
-MAX_STATE = 1e12  # a coordinate or velocity beyond this counts as an exploding state
 COLLAPSE_CALLS = 1000  # ~80 steps of an explicit pair
-COLLAPSE_SPAN = 1e-8
 CRAWL_CALLS = 240
 RELAXED_CRAWL_CALLS = 1000
 STUCK_CALLS = 20000  # an interval that crawls this long near a singular position at the loosest tolerance stops
-ANGLES_NEAR = 1e-2  # |det H| of a part's angles below this (0.57° from their singular position): angle rates
-# above 100 times the angular velocity
 ANGLES_CRAWL_CALLS = 5000  # ~400 steps of an explicit pair within ANGLES_NEAR in one interval: a body that
 # passes by needs a few, one that falls onto the position (a bicycle lying down) never gets past it
 
@@ -93,7 +90,7 @@ class StateDerivative:
         if self.on_manifold is not None:  # a step across a singular position (crossing.py)
             y = self._on_manifold(y)
         if self.calls % COLLAPSE_CALLS == 0:
-            if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, 1e4 * np.finfo(float).eps * abs(t)):
+            if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, STEP_RESOLUTION * abs(t)):
                 raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
             self.t_mark = t
         if self.angles and self.angles.nearest(y) < ANGLES_NEAR:

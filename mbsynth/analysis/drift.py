@@ -10,19 +10,17 @@ inconsistency), so a span is kept short enough that the relative drift (projecti
 """
 
 import numpy as np
+from ..core.tolerances import DRIFT_REDO, DRIFT_TARGET, REDO_MIN_SPAN
 
-DRIFT_TARGET = 1e-9  # largest relative drift off the manifold between two corrections or projections
-DRIFT_REDO = 1e3  # a span that drifted more than this × DRIFT_TARGET is integrated again, shorter
-MIN_SPAN = 1e-6  # of the output interval: the shortest span that is integrated again
 
 
 def next_cap(drift, taken, cap, room, interval):
     """(redo, cap): after a span of length ``taken`` drifted by ``drift``, whether to integrate
     it again (at a quarter of its length: it drifted more than DRIFT_REDO × DRIFT_TARGET and
-    is longer than MIN_SPAN of the ``interval``), and the cap on the spans that follow —
+    is longer than REDO_MIN_SPAN of the ``interval``), and the cap on the spans that follow —
     halved after a drift above DRIFT_TARGET, doubled after one below a hundredth of it, lifted
     (np.inf) once twice the cap reaches ``room``, else ``cap`` as it was (np.inf: none)."""
-    if drift > DRIFT_REDO * DRIFT_TARGET and taken > MIN_SPAN * interval:
+    if drift > DRIFT_REDO * DRIFT_TARGET and taken > REDO_MIN_SPAN * interval:
         return True, taken / 4
     if drift > DRIFT_TARGET:
         return False, taken / 2

@@ -85,7 +85,7 @@ from ..core.errors import SolveError
 from ..model.data import shared
 from .projection import relative_drift
 from ..symbolic.derive import T_SYMBOL, compile_function, jacobian
-from ..core.tolerances import (CHANGE_POINT_RTOL, NAME_RTOL, NEAR_SINGULAR, ON_MANIFOLD_RTOL, RANK_RTOL,
+from ..core.tolerances import (CHANGE_POINT_RTOL, COMPLEX_STEP, NAME_RTOL, NEAR_SINGULAR, ON_MANIFOLD_RTOL, RANK_RTOL,
                                STRUCTURAL_ZERO_RTOL)
 
 _CACHE_SIZE = 8
@@ -446,7 +446,6 @@ class HeldRows:
 
 NON_ANALYTIC = (sp.Abs, sp.sign, sp.atan2, sp.Piecewise, sp.Min, sp.Max, sp.floor, sp.ceiling, sp.Heaviside,
                 sp.re, sp.im)  # functions a complex step cannot differentiate through
-COMPLEX_STEP = 1e-30  # Im f(x + i h)/h = f'(x) + O(h²): no cancellation, so h can be tiny
 
 
 class BlockFunction:

@@ -23,11 +23,11 @@ from .projection import project_positions
 from .statics import equilibrium as find_equilibrium
 from .steady import check_steady
 from .trajectory import Trajectory
-from ..core.tolerances import ACCELERATION_TOL, MODE_ZERO_RTOL, STABILITY_RTOL
+from ..core.tolerances import (ACCELERATION_TOL, COMPLEX_SHAPE_TOL, DAMPING_ROUNDING, DEGENERATE_RTOL, DIVISION_GUARD,
+                               IMAGINARY_SHOWN_RTOL, MODE_SHOWN_RTOL, MODE_ZERO_RTOL, NODE_SHAPE_RTOL,
+                               SHAPE_ENTRY_ZERO, STABILITY_RTOL)
 
 SHOWN = 3  # coordinates named per mode in the table
-DEGENERATE_RTOL = 1e-6  # eigenvalues this close (relative) are one repeated mode, split by rounding
-NODE_SHAPE_RTOL = 1e-9  # a flexible body's elastic coordinates below this share of a shape's largest: it does not bend
 
 
 @dataclass(frozen=True)
@@ -236,7 +236,7 @@ def _damping(s, scale):
     """−Re s/|s|; NaN for a free mode, 0 where Re s is rounding (below ε times the largest |s|)."""
     if abs(s) <= MODE_ZERO_RTOL * scale:
         return float("nan")
-    return 0.0 if abs(s.real) <= 8 * np.finfo(float).eps * scale else float(-s.real / abs(s))
+    return 0.0 if abs(s.real) <= DAMPING_ROUNDING * scale else float(-s.real / abs(s))
 
 
 def _kind(s, scale):
@@ -350,7 +350,7 @@ def _largest(result, mode):
         return ""
     values = values / values[np.argmax(np.abs(values))]
     order = np.argsort(-np.abs(values))[:SHOWN]
-    return ", ".join(f"{names[j]} {_short(values[j])}" for j in order if abs(values[j]) > 1e-6)
+    return ", ".join(f"{names[j]} {_short(values[j])}" for j in order if abs(values[j]) > MODE_SHOWN_RTOL)
 
 
 def _nodes(name, nodes):
@@ -365,14 +365,15 @@ def _nodes(name, nodes):
 
 
 def _vector(v):
-    """(x, y, z) short, real and imaginary parts below 1e-6 of the vector's size shown as 0."""
-    small = 1e-6 * np.linalg.norm(v)
+    """(x, y, z) short, real and imaginary parts below MODE_SHOWN_RTOL of the vector's size shown as 0."""
+    small = MODE_SHOWN_RTOL * np.linalg.norm(v)
     v = np.where(np.abs(v.real) > small, v.real, 0.0) + 1j * np.where(np.abs(v.imag) > small, v.imag, 0.0)
     return f"({', '.join(_short(x) for x in v)})"
 
 
 def _short(z):
-    return f"{z.real:.3g}" if abs(z.imag) <= 1e-9 * max(abs(z), 1e-300) else f"{z.real:.3g}{z.imag:+.3g}j"
+    real = abs(z.imag) <= IMAGINARY_SHOWN_RTOL * max(abs(z), DIVISION_GUARD)
+    return f"{z.real:.3g}" if real else f"{z.real:.3g}{z.imag:+.3g}j"
 
 
 def to_dict(result):
@@ -389,12 +390,14 @@ def to_dict(result):
     for mode in result.modes:
         entry = {"eigenvalue": [mode.eigenvalue.real, mode.eigenvalue.imag], "frequency_hz": mode.frequency,
                  "damping_ratio": None if np.isnan(mode.damping_ratio) else mode.damping_ratio, "kind": mode.kind,
-                 "shape": {c: float(x.real) for c, x in zip(result.coordinates, mode.shape) if abs(x) > 1e-12},
+                 "shape": {c: float(x.real) for c, x in zip(result.coordinates, mode.shape)
+                           if abs(x) > SHAPE_ENTRY_ZERO},
                  "joint_shape": {j: [float(x) for x in v.real] for j, v in mode.joint_shape.items()}}
         if mode.node_shape:
             entry["node_shape"] = {name: _node_entry(nodes, np.real) for name, nodes in mode.node_shape.items()}
-        if np.abs(mode.shape.imag).max(initial=0.0) > 1e-9:
-            entry["shape_imag"] = {c: float(x.imag) for c, x in zip(result.coordinates, mode.shape) if abs(x) > 1e-12}
+        if np.abs(mode.shape.imag).max(initial=0.0) > COMPLEX_SHAPE_TOL:
+            entry["shape_imag"] = {c: float(x.imag) for c, x in zip(result.coordinates, mode.shape)
+                                   if abs(x) > SHAPE_ENTRY_ZERO}
             entry["joint_shape_imag"] = {j: [float(x) for x in v.imag] for j, v in mode.joint_shape.items()}
             if mode.node_shape:
                 entry["node_shape_imag"] = {name: _node_entry(nodes, np.imag) for name, nodes in mode.node_shape.items()}

@@ -23,11 +23,11 @@ from ..core.equations import term_scales
 from ..model.data import workspace
 from ..model.evaluation import DENSE_ENTRIES
 from ..core.errors import SolveError
-from ..core.tolerances import DRIFT_FLOOR, NEAR_SINGULAR, PROJECTION_RTOL
+from ..core.tolerances import (COLUMN_FLOOR, CURVATURE_STEP, DIVISION_GUARD, DRIFT_FLOOR, NEAR_SINGULAR,
+                               PROJECTION_DIVERGED, PROJECTION_RCOND, PROJECTION_RTOL, SPARSE_ACCEPT, VELOCITY_ACCEPT)
 from ..core.memo import MEMO
 
 MAX_ITERATIONS = 50
-DIVERGED = 1e6  # a last pass stops where its largest residual exceeds this times its smallest so far
 
 
 def _free_columns(n, fixed):
@@ -37,10 +37,6 @@ def _free_columns(n, fixed):
     return free
 
 
-SPARSE_ACCEPT = 1e-10  # relative residual under which the sparse least-norm step is taken
-PROJECTION_RCOND = 1e-8  # directions of J (columns equilibrated) below this × σ₁ count as dependent
-VELOCITY_ACCEPT = 1e-9  # largest relative ψ after the one (linear) velocity step
-COLUMN_FLOOR = 1e-4  # a retried projection's smallest column scale, relative to the largest entry of its rows
 
 
 def _correction(J, r, groups, floor=0.0):
@@ -72,7 +68,7 @@ def _correction(J, r, groups, floor=0.0):
     columns = _floored(columns, floor * np.asarray(touched.max(axis=0).todense()).ravel())
     D = scipy.sparse.diags(1.0 / columns)
     G = (J @ D).tocsr()
-    size = np.linalg.norm(r) + 1e-300
+    size = np.linalg.norm(r) + DIVISION_GUARD
     try:
         with np.errstate(all="ignore"):
             z = G.T @ scipy.sparse.linalg.splu((G @ G.T).tocsc()).solve(r)
@@ -93,7 +89,7 @@ def _dense_correction(J, r, groups, floor=0.0):
         least = floor * touched.max(axis=0, initial=0.0)
     d = 1.0 / _floored(columns, least)
     G = J * d
-    size = np.linalg.norm(r) + 1e-300
+    size = np.linalg.norm(r) + DIVISION_GUARD
     try:
         with np.errstate(all="ignore"):
             z = G.T @ np.linalg.solve(G @ G.T, r)
@@ -170,7 +166,7 @@ def _newton(data, t, q, free, tolerance, floor, last=False, arrays=None):
             return None
         if size < best[0]:
             best = (size, q.copy())
-        elif size > DIVERGED * best[0]:  # the last pass gives up once it runs away from its best
+        elif size > PROJECTION_DIVERGED * best[0]:  # the last pass gives up once it runs away from its best
             break
         previous = size
         q[free] -= _correction(arrays.A[rows][:, free], phi[rows], data.model.coordinate_groups[free], floor)
@@ -380,5 +376,4 @@ def _dependency(data, t, q, A, phi, free):
 
 
 DIAGNOSED_DIRECTIONS = 60  # the curvature is taken along at most this many free directions
-CURVATURE_STEP = 1e-5  # central differences of A, relative to the largest coordinate (at least 1)
 DEPENDENCY_SHARE = 0.1  # a row is named in a dependency where its weight exceeds this share of the largest

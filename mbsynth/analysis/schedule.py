@@ -7,6 +7,7 @@ samples t0 + j h are computed as they come, so a short control interval costs no
 import math
 
 import numpy as np
+from ..core.tolerances import SAMPLE_ROUNDING
 
 
 class Schedule:
@@ -18,7 +19,7 @@ class Schedule:
         self.t0, self.t_end = float(self.outputs[0]), float(self.outputs[-1])
         self.h = None if sample_dt is None else float(sample_dt)
         span = self.t_end - self.t0
-        self.count = 0 if self.h is None else int(np.ceil(span / self.h - 1e-9))  # samples in [t0, t_end)
+        self.count = 0 if self.h is None else int(np.ceil(span / self.h - SAMPLE_ROUNDING))  # samples in [t0, t_end)
         self.skipped = None  # ``skip_through``'s time, for the iteration to go on after
 
     def sample(self, j):

@@ -42,6 +42,7 @@ from .projection import consistent_initial_state
 from .recording import Recorder
 from .schedule import Schedule
 from .trajectory import COMPLETED
+from ..core.tolerances import INTEGRATION_ATOL, INTEGRATION_RTOL, LAST_INTERVAL_MERGE
 
 log = logging.getLogger(__name__)
 
@@ -49,7 +50,8 @@ STABILIZATIONS = ("projection", "baumgarte", "none")
 DEFAULT_OUTPUTS = 500
 
 
-def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=1e-10, atol=1e-10,
+def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=INTEGRATION_RTOL,
+             atol=INTEGRATION_ATOL,
              stabilization="projection", baumgarte=(10.0, 10.0), out=None, progress=None, controller=None,
              control_dt=None, path=None):
     """Integrate ``system`` from t0 to t_end; returns a Trajectory with one row per output time
@@ -176,12 +178,13 @@ def _output_count(t0, t_end, dt):
     if not dt > 0:
         raise ValueError(f"dt must be positive, got {dt}")
     count = math.ceil((t_end - t0) / dt)  # np.arange's length
-    return count + 1 if t_end - (t0 + (count - 1) * dt) > 1e-12 * dt else count
+    return count + 1 if t_end - (t0 + (count - 1) * dt) > LAST_INTERVAL_MERGE * dt else count
 
 
 def _output_times(t0, t_end, dt):
-    """Every dt from t0, and t_end (a last interval shorter than 1e-12 dt merged into the one before)."""
+    """Every dt from t0, and t_end (a last interval shorter than LAST_INTERVAL_MERGE · dt merged into the
+    one before)."""
     if dt is None:
         return np.linspace(t0, t_end, DEFAULT_OUTPUTS + 1)
     times = np.arange(t0, t_end, dt)
-    return np.append(times, t_end) if t_end - times[-1] > 1e-12 * dt else np.append(times[:-1], t_end)
+    return np.append(times, t_end) if t_end - times[-1] > LAST_INTERVAL_MERGE * dt else np.append(times[:-1], t_end)

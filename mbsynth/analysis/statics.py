@@ -51,7 +51,7 @@ import scipy.optimize
 from ..core.errors import NoEquilibrium, SolveError
 from .linearization import finite_state, linearize, prescribed_motion
 from .projection import project_positions
-from ..core.tolerances import ACCELERATION_TOL, ISOLATED_RTOL
+from ..core.tolerances import ACCELERATION_TOL, FREE_SHOWN_RTOL, ISOLATED_RTOL, TRUST_CURVATURE_RTOL, V_ROUNDING
 
 MAX_ITERATIONS = 200
 HALVINGS = 30  # refused steps in a row (each shrinks Δ) before the search gives up
@@ -60,8 +60,6 @@ ETA = 0.01  # a step is taken where Ψ falls by at least this share of the model
 SHRINK = 0.25  # Δ after a refused step or a poor one (actual < GOOD × predicted), times the step's length
 EXPAND = 3.0  # Δ after a good step that reached the boundary, times Δ
 GOOD = 0.75
-V_ROUNDING = 1e-9  # a change of V below this share of |V| is rounding-limited: the trapezoid judges it
-CURVATURE_RTOL = 1e-12  # in the trust-region problem: a curvature below this times the largest is zero
 
 
 def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iterations=MAX_ITERATIONS, nearest=False):
@@ -177,8 +175,8 @@ def _trust_region(c, d, radius):
     eigenbasis): y = −c/(d + λ) with λ ≥ max(0, −min d), λ = 0 where that step lies inside
     (Newton's, least-norm along the curvatures that are zero), else ‖y‖ = Δ; in the hard
     case (negative curvature that c has no share along, as at a maximum) y fills up to Δ
-    along it. Curvatures below CURVATURE_RTOL of the largest are zero."""
-    d = np.where(np.abs(d) <= CURVATURE_RTOL * max(np.abs(d).max(), np.finfo(float).tiny), 0.0, d)
+    along it. Curvatures below TRUST_CURVATURE_RTOL of the largest are zero."""
+    d = np.where(np.abs(d) <= TRUST_CURVATURE_RTOL * max(np.abs(d).max(), np.finfo(float).tiny), 0.0, d)
     low = max(0.0, -d.min())
     lowest = d + low == 0
 
@@ -297,12 +295,11 @@ def _check_isolated(system, t, q, lin, K):
         moves = [lin.basis @ v for v in free]
         directions = [_described(system, t, q, dq) for dq in moves]
         coordinates = sorted({system.coordinates[i] for dq in moves
-                              for i in np.flatnonzero(np.abs(dq) > SHOWN_RTOL * np.abs(dq).max())})
+                              for i in np.flatnonzero(np.abs(dq) > FREE_SHOWN_RTOL * np.abs(dq).max())})
         raise NoEquilibrium(f"model '{system.name}': the equilibrium is not isolated: it rests as well after a move "
                             f"along {len(free)} free direction(s) {directions}", coordinates=coordinates)
 
 
-SHOWN_RTOL = 1e-6  # a direction's component below this share of its largest is not shown
 
 
 def _described(system, t, q, dq):
@@ -317,4 +314,4 @@ def _described(system, t, q, dq):
         entries.update({name if len(rates) == 1 else f"{name}[{i}]": x for i, x in enumerate(rates)})
     entries.update({c: x for i, (c, x) in enumerate(zip(system.coordinates, dq)) if i not in held})
     top = max(entries.values(), key=abs)
-    return {c: round(float(x / top), 6) for c, x in entries.items() if abs(x) > SHOWN_RTOL * abs(top)}
+    return {c: round(float(x / top), 6) for c, x in entries.items() if abs(x) > FREE_SHOWN_RTOL * abs(top)}

@@ -15,7 +15,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..core.errors import NoEquilibrium, SolveError
-from ..core.tolerances import ACCELERATION_TOL, ON_MANIFOLD_RTOL, RANK_RTOL
+from ..core.tolerances import ACCELERATION_TOL, ON_MANIFOLD_RTOL, RANK_RTOL, STEADY_FIT_TOL
 from .linearization import finite_state, linearize
 from .projection import project_positions
 
@@ -113,7 +113,8 @@ def _solved(system, t, q, given, solve, index):
         return system.motion(t, moved_q, _least_energy_velocities(system, t, moved_q, moved)).qdd[speeds]
 
     guess = [given[index[c.removesuffix("_dot")]] if c.endswith("_dot") else q[index[c]] for c in solve]
-    fit = scipy.optimize.least_squares(residual, guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    fit = scipy.optimize.least_squares(residual, guess, xtol=STEADY_FIT_TOL, ftol=STEADY_FIT_TOL,
+                                      gtol=STEADY_FIT_TOL)
     return state(fit.x)
 
 

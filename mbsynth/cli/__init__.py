@@ -16,6 +16,9 @@ what it left of each (outputs.py).
     check.py, simulate.py, sweep.py, view.py, validate.py, robots.py
                  one module per command: ``run(args)`` and its report (``OUTPUTS``: its
                  output flags)
+    compile_ahead.py
+                 ``python -m mbsynth.cli.compile_ahead``: the fast path's kernels compiled
+                 ahead, on warm-up models (``make install``)
 
 ``main`` imports only the module of the command it runs, so ``mbsynth check`` loads no
 pandas, dask, matplotlib, meshcat or pinocchio.

@@ -7,6 +7,7 @@ import re
 from ..analysis.diagnose import diagnose
 from ..compiled.background import default_path_as
 from .parsers import model_of
+from ..core.tolerances import CHECK_RESIDUAL_TOL
 
 
 def run(args):
@@ -68,7 +69,7 @@ def format_check(report, path, coordinates="joints"):
         accelerations = ", ".join(f"{c} = {x:.6g}" for c, x in report.qdd.items())
         lines.append(f"  accelerations at the initial state{'' if report.unique else ' (η = 0)'}: {accelerations}")
     violated = [name for name, r in report.constraint_residuals.items()
-                if any(v is not None and abs(v) > 1e-9 for v in r.values())]
+                if any(v is not None and abs(v) > CHECK_RESIDUAL_TOL for v in r.values())]
     if violated:
         lines.append(f"  warning: the initial state violates {', '.join(violated)}")
     return "\n".join(lines)

@@ -7,6 +7,7 @@ import math
 from collections.abc import Sequence
 
 from ..core.errors import ModelError
+from ..core.tolerances import INTEGRATION_ATOL, INTEGRATION_RTOL, VALIDATION_RTOL
 
 
 # The exit status of every command (main maps what a command raises onto it): the one table
@@ -124,8 +125,10 @@ def _simulate(commands):
                      help="what the figure's top panel draws (with --plot): coordinates (part.c), velocities "
                           "(part.c_dot), outputs; a name the model lacks is refused before the run")
     sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
-    sim.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
-    sim.add_argument("--atol", type=float, default=1e-10, help="absolute tolerance (default 1e-10)")
+    sim.add_argument("--rtol", type=float, default=INTEGRATION_RTOL,
+                     help=f"relative tolerance (default {INTEGRATION_RTOL:g})")
+    sim.add_argument("--atol", type=float, default=INTEGRATION_ATOL,
+                     help=f"absolute tolerance (default {INTEGRATION_ATOL:g})")
     sim.add_argument("--stabilization", choices=_Deferred("mbsynth.analysis.simulate", "STABILIZATIONS"), metavar="KIND",
                      default="projection", help="drift control: %(choices)s (default projection)")
     sim.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -196,7 +199,8 @@ def _validate(commands):
     val.add_argument("target", metavar="ROBOT_OR_MODEL", help="robot name, URDF file or model file")
     val.add_argument("--samples", type=int, default=20, help="random states per base (default 20)")
     val.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    val.add_argument("--tolerance", type=float, default=1e-9, help="largest relative error that passes (default 1e-9)")
+    val.add_argument("--tolerance", type=float, default=VALIDATION_RTOL,
+                     help=f"largest relative error that passes (default {VALIDATION_RTOL:g})")
     val.add_argument("--json", action="store_true", help="print one JSON object")
     return val
 

@@ -1,16 +1,15 @@
 """The kernel's largest parts compiled in helper processes, alongside this one.
 
 numba compiles on one thread per process (its compiler lock), and a cold compile of
-``kernel.motion`` with everything it calls takes about 40 s of one core, most of it in a
-few callees. When the cache holds no kernels yet (background.compiled()), ``start``
-launches helper processes (``python -m mbsynth.compiled.ahead GROUP VARIANT...``), each
-compiling one of GROUPS, for the argument types ``motion`` hands those functions in each
-variant, into numba's on-disk cache, while this process compiles the model's generated
-function; ``finish`` lets them finish, and compiling ``motion`` then loads them from the
-cache (Engine.warm). A caller that knows the variant of a System it is about to build (a
-robot is a rigid tree) may start them earlier, beside the derivation
-(background.compile_ahead). The groups are balanced for two cores. A helper that fails
-costs time only: numba compiles whatever the cache lacks.
+``kernel.motion`` with everything it calls spends most of its time in a few callees. When
+the cache holds no kernels yet (background.compiled()), ``start`` launches helper processes
+(``python -m mbsynth.compiled.ahead GROUP VARIANT...``), each compiling one of GROUPS, for
+the argument types ``motion`` hands those functions in each variant, into numba's on-disk
+cache, while this process compiles the model's generated function; ``finish`` lets them
+finish, and compiling ``motion`` then loads them from the cache (Engine.warm). A caller that
+knows the variant of a System it is about to build (a robot is a rigid tree) may start them
+earlier, beside the derivation (background.compile_ahead). The groups are balanced for two
+cores. A helper that fails costs time only: numba compiles whatever the cache lacks.
 
 Each function is named with the types of its arguments in a short notation: ``f2`` a
 C-contiguous 2-d float64 array, ``i1`` a 1-d int64 array, ``(...)`` a tuple, ``int64``,

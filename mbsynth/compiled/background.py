@@ -2,7 +2,7 @@
 
 numba compiles the kernels once per machine and keeps them on disk (cache.py); a cold
 compile takes minutes, loading a warm cache well under a second. ``python -m
-mbsynth.compiled`` compiles ahead (``make install`` runs it).
+mbsynth.cli.compile_ahead`` compiles ahead (``make install`` runs it).
 
 A model's path is chosen when its Data is made (model/data.py): "compiled" or "kkt",
 by default ``default_path()`` — "compiled", or "kkt" where ``MBSYNTH_FAST=off`` (the

@@ -30,12 +30,12 @@ cache.configure()  # every kernel module imports this one before it compiles: nu
 
 from numba import njit  # noqa: E402
 
-OPTIONS = dict(cache=True, error_model="numpy")  # fastmath (contract, reassoc) measured 9–17 % slower
+OPTIONS = dict(cache=True, error_model="numpy")  # no fastmath: contract and reassoc do not pay here
 # numba inlines INLINE functions into each caller (their IR retyped at every call site, which
 # costs compile time): for the node steps, whose constant sizes must meet the caller's, and the
-# 3-tuple helpers (cross3, dot3, times3: left to LLVM they cost the kernel 10 %). The rest
+# 3-tuple helpers (cross3, dot3, times3: left to LLVM they slow the kernel). The rest
 # (the packed views, the closed-form null space, the SPD inverse, the rigid transport) stays
-# OPTIONS: LLVM inlines what pays, at no cost in time measured (benchmarks/fast_ab.py).
+# OPTIONS: LLVM inlines what pays (benchmarks/fast_ab.py).
 INLINE = dict(OPTIONS, inline="always")
 
 

@@ -7,7 +7,7 @@ step of the projection in the mass metric: positions with r = φ(q) (repeated wh
 above CORRECTION_RTOL of the coordinates' size, at most MAX_STEPS times), then velocities with
 r = φ̇(q, q̇) = A q̇, a linear problem one step solves. From an integrator's drift of
 5e-9 one step leaves rounding (2e-15 on a UR5). After a single position step of at most
-REUSE of the coordinates' size, with φ̇ at most REUSE of the rates, the velocity step
+CORRECTION_REUSE of the coordinates' size, with φ̇ at most CORRECTION_REUSE of the rates, the velocity step
 reuses that step's factorization: A at the uncorrected q leaves φ̇ off by about
 |Δq| |Δq̇|, REUSE² relative; each body's quaternion rate first loses its part along u
 (``_unit_rates``), so that the reusing call solves for the joint rows' right sides alone
@@ -39,11 +39,9 @@ from .joints import RIGID
 from .kernel import LAYOUT, OK, REUSED, UNCHECKED, WORK, motion
 from .packing import view1
 from .rows import Rows, largest, residuals_energy
-from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL
+from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_REUSE, CORRECTION_RTOL, CORRECTION_SHRINK
 
 MAX_STEPS = 3  # position steps before the state goes to projection.py
-REUSE = 1e-8  # the largest position step and φ̇ (relative) for which the velocity step reuses a factorization
-SHRINK = 1e-3  # a velocity step must cut φ̇ by this much at least ...
 TINY = np.finfo(float).tiny  # the largest rate's floor
 # a thread of ``Correction.block`` takes states of this many coordinates in all at least: handing
 # work to a thread costs about what correcting states of several hundred coordinates costs
@@ -125,7 +123,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
                            general)[0] != OK:
                 declined = True
                 break
-            reuse = step == 0 and largest(qdd) <= REUSE * size  # the Work keeps q's factorization
+            reuse = step == 0 and largest(qdd) <= CORRECTION_REUSE * size  # the Work keeps q's factorization
             for c in range(q.shape[0]):
                 factored[c] = q[c] if reuse else factored[c]
                 q[c] += qdd[c]
@@ -137,7 +135,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
             _, _, _, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
         rates = max(qd_max, TINY)
         _negated(psi, shift)
-        if reuse and psi_max <= REUSE * rates:
+        if reuse and psi_max <= CORRECTION_REUSE * rates:
             for i in range(kind.shape[0]):
                 if kind[i] == RIGID:
                     shift[quat_row[i]] = 0.0  # met by _unit_rates, to rounding: the kernel redoes only the solve
@@ -150,7 +148,7 @@ def correct(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, gen
         for c in range(qd.shape[0]):
             qd[c] += qdd[c]
         kinetic, potential, phi_max, psi_max, _, _ = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs)
-        if psi_max <= max(SHRINK * before, CORRECTION_RATE_RTOL * size * rates):
+        if psi_max <= max(CORRECTION_SHRINK * before, CORRECTION_RATE_RTOL * size * rates):
             found[b, KINETIC], found[b, POTENTIAL], found[b, PHI_MAX], found[b, PSI_MAX] = \
                 kinetic, potential, phi_max, psi_max
             found[b, DONE] = 1.0
@@ -246,7 +244,7 @@ class Correction:
     def __call__(self, q, qd):
         """``Corrected`` (q, q̇) on the constraints (new arrays) with their rows, or None where
         the kernel declines the state, MAX_STEPS position steps leave φ above CORRECTION_RTOL, or
-        the velocity step leaves φ̇ above SHRINK of what it was (and above rounding)."""
+        the velocity step leaves φ̇ above CORRECTION_SHRINK of what it was (and above rounding)."""
         return self.block(q[None, :], qd[None, :]).row(0)
 
     def block(self, Q, QD, fractions=None):

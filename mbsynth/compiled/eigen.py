@@ -10,6 +10,7 @@ import math
 from numba import njit
 
 from .bodies import OPTIONS
+from ..core.tolerances import JACOBI_OFF_RTOL
 
 SWEEPS = 60
 
@@ -27,7 +28,7 @@ def symmetric_eigen(S, V, values):
             total += S[i, i] ** 2
             for j in range(i + 1, p):
                 off += S[i, j] ** 2
-        if off <= 1e-36 * (total + 2 * off) or off == 0.0:
+        if off <= JACOBI_OFF_RTOL * (total + 2 * off) or off == 0.0:
             break
         for i in range(p - 1):
             for j in range(i + 1, p):

@@ -8,7 +8,7 @@ A Δ = −r ((2.14) with Q = 0). Positions: Gauss–Newton steps with r = φ, th
 the extra rows, while a row's |φ| exceeds CORRECTION_RTOL of its terms (Σ_j |A_ij q_j|, as
 core/equations.term_scales: alike at every scale), at most MAX_STEPS of them; then
 velocities, one step with r = φ̇ = A q̇ (linear). A velocity step must cut each row's φ̇ by
-SHRINK at least, or leave it below CORRECTION_RATE_RTOL of its terms. A state the kernel declines
+CORRECTION_SHRINK at least, or leave it below CORRECTION_RATE_RTOL of its terms. A state the kernel declines
 (its dense Schur step finds the rows contradict) or whose steps do not meet these goals goes
 to projection.py (None), as with correction.py.
 
@@ -29,9 +29,9 @@ import threading
 import numpy as np
 
 from . import kernel
-from .correction import MAX_STEPS, SHRINK, TINY, Corrected, CorrectedRows
-from ..core.equations import TERM_FLOOR, entry_term_scales
-from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, DRIFT_FLOOR
+from .correction import MAX_STEPS, TINY, Corrected, CorrectedRows
+from ..core.equations import entry_term_scales
+from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, CORRECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
 from .least_direction import LeastDirection
 
 
@@ -121,7 +121,8 @@ class ExtraCorrection:
             qd += delta
             self._evaluate(q, qd)
             psi = self._rates(qd)
-            if not np.all(np.abs(psi) <= np.maximum(SHRINK * before, CORRECTION_RATE_RTOL * self._terms(qd, TERM_FLOOR))):
+            if not np.all(np.abs(psi) <= np.maximum(CORRECTION_SHRINK * before,
+                                                    CORRECTION_RATE_RTOL * self._terms(qd, TERM_FLOOR))):
                 return None
             return Corrected(q, qd, np.nan, np.nan, float(np.abs(self.gen[self.phi]).max(initial=0.0)),
                              float(np.abs(psi).max(initial=0.0)))

@@ -25,7 +25,7 @@ dropped with their part of the right side (least squares), and a nearly dependen
 drift does not explain goes to the exact treatment (NEAR_SINGULAR).
 
 Status: OK, or why the caller must hand the problem to the exact treatment — a singular
-tree block (SINGULAR), the cases above, a residual above ``RESIDUAL_MAX`` or a
+tree block (SINGULAR), the cases above, a residual above ``KERNEL_RESIDUAL_MAX`` or a
 non-finite result. ``residual`` is the relative residual of the equilibrated KKT
 equations M q̈ + Aᵀλ = Q + C, A q̈ = b (its numerator bounds that of (2.12), since
 P Aᵀ = 0 and ‖P‖ = 1).
@@ -44,16 +44,15 @@ from .joints import RIGID
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve, spd_inverse
-from ..core.tolerances import (DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL, KERNEL_NULL_RTOL,
-                               NEAR_SINGULAR as NEAR_SINGULAR_RTOL, SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL,
-                               SPLIT_MOVES)
+from ..core.tolerances import (DIVISION_GUARD, DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL,
+                               KERNEL_NULL_RTOL, KERNEL_RESIDUAL_MAX, NEAR_SINGULAR as NEAR_SINGULAR_RTOL,
+                               SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE, NEAR_SINGULAR = range(7)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
 # checks): numpy integers, which numba types as int64 rather than as a literal per value (one compilation)
 RIGID_TREE, GENERAL = None, True  # ``motion``'s ``general``: numba prunes the branches on ``general is None``, so
 # a rigid tree's motion compiles without particle joints, extra rows and extra coordinates (Layout.general)
-RESIDUAL_MAX = 1e-9
 ESTIMATE_MARGIN = 10.0  # banded.inverse_norm1 is a lower bound of ‖S⁻¹‖₁: certified with this much to spare
 LAYOUT, WORK = fields(Layout), fields(Work)
 
@@ -179,7 +178,7 @@ def _close_solve(topology, segs, seg6, factored, Fx, xb, ry, z0, y, w, z, vector
         if drift >= 0.0:  # least squares: the rows' right side less its part along the dropped direction
             for x in range(mx):
                 xb[x] -= coef * vectors[nx + x, e]
-    if drift < 0.0 and math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
+    if drift < 0.0 and math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + DIVISION_GUARD):
         return INCONSISTENT
     _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
     return OK
@@ -245,7 +244,7 @@ def _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, 
                 lam[nx + c] += coef / values[e] * Vc[c, e]
         else:
             dropped += coef * coef
-    if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + 1e-300):
+    if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + DIVISION_GUARD):
         return INCONSISTENT
     for c in range(nx):  # q̈_x = Mx⁻¹ F_x − (Mx⁻¹ A_xᵀ) λ
         total = qx[c]
@@ -525,7 +524,7 @@ def _residual(topology, kind, segs, seg6, H, F, J, P, rb, s, z, lam, xb, Ax, Mx,
         res += t * t
         norm_x += lam[c] ** 2
         norm_r += Fx[c] ** 2
-    scale = (math.sqrt(norm_M) + math.sqrt(norm_A)) * math.sqrt(norm_x) + math.sqrt(norm_r) + 1e-300
+    scale = (math.sqrt(norm_M) + math.sqrt(norm_A)) * math.sqrt(norm_x) + math.sqrt(norm_r) + DIVISION_GUARD
     return math.sqrt(res) / scale
 
 
@@ -657,7 +656,7 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
                              view1(WF, WX, WORK.rhs))
     if not _finite(qdd, Qc):
         return NOT_FINITE, residual
-    if not residual <= RESIDUAL_MAX:
+    if not residual <= KERNEL_RESIDUAL_MAX:
         return RESIDUAL, residual
     return OK, residual
 

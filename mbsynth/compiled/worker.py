@@ -22,7 +22,7 @@ import time
 
 _workers = []  # every Worker made, closed at exit
 INTERRUPTED = 130  # the exit status of a process ended by Ctrl-C (128 + SIGINT), as the CLI's
-POLL = 0.01  # seconds between looks at a numba import in progress at exit (it takes about a second)
+POLL = 0.01  # seconds between looks at a numba import in progress at exit
 
 
 class Worker:

@@ -62,10 +62,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import SolveError
-from .tolerances import (CONSISTENCY_RTOL, DRIFT_RANK, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL, SYMMETRY_RTOL,
-                         VERDICT_MARGIN)
+from .tolerances import (CONSISTENCY_ROUNDING, CONSISTENCY_RTOL, DRIFT_RANK, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL,
+                         SYMMETRY_RTOL, TERM_FLOOR, VERDICT_MARGIN)
 
-TERM_FLOOR = 1e-3  # term_scales: the share of ‖A_i‖₁ ‖x‖∞ that a row with coordinates near zero keeps
 DRIFT_GAIN = 10.0  # a nearly dependent direction asking more than this times the rest's acceleration is drift
 
 _EPS = np.finfo(float).eps
@@ -335,7 +334,7 @@ def term_scales(A, x, floor=TERM_FLOOR):
     (a thousandth unless given) of ‖A_i‖₁ ‖x‖∞ for rows whose coordinates are near zero.
     A dense or scipy.sparse A."""
     x = np.abs(np.asarray(x, dtype=float))
-    if hasattr(A, "tocsr"):  # scipy.sparse, from the CSR arrays (scipy's abs and sum build matrices: 10× slower)
+    if hasattr(A, "tocsr"):  # scipy.sparse, from the CSR arrays (scipy's abs and sum would build matrices)
         A = A.tocsr()
         return entry_term_scales(np.repeat(np.arange(A.shape[0]), np.diff(A.indptr)), A.indices, A.data, A.shape[0],
                                  x, floor)
@@ -499,7 +498,7 @@ def _row_space(X, rtol):
 
 def _tol(s, r, size):
     """Relative tolerance for components along a computed null space (module docstring)."""
-    return max(CONSISTENCY_RTOL, 8 * size * _EPS * s[0] / s[r - 1]) if r else CONSISTENCY_RTOL
+    return max(CONSISTENCY_RTOL, CONSISTENCY_ROUNDING * size * s[0] / s[r - 1]) if r else CONSISTENCY_RTOL
 
 
 def _named(weights):

@@ -10,15 +10,14 @@ import numpy as np
 
 from . import equations
 from .equations import Motion
+from .tolerances import DIVISION_GUARD, KKT_RCOND_MIN, KKT_RESIDUAL_MAX
 
 
 SPARSE_SIZE = 200  # KKT systems of this order and larger are factored sparse (SuperLU)
-RCOND_MIN = 1e-8  # KKT systems less well conditioned than this go to the reference (2.14)
-RESIDUAL_MAX = 1e-9  # a KKT solution whose relative residual of (2.12) exceeds this goes too
 
 
 def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
-                     rcond_min=RCOND_MIN, drift=None) -> Motion:
+                     rcond_min=KKT_RCOND_MIN, drift=None) -> Motion:
     """q̈ from the augmented (KKT) system [[M, Aᵀ], [A, 0]] [q̈; λ] = [Q + C; b].
 
     Why it gives (2.14): by (2.10), P Qc = P C with P = I − A⁺A, so Qc − C lies in
@@ -33,7 +32,7 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
     or Higham's estimate); one step of iterative refinement restores accuracy on moderately
     ill-conditioned systems. ``residual`` is the relative residual of the equilibrated KKT
     equations (its numerator bounds that of (2.12), since P Aᵀ = 0 and ‖P‖ = 1). When
-    rcond is below ``rcond_min``, when that residual exceeds ``RESIDUAL_MAX``,
+    rcond is below ``rcond_min``, when that residual exceeds ``KKT_RESIDUAL_MAX``,
     or when anything is not finite, the reference ``equations.constrained_acceleration``
     decides instead (with ``drift`` passed on): non-unique motion, dependent constraints,
     near-singular positions, or ``SolveError`` for inconsistent data. One verdict: rcond
@@ -47,8 +46,8 @@ def kkt_acceleration(M, Q, A, b, C=None, *, coordinates=None, constraints=None,
     solve = _sparse_solve if n + m >= SPARSE_SIZE else _dense_solve
     K, x, rcond = solve(d)
     if x is not None and rcond >= rcond_min and np.isfinite(x).all():
-        residual = np.linalg.norm(K @ x - rhs) / (_norm(K) * np.linalg.norm(x) + np.linalg.norm(rhs) + 1e-300)
-        if residual <= RESIDUAL_MAX:
+        residual = np.linalg.norm(K @ x - rhs) / (_norm(K) * np.linalg.norm(x) + np.linalg.norm(rhs) + DIVISION_GUARD)
+        if residual <= KKT_RESIDUAL_MAX:
             qdd = x[:n]
             return Motion(qdd=qdd, unique=True, nullspace=np.zeros((n, 0)), Qc=d.M @ qdd - d.Q,
                           residual=float(residual), method="kkt")

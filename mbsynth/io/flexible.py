@@ -1,4 +1,4 @@
-"""Reading a flexible body (``type: flexible_body``, issue 46): its FE model from the beam
+"""Reading a flexible body (``type: flexible_body``): its FE model from the beam
 generator (``beam:``) or from files (``fe:``, relative to the model file), its reduction,
 damping, centrifugal stiffening (beams), frames at FE nodes and initial state (sections in
 schema.py). Every error of the

@@ -33,9 +33,9 @@ from .schema import SECTIONS
 from .placement import Placement, place_initial
 from .source import Document, LineDict, LineList, read_document
 from .substructures import Scoped, included_from, read_includes
+from ..core.tolerances import ASSEMBLED_TOL
 
 RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {"t"}
-ASSEMBLED = 1e-6  # a joint whose rows are all below this at the initial state is assembled there
 
 
 def load(path, parameters=None):
@@ -590,7 +590,7 @@ class _Builder:
                           f"joint '{own}' has the name of {clash}: rename the joint")
             values = functools.cache(functools.partial(value_expressions, joint))
             symbols = functools.cache(functools.partial(constraint_symbols, joint))
-            for key in value_names(joint):  # derived when an expression uses them (sympy: tenths of a second)
+            for key in value_names(joint):  # derived only when an expression uses them (a sympy derivation)
                 model.global_symbols[f"{joint.name}.{key}"] = _Deferred(values, key)
                 model.constraint_symbols[f"{joint.name}.{key}"] = _Deferred(symbols, key)
 
@@ -694,7 +694,7 @@ class _Builder:
         A joint whose rows do not hold yet is left to the state made consistent."""
         q, qd = system.initial_state()
         phi, _ = system.constraint_residuals(0.0, q, qd)
-        apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED}
+        apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED_TOL}
         for joint, problem in system.branch_problems(q):
             if joint not in apart:
                 builder, place = self.entry_named(joint)

@@ -13,6 +13,8 @@ from ..core.kinematics import axis_matrix, matrix_quaternion, quaternion_matrix,
 from ..model.parts import EulerBody, Frame, Particle, PlanarBody, RigidBody, Spring
 from ..model.parts.euler_body import SEQUENCES, angle_rates_of, angles_of, coordinates
 from .placement import quaternion_sign
+from ..core.tolerances import (DIVISION_GUARD, INERTIA_NEGATIVE_RTOL, INERTIA_SYMMETRY_RTOL, QUATERNION_NORM_TOL,
+                               TRIANGLE_RTOL)
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
 SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None, "line": None}
@@ -111,14 +113,14 @@ def read_inertia(builder, node, path):
     else:
         builder.fail(path, "inertia must be [Ixx, Iyy, Izz] or a 3 × 3 matrix [[...], [...], [...]]")
     values = np.array([[builder.value(x) for x in row] for row in J.tolist()])
-    scale = max(np.abs(values).max(), 1e-300)
-    if np.abs(values - values.T).max() > 1e-12 * scale:
+    scale = max(np.abs(values).max(), DIVISION_GUARD)
+    if np.abs(values - values.T).max() > INERTIA_SYMMETRY_RTOL * scale:
         builder.fail(path, "the inertia matrix is not symmetric")
     moments = np.linalg.eigvalsh(values)
-    if moments.min() < -1e-12 * scale:
+    if moments.min() < -INERTIA_NEGATIVE_RTOL * scale:
         builder.fail(path, f"the inertia matrix is not positive semi-definite (principal moments {moments})")
     a, b, c = moments
-    if a + b < c * (1 - 1e-9) - 1e-12 * scale:
+    if a + b < c * (1 - TRIANGLE_RTOL) - INERTIA_NEGATIVE_RTOL * scale:
         builder.fail(path, f"principal moments {moments} violate the triangle inequality I1 + I2 ≥ I3: "
                            "no mass distribution has them")
     return J
@@ -141,7 +143,7 @@ def read_rotation(builder, node, path, fixed=False):
         builder.fail(path + (key,), f"{key} must not be zero")
     if key == "axis":
         return axis_matrix(values)
-    if abs(np.linalg.norm(values) - 1) > 1e-6:
+    if abs(np.linalg.norm(values) - 1) > QUATERNION_NORM_TOL:
         builder.fail(path + (key,), f"quaternion {values} is not of unit norm (norm {np.linalg.norm(values):.6g})")
     return quaternion_matrix(values)
 

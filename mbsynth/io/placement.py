@@ -16,10 +16,9 @@ import numpy as np
 import sympy as sp
 
 from ..core.kinematics import matrix_quaternion
+from ..core.tolerances import PLANE_RTOL, SIGN_TOL
 
 POSE_KINDS = ("rigid_body", "flexible_body")  # a position and a scalar-first unit quaternion
-PLANE_RTOL = 1e-12  # a turn whose R_zz is this close to 1 keeps the xy plane (rpy rounding)
-SIGN_TOL = 1e-12  # a unit quaternion's component below this is rounding (w of a half turn): it cannot fix the sign
 
 
 class Placement:

@@ -42,7 +42,7 @@ class LineList(list):
 
 
 try:  # libyaml's scanner and parser (C) under PyYAML's composer and safe constructor: the same
-    from yaml.cyaml import CParser  # documents, events and marks, the events several times faster
+    from yaml.cyaml import CParser  # documents, events and marks, the events in C
 
     class _Base(yaml.composer.Composer, CParser, yaml.constructor.SafeConstructor, yaml.resolver.Resolver):
         def __init__(self, text):

@@ -22,7 +22,7 @@ from ..core.equations import rank_report
 from ..core.errors import ModelError
 from ..symbolic.derive import T_SYMBOL, exceeds, tidy
 from .system import Closure
-from ..core.tolerances import BALANCE_ZERO_RTOL
+from ..core.tolerances import BALANCE_ENTRY_ZERO, BALANCE_ZERO_RTOL, RATIONAL_TOL, READABLE_DROP
 
 SAMPLES = 8
 
@@ -85,7 +85,7 @@ def balances(data, t=0.0, q=None, qd=None):
     arrays = data.evaluate(t, q, qd)
     numeric = AngleParts(system).set_aside(q, rank_report(arrays.M, arrays.A).nullspace)[1]
     if numeric.shape[1] == 0:
-        return []  # before the sympy form of the model: seconds on a robot
+        return []  # before the sympy form of the model (costly on a robot)
     values = {sp.Symbol(k): sp.nsimplify(v, rational=True) for k, v in data.parameters.items()}
     M, Q, A, _, C = system.symbolic()
     force = Q + C
@@ -108,17 +108,16 @@ def balances(data, t=0.0, q=None, qd=None):
             expression = sp.S.Zero if is_free else tidy((w.T * force)[0])  # tidy: bounded (derive.py)
             vector = np.array(w.subs(state).evalf(), dtype=float).ravel()
             vector /= vector[np.argmax(np.abs(vector))]
-            result.append(Balance({c: float(v) for c, v in zip(system.coordinates, vector) if abs(v) > 1e-12},
-                                  expression, state_dependent, float(vector @ (arrays.Q + arrays.C))))
+            entries = {c: float(v) for c, v in zip(system.coordinates, vector) if abs(v) > BALANCE_ENTRY_ZERO}
+            result.append(Balance(entries, expression, state_dependent, float(vector @ (arrays.Q + arrays.C))))
     return result
 
 
 SYMBOLIC_SIZE_MAX = 400  # nodes of an expression (or of a matrix's non-numeric entries) beyond which it is not
-# factored, put through a simplifying nullspace or printed: minutes on a flexible body's balance (50,000 nodes)
+# factored, put through a simplifying nullspace or printed (a flexible body's balance has 50,000 nodes)
 
 
 READABLE_DIGITS = 6  # significant digits of the numbers in a printed balance
-READABLE_DROP = 1e-9  # a term of a sum below this times its largest coefficient is left out of a printed balance
 
 
 def readable(expression):
@@ -184,7 +183,7 @@ def _separate(W, system, q, qd, t):
 
 
 def _rational_rows(rows):
-    return [[sp.nsimplify(x, rational=True, tolerance=1e-12) for x in row] for row in rows]
+    return [[sp.nsimplify(x, rational=True, tolerance=RATIONAL_TOL) for x in row] for row in rows]
 
 
 def _canonical(D, state, dynamic):

@@ -37,7 +37,7 @@ from ..core.equations import equilibrate_rows
 from ..core.errors import SolveError
 from ..core.joint_kinds import FRICTION_KINDS, KINDS
 from ..symbolic.derive import T_SYMBOL, compile_function
-from ..core.tolerances import COULOMB_LOAD_RTOL, RANK_RTOL
+from ..core.tolerances import COULOMB_LOAD_RTOL, COULOMB_NOISE, RANK_RTOL
 
 MAX_ITERATIONS = 50
 
@@ -111,7 +111,7 @@ def coulomb_motion(constraints, arrays, solve, t, q, qd, p):
     Ae, norms = equilibrate_rows(arrays.A)
     # λ of the load rows from Aᵀλ = Q + C − M q̈, solved on the rows of A scaled to unit norm
     L = (np.linalg.pinv(Ae.T, rcond=RANK_RTOL) / norms[:, None])[rows]
-    noise = 16 * np.finfo(float).eps * np.array([np.linalg.norm(L[s]) for _, _, s in sliding])
+    noise = COULOMB_NOISE * np.array([np.linalg.norm(L[s]) for _, _, s in sliding])
     N = np.zeros(len(sliding))
     for _ in range(MAX_ITERATIONS):
         C = arrays.C + sum(load * force for load, (_, force, _) in zip(N, sliding))

@@ -280,7 +280,7 @@ def _floats(f):
 
 
 def _rotation_vector(RA, RB, origin):
-    from scipy.spatial.transform import Rotation  # scipy.spatial loads in a few tenths of a second
+    from scipy.spatial.transform import Rotation  # scipy.spatial is imported only where used
     return Rotation.from_matrix(_orthonormal(RA.T @ RB)).as_rotvec()
 
 

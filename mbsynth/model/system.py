@@ -28,6 +28,7 @@ from ..core.values import freeze, frozen_mapping, read_only
 from .joint_values import JointKinematics, value_expressions
 from .parts import LINK_FRAME, Frame
 from ..symbolic.derive import T_SYMBOL
+from ..core.tolerances import DIVISION_GUARD, MASS_NEGATIVE_RTOL
 
 
 @dataclass(frozen=True)
@@ -311,7 +312,7 @@ class System:
                 M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], p)
             if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
                 problems.append((part.name, f"subsystem '{part.name}': M or Q is not finite at the initial state"))
-            elif np.linalg.eigvalsh(M).min() < -1e-12 * max(np.abs(M).max(), 1e-300):
+            elif np.linalg.eigvalsh(M).min() < -MASS_NEGATIVE_RTOL * max(np.abs(M).max(), DIVISION_GUARD):
                 problems.append((part.name, f"subsystem '{part.name}': the mass matrix is not positive "
                                             "semi-definite at the initial state (a negative mass or inertia, "
                                             "or a T that is no kinetic energy)"))

@@ -36,6 +36,7 @@ from ..core.kinematics import axis_matrix, matrix_quaternion
 from ..model.parts import LINK_FRAME, Frame, RigidBody
 from ..model.system import System
 from .urdf import read_urdf
+from ..core.tolerances import EXACT_ENTRY_TOL
 
 GRAVITY = (0.0, 0.0, -9.81)
 # example-robot-data's own short names (those of its Python loaders), by file
@@ -240,11 +241,11 @@ def fix_base(system):
 
 
 def exact(values):
-    """A sympy matrix of ``values`` with entries within 1e-15 of −1, 0 or 1 made exact
+    """A sympy matrix of ``values`` with entries within EXACT_ENTRY_TOL of −1, 0 or 1 made exact
     integers: ``1.0*x`` and ``0.0*x`` terms would otherwise fill every derivative."""
     values = np.atleast_1d(np.asarray(values, dtype=float))
     near = np.round(values)
-    exact_entries = (np.abs(values - near) < 1e-15) & (np.abs(near) <= 1)
+    exact_entries = (np.abs(values - near) < EXACT_ENTRY_TOL) & (np.abs(near) <= 1)
     return sp.Matrix(values.shape[0], values.shape[1] if values.ndim > 1 else 1,
                      [sp.Integer(int(n)) if e else sp.Float(v) for v, n, e in
                       zip(values.ravel(), near.ravel(), exact_entries.ravel())])

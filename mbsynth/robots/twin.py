@@ -40,6 +40,7 @@ from ..core.kinematics import body_rate_matrix, rotation
 from ..model.parts import LINK_FRAME, Frame, RigidBody
 from ..model.parts.base import frame_velocity
 from ..symbolic.derive import compile_function, jacobian
+from ..core.tolerances import PROXIMAL_ACCURACY, PROXIMAL_MU
 
 # per kind its Pinocchio counterparts (core/joint_kinds.py: a kind's ``pinocchio``): the joint
 # models that hang a body (WELD: on its parent's joint) and the rigid constraints that close a
@@ -47,7 +48,7 @@ from ..symbolic.derive import compile_function, jacobian
 TREE_JOINTS = {name: kind.pinocchio.tree for name, kind in KINDS.items() if kind.pinocchio.tree}
 LOOPS = {name: (getattr(pin.ContactType, kind.pinocchio.loop[0]), kind.pinocchio.loop[1])
          for name, kind in KINDS.items() if kind.pinocchio.loop}
-PROXIMAL = (1e-13, 1e-10, 200)  # constraintDynamics: accuracy, μ, iterations (redundant loop rows allowed)
+PROXIMAL = (PROXIMAL_ACCURACY, PROXIMAL_MU, 200)  # constraintDynamics: accuracy, μ, iterations
 
 
 def no_twin(system, why):

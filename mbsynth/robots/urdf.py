@@ -17,6 +17,7 @@ import numpy as np
 from ..core.errors import ModelError
 from ..core.joint_kinds import URDF_KINDS
 from ..core.kinematics import quaternion_matrix, rpy_matrix
+from ..core.tolerances import URDF_INERTIA_ATOL, URDF_INERTIA_RTOL
 
 
 @dataclass(frozen=True)
@@ -93,9 +94,6 @@ class Description:
         return order
 
 
-# a principal moment below −max(INERTIA_RTOL × the largest, INERTIA_ATOL) is negative, not rounding
-# (icub's head has moments of ±2.4e-35 kg m²: zero, printed with noise; URDF units are SI)
-INERTIA_RTOL, INERTIA_ATOL = 1e-12, 1e-15
 
 
 def read_urdf(path, package_dirs=()):
@@ -217,8 +215,8 @@ def _link(element, path, dirs, materials):
     if not np.all(np.isfinite(inertia)):
         raise ModelError(f"{where}: its inertia overflows (in link axes: {inertia.tolist()})")
     eigenvalues = np.linalg.eigvalsh(inertia)
-    if eigenvalues.min() < -max(INERTIA_RTOL * abs(eigenvalues).max(),
-                                                                        INERTIA_ATOL):
+    if eigenvalues.min() < -max(URDF_INERTIA_RTOL * abs(eigenvalues).max(),
+                                                                        URDF_INERTIA_ATOL):
         raise ModelError(f"{where}: its inertia is not positive semi-definite (principal moments "
                          f"{', '.join(f'{x:.3g}' for x in eigenvalues)}); no rigid body has it — fix the "
                          "<inertia> of the file")

@@ -43,7 +43,7 @@ from ..core.errors import ModelError, SolveError
 from ..analysis.projection import project
 from .build import describe, fix_base, from_robot, robot_files
 from .twin import Twin
-from ..core.tolerances import SELF_STRESS_RTOL, VALIDATION_RTOL
+from ..core.tolerances import NULLSPACE_SHOWN_TOL, SAME_STATE_TOL, SELF_STRESS_RTOL, VALIDATION_RTOL
 
 MAX_TRIES = 20  # samples drawn to find one a loop can close at
 
@@ -273,7 +273,7 @@ def _consistent_sample(system, twin, rng):
     raise SolveError(f"model '{system.name}': no random state of {MAX_TRIES} could be put on its constraints")
 
 
-def _same_state(a, b, tol=1e-8):
+def _same_state(a, b, tol=SAME_STATE_TOL):
     """Whether two maximal states (q, q̇) of rigid bodies agree, a quaternion's sign aside."""
     (qa, qda), (qb, qdb) = (np.reshape(x, (-1, 7)) for x in a), (np.reshape(x, (-1, 7)) for x in b)
     sign = np.sign(np.sum(qa[:, 3:] * qb[:, 3:], axis=1))[:, None]
@@ -298,7 +298,7 @@ def _why(motion, reference, system):
         parts.append(f"mbsynth: no motion exists ({motion})")
     elif not motion.unique:
         worst = np.abs(motion.nullspace).max(axis=1)
-        moving = [c for c, x in zip(system.coordinates, worst) if x > 1e-6]
+        moving = [c for c, x in zip(system.coordinates, worst) if x > NULLSPACE_SHOWN_TOL]
         parts.append(f"mbsynth: the motion is not unique ({motion.nullspace.shape[1]} indeterminate "
                      f"direction(s) in {', '.join(moving[:6])}{' ...' if len(moving) > 6 else ''})")
     return "; ".join(parts)

@@ -41,6 +41,7 @@ from ..core.memo import MEMO
 from ..io import load, loads
 from ..analysis.simulate import simulate
 from ..symbolic.derive import T_SYMBOL
+from ..core.tolerances import ELAPSED_FLOOR
 
 log = logging.getLogger(__name__)
 
@@ -340,7 +341,7 @@ def _execute(client, model, todo, job, trajectories, results, out, progress, tot
             _write_results(out, pd.DataFrame(list(results.values())))
             last_write = time.perf_counter()
         if progress is not None:
-            rate = finished / max(time.perf_counter() - started, 1e-9)
+            rate = finished / max(time.perf_counter() - started, ELAPSED_FLOOR)
             failed = sum(r["status"] != "ok" for r in results.values())
             progress(len(results), failed, total, (total - len(results)) / rate)
 

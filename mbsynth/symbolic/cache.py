@@ -72,7 +72,7 @@ def remembered(kind, inputs, derive, *, store=_stable, load=lambda stored: store
     path = folder / f"{kind}-{key}.pkl"
     if path.exists():
         try:
-            with evaluate(False):  # stored in canonical form: rebuilt as is, four times faster
+            with evaluate(False):  # stored in canonical form: rebuilt as is, not evaluated again
                 stored = pickle.loads(path.read_bytes())
             return load(stored)
         except Exception:  # noqa: BLE001 - a damaged or foreign entry: derive it again

@@ -28,9 +28,9 @@ _LARGEST = sp.Float(np.finfo(float).max)
 # Python floats raise on overflow and division by zero ((2*pi + 1e308)**251, 1/(1 - t) at
 # t = 1) where numpy's give inf, which the checks of M, Q, A, b then report
 _FLOAT64 = {"pi": np.float64(np.pi), "e": np.float64(np.e)}
-SIMPLIFY_MAX_OPS = 60  # sympy.simplify takes seconds beyond this, growing fast (nested sin, exp)
+SIMPLIFY_MAX_OPS = 60  # sympy.simplify's cost grows fast beyond this (nested sin, exp)
 # an expression of more nodes has more than SIMPLIFY_MAX_OPS operations (a node adds at most about
-# three nodes per operation): not counted by count_ops, which takes seconds on a flexible body's
+# three nodes per operation): not counted by count_ops, whose cost grows with the expression
 SIMPLIFY_MAX_NODES = 10 * SIMPLIFY_MAX_OPS
 
 
@@ -320,7 +320,7 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
 def symbols_in(exprs):
     """The symbols in ``exprs``, as ``free_symbols`` gives them for expressions without
     bound variables (derivatives, which share subexpressions): each object visited once,
-    where free_symbols walks a shared subexpression at every use (25× slower on joints)."""
+    where free_symbols walks a shared subexpression at every use (a joint's rows share many)."""
     seen, found, stack = set(), set(), [sp.sympify(e) for e in exprs]
     while stack:
         expr = stack.pop()

@@ -8,6 +8,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 import numpy as np  # noqa: E402
 
 from ..core.files import write_atomically  # noqa: E402
+from ..core.tolerances import LOG_PLOT_FLOOR
 
 MAX_LINES = 12
 
@@ -32,7 +33,7 @@ def plot_trajectory(traj, path, title=None, system=None, names=None):
         ax_q.set_title(f"first {MAX_LINES} of {len(series)} {label}", fontsize="small")
     _energy(ax_e, traj, system)
     for values, name in ((traj.residual_position, "position |φ|"), (traj.residual_velocity, "velocity |φ̇|")):
-        ax_r.semilogy(traj.t, np.maximum(values, 1e-18), label=name)
+        ax_r.semilogy(traj.t, np.maximum(values, LOG_PLOT_FLOOR), label=name)
     ax_r.set_ylabel("max constraint residual")
     ax_r.set_xlabel("t [s]")
     ax_r.legend(fontsize="small")

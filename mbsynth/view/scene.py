@@ -47,6 +47,7 @@ from ..io.parts import COLORS
 from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from ..symbolic.derive import T_SYMBOL, compile_function
+from ..core.tolerances import FRAME_SPACING_RTOL, SEGMENT_SCALE_FLOOR
 
 FPS = 30  # at most this many drawn states per second of motion
 PALETTE = ("blue", "orange", "green", "red", "purple", "yellow")
@@ -213,7 +214,7 @@ def drawn_rows(t, fps=FPS):
         raise ValueError("the trajectory has no rows to draw")
     keep = [0]
     for i in range(1, len(t)):
-        if t[i] - t[keep[-1]] >= (1 - 1e-9) / fps:
+        if t[i] - t[keep[-1]] >= (1 - FRAME_SPACING_RTOL) / fps:
             keep.append(i)
     if keep[-1] != len(t) - 1:
         keep.append(len(t) - 1)
@@ -231,7 +232,7 @@ def segment_transforms(a, b):
     y /= np.linalg.norm(y, axis=1)[:, None]
     z = np.cross(x, y)
     T = np.zeros((len(a), 4, 4))
-    T[:, :3, 0] = x * np.maximum(length, 1e-9)[:, None]
+    T[:, :3, 0] = x * np.maximum(length, SEGMENT_SCALE_FLOOR)[:, None]
     T[:, :3, 1], T[:, :3, 2], T[:, :3, 3], T[:, 3, 3] = y, z, a, 1.0
     return T
 

@@ -35,6 +35,7 @@ import numpy as np
 from ..core.files import write_atomically
 from ..core.kinematics import matrix_quaternion
 from .scene import FPS, build_scene
+from ..core.tolerances import GRID_SPACING_RTOL, VIEW_TIE_BREAK
 
 FIELD_OF_VIEW = np.radians(75.0)  # meshcat's default camera
 CAMERA = "/Cameras/default/rotated/<object>"
@@ -276,13 +277,13 @@ def world_tracks(scene):
 def grid_spacing(size):
     """The largest of 1, 2, 5 × 10^k not above size / 5."""
     decade = 10.0 ** np.floor(np.log10(size / 5))
-    return max(step * decade for step in (1, 2, 5) if step * decade <= size / 5 * (1 + 1e-12))
+    return max(step * decade for step in (1, 2, 5) if step * decade <= size / 5 * (1 + GRID_SPACING_RTOL))
 
 
 def view_direction(extent):
     """A unit vector from the model toward the camera: across its thinnest side, from
     slightly above and to the right (meshcat keeps z up)."""
-    thin = int(np.argmin(extent + np.array([0.0, -1e-9, 1e-9])))  # ties: look along y, then x
+    thin = int(np.argmin(extent + np.array([0.0, -VIEW_TIE_BREAK, VIEW_TIE_BREAK])))  # ties: look along y, then x
     direction = {0: [1.0, -0.35, 0.45], 1: [0.35, -1.0, 0.45], 2: [0.25, -0.5, 1.0]}[thin]
     return np.array(direction) / np.linalg.norm(direction)
 

@@ -1,4 +1,4 @@
-"""The field's benchmark problems (issue 18) run to the end and meet independent references.
+"""The field's benchmark problems run to the end and meet independent references.
 
 IFToMM/LIM A01 (simple pendulum), A02 (N-four-bar through its singular positions), A03 /
 the IVP test set's `andrews`, A04 (Bricard's over-constrained loop), A05 (the stiff
@@ -13,14 +13,13 @@ written by hand, and the slider-crank library's published solution.
 
 They fail on a solver that stops at, or mis-steps through, a configuration where the
 dependent rows change (Bricard, the N-four-bar) or that judges consistency with an
-absolute tolerance (the 1 km pendulum), as mbsynth did before issue 18. Output intervals
+absolute tolerance (the 1 km pendulum). Output intervals
 are coarse to keep each run short (drift control projects between them as needed);
 accuracy is `simulate`'s default (DOP853, rtol = atol = 1e-10).
 """
 
 import functools
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +30,7 @@ from mbsynth.analysis.diagnose import diagnose
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISMS = ROOT / "models" / "mechanisms"
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 load = functools.cache(lambda name: mb.load(MECHANISMS / name))
 
@@ -306,7 +304,7 @@ def test_slider_crank_3d_follows_the_crank_equation_and_the_published_solution()
 def test_only_merges_its_rows_into_an_existing_table(tmp_path):
     """--only with an existing results file: the problem run replaces its own row and
     note, every other row stays, and one line says which rows were run again."""
-    import iftomm
+    from benchmarks import iftomm
     out = tmp_path / "results.md"
     old = (ROOT / "benchmarks" / "iftomm_results.md").read_text()
     out.write_text(old)
@@ -327,7 +325,7 @@ def test_only_merges_its_rows_into_an_existing_table(tmp_path):
 def test_benchmark_script_quick_writes_its_table(tmp_path):
     """benchmarks/iftomm.py --quick on three problems: a table row each, a failure
     reported in its row rather than raised."""
-    import iftomm
+    from benchmarks import iftomm
     out = tmp_path / "results.md"
     results = iftomm.main(["--quick", "--only", "pendulum,andrews,pendulum_1km", "--out", str(out)])
     text = out.read_text()

@@ -16,7 +16,7 @@ from scipy.special import ellipj, ellipk
 
 import mbsynth as mb
 from mbsynth.analysis import trajectory
-from mbsynth.analysis.derivative import MAX_STATE
+from mbsynth.core.tolerances import MAX_STATE
 from mbsynth.analysis.simulate import simulate
 from mbsynth.analysis.trajectory import Trajectory, TrajectoryWriter, load_trajectory, output_file
 

@@ -3,7 +3,6 @@ the stability exponents of rolling disks, a sleigh on a massless blade and the W
 bicycle, against closed forms, an independent derivation by Kane's method (sympy), and
 the bicycle benchmark's published eigenvalues and self-stable speeds."""
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +15,7 @@ from mbsynth.analysis.modes import to_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 # J. P. Meijaard, J. M. Papadopoulos, A. Ruina, A. L. Schwab, Proc. R. Soc. A 463 (2007)
 # 1955-1982, Table 2: the benchmark bicycle's eigenvalues (1/s) at 4, 5 and 10 m/s, and its

@@ -1,4 +1,4 @@
-"""Tolerances are relative (issue 18): the same mechanism in millimetres, metres or
+"""Tolerances are relative: the same mechanism in millimetres, metres or
 kilometres, with masses in grams or tonnes, completes and moves alike after rescaling time.
 
 Lengths ×s with g fixed scale time by √s (Froude similarity); masses scale no motion. The
@@ -7,7 +7,6 @@ exact one-degree-of-freedom motion (benchmarks/iftomm_reference.py).
 """
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,8 +16,7 @@ import mbsynth as mb
 from mbsynth.analysis.projection import project_positions
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 SCALES = [(1e-3, 1.0), (1.0, 1e-3), (1.0, 1e3), (1e3, 1.0), (1e3, 1e3)]  # (length ×, mass ×)
 

@@ -1,5 +1,5 @@
 """The integrator's form of the state (analysis/velocity_form.py): each rigid body's
-quaternion rates replaced by half its body angular velocity, against tests/rotations.py's E and a
+quaternion rates replaced by half its body angular velocity, against tests/helpers/rotations.py's E and a
 rotation in closed form; and the tennis-racket flip through ``simulate`` against Euler's
 equations."""
 
@@ -11,7 +11,8 @@ import scipy.integrate
 
 import mbsynth as mb
 from mbsynth.analysis.velocity_form import VelocityForm
-from rotations import E
+from tests.helpers.rotations import E
+from tests.helpers.states import quaternion_of, random_state
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -29,20 +30,10 @@ def rod():
     return system
 
 
-def random_state(system, rng, norm=1.0):
-    """(q, q̇) with the rigid body's u of norm ``norm`` and u̇ ⟂ u; its quaternion's slice."""
-    q, qd = rng.standard_normal(system.n), rng.standard_normal(system.n)
-    start = system.coordinates.index("rod.qw")
-    u = slice(start, start + 4)
-    q[u] *= norm / np.linalg.norm(q[u])
-    qd[u] -= q[u] * (q[u] @ qd[u]) / (q[u] @ q[u])
-    return q, qd, u
-
-
 def test_the_integrators_velocities_are_half_each_bodys_angular_velocity_and_convert_back(rod):
     form = VelocityForm(rod)
     rng = np.random.default_rng(5)
-    q, qd, u = random_state(rod, rng)
+    (q, qd), u = random_state(rod, rng, tangent=True), quaternion_of(rod, "rod")
     y = form.to_integrator(q, qd)
     assert y.size == 2 * rod.n - 1
     v = y[rod.n:]
@@ -53,7 +44,7 @@ def test_the_integrators_velocities_are_half_each_bodys_angular_velocity_and_con
     q_back, qd_back = form.to_state(y)
     np.testing.assert_array_equal(q_back, q)
     np.testing.assert_allclose(qd_back, qd, rtol=0, atol=1e-15)
-    rows = np.array([y, form.to_integrator(*random_state(rod, rng)[:2])])
+    rows = np.array([y, form.to_integrator(*random_state(rod, rng, tangent=True))])
     q_rows, qd_rows = form.states(rows)
     for row, q_row, qd_row in zip(rows, q_rows, qd_rows):
         np.testing.assert_array_equal(np.concatenate([q_row, qd_row]), form.state(row))
@@ -63,7 +54,7 @@ def test_the_integrators_velocities_are_half_each_bodys_angular_velocity_and_con
 def test_a_quaternion_off_unit_norm_keeps_its_norm_and_angular_velocity(rod):
     """u = s û: u̇ = E(u)ᵀ h is tangent (|u| stays) and s times û's rate, so h = ω/2 is û's."""
     form = VelocityForm(rod)
-    q, qd, u = random_state(rod, np.random.default_rng(6), norm=1 + 1e-6)
+    (q, qd), u = random_state(rod, np.random.default_rng(6), norm=1 + 1e-6, tangent=True), quaternion_of(rod, "rod")
     y = form.to_integrator(q, qd)
     _, qd_back = form.to_state(y)
     assert abs(q[u] @ qd_back[u]) < 1e-15
@@ -78,7 +69,7 @@ def test_rates_of_a_body_turning_about_a_body_axis_give_its_angular_acceleration
     ω̇ = θ̈ a in closed form (u̇ = ½ u ⊗ (0, ω)); the integrator holds ω/2."""
     form = VelocityForm(rod)
     rng = np.random.default_rng(7)
-    q, qd, u = random_state(rod, rng)
+    (q, qd), u = random_state(rod, rng, tangent=True), quaternion_of(rod, "rod")
     qdd = rng.standard_normal(rod.n)
     u0 = q[u].copy()
     a = np.array([0.3, -0.8, 0.5]) / np.linalg.norm([0.3, -0.8, 0.5])

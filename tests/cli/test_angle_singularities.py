@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from processes import HANG
+from tests.helpers.processes import HANG
 
 ROOT = Path(__file__).resolve().parents[2]
 

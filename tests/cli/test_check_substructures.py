@@ -14,7 +14,7 @@ from dataclasses import replace
 import mbsynth as mb
 from mbsynth.analysis.diagnose import diagnose
 from mbsynth.cli.check import format_check
-from n_four_bar_files import write_n_four_bar
+from tests.helpers.n_four_bar_files import write_n_four_bar
 
 
 def check(*args):

@@ -108,8 +108,7 @@ def test_simulate_names_the_singular_position_it_passed(capsys):
     freedom motion J ψ̈ = K sin ψ from vertical at 1 m/s reaches ψ = π/2: t = 0.714356 s
     (benchmarks/iftomm_reference.py, scipy at 1e-13). The summary says so."""
     root = Path(__file__).resolve().parents[2]
-    sys.path.insert(0, str(root / "benchmarks"))
-    import iftomm_reference as ref
+    from benchmarks import iftomm_reference as ref
     import numpy as np
 
     assert main(["simulate", str(root / "models" / "mechanisms" / "n_four_bar.yaml"), "--t-end", "1", "--json"]) == 0

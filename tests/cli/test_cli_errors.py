@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from processes import HANG, ended_within, meshcat_servers, needs_proc, readline_within, running
+from tests.helpers.processes import HANG, ended_within, meshcat_servers, needs_proc, readline_within, running
 
 from mbsynth.cli import simulate as simulate_command
 from mbsynth.cli import main

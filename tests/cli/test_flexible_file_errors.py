@@ -4,7 +4,6 @@ fault is in one), never exit 3 with a raw numpy, zipfile or sympy exception."""
 
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,8 +11,7 @@ import pytest
 from mbsynth.model.flexible.beam import beam
 from mbsynth.model.flexible.files import write_fe
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "model" / "flexible"))
-from flexible_beams import truss  # noqa: E402  (a helper beside the FE tests)
+from tests.helpers.flexible_beams import truss
 
 BEAM = "{length: 1.0, elements: 4, area: 1e-4, Iy: 2e-9, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000}"
 CB = "{method: craig_bampton, interface: [0], modes: 1}"
@@ -108,7 +106,7 @@ def test_text_complex_and_unphysical_mass_matrices_are_refused(tmp_path, mass, w
 def test_craig_bampton_of_a_solid_is_refused_with_the_right_advice(tmp_path, interface):
     """A solid (3 DOFs per node: a point-mass truss) reduced by Craig–Bampton: holding the
     reference node's translations at the frame leaves the rotation about it to the reduced
-    coordinates. Refused at once (not "add interface nodes", not minutes in sympy), and
+    coordinates. Refused at once (not "add interface nodes", not a long sympy derivation), and
     free-interface modes, the advice, give a model ``check`` finds unique."""
     write_fe(truss(), tmp_path / "rod.npz")
     refused(tmp_path, "fe: {bundle: rod.npz}", f"{{method: craig_bampton, interface: {interface}, modes: 2}}", 6,

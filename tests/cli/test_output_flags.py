@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from processes import HANG
+from tests.helpers.processes import HANG
 
 import mbsynth as mb
 from mbsynth.cli import main

@@ -1,4 +1,4 @@
-"""``python -m mbsynth.compiled`` (the compile step of ``make install``) says why it compiles,
+"""``python -m mbsynth.cli.compile_ahead`` (the compile step of ``make install``) says why it compiles,
 then what it compiles and how far it is, one line per stage on stderr; on a warm cache it
 says that the kernels are compiled already and only loads them."""
 
@@ -18,7 +18,7 @@ STAGE = re.compile(r"^mbsynth: \[(\d+)/(\d+)\] \S")
 @pytest.mark.timeout(900)  # a cold cache compiles for minutes (the command's own point); a warm one loads in seconds
 def test_compiling_ahead_says_what_and_how_far():
     cold = not background.compiled()
-    done = subprocess.run([sys.executable, "-m", "mbsynth.compiled"], cwd=ROOT, capture_output=True, text=True,
+    done = subprocess.run([sys.executable, "-m", "mbsynth.cli.compile_ahead"], cwd=ROOT, capture_output=True, text=True,
                           timeout=900)
     assert done.returncode == 0, done.stderr[-3000:]
     lines = done.stderr.splitlines()

@@ -1,4 +1,4 @@
-"""Continuous integration with the kernel's own correction (issue 20): the compiled rows
+"""Continuous integration with the kernel's own correction: the compiled rows
 (fast/rows.py) against the System's residuals and energies, the correction
 (fast/correction.py) against the least-mass-norm step's defining identity, and a whole
 run against Pinocchio's aba in the same scipy integrator."""

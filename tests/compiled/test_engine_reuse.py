@@ -26,6 +26,8 @@ from mbsynth.model.data import shared
 from mbsynth.model.system import System
 from mbsynth.compiled.layout import build as build_layout
 
+from tests.helpers.compare import rel
+
 # Parameters in a mass, an inertia, frame offsets, a rod's length, gravity and a force.
 MODEL = """
 name: reuse
@@ -49,8 +51,6 @@ forces:
 """
 
 
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
 
 
 @pytest.fixture(scope="module")

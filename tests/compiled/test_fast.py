@@ -34,9 +34,10 @@ from mbsynth.compiled.rows import Rows
 from mbsynth.compiled.tree import _components_closed, _null_space_components
 from mbsynth.core import kinematics
 from mbsynth.core.kinematics import body_rate_matrix
-from mbsynth.model.parts import RigidBody
 
-from literal import literal_2_14
+from tests.helpers.compare import rel
+from tests.helpers.literal import literal_2_14
+from tests.helpers.states import random_state
 
 MODELS = sorted((Path(__file__).resolve().parents[2] / "models").glob("**/*.yaml"))
 TREE = "tree (Baraff)"
@@ -81,21 +82,6 @@ def loads(text):
     return mb.loads(textwrap.dedent(text), name="model.yaml")
 
 
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
-
-
-def random_state(system, rng, unit=True, spread=1.0):
-    """Random coordinates and velocities; quaternions of unit length unless ``unit`` is False."""
-    q = spread * rng.standard_normal(system.n)
-    qd = rng.standard_normal(system.n)
-    for part, start in zip(system.parts, np.cumsum([0] + [len(p.coordinates) for p in system.parts])):
-        if isinstance(part, RigidBody):
-            u = q[start + 3:start + 7]
-            q[start + 3:start + 7] = u / np.linalg.norm(u) * (1.0 if unit else rng.uniform(0.7, 1.4))
-    return q, qd
-
-
 @pytest.fixture(scope="module")
 def all_joints():
     return loads(ALL_JOINTS)
@@ -113,7 +99,7 @@ def test_joint_rows_equal_the_sympy_rows(all_joints):
     A, b = np.zeros((6, 14)), np.zeros(6)
     rng = np.random.default_rng(3)
     for trial in range(5):
-        q, qd = random_state(system, rng, unit=trial % 2 == 0)
+        q, qd = random_state(system, rng, norm=1.0 if trial % 2 == 0 else (0.7, 1.4))
         for j, con in enumerate(kernel_joints):
             a_ref, b_ref, _ = con.evaluate(0.0, q, qd, system.parameter_values)
             k = int(L.joint_k[j])
@@ -141,7 +127,7 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
     Rs = make_work(L).Rs  # with the world's slot
     rng = np.random.default_rng(4)
     for trial in range(4):
-        q, qd = random_state(system, rng, unit=trial % 2 == 0)
+        q, qd = random_state(system, rng, norm=1.0 if trial % 2 == 0 else (0.7, 1.4))
         mu = nodes(q, qd, np.zeros(0), L.node_kind, L.node_q, L.node_mass, L.node_mg, L.node_J, L.quat_row,
                    np.zeros(system.n), np.zeros(system.n), np.zeros((len(L.node_kind), 6, 6)),
                    np.zeros((len(L.node_kind), 6)), np.zeros(len(L.node_kind)), np.zeros(len(L.node_kind)),
@@ -276,7 +262,7 @@ def test_rigid_transport_carries_the_parent_rows(all_joints):
     rng = np.random.default_rng(5)
     checked = set()
     for trial in range(4):
-        q, qd = random_state(all_joints, rng, unit=trial % 2 == 0)
+        q, qd = random_state(all_joints, rng, norm=1.0 if trial % 2 == 0 else (0.7, 1.4))
         engine.motion(0.0, q, qd)
         for i in np.flatnonzero((L.node_transport != 0) & (L.node_parent >= 0)):
             r0, k = L.node_rows[i], L.node_k[i]

@@ -7,7 +7,6 @@ one-degree-of-freedom motion of the N-four-bar (benchmarks/iftomm_reference.py) 
 singular positions, and energy conservation.
 """
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,8 +16,7 @@ import mbsynth as mb
 from mbsynth.compiled import kernel, layout
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 LOOPS = ["bricard.yaml", "bennett.yaml", "sarrus.yaml", "four_bar_3d.yaml"]
 

@@ -8,9 +8,8 @@ from mbsynth.core.equations import (RANK_RTOL, constrained_acceleration, rank_re
                                udwadia_kalaba)
 from mbsynth.core.errors import SolveError
 
-
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
+from tests.helpers.compare import rel
+from tests.helpers.literal import augmented, literal_2_14
 
 
 def psd(rng, n, r):
@@ -22,14 +21,6 @@ def constraints_of_rank(rng, m, n, k):
     """m × n matrix of rank k (rows beyond the k-th are combinations of the first k)."""
     base = rng.standard_normal((k, n))
     return rng.standard_normal((m, k)) @ base if m > k else base[:m]
-
-
-def literal_2_14(M, Q, A, b, C):
-    """(2.14), η = 0, with numpy's pinv and nothing else."""
-    n = len(Q)
-    P = np.eye(n) - np.linalg.pinv(A) @ A
-    Mbar = np.vstack([P @ M, A])
-    return np.linalg.pinv(Mbar) @ np.concatenate([Q + C, b]), Mbar, P
 
 
 def consistent_force(rng, M, A, n):
@@ -82,7 +73,7 @@ def test_2_15_equals_4_24_for_positive_definite_M(seed, n):
     uk = udwadia_kalaba(M, Q, A, b, C)
     assert ref.unique and uk.unique
     assert rel(ref.qdd, uk.qdd) < 1e-10
-    assert rel(ref.qdd, literal_2_14(M, Q, A, b, C)[0]) < 1e-10
+    assert rel(ref.qdd, literal_2_14(M, Q, A, b, C)) < 1e-10
     # (4.24) written out independently with scipy's sqrtm and numpy's pinv
     from scipy.linalg import sqrtm
     Mih = np.linalg.inv(np.real(sqrtm(M)))
@@ -105,7 +96,7 @@ def test_solution_satisfies_2_12_and_2_10(seed):
     Q = F - C
     b = rng.standard_normal(m)
     mo = constrained_acceleration(M, Q, A, b, C)
-    expected, Mbar, P = literal_2_14(M, Q, A, b, C)
+    expected, (Mbar, P) = literal_2_14(M, Q, A, b, C), augmented(M, A)
     assert rel(mo.qdd, expected) < 1e-9
     assert rel(A @ mo.qdd, b) < 1e-10  # (2.4)
     force = np.linalg.norm(M) * np.linalg.norm(mo.qdd) + np.linalg.norm(Q) + np.linalg.norm(C)
@@ -395,7 +386,7 @@ def test_rank_tolerance_is_relative():
 
 def test_forces_that_cancel_are_judged_against_the_terms_not_their_sum():
     """Q + C = −2⁻⁵² Q on a massless coordinate is rounding of the forces involved (1e3), not
-    a load no mass resists: the consistency scale is ‖Q‖ + ‖C‖ + ‖M q̈‖ (issue 18); an
+    a load no mass resists: the consistency scale is ‖Q‖ + ‖C‖ + ‖M q̈‖; an
     imbalance of 1e-6 of them still is one."""
     Q = np.array([0.0, 1e3])
     motion = constrained_acceleration(np.diag([1.0, 0.0]), Q, np.zeros((0, 2)), np.zeros(0), C=-Q * (1 + 2**-52))

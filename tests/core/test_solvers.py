@@ -9,11 +9,8 @@ from mbsynth.core.equations import constrained_acceleration
 from mbsynth.core.errors import SolveError
 from mbsynth.core.solvers import kkt_acceleration
 
-from literal import literal_2_14
-
-
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
+from tests.helpers.compare import rel
+from tests.helpers.literal import literal_2_14
 
 
 def unique_problem(rng, n, singular):

@@ -1,4 +1,4 @@
-"""One verdict on uniqueness (issue 18): every path — the KKT solve, the tree kernel, the
+"""One verdict on uniqueness: every path — the KKT solve, the tree kernel, the
 Udwadia–Kalaba form — says "unique" exactly where the reference (2.14) does, and gives its
 q̈, on random singular, redundant and near-singular problems. The fast paths defer to the
 reference near their own thresholds, so the reference's rank rule decides every close case.
@@ -21,12 +21,10 @@ import mbsynth as mb
 from mbsynth.core.equations import RANK_RTOL, constrained_acceleration, equilibrate_rows, rank_report, udwadia_kalaba
 from mbsynth.core.solvers import SPARSE_SIZE, kkt_acceleration
 
+from tests.helpers.compare import rel
+
 ROOT = Path(__file__).resolve().parents[2]
 EPS = np.finfo(float).eps
-
-
-def rel(x, y):
-    return np.linalg.norm(np.asarray(x) - np.asarray(y)) / max(np.linalg.norm(y), 1e-300)
 
 
 def agreement(M, A, F, qdd):

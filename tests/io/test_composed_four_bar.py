@@ -16,8 +16,7 @@ import mbsynth as mb
 
 ROOT = Path(__file__).resolve().parents[2]
 MODEL = ROOT / "models" / "mechanisms" / "n_four_bar.yaml"
-sys.path.insert(0, str(ROOT / "benchmarks"))
-import iftomm_reference as ref  # noqa: E402
+from benchmarks import iftomm_reference as ref
 
 
 @functools.cache

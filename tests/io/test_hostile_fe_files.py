@@ -4,7 +4,7 @@ loads, or is refused with a ModelError ``rod.yaml:LINE: at subsystems.rod.<key>:
 that key, naming the data file where the fault is in one; never another exception.
 
 Property-based (hypothesis), derandomized and of a fixed number of cases: the same cases in
-every run, tens of seconds in all.
+every run.
 """
 
 import re
@@ -28,7 +28,7 @@ SOURCE_LINE, REDUCTION_LINE = 5, 6  # the lines of fe:/beam: and reduction: in `
 
 def fuzz(examples):
     """The same ``examples`` cases in every run, no time limit on one (a case that loads builds
-    the part: about a second)."""
+    the part)."""
     return settings(max_examples=examples, derandomize=True, deadline=None, database=None,
                     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 

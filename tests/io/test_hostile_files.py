@@ -27,7 +27,7 @@ from mbsynth import ModelError, SolveError, load, loads
 from mbsynth.analysis.diagnose import diagnose
 
 ROOT = Path(__file__).resolve().parents[2]
-# robot models take tens of seconds each to derive: too slow to load a few hundred times
+# robot models are large derivations: too slow to load a few hundred times
 MODELS = sorted(p for p in (ROOT / "models").glob("**/*.yaml") if "robots" not in p.parts)
 CORPUS = sorted((ROOT / "tests" / "corpus").glob("*.yaml"))
 NAME = "hostile.yaml"
@@ -441,7 +441,7 @@ def test_alias_bombs_are_refused_quickly(width, levels, place):
 
 
 TEXTS = [path.read_text() for path in MODELS]
-QUICK = [text for text in TEXTS if "rigid_body" not in text]  # rigid bodies take ~0.5 s each to derive
+QUICK = [text for text in TEXTS if "rigid_body" not in text]  # rigid bodies' derivations are the slow ones
 
 
 def mutate(text, data):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rotations import E, G
+from tests.helpers.rotations import E, G
 
 import mbsynth as mb
 from mbsynth.analysis.diagnose import diagnose

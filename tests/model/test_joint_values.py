@@ -1,4 +1,4 @@
-"""Joint values and reactions (issue 19) against Pinocchio, analytic solutions and
+"""Joint values and reactions against Pinocchio, analytic solutions and
 finite differences."""
 
 from pathlib import Path

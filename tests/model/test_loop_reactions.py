@@ -1,4 +1,4 @@
-"""Reactions of loop-closing joints (issue 19, item 3): mbsynth's ``System.reactions``
+"""Reactions of loop-closing joints: mbsynth's ``System.reactions``
 against Newton–Euler about a fixed point and against Pinocchio's ``lambda_c`` of
 ``constraintDynamics`` (``Twin.loop_wrench_maps``; validate.loop_reaction_error)."""
 

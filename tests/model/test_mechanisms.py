@@ -16,7 +16,7 @@ import mbsynth as mb
 from mbsynth.cli import main
 from mbsynth.analysis.diagnose import diagnose
 from mbsynth.core.equations import rank_report, term_scales
-from rotations import G, R, body_coordinates
+from tests.helpers.rotations import G, R, body_coordinates
 
 MECHANISMS = Path(__file__).resolve().parents[2] / "models" / "mechanisms"
 THETA = sp.Symbol("theta")

@@ -1,4 +1,4 @@
-"""Declared outputs (issue 19): expressions, joint values, frame positions and velocities,
+"""Declared outputs: expressions, joint values, frame positions and velocities,
 reactions and energies, against the pendulum's closed forms and System's own answers."""
 
 from pathlib import Path

@@ -12,7 +12,7 @@ import sympy as sp
 
 import mbsynth as mb
 from mbsynth.analysis.diagnose import diagnose
-from rotations import E, G, R, R_rate, body_coordinates, rotation_about
+from tests.helpers.rotations import E, G, R, R_rate, body_coordinates, rotation_about
 
 RIGID = Path(__file__).resolve().parents[2] / "models" / "rigid"
 load = functools.cache(mb.load)  # each model compiled once per session

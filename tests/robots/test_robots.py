@@ -1,7 +1,7 @@
 """Whole robots as parts, checked against Pinocchio's reduced-coordinate dynamics.
 
-Every robot is built once per module (building one costs about a second per link: the
-joints' rows are derived symbolically). The references are Pinocchio's own: its URDF
+Every robot is built once per module (building one derives every link's joint rows
+symbolically). The references are Pinocchio's own: its URDF
 parser and aba / crba / constraintDynamics; only the state maps are ours, and those are
 checked by a round trip and by finite differences.
 """

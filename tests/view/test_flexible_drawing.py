@@ -13,8 +13,7 @@ from scipy.spatial.transform import Rotation
 import mbsynth as mb
 from mbsynth.cli import main
 from mbsynth.view.scene import build_scene
-from test_structure import animation_clips, segment_ends
-from test_viewer import node, trajectory_of
+from tests.helpers.scenes import animation_clips, node, segment_ends, trajectory_of
 
 ELEMENTS = 10
 STRIP = f"""

@@ -8,20 +8,18 @@ mass-weighted centre of mass. The saved HTML is decoded (meshcat's msgpack comma
 check that its animation moves the world by minus that centre.
 """
 
-import base64
 import re
 from pathlib import Path
 
 import numpy as np
 import pytest
-import umsgpack
 from scipy.spatial.transform import Rotation
 
 import mbsynth as mb
 from mbsynth.cli import main
 from mbsynth.view import viewer
 from mbsynth.view.scene import build_scene
-from test_viewer import node, trajectory_of
+from tests.helpers.scenes import animation_clips, node, segment_ends, trajectory_of
 
 ROOT = Path(__file__).resolve().parents[2]
 DISK = ROOT / "models" / "rolling" / "rolling_disk.yaml"
@@ -103,10 +101,6 @@ def moved_rows(system, count, step):
 
 def centre_of_mass(pose):
     return sum(MASSES[b] * pose[b][0] for b in MASSES) / sum(MASSES.values())
-
-
-def segment_ends(T):
-    return (T @ [0, 0, 0, 1])[:3], (T @ [1, 0, 0, 1])[:3]
 
 
 def test_two_wheeler_is_drawn_as_wheels_rods_and_centres_of_mass():
@@ -288,17 +282,3 @@ def test_live_view_follows_too(tmp_path):
     with viewer.show(system, traj, block=False, follow=True) as view:
         model = animation_clips(view.html())["/meshcat/model"]
     np.testing.assert_allclose(model["position"][1], -centres, atol=1e-9)
-
-
-def animation_clips(html):
-    """{path: {track: (times, values)}} of the set_animation command in meshcat's page."""
-    commands = [umsgpack.unpackb(base64.b64decode(blob))
-                for blob in re.findall(r'data:application/octet-binary;base64,([A-Za-z0-9+/=]+)', html)]
-    (animation,) = [c for c in commands if c["type"] == "set_animation"]
-    clips = {}
-    for entry in animation["animations"]:
-        path = entry["path"] if isinstance(entry["path"], str) else "/" + "/".join(entry["path"])
-        clips[path] = {track["name"].lstrip("."): (np.array([k["time"] for k in track["keys"]]),
-                                                   np.array([k["value"] for k in track["keys"]]))
-                       for track in entry["clip"]["tracks"]}
-    return clips

@@ -1,7 +1,7 @@
 """The viewer on a model made of model files: each top-level substructure drawn under a
 meshcat path of its own, its parts in one colour of the palette, each copy in the next.
 
-The N-four-bar (tests/n_four_bar_files.py) declares no geometry, so it is drawn as its
+The N-four-bar (tests/helpers/n_four_bar_files.py) declares no geometry, so it is drawn as its
 structure: rods from each body's centre of mass to its frames, in the part's colour."""
 
 import base64
@@ -13,8 +13,8 @@ import mbsynth as mb
 from mbsynth.io.parts import COLORS
 from mbsynth.view import viewer
 from mbsynth.view.scene import PALETTE, build_scene
-from n_four_bar_files import write_n_four_bar
-from test_viewer import trajectory_of
+from tests.helpers.n_four_bar_files import write_n_four_bar
+from tests.helpers.scenes import trajectory_of
 
 N = 3
 

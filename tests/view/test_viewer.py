@@ -25,7 +25,8 @@ from mbsynth.view import screenshot as screenshot_module
 from mbsynth.view.screenshot import chromium, screenshot
 from mbsynth.analysis.trajectory import Trajectory
 from mbsynth.view.scene import build_scene, drawn_rows
-from processes import HANG, ended_within, needs_proc, proc_stat, running
+from tests.helpers.processes import HANG, ended_within, needs_proc, proc_stat, running
+from tests.helpers.scenes import node, trajectory_of
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE3 = ROOT / "models" / "paper" / "example3_two_masses.yaml"
@@ -49,18 +50,6 @@ subsystems:
     frames:
       corner: {position: [a, 0, 0]}
 """
-
-
-def trajectory_of(system, q):
-    """A Trajectory with the given rows of coordinates (times 0, 1, ...)."""
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    n = len(q)
-    return Trajectory(system.coordinates, np.arange(n, dtype=float), q, np.zeros_like(q), *np.zeros((4, n)))
-
-
-def node(scene, path):
-    (found,) = [n for n in scene.nodes if n.path == path]
-    return found
 
 
 def rotation_z(angle):

@@ -162,8 +162,8 @@ def _rotation_at(part, frame, values):
     """The world rotation of ``frame`` (on ``part``, None: the world) at ``values`` as floats,
     or None where that is no real number. The shared part kinds are computed from their
     coordinates' values — R(u) R_frame in R(u)'s homogeneous form (kinematics.quaternion_rotation),
-    R_z(θ) R_frame, R_frame — since substituting into the pose's sympy matrices took 1.6 s
-    per check on talos; other parts by substitution."""
+    R_z(θ) R_frame, R_frame — not by substitution into the pose's sympy matrices, which grows
+    with the model (a robot of many links); other parts by substitution."""
     if part is not None and not isinstance(part, SHARED_PARTS):
         return _numeric(pose(part, frame)[1], values)
     own = frame.constant_rotation
@@ -186,7 +186,7 @@ def _turned(joint, relative):
         return None
     if np.trace(relative) * np.sqrt(3) > 1.5 * np.linalg.norm(relative):  # well below 90°: for a turn R scaled
         return None  # by s (unnormalized quaternions), tr = s (1 + 2 cos θ) and |sR| = s √3, so cos θ > 0.25
-    from scipy.spatial.transform import Rotation  # scipy.spatial: a tenth of a second, only here
+    from scipy.spatial.transform import Rotation  # scipy.spatial is imported only where used
 
     turn = Rotation.from_matrix(relative).as_rotvec()
     angle = np.degrees(np.linalg.norm(turn))

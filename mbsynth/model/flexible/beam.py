@@ -19,6 +19,7 @@ import scipy.sparse
 
 from ...core.errors import ModelError
 from .matrices import fe_model
+from ...core.tolerances import BEAM_UP_PARALLEL_RTOL
 
 GAUSS = np.polynomial.legendre.leggauss(5)  # exact to degree 9; the products here are of degree ≤ 6
 THEORIES = ("euler_bernoulli", "timoshenko")
@@ -126,7 +127,7 @@ def _section_axes(axis, up, where):
     x = x / np.linalg.norm(x)
     z = np.asarray(up, float)
     z = z - (z @ x) * x if z.shape == (3,) else z
-    if z.shape != (3,) or not np.linalg.norm(z) > 1e-9 * max(np.linalg.norm(up), 1.0):
+    if z.shape != (3,) or not np.linalg.norm(z) > BEAM_UP_PARALLEL_RTOL * max(np.linalg.norm(up), 1.0):
         raise ModelError(f"{where}: up must be a 3-vector not parallel to the axis, not {up!r}")
     z = z / np.linalg.norm(z)
     return np.array([x, np.cross(z, x), z])

@@ -18,10 +18,8 @@ import scipy.sparse
 import scipy.sparse.linalg
 
 from ...core.errors import ModelError
+from ...core.tolerances import FE_SEMIDEFINITE_RTOL, FE_SYMMETRY_RTOL, FE_TRANSLATION_MASS_RTOL
 
-FE_SYMMETRY_RTOL = 1e-8  # largest |A − Aᵀ| accepted, relative to max |A| (exports round to ~8 digits)
-FE_TRANSLATION_MASS_RTOL = 1e-6  # the rigid translations' 3 × 3 mass must be m·I to this, relative to m
-FE_SEMIDEFINITE_RTOL = 1e-8  # A + FE_SEMIDEFINITE_RTOL · max|A| · I must be positive definite
 DOFS_PER_NODE = (3, 6)  # ux uy uz (solids), and θx θy θz (beams, shells)
 DENSE_CHECK_MAX = 3000  # up to this many DOFs the lowest eigenvalue an error reports is found by a dense solver
 

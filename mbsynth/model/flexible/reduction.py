@@ -20,13 +20,13 @@ are never returned. The Ritz vectors are refined by the projected problem: the m
 M-orthonormal to rounding.
 
 Repeated frequencies (a round section's two bending planes, a symmetric model's): modes
-whose ω² agree to CLUSTER_RTOL span one eigenspace, whose basis a solver leaves to rounding.
+whose ω² agree to FE_CLUSTER_RTOL span one eigenspace, whose basis a solver leaves to rounding.
 Each such cluster gets a fixed basis (``_fixed_basis``: the shape of largest component at the
 first DOF that has it, then the same in what is left), so every process gives the same modes.
 A count that would split a cluster is refused (a part's coordinates would depend on which of
 equal modes came first); ``max_frequency`` takes a cluster whole or leaves it out.
 
-Scale: ω² of the modes a double-precision K resolves lie above ZERO_RTOL · tr K / tr M (rigid-body
+Scale: ω² of the modes a double-precision K resolves lie above FE_ZERO_RTOL · tr K / tr M (rigid-body
 modes come out at rounding, a few ε of the largest ω²); the shift sits just above that level,
 below every such mode whatever the model's size, so the modes sought are the operator's best
 separated ones. A Craig–Bampton interface that leaves a motion free (a rigid-body one, from the
@@ -43,20 +43,13 @@ import scipy.sparse.linalg
 from ...core.errors import ModelError
 from .invariants import rigid_body_modes
 from .matrices import FEModel
+from ...core.tolerances import (FE_CLUSTER_RTOL, FE_DENSE_SHIFT_RTOL, FE_FINITE_RTOL, FE_RIGID_RANK_RTOL,
+                                FE_SHIFT_RTOL, FE_TIE_RTOL, FE_ZERO_RTOL)
 
-ZERO_RTOL = 1e-15  # ω² below ZERO_RTOL · tr K / tr M is rounding of K's null space (a few ε of the largest ω²)
-SHIFT_RTOL = 1e-14  # the default shift −SHIFT_RTOL · tr K / tr M: 10× the zero level (rigid-body modes factor)
-DENSE_SHIFT_RTOL = 1e-8  # the dense solver's shift: finite modes up to 1e4 · tr K / tr M stay apart from a singular
-# M's infinite ones (FINITE_RTOL); a dense solve needs no convergence, and the Ritz quotients refine the lowest
-CLUSTER_RTOL = 1e-4  # modes whose ω² differ by less than this fraction span one eigenspace (a 2,000-element
-# beam's equal frequencies come out 1e-5 apart)
-TIE_RTOL = 1e-4  # components within this fraction of the largest tie: the first DOF of them fixes a cluster's basis
 RIGID_MODES_MAX = 6  # a free body has at most six rigid-body modes; more zero modes: a mechanism
 FIRST_BATCH = 12  # modes asked for first when they are chosen by frequency (doubled until past it)
 LOOK_PAST = 4  # modes asked for beyond a count, to see whether the last one's frequency repeats
 DENSE_MODES_MAX = 120  # up to this many DOFs the modes come from a dense solver, every finite one at once
-RIGID_RANK_RTOL = 1e-9  # singular values of the rigid-body modes at the interface below this fraction: a motion it leaves
-FINITE_RTOL = 1e-12  # a dense mode with 1/(λ + shift) below FINITE_RTOL / shift is an infinite one (M φ = 0)
 EIGSH_RESTARTS = 300  # eigsh's restarts at most (tens suffice about this shift): a spectrum lost in rounding ends
 START_SEED = 0  # eigsh's start vector (and any restart it draws) from this seed: the same modes in every process
 
@@ -155,7 +148,7 @@ def normal_modes(M, K, *, count=None, max_frequency=None, shift=None, rigid=True
     (ω² at the rounding level, at most RIGID_MODES_MAX) left out, ``count`` counting the
     others. Equal frequencies come with a fixed basis; a count that splits them is refused
     (the module's docstring). ``shift`` (ω², > 0): the shift-invert point is −shift (default
-    SHIFT_RTOL · tr K / tr M). Up to DENSE_MODES_MAX DOFs a dense solver, above it eigsh."""
+    FE_SHIFT_RTOL · tr K / tr M). Up to DENSE_MODES_MAX DOFs a dense solver, above it eigsh."""
     if (count is None) == (max_frequency is None):
         raise ModelError(f"{source}: choose the modes by count or by max_frequency (one of them)")
     M, K = scipy.sparse.csc_array(M), scipy.sparse.csc_array(K)
@@ -168,7 +161,7 @@ def normal_modes(M, K, *, count=None, max_frequency=None, shift=None, rigid=True
         raise ModelError(f"{source}: max_frequency must be ≥ 0 Hz, not {max_frequency!r}")
     if count == 0 or n == 0:
         return np.zeros(0), np.zeros((n, 0))
-    zero = ZERO_RTOL * _scale(M, K)
+    zero = FE_ZERO_RTOL * _scale(M, K)
     limit = None if max_frequency is None else (2 * np.pi * max_frequency) ** 2
 
     def first_kept(lam):
@@ -220,8 +213,8 @@ def _solve(M, K, shift, batch, enough, zero, source):
     eigsh's, ``batch`` of them doubled until ``enough(λ, clusters)`` or n − 2 of them."""
     n = M.shape[0]
     if n <= DENSE_MODES_MAX:
-        return _dense_modes(M, K, -(shift if shift is not None else DENSE_SHIFT_RTOL * _scale(M, K)), source)
-    sigma = -(shift if shift is not None else SHIFT_RTOL * _scale(M, K))
+        return _dense_modes(M, K, -(shift if shift is not None else FE_DENSE_SHIFT_RTOL * _scale(M, K)), source)
+    sigma = -(shift if shift is not None else FE_SHIFT_RTOL * _scale(M, K))
     try:
         inverse = scipy.sparse.linalg.splu(K - sigma * M, **_SYMMETRIC)
     except RuntimeError as err:
@@ -249,7 +242,7 @@ def _dense_modes(M, K, sigma, source):
         raise ModelError(_NEITHER.format(source)) from err
     half = scipy.linalg.solve_triangular(L, M.toarray(), lower=True)
     mu, Y = scipy.linalg.eigh(scipy.linalg.solve_triangular(L, half.T, lower=True))
-    finite = mu * -sigma > FINITE_RTOL
+    finite = mu * -sigma > FE_FINITE_RTOL
     vectors = scipy.linalg.solve_triangular(L.T, Y[:, finite][:, ::-1], lower=False)
     return _ritz(M, K, vectors, source)
 
@@ -293,10 +286,10 @@ def _ritz(M, K, vectors, source):
 
 def _clusters(lam, zero):
     """[(start, end)] of the runs of ascending λ that are one eigenspace: neighbours within
-    CLUSTER_RTOL of the larger, or both at the zero level."""
+    FE_CLUSTER_RTOL of the larger, or both at the zero level."""
     bounds = [0]
     for j in range(1, len(lam)):
-        if lam[j] - lam[j - 1] > CLUSTER_RTOL * abs(lam[j]) and lam[j] > zero:
+        if lam[j] - lam[j - 1] > FE_CLUSTER_RTOL * abs(lam[j]) and lam[j] > zero:
             bounds.append(j)
     return list(zip(bounds, bounds[1:] + [len(lam)]))
 
@@ -304,7 +297,7 @@ def _clusters(lam, zero):
 def _fixed_basis(M, K, lam, vectors, clusters):
     """Each cluster's M-orthonormal basis made independent of the one the solver gave: its
     first vector is the cluster's shape of largest component at the DOF of most kinetic
-    energy (√M_jj |φ_j| largest; the first DOF within TIE_RTOL of it), that component
+    energy (√M_jj |φ_j| largest; the first DOF within FE_TIE_RTOL of it), that component
     positive, then the same in the part of the cluster M-orthogonal to it, and so on: a
     round beam's pair bends in the section's y, then z plane. λ: the vectors' Rayleigh
     quotients."""
@@ -315,7 +308,7 @@ def _fixed_basis(M, K, lam, vectors, clusters):
         fixed = []
         while W.shape[1]:
             reach = weight * np.linalg.norm(W, axis=1)  # the largest weighted component a unit shape of span(W) has
-            dof = int(np.argmax(reach >= (1 - TIE_RTOL) * reach.max()))
+            dof = int(np.argmax(reach >= (1 - FE_TIE_RTOL) * reach.max()))
             a = W[dof] / np.linalg.norm(W[dof])
             fixed.append(W @ a)
             W = W @ scipy.linalg.null_space(a[None, :])
@@ -330,10 +323,10 @@ def _stops_rigid_motion(fe, b, singular):
     does not resist: a combination of the rigid-body modes (the nodes' geometry) zero at
     every interface DOF, with ω² at the rounding level."""
     G = rigid_body_modes(fe)
-    free = scipy.linalg.null_space(G[b], rcond=RIGID_RANK_RTOL)
+    free = scipy.linalg.null_space(G[b], rcond=FE_RIGID_RANK_RTOL)
     for a in free.T:
         u = G @ a
-        if u @ (fe.stiffness @ u) <= ZERO_RTOL * _scale(fe.mass, fe.stiffness) * (u @ (fe.mass @ u)):
+        if u @ (fe.stiffness @ u) <= FE_ZERO_RTOL * _scale(fe.mass, fe.stiffness) * (u @ (fe.mass @ u)):
             raise ModelError(singular + "the interface does not stop every rigid-body motion (add interface nodes: "
                              "three not on one line for nodes without rotations)")
 
@@ -350,10 +343,10 @@ def _rayleigh_bound(fe, i, Mii, interior):
 
 def _resolved(Mii, Kii, lowest, singular):
     """Refuse a Craig–Bampton interior whose lowest ω² (or an upper bound of it) is at the rounding level."""
-    if lowest <= ZERO_RTOL * _scale(Mii, Kii):
+    if lowest <= FE_ZERO_RTOL * _scale(Mii, Kii):
         raise ModelError(singular + f"its lowest mode, ω² ≤ {lowest:.3g} (rad/s)², is at the rounding level of K "
-                         f"({ZERO_RTOL:g} · tr K / tr M = {ZERO_RTOL * _scale(Mii, Kii):.3g}): a motion the interface "
-                         f"does not stop (a mechanism, a piece it does not reach), or {_TOO_FINE}")
+                         f"({FE_ZERO_RTOL:g} · tr K / tr M = {FE_ZERO_RTOL * _scale(Mii, Kii):.3g}): a motion the "
+                         f"interface does not stop (a mechanism, a piece it does not reach), or {_TOO_FINE}")
 
 
 def _scale(M, K):

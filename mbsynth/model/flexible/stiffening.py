@@ -1,4 +1,4 @@
-"""Centrifugal stiffening of a reduced FE model on a spinning floating frame (issue 46).
+"""Centrifugal stiffening of a reduced FE model on a spinning floating frame.
 
 The linear displacement field u = Φη misses the second-order shortening u₂(η) of a bent
 member (a beam's ends draw together by ½∫w'²). Where the part spins, the centrifugal

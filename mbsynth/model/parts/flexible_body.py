@@ -1,4 +1,4 @@
-"""A flexible body in the floating frame of reference (issue 46): coordinates x, y, z (the
+"""A flexible body in the floating frame of reference: coordinates x, y, z (the
 frame's origin in the world), the unit quaternion qw, qx, qy, qz of its axes (as a rigid
 body, with the same unit-norm row) and the amplitudes eta1 … etar of a reduced FE model
 (model/flexible/reduction.py), u = Φ η the nodal DOFs in the frame's axes.
@@ -34,8 +34,8 @@ from ...symbolic.derive import positions
 from ..flexible.invariants import invariants
 from .base import Frame, Part
 from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
+from ...core.tolerances import GRAM_ZERO_RTOL
 
-GRAM_ZERO_RTOL = 1e-14  # invariant entries below this fraction of the largest are rounding: written as zero
 
 
 class FlexibleBody(Part):

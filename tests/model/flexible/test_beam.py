@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_modes, plane_share, strip
+from tests.helpers.flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_modes, plane_share, strip
 from mbsynth.core.errors import ModelError
 from mbsynth.model.flexible.beam import _bending, beam, geometric_stiffness
 from mbsynth.model.flexible.reduction import normal_modes

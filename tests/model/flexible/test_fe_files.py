@@ -9,7 +9,7 @@ import pytest
 import scipy.io
 import scipy.sparse
 
-from flexible_beams import strip
+from tests.helpers.flexible_beams import strip
 from mbsynth.core.errors import ModelError
 from mbsynth.model.flexible.files import read_fe, write_fe
 from mbsynth.model.flexible.matrices import fe_model

@@ -8,7 +8,7 @@ import pytest
 import sympy as sp
 
 import mbsynth as mb
-from flexible_beams import strip
+from tests.helpers.flexible_beams import strip
 from mbsynth.model.flexible.reduction import craig_bampton
 from mbsynth.model.parts.flexible_body import FlexibleBody, coordinates, modal_damping, rayleigh_damping
 
@@ -91,7 +91,7 @@ def flexible_body(reduction, name="beam", **kwargs):
     return FlexibleBody(name, q, qd, reduction, sp.Matrix(GRAVITY), [], **kwargs)
 
 
-def random_state(r, rng):
+def random_body_state(r, rng):
     """A unit quaternion with a tangent rate (uᵀu̇ = 0), small η."""
     u = rng.normal(size=4)
     u /= np.linalg.norm(u)
@@ -127,7 +127,7 @@ def test_the_parts_M_and_Q_are_lagranges_of_the_unreduced_model(beam):
     rng = np.random.default_rng(46)
     n = 7 + reduction.size
     for _ in range(3):
-        q, qd, qdd = random_state(reduction.size, rng)
+        q, qd, qdd = random_body_state(reduction.size, rng)
         M, Q = part.evaluate(0.0, q, qd, np.zeros(0))
         expected = np.array([[full.T(q, a + b) - full.T(q, a) - full.T(q, b) for b in np.eye(n)] for a in np.eye(n)]).real
         np.testing.assert_allclose(M, expected, rtol=1e-10, atol=1e-10 * np.abs(expected).max())
@@ -144,7 +144,7 @@ def test_the_potential_is_the_unreduced_models(beam):
     rng = np.random.default_rng(3)
     gaps = []
     for _ in range(3):
-        q, qd, _ = random_state(reduction.size, rng)
+        q, qd, _ = random_body_state(reduction.size, rng)
         V = part.energy(0.0, q, qd, np.zeros(0))[1]
         gaps.append(V - full.V(q).real)
     np.testing.assert_allclose(gaps, gaps[0], atol=1e-9 * abs(V))
@@ -155,7 +155,7 @@ def test_node_frames_follow_the_deformed_nodes(beam):
     rotation orthogonal and A(I + [θ]×) to first order in θ (θ the node's rotation DOFs)."""
     reduction, part, full = beam
     rng = np.random.default_rng(8)
-    q, _, _ = random_state(reduction.size, rng)
+    q, _, _ = random_body_state(reduction.size, rng)
     position, rotation = part.pose(part.frames["node_8"])
     values = dict(zip(part.q, q))
     p = np.array(position.xreplace(values), dtype=float).ravel()
@@ -176,7 +176,7 @@ def test_a_node_frames_angular_velocity_is_its_rotations_rate(beam):
     elastic turn rate."""
     reduction, part, _ = beam
     rng = np.random.default_rng(12)
-    q, qd, _ = random_state(reduction.size, rng)
+    q, qd, _ = random_body_state(reduction.size, rng)
     frame = part.frames["node_8"]
     R = sp.lambdify([part.q], part.pose(frame)[1])
     values = {**dict(zip(part.q, q)), **dict(zip(part.qd, qd))}

@@ -5,7 +5,7 @@ body spinning in free flight keeping its energy."""
 import numpy as np
 
 import mbsynth as mb
-from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli
+from tests.helpers.flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli
 
 STRIP_FILE = ", ".join(f"{k}: {v}" for k, v in STRIP.items())
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.integrate
 
-from flexible_beams import LENGTH, STRIP, strip, truss
+from tests.helpers.flexible_beams import LENGTH, STRIP, strip, truss
 from mbsynth.model.flexible.invariants import invariants
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface
 
@@ -86,7 +86,8 @@ def model():
     return Unreduced(reduction), invariants(reduction)
 
 
-def random_state(r, rng):
+def random_euler_state(r, rng):
+    """(q, q̇, q̈) of the unreduced model: a position, Euler angles in (−1, 1), small η (r modes)."""
     q = np.concatenate([rng.normal(size=3), rng.uniform(-1, 1, 3), 1e-2 * rng.normal(size=r)])
     return q, rng.normal(size=6 + r), rng.normal(size=6 + r)
 
@@ -97,7 +98,7 @@ def test_the_mass_matrix_is_the_unreduced_kinetic_energys(model):
     full, inv = model
     rng = np.random.default_rng(3)
     for _ in range(3):
-        q, qd, _ = random_state(inv.modes, rng)
+        q, qd, _ = random_euler_state(inv.modes, rng)
         nu = full.nu(q, qd)
         np.testing.assert_allclose(inv.kinetic_energy(q[6:], nu), full.T(q, qd), rtol=1e-12)
         B = np.column_stack([full.nu(q, e) for e in np.eye(len(q))])  # ν = B q̇
@@ -130,7 +131,7 @@ def test_the_motion_is_lagranges_of_the_unreduced_model(model):
     g = np.array([0.3, -9.81, 1.2])
     step = 1e-4
     for _ in range(3):
-        q, qd, qdd = random_state(inv.modes, rng)
+        q, qd, qdd = random_euler_state(inv.modes, rng)
         path = lambda t: (q + qd * t + qdd * t * t / 2, qd + qdd * t)  # noqa: E731
         n = len(q)
         momentum = lambda t: np.array([derivative(lambda v: full.T(path(t)[0], v), path(t)[1], i, 1.0)  # noqa: E731

@@ -14,7 +14,7 @@ import pytest
 import scipy.linalg
 import scipy.sparse
 
-from flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
+from tests.helpers.flexible_beams import CLAMPED_FREE, FREE_FREE, LENGTH, STRIP, euler_bernoulli, plane_share, strip, truss
 from mbsynth.core.errors import ModelError
 from mbsynth.model.flexible.matrices import fe_model
 from mbsynth.model.flexible.reduction import craig_bampton, free_interface, normal_modes
@@ -202,7 +202,7 @@ def test_free_interface_gives_every_mode_asked_for_or_refuses():
 def test_a_2000_element_beam_reduces_in_seconds_to_the_closed_form():
     """Craig–Bampton of a clamped round strip of 2,000 elements (12,006 DOFs; its ω² span 10¹⁴):
     the first three bending pairs at the Euler–Bernoulli frequencies to 1e-5 (rounding of the
-    stiff matrix: ~1e-5), in seconds."""
+    stiff matrix: ~1e-5), within the test's time limit."""
     fe = strip(2000, **ROUND)
     reduced = craig_bampton(fe, [0], count=6)
     np.testing.assert_allclose(reduced.frequencies, np.repeat(euler_bernoulli(CLAMPED_FREE, STRIP["Iz"]), 2),
@@ -224,14 +224,15 @@ def test_an_unconnected_piece_is_refused():
 def test_a_round_beams_reductions_are_the_same_in_two_processes():
     """A pinned round strip's free-interface modes (pairs kept whole) and its Craig–Bampton
     reduction, on eigsh's side: byte for byte the same bases and frequencies in two processes."""
-    script = ("import hashlib, sys; sys.path.insert(0, sys.argv[1]); from flexible_beams import strip, STRIP; "
+    script = ("import hashlib; from tests.helpers.flexible_beams import strip, STRIP; "
               "from mbsynth.model.flexible.reduction import craig_bampton, free_interface; "
               "fe = strip(60, Iy=STRIP['Iz']); "
               "rs = [free_interface(fe, [0], count=4, rigid=False), craig_bampton(fe, [0, 60], count=6)]; "
               "print([(len(r.frequencies), hashlib.sha256(r.basis.tobytes() + r.frequencies.tobytes()).hexdigest()) "
               "for r in rs])")
-    here = str(Path(__file__).parent)
-    runs = [subprocess.Popen([sys.executable, "-c", script, here], stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    root = Path(__file__).resolve().parents[3]  # the repository: tests.helpers and this mbsynth
+    runs = [subprocess.Popen([sys.executable, "-c", script], cwd=root, stdout=subprocess.PIPE, text=True)
+            for _ in range(2)]
     outs = [run.communicate(timeout=120)[0] for run in runs]
     assert all(run.returncode == 0 for run in runs)
     assert outs[0] == outs[1] and "(4, " in outs[0] and "(6, " in outs[0]

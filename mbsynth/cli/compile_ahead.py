@@ -1,8 +1,10 @@
-"""``python -m mbsynth.compiled``: compile the fast path's kernels into the cache ahead of use.
+"""``python -m mbsynth.cli.compile_ahead`` (run by ``make install``): compile the fast path's
+kernels (mbsynth.compiled) into the cache ahead of use, on warm-up models read as model files
+(hence here, on the floor that may read them).
 
 On two cores: first the kernel's largest parts for both variants of ``kernel.motion`` in
 helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
-correction) in a helper (``python -m mbsynth.compiled rigid``) while this process compiles the
+correction) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
 general ones; then each warm-up model here, loading what is missing from the cache (all of
 it, unless a helper failed). Each stage says on stderr what it compiles and how far it is
 (``[k/N]``); when the cache holds the kernels already, it says so and only loads them.
@@ -14,14 +16,14 @@ import time
 
 import numpy as np
 
-from . import cache, row_fit
+from ..compiled import cache, row_fit
 
 COLD_TIME = "about 2-3 minutes on 2 cores"  # measured: `make install` on a 2-core machine
 
 
 def warm(texts):
     """Build each model's Engine and run every kernel entry point on it."""
-    from . import background
+    from ..compiled import background
     from ..io import loads
     for text in texts:
         system = loads(text, "warm-up")
@@ -40,7 +42,7 @@ def main():
     if sys.argv[1:] == ["rigid"]:  # the helper compiling the rigid tree's entry points
         warm([WARM_RIGID])
         return
-    from . import ahead, background, kernel
+    from ..compiled import ahead, background, kernel
     cold = not background.compiled()
     where = os.environ.get("NUMBA_CACHE_DIR") or cache.cache_dir()
     if cold:

@@ -1,4 +1,4 @@
-"""Shared by the flexible-body tests (imported by name): a steel strip, the analytic
+"""Shared by the flexible-body tests: a steel strip, the analytic
 Euler–Bernoulli frequencies, the FE modes of one bending plane, and a point-mass truss
 (3 DOFs per node)."""
 
