@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 import mbsynth as mb
-from mbsynth.io.schema import SECTIONS
+from mbsynth.io.part_types import SECTIONS
 
 URDF = """<robot name="arm">
   <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>

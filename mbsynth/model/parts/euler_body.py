@@ -20,6 +20,7 @@ from ...core.kinematics import euler_rate_matrix, euler_rotation
 from ...core.tolerances import NEAR_SINGULAR
 from ...symbolic.cache import placeholder, remembered
 from .base import Part
+from .part_type import ANGLES, BODY, EXTRA_NODE, PartType, check
 
 SEQUENCES = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx",  # Tait–Bryan: three different axes
              "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")  # proper Euler: the first axis again last
@@ -31,7 +32,9 @@ class EulerBody(Part):
     premultiplied by Hᵀ, as virtual turns are H δα. M is regular away from the angles'
     singular position; the body adds no constraint of its own."""
 
-    kind = "euler_body"
+    part_type = check(PartType("euler_body", node=EXTRA_NODE, orientation=ANGLES, quaternion=None,
+                               points=(("x", "y", "z"),), elastic=False, body_rates=False, origin=True,
+                               shared_pose=False, drawing=BODY))
     groups = (("x", "y", "z"),)
 
     def __init__(self, name, sequence, q, qd, mass, inertia, gravity, params, frames=(), geometry=(),

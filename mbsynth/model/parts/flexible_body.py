@@ -33,6 +33,7 @@ from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import positions
 from ..flexible.invariants import invariants
 from .base import Frame, Part
+from .part_type import EXTRA_NODE, FE_MESH, PartType, QUATERNION, check
 from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
 
 GRAM_ZERO_RTOL = 1e-14  # invariant entries below this fraction of the largest are rounding: written as zero
@@ -48,7 +49,9 @@ class FlexibleBody(Part):
     ``centrifugal_stiffening``, default none. ``frame_nodes``: {frame name: FE node};
     ``elastic``: the slice of the part's coordinates that are η."""
 
-    kind = "flexible_body"
+    part_type = check(PartType("flexible_body", node=EXTRA_NODE, orientation=QUATERNION, quaternion=slice(3, 7),
+                               points=(("x", "y", "z"),), elastic=True, body_rates=False, origin=True,
+                               shared_pose=False, drawing=FE_MESH))
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}
 

@@ -11,6 +11,7 @@ from ...symbolic.cache import placeholder, remembered
 from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import differentiate, positions
 from .base import Part
+from .part_type import BODY, PartType, QUATERNION, RIGID_NODE, check
 
 COORDINATES = ("x", "y", "z", "qw", "qx", "qy", "qz")
 
@@ -24,7 +25,9 @@ class RigidBody(Part):
     (3 × 3, about the centre of mass, body axes) are sympy expressions of parameters.
     """
 
-    kind = "rigid_body"
+    part_type = check(PartType("rigid_body", node=RIGID_NODE, orientation=QUATERNION, quaternion=slice(3, 7),
+                               points=(("x", "y", "z"),), elastic=False, body_rates=True, origin=True,
+                               shared_pose=True, drawing=BODY))
     COORDINATES = COORDINATES
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}  # the identity orientation
