@@ -17,6 +17,7 @@ from .flexible import read_flexible_body
 from .parts import read_lagrangian, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import read_robot
 from .schema import SECTIONS as _OWN_SECTIONS
+from .solid import SOLID, read_solid
 
 
 class FileType(NamedTuple):
@@ -41,6 +42,7 @@ FILE_TYPES = {t.name: t for t in (
     file_type(_OWN_SECTIONS["spring"], read_spring, Spring),
     file_type(_OWN_SECTIONS["robot"], read_robot, RigidBody),
     file_type(_OWN_SECTIONS["flexible_body"], read_flexible_body, FlexibleBody),
+    file_type(SOLID, read_solid, RigidBody),
 )}
 SECTIONS = {**_OWN_SECTIONS, **{t.section.name: t.section for t in FILE_TYPES.values()}}
 

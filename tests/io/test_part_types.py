@@ -51,6 +51,14 @@ EXAMPLES = {
         subsystems:
           arm: {type: robot, robot: double_pendulum, initial: {}}
         """],
+    "solid": ["""
+        gravity: [0, 0, -9.81]
+        subsystems:
+          s: {type: solid, shape: {capsule: [0.05, 0.4]}, density: 1000, frames: {top: {position: [0, 0, 0.25]}},
+              initial: {position: [0, 0, -0.25]}}
+        joints:
+          - {name: pin, type: spherical, parent: world, child: s.top}
+        """],
     "flexible_body": ["""
         gravity: [0, 0, -9.81]
         subsystems:
