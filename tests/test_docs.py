@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from mbsynth.cli.parsers import parser
-from mbsynth.io.schema import SECTIONS
+from mbsynth.io.part_types import SECTIONS
 
 DOCS = Path(__file__).parent.parent / "docs"
 EXTENSION = DOCS / "_ext" / "mbsynth_reference.py"

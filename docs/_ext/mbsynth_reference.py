@@ -1,6 +1,6 @@
 """Sphinx extension: the model-file and CLI reference pages, generated at build time.
 
-``model_files_page()`` writes the loader's schema (mbsynth.io.schema.SECTIONS) as MyST
+``model_files_page()`` writes the loader's schema (mbsynth.io.part_types.SECTIONS) as MyST
 markdown, ``cli_page()`` the ``mbsynth`` argparse parsers (mbsynth.cli.parsers.parser);
 ``setup`` writes both into the source folder (``model-files.md``, ``cli.md``, not kept in
 git) when the build starts, so neither page can drift from the code.
@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 
 from mbsynth.cli.parsers import EXIT_CODES, VERDICTS, parser
-from mbsynth.io.schema import SECTIONS
+from mbsynth.io.part_types import SECTIONS
 
 _CODE = re.compile(r"(``.*?``|`[^`]*`)")
 

@@ -16,6 +16,7 @@ import numpy as np
 from ..model.angle_singularity import AngleParts
 from ..model.balances import balances
 from ..model.data import workspace
+from ..model.parts.part_type import PLANE, POINT, QUATERNION
 from ..core.equations import rank_report
 from ..core.errors import SolveError
 from ..core.kinematics import body_rate_matrix, quaternion_matrix, rotation_z
@@ -142,11 +143,11 @@ def effort(system, direction, force, q):
     times its largest entry is 0."""
     owners = {name.split(".")[0] for name in direction}
     part = next((p for p in system.parts if {p.name} == owners), None)
-    if part is None or part.kind not in ("rigid_body", "planar_body", "particle"):
+    if part is None or not _one_piece(part.part_type):
         return None
     index = [system.coordinates.index(f"{part.name}.{c}") for c in part.coordinates]
     w = np.array([direction.get(f"{part.name}.{c}", 0.0) for c in part.coordinates])
-    shift, turn, rotation = _motion_of(part.kind, w, q[index])
+    shift, turn, rotation = _motion_of(part.part_type, w, q[index])
     if np.any(shift) == np.any(turn):  # both (turning about another point) or neither
         return None
     moving = np.any(shift)
@@ -156,17 +157,25 @@ def effort(system, direction, force, q):
     return {"name": f"{name} {words}", "value": 0.0 if abs(value) <= BALANCE_ZERO_RTOL * np.abs(force).max() else value}
 
 
-def _motion_of(kind, w, x):
+def _one_piece(part_type):
+    """Whether a step of a part's coordinates reads as one shift and one turn (``_motion_of``):
+    a point, or a rigid body turned by a quaternion or in the plane."""
+    if part_type.orientation == POINT:
+        return len(part_type.points) == 1
+    return part_type.rigid and part_type.orientation in (QUATERNION, PLANE)
+
+
+def _motion_of(part_type, w, x):
     """(displacement, turn, both in world axes, and the part's rotation or None) of the
-    step w of a part's coordinates x."""
-    if kind == "particle":
+    step w of the coordinates x of a part of type ``part_type`` (``_one_piece``)."""
+    if part_type.orientation == POINT:
         return w[:3], np.zeros(3), None
-    if kind == "planar_body":
+    if part_type.orientation == PLANE:
         return np.array([w[0], w[1], 0.0]), np.array([0.0, 0.0, w[2]]), np.array(rotation_z(x[2]), dtype=float)
-    R = quaternion_matrix(x[3:])
-    u = x[3:] / np.linalg.norm(x[3:])
-    E = np.array(body_rate_matrix(u), dtype=float)
-    return w[:3], R @ (2 * E @ w[3:]), R
+    u = x[part_type.quaternion]
+    R = quaternion_matrix(u)
+    E = np.array(body_rate_matrix(u / np.linalg.norm(u)), dtype=float)
+    return w[:3], R @ (2 * E @ w[part_type.quaternion]), R
 
 
 def _axis(vector, name, rotation):

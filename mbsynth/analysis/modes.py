@@ -260,7 +260,7 @@ def _node_shapes(system, shape):
     found, start = {}, 0
     for part in system.parts:
         n = len(part.coordinates)
-        if part.kind == "flexible_body":
+        if part.part_type.elastic:
             reduction = part.reduction
             eta = shape[start:start + n][part.elastic]
             if np.abs(eta).max(initial=0.0) > NODE_SHAPE_RTOL * np.abs(shape).max():

@@ -235,7 +235,7 @@ def _elastic_coordinates(system):
     """Indices of the flexible bodies' elastic coordinates (``FlexibleBody.elastic``)."""
     found, start = [], 0
     for part in system.parts:
-        if part.kind == "flexible_body":
+        if part.part_type.elastic:
             found += range(start + part.elastic.start, start + part.elastic.stop)
         start += len(part.coordinates)
     return found

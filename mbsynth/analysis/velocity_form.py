@@ -37,8 +37,8 @@ class VelocityForm:
     def __init__(self, model):
         starts, start = [], 0
         for part in model.parts:
-            if part.kind == "rigid_body":
-                starts.append(start + 3)  # its quaternion (qw, qx, qy, qz) after its position
+            if part.part_type.body_rates:
+                starts.append(start + part.part_type.quaternion.start)  # its quaternion (qw, qx, qy, qz)
             start += len(part.coordinates)
         self.n = start
         self.starts = np.array(starts, dtype=np.int64)

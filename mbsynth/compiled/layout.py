@@ -1,8 +1,8 @@
 """What the fast path computes where: a System turned, once, into index and number arrays.
 
 Kernel nodes are the rigid bodies (with their own ``<body>.unit_quaternion`` row) and the
-particles (their ``kind``); kernel joints are the holonomic joints (of a kind whose record
-says ``compiled``, core/joint_kinds.py) whose ends are nodes or the world and
+particles (their type's ``node``); kernel joints are the holonomic joints (of a kind whose
+record says ``compiled``, core/joint_kinds.py) whose ends are nodes or the world and
 whose frames are constant. A breadth-first search from the world (then from each body no
 joint path reaches) picks each node's parent joint: those joints form the tree
 (tree.py); the other kernel joints close loops, and their rows join the *extra rows*.
@@ -37,14 +37,14 @@ from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
 # is dense (Jacobi's eigendecomposition, O(p³)); beyond it, where the extra coordinates' mass is diagonal, the
 # rows' Schur matrix is banded (banded.py), else the System is left to the KKT path
 DENSE_SCHUR_MAX = 64
-# the parts' ``kind`` of the kernel's nodes: the model is read through its parts' and joints'
-# attributes (``kind``, ``joint_kind``, masses, frames), not their classes
-RIGID_BODY, PARTICLE_PART = "rigid_body", "particle"
+# what a part is to the kernels, its type's ``node`` (model/parts/part_type.py): the model is read through its
+# parts' and joints' attributes (``part_type.node``, ``joint_kind``, masses, frames), not their classes
+RIGID_NODE, PARTICLE_NODE, EXTRA_NODE = "rigid", "particle", "extra"  # extra: coordinates of the Schur system
 
 
-def _kind(part):
-    """The ``kind`` of a part, None for the world (a joint's missing end)."""
-    return None if part is None else part.kind
+def _node(part):
+    """The kernel node kind of a part's type, None for the world (a joint's missing end)."""
+    return None if part is None else part.part_type.node
 
 
 class Layout(NamedTuple):
@@ -160,11 +160,11 @@ def build(system):
     row_starts = np.cumsum([0] + [c.size for c in system.connectors])
     quat = {c.name: r for c, r in zip(system.connectors, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.parts, starts)
-             if (_kind(part) == RIGID_BODY and f"{part.name}.unit_quaternion" in quat) or _kind(part) == PARTICLE_PART]
+             if (_node(part) == RIGID_NODE and f"{part.name}.unit_quaternion" in quat) or _node(part) == PARTICLE_NODE]
     if not nodes and system.n > DENSE_SCHUR_MAX and not all(part.M.is_diagonal() for part in system.parts):
         return None  # its Schur system has at least its n coordinates, and cannot be banded
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
-    quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _kind(part) == RIGID_BODY}
+    quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _node(part) == RIGID_NODE}
     joints, others = [], []
     for con, row in zip(system.connectors, row_starts):
         if int(row) in quat_rows and con.size == 1:
@@ -259,7 +259,7 @@ def _numbers(parts, joints, number):
     kernel ``joints``: node_mass, node_mg, node_J, joint_s, joint_R, joint_length."""
     masses, mg, inertia = [], [], []
     for part in parts:
-        if _kind(part) == RIGID_BODY:
+        if _node(part) == RIGID_NODE:
             masses.append(number(part.mass)[0, 0])
             inertia.append(number(part.inertia))
             mg.append(number(part.mass * part.gravity).ravel())
@@ -270,7 +270,7 @@ def _numbers(parts, joints, number):
     offsets, rotations, lengths = [], [], []
     for con in joints:
         for part, frame in zip(con.parts, con.frames):
-            offsets.append(np.zeros(3) if _kind(part) == PARTICLE_PART else number(frame.position).ravel())
+            offsets.append(np.zeros(3) if _node(part) == PARTICLE_NODE else number(frame.position).ravel())
             rotations.append(number(frame.rotation))
         lengths.append(number(con.length)[0, 0] if KINDS[con.joint_kind].has_length else 1.0)
     N = len(parts)
@@ -296,7 +296,7 @@ class _Builder:
 
     def layout(self):
         nodes, joints = self.nodes, self.joints
-        rigid = [_kind(part) == RIGID_BODY for part, _ in nodes]
+        rigid = [_node(part) == RIGID_NODE for part, _ in nodes]
         v = [6 if r else 3 for r in rigid]
         k = [joints[j][0].size if j >= 0 else 0 for j in self.pjoint]
         d = [a + b for a, b in zip(v, k)]
@@ -373,7 +373,7 @@ class _Builder:
                 starts.append(0)
             else:
                 i = self.node_of[part.name]
-                kinds.append(RIGID if _kind(part) == RIGID_BODY else PARTICLE)
+                kinds.append(RIGID if _node(part) == RIGID_NODE else PARTICLE)
                 starts.append(self.nodes[i][1])
         program = np.zeros((MAX_ROWS, 3), dtype=np.int64)
         program[:con.size] = KINDS[con.joint_kind].program

@@ -12,10 +12,9 @@ rest length and damping are expressions of parameters, ≥ 0. ``name`` defaults 
 
 from ..model.forces import AXES, applied_force, applied_torque, point_spring
 from .joints import frame_reference
+from .part_types import either, file_types_of
 from .parts import read_nonnegative
 from .schema import FORCE_SECTIONS
-
-TURNING = ("rigid_body", "euler_body", "planar_body")  # parts with an orientation a torque can act on
 
 
 def read_forces(builder):
@@ -78,8 +77,9 @@ def _torque(builder, name, spec, path):
     if not isinstance(part_name, str) or part_name not in builder.parts:
         builder.fail(path + ("part",), f"unknown part {part_name!r}; parts: {', '.join(builder.parts)}")
     part = builder.parts[part_name]
-    if part.kind not in TURNING:
-        builder.fail(path + ("part",), f"a torque acts on a {' or '.join(TURNING)}; '{part_name}' is a {part.kind}")
+    if not part.part_type.rigid:  # a torque turns a part with an orientation of its own, as one piece
+        named = either(file_types_of(lambda part_type: part_type.rigid))
+        builder.fail(path + ("part",), f"a torque acts on a {named} part; '{part_name}' is a {part.kind}")
     axes = spec.get("axes", "world")
     if axes not in AXES:
         builder.fail(path + ("axes",), f"axes must be one of {', '.join(AXES)}, got {axes!r}")

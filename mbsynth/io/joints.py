@@ -12,13 +12,15 @@ from ..core.joint_kinds import JOINT_KINDS, KINDS
 from ..model.connectors.joints import Joint
 from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
+from ..model.parts.part_type import ANGLES, PLANE, QUATERNION
 from .joint_forces import read_friction, read_joint_forces
 from .parts import read_frames
 from .substructures import COUNT_MAX
+from .part_types import either, file_types_of
 from .placement import place_height
 
-# ground contacts (their keys: schema.py): the part kinds they may sit on
-CONTACT_TYPES = {"rolling_disk": ("rigid_body", "euler_body"), "knife_edge": ("rigid_body", "euler_body", "planar_body")}
+# ground contacts (their keys: schema.py): the orientations (model/parts/part_type.py) of the rigid parts they may sit on
+CONTACT_TYPES = {"rolling_disk": (QUATERNION, ANGLES), "knife_edge": (QUATERNION, ANGLES, PLANE)}
 
 
 def read_world(builder):
@@ -68,7 +70,7 @@ def frame_reference(builder, text, path):
     elif part_name in builder.parts:
         part = builder.parts[part_name]
         frames = part.frames
-        if part.kind in ("lagrangian", "spring") and not frame_name:
+        if not part.part_type.origin and not frame_name:
             builder.fail(path, f"a {part.kind} part has no frame of its own: name one of its frames "
                                f"({', '.join(frames) or 'it declares none'})")
     else:
@@ -166,13 +168,13 @@ def read_contact(builder, spec, path, names, suffix=""):
     axis; ``radius``; ``ground`` the height of the plane, 0 by default, in the file's axes:
     raised with its placement) or ``knife_edge`` (``child`` a frame whose x axis is the blade)."""
     kind = spec["type"]
-    hosts = CONTACT_TYPES[kind]
+    hosts = _contact_host(CONTACT_TYPES[kind])
     spec = builder.section(spec, path, kind)
     name = _joint_name(builder, spec, path, names, suffix)
     part, frame = frame_reference(builder, spec["child"], path + ("child",))
-    if part is None or part.kind not in hosts:
-        named = dict.fromkeys("rigid_body" if h == "euler_body" else h for h in hosts)  # a model file's types
-        builder.fail(path + ("child",), f"a {kind} is a frame on a {' or '.join(named)}, not on "
+    if part is None or not hosts(part.part_type):
+        named = file_types_of(hosts)  # a model file's types
+        builder.fail(path + ("child",), f"a {kind} is a frame on a {either(named)} part, not on "
                                         f"{'the world' if part is None else 'a ' + part.kind}")
     args = (builder.q, builder.qd, builder.parameter_symbols)
     if kind == "knife_edge":
@@ -183,6 +185,11 @@ def read_contact(builder, spec, path, names, suffix=""):
     ground = builder.constant(spec.get("ground", 0), path + ("ground",))
     ground = place_height(builder.placement, ground, lambda why: builder.fail(path, why))
     return RollingDisk(name, part, frame, radius, ground, *args)
+
+
+def _contact_host(orientations):
+    """Whether a part type may carry a contact that needs one of ``orientations``: a rigid part turned so."""
+    return lambda part_type: part_type.rigid and part_type.orientation in orientations
 
 
 def _joint_name(builder, spec, path, names, suffix=""):

@@ -20,16 +20,13 @@ from ..model.connectors.base import Connector
 from ..model.joint_values import constraint_symbols, value_expressions, value_names
 from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..core.errors import ModelError
-from ..model.parts import LagrangianPart
 from ..symbolic.derive import T_SYMBOL, joint_values_in
 from ..model.system import Substructure, System
-from .flexible import read_flexible_body
 from .forces import read_forces
 from .joints import read_joints, read_ports, read_world
 from .outputs import read_outputs
-from .parts import read_frames, read_geometry, read_particle, read_planar_body, read_rigid_body, read_spring
-from .robot import connect_robots, read_robot, read_robots
-from .schema import SECTIONS
+from .part_types import FILE_TYPES, SECTIONS
+from .robot import connect_robots, read_robots
 from .placement import Placement, place_initial
 from .source import Document, LineDict, LineList, read_document
 from .substructures import Scoped, included_from, read_includes
@@ -384,10 +381,10 @@ class _Builder:
                     parts += child.read_subsystems()
                 continue
             kind = spec.get("type")
-            if kind not in SUBSYSTEM_TYPES:
+            if kind not in FILE_TYPES:
                 self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: "
-                                            f"{', '.join((*SUBSYSTEM_TYPES, 'model'))}")
-            made = SUBSYSTEM_TYPES[kind](self, self.full_name(name), spec, path)
+                                            f"{', '.join((*FILE_TYPES, 'model'))}")
+            made = FILE_TYPES[kind].read(self, self.full_name(name), spec, path)
             made = made if isinstance(made, list) else [made]  # a robot gives one part per link
             for part in made:
                 self.assembly.parts[part.name] = part
@@ -449,34 +446,6 @@ class _Builder:
         return tuple(Substructure(child.prefix[:-1], str(child.doc.name), tuple(p.name for p in child.own_parts),
                                   child.substructures())
                      for _, copies in self.children for child in copies)
-
-    def read_lagrangian(self, name, spec, path):
-        self.section(spec, path, "lagrangian")
-        coords = spec["coordinates"]
-        if not isinstance(coords, LineList) or not coords:
-            self.fail(path + ("coordinates",), "expected a non-empty list of coordinate names")
-        for i, c in enumerate(coords):
-            self.identifier(c, path + ("coordinates", i), "coordinate")
-            if c.endswith("_dot"):
-                self.fail(path + ("coordinates", i), f"coordinate '{c}' must not end in '_dot' (that names velocities)")
-            if c in self.parameters:
-                self.fail(path + ("coordinates", i), f"coordinate '{c}' has the name of a parameter")
-            if coords.index(c) != i:
-                self.fail(path + ("coordinates", i), f"coordinate '{c}' is listed twice")
-        q, qd = self.part_symbols(name, coords)
-        symbols = dict(self.param_symbols, t=T_SYMBOL)
-        symbols.update(zip(coords, q))
-        symbols.update(zip((f"{c}_dot" for c in coords), qd))
-        T = self.differentiable(self.expression(spec["T"], path + ("T",), symbols), path + ("T",), qd)
-        V = self.differentiable(self.expression(spec.get("V", 0), path + ("V",), symbols), path + ("V",), ())
-        if V.free_symbols & set(qd):
-            self.fail(path + ("V",), "potential energy V must not depend on velocities")
-        forces_node = self.mapping(spec.get("forces", LineDict()), path + ("forces",), set(coords))
-        forces = [self.expression(forces_node[c], path + ("forces", c), symbols) if c in forces_node
-                  else sp.S.Zero for c in coords]
-        frames = read_frames(self, name, spec.get("frames"), path + ("frames",), True, symbols)
-        return LagrangianPart(name, coords, q, qd, T, V, forces, self.parameter_symbols, frames,
-                                   read_geometry(self, spec.get("geometry"), path + ("geometry",)))
 
     def read_constraints(self):
         node = self.root.get("constraints", LineList())
@@ -699,11 +668,6 @@ class _Builder:
             if joint not in apart:
                 builder, place = self.entry_named(joint)
                 builder.fail(place or ("initial",), problem)
-
-
-SUBSYSTEM_TYPES = {"lagrangian": _Builder.read_lagrangian, "rigid_body": read_rigid_body,
-                   "particle": read_particle, "planar_body": read_planar_body, "spring": read_spring,
-                   "robot": read_robot, "flexible_body": read_flexible_body}
 
 
 def _real(expr, values):

@@ -10,11 +10,13 @@ import numpy as np
 import sympy as sp
 
 from ..core.kinematics import axis_matrix, matrix_quaternion, quaternion_matrix, rpy_matrix
-from ..model.parts import EulerBody, Frame, Particle, PlanarBody, RigidBody, Spring
+from ..model.parts import EulerBody, Frame, LagrangianPart, Particle, PlanarBody, RigidBody, Spring
 from ..model.parts.euler_body import SEQUENCES, angle_rates_of, angles_of, coordinates
+from ..symbolic.derive import T_SYMBOL
 from .placement import quaternion_sign
 from ..core.tolerances import (DIVISION_GUARD, INERTIA_NEGATIVE_RTOL, INERTIA_SYMMETRY_RTOL, QUATERNION_NORM_TOL,
                                TRIANGLE_RTOL)
+from .source import LineDict, LineList
 
 ORIENTATION_KEYS = ("rpy", "axis", "quaternion")
 SHAPES = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": None, "line": None}
@@ -22,6 +24,37 @@ MESH_FORMATS = (".stl", ".obj", ".dae")
 COLORS = {"red": (0.85, 0.2, 0.2), "green": (0.2, 0.7, 0.3), "blue": (0.2, 0.4, 0.85), "grey": (0.6, 0.6, 0.6),
           "gray": (0.6, 0.6, 0.6), "black": (0.1, 0.1, 0.1), "white": (0.95, 0.95, 0.95),
           "orange": (0.95, 0.55, 0.1), "yellow": (0.95, 0.85, 0.2), "purple": (0.55, 0.3, 0.75)}
+
+
+def read_lagrangian(builder, name, spec, path):
+    """A part given by its energies: ``coordinates``, T, V (of the coordinates, their rates ``c_dot``,
+    the parameters and t), generalized ``forces`` and frames at expressions of its coordinates."""
+    builder.section(spec, path, "lagrangian")
+    coords = spec["coordinates"]
+    if not isinstance(coords, LineList) or not coords:
+        builder.fail(path + ("coordinates",), "expected a non-empty list of coordinate names")
+    for i, c in enumerate(coords):
+        builder.identifier(c, path + ("coordinates", i), "coordinate")
+        if c.endswith("_dot"):
+            builder.fail(path + ("coordinates", i), f"coordinate '{c}' must not end in '_dot' (that names velocities)")
+        if c in builder.parameters:
+            builder.fail(path + ("coordinates", i), f"coordinate '{c}' has the name of a parameter")
+        if coords.index(c) != i:
+            builder.fail(path + ("coordinates", i), f"coordinate '{c}' is listed twice")
+    q, qd = builder.part_symbols(name, coords)
+    symbols = dict(builder.param_symbols, t=T_SYMBOL)
+    symbols.update(zip(coords, q))
+    symbols.update(zip((f"{c}_dot" for c in coords), qd))
+    T = builder.differentiable(builder.expression(spec["T"], path + ("T",), symbols), path + ("T",), qd)
+    V = builder.differentiable(builder.expression(spec.get("V", 0), path + ("V",), symbols), path + ("V",), ())
+    if V.free_symbols & set(qd):
+        builder.fail(path + ("V",), "potential energy V must not depend on velocities")
+    forces_node = builder.mapping(spec.get("forces", LineDict()), path + ("forces",), set(coords))
+    forces = [builder.expression(forces_node[c], path + ("forces", c), symbols) if c in forces_node
+              else sp.S.Zero for c in coords]
+    frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), True, symbols)
+    return LagrangianPart(name, coords, q, qd, T, V, forces, builder.parameter_symbols, frames,
+                          read_geometry(builder, spec.get("geometry"), path + ("geometry",)))
 
 
 def read_rigid_body(builder, name, spec, path):

@@ -17,8 +17,7 @@ import sympy as sp
 
 from ..core.kinematics import matrix_quaternion
 from ..core.tolerances import PLANE_RTOL, SIGN_TOL
-
-POSE_KINDS = ("rigid_body", "flexible_body")  # a position and a scalar-first unit quaternion
+from ..model.parts.part_type import ANGLES, PLANE, QUATERNION
 
 
 class Placement:
@@ -57,28 +56,25 @@ def place_initial(part, values, placement, fail):
         return dict(values)
     full = {c: sp.sympify(values.get(c, part.defaults.get(c, 0))) for c in part.coordinates}
     full.update({f"{c}_dot": sp.sympify(values.get(f"{c}_dot", 0)) for c in part.coordinates})
-    kind = part.kind
+    kind = part.part_type
     moved = dict(full)
-    if kind in ("particle", "spring") or kind in POSE_KINDS or kind == "euler_body":
-        ends = (("x1", "y1", "z1"), ("x2", "y2", "z2")) if kind == "spring" else (("x", "y", "z"),)
-        for end in ends:
-            _move_point(moved, full, end, placement)
-    if kind in POSE_KINDS:
+    for end in kind.points:
+        _move_point(moved, full, end, placement)
+    if kind.orientation == QUATERNION:
         turn = _quaternion_product(matrix_quaternion(placement.R))
+        names = list(part.coordinates[kind.quaternion])
         for suffix in ("", "_dot"):
-            names = [f"q{c}{suffix}" for c in "wxyz"]
-            moved.update(zip(names, turn * sp.Matrix([full[n] for n in names])))
-        names = [f"q{c}" for c in "wxyz"]
+            moved.update(zip((n + suffix for n in names), turn * sp.Matrix([full[n + suffix] for n in names])))
         if not any(sp.sympify(moved[n]).free_symbols for n in names) and \
                 quaternion_sign([float(moved[n]) for n in names]) < 0:
             moved.update({n: -moved[n] for n in names + [f"{n}_dot" for n in names]})
-    elif kind == "euler_body" and placement.turns:
+    elif kind.orientation == ANGLES and placement.turns:
         fail(f"part '{part.name}' has angle coordinates ({part.sequence}): a placement that turns it would move "
              "their singular position; give it rotation: quaternion, or place it by translation alone")
-    elif kind == "planar_body":
+    elif kind.orientation == PLANE:
         _place_planar(part, moved, full, placement, fail)
-    elif kind not in ("particle", "spring", "euler_body"):
-        fail(f"part '{part.name}' is a {kind} part: its coordinates are its own, with no pose a placement "
+    elif not kind.points:
+        fail(f"part '{part.name}' is a {kind.name} part: its coordinates are its own, with no pose a placement "
              "could move; give its position through parameters, or include the file without placement")
     return {k: v for k, v in moved.items() if v != full[k] or k in values}
 

@@ -85,6 +85,8 @@ _MASS = _required("mass", _EXPR + ", ≥ 0", "mass [kg]; zero is allowed (a mass
 _BETWEEN = _required("between", "list of 2 frames", "the two frames joined (at most one on the world)",
                      "[body.tip, world.anchor]")
 _FORCE_KEYS = (_NAME, Key("type", "string", "the kind of force element", "spring", required=True), _DESCRIPTION)
+# the keys a part type's section written in the type's own module (io/solid.py) shares with those here
+SHARED_KEYS = {key.name: key for key in (_DESCRIPTION, _FRAMES, _GEOMETRY)}
 
 SECTIONS = {section.name: section for section in (
     Section("model", "the top level of a model file",
@@ -96,9 +98,9 @@ SECTIONS = {section.name: section for section in (
              Key("gravity", "list of 3 " + _EXPRS, "gravitational acceleration acting on rigid bodies, "
                  "particles, planar bodies, spring masses and flexible bodies [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
              Key("world", "mapping (section *world*)", "frames fixed in the world", "{frames: {pin: {}}}"),
-             _required("subsystems", "mapping name → part", "the parts, each with a ``type`` "
-                       "(sections *lagrangian*, *rigid_body*, *particle*, *planar_body*, *spring*, *robot*, *flexible_body*, "
-                       "*model_part*)", "{wheel: {type: particle, mass: m}}"),
+             _required("subsystems", "mapping name → part", "the parts, each with a ``type`` whose section "
+                       "below lists its keys (e.g. *rigid_body*; *model_part* for another model file)",
+                       "{wheel: {type: particle, mass: m}}"),
              Key("constraints", "list of constraints (section *constraint*)",
                  "constraints written as equations in the parts' coordinates", "[{holonomic: a.x - b.x}]",
                  default="[]"),

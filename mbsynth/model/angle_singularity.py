@@ -17,6 +17,7 @@ from numba import njit
 
 from ..core.tolerances import ANGLES_IN_NULLSPACE
 from .parts.euler_body import proper_euler, singular_values_text
+from .parts.part_type import ANGLES
 
 
 @dataclass(frozen=True)
@@ -80,7 +81,7 @@ class AngleParts:
     def __init__(self, system):
         self.coordinates = list(system.coordinates)
         index = {c: i for i, c in enumerate(self.coordinates)}
-        self.parts = [p for p in system.parts if p.kind == "euler_body"]
+        self.parts = [p for p in system.parts if p.part_type.orientation == ANGLES]
         self.angles = np.array([[index[f"{p.name}.{c}"] for c in p.coordinates[3:]] for p in self.parts],
                                dtype=np.int64).reshape(-1, 3)
         self.middle = self.angles[:, 1].copy()

@@ -3,7 +3,7 @@ and reaction frame (joint_values.py).
 
 What a joint derives depends on its kind, the types of its two parts (and their numbers of
 coordinates) and its frames' offsets and rotations. Joints between parts whose poses depend on
-their coordinates alone (``SHARED_PARTS``), with frames fixed on them, share one derivation,
+their coordinates alone (their type's ``shared_pose``), with frames fixed on them, share one derivation,
 a template: derived with the frames' entries as placeholder symbols and the parts'
 coordinates and velocities as slots, once per process and kept on disk
 (symbolic.cache.remembered); each joint then puts in its frames' values (``constants``) and
@@ -16,9 +16,7 @@ import sympy as sp
 
 from ..symbolic.cache import placeholder, remembered
 from ..symbolic.derive import Slots
-from .parts import Frame, Particle, PlanarBody, RigidBody
-
-SHARED_PARTS = (RigidBody, Particle, PlanarBody)  # poses that depend on their coordinates alone
+from .parts import Frame
 
 
 class Placeholders(NamedTuple):
@@ -73,7 +71,7 @@ class Templates:
 
 def shared(*parts):
     """Whether joints on ``parts`` (None: the world) may take a template."""
-    return all(type(p) in SHARED_PARTS for p in parts if p is not None)
+    return all(p.part_type.shared_pose for p in parts if p is not None)
 
 
 def joint_coordinates(parent, child):

@@ -37,7 +37,8 @@ from ..model.connectors.joints import Joint
 from ..core.errors import ModelError
 from ..core.joint_kinds import KINDS, WELD
 from ..core.kinematics import body_rate_matrix, rotation
-from ..model.parts import LINK_FRAME, Frame, RigidBody
+from ..compiled.layout import RIGID_NODE
+from ..model.parts import LINK_FRAME, Frame
 from ..model.parts.base import frame_velocity
 from ..symbolic.derive import compile_function, jacobian
 from ..core.tolerances import PROXIMAL_ACCURACY, PROXIMAL_MU
@@ -115,7 +116,8 @@ class Twin:
         self.model = pin.Model()
         self.bodies, self.coordinates, self.constraints, self.loops = {}, [], [], []
         parts = {p.name: p for p in system.parts}
-        odd = [p.name for p in system.parts if not isinstance(p, RigidBody)]
+        # a Pinocchio body is what a kernel rigid node is: mass, inertia about the centre of mass, a quaternion
+        odd = [p.name for p in system.parts if p.part_type.node != RIGID_NODE]
         if odd:
             raise no_twin(system, f"parts {odd} are not rigid bodies")
         own = {f"{p.name}.unit_quaternion" for p in system.parts}

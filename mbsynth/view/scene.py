@@ -1,12 +1,12 @@
 """What the viewer draws, as numbers: nodes with a world transform per drawn time.
 
 Each node carries shapes (the geometry dicts of ``io/parts.py``) at a fixed offset from
-it. Its transform follows the part it sits on:
-
-- rigid_body: [R(u), r] with R(u) of the quaternion coordinates, normalized;
-- particle: [I, r]; planar_body: [Rz(θ), (x, y, 0)];
-- a frame: the part's ``pose(frame)`` (a lagrangian part's frames are points given by
-  expressions of its coordinates; its own geometry stays at the world origin).
+it. Its transform follows the part it sits on, the part's ``pose`` of the node's frame (a
+part's own node: of its origin): [R(u), r] for a rigid body, R(u) of its quaternion
+coordinates normalized (its type's ``quaternion``); [I, r] for a particle; [Rz(θ), (x, y,
+0)] for a planar body; a lagrangian part's frames are points given by expressions of its
+coordinates, its own geometry stays at the world origin. What a part without geometry is
+drawn as is its type's ``drawing`` (model/parts/part_type.py).
 
 Lines (``line:`` shapes between two frames of a part, spring parts, distance joints,
 force elements that expose their two ``points``) are nodes whose transform maps the
@@ -46,6 +46,7 @@ from ..core.joint_kinds import KINDS
 from ..io.parts import COLORS
 from ..model.connectors.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
+from ..model.parts.part_type import BODY, FE_MESH, FRAMES, LINE, SPHERE
 from ..symbolic.derive import T_SYMBOL, compile_function
 from ..core.tolerances import FRAME_SPACING_RTOL, SEGMENT_SCALE_FLOOR
 
@@ -53,8 +54,6 @@ FPS = 30  # at most this many drawn states per second of motion
 PALETTE = ("blue", "orange", "green", "red", "purple", "yellow")
 LINE_COLOR = [0.35, 0.35, 0.35, 1.0]
 ROD_COLOR = [0.1, 0.1, 0.1, 1.0]
-POINT_LIKE = ("particle",)
-BODIES = ("rigid_body", "planar_body", "euler_body")
 # default sizes, as fractions of the model's length (Scene.length)
 LINE_RADIUS = 0.004  # springs, distance joints, line: shapes
 ROD_RADIUS = 0.008  # a body's rods from its centre of mass to its frames
@@ -298,24 +297,24 @@ def _part_specs(part, poses, color, axes, model_drawn, mass):
     no geometry gets a default: a sphere sized by its ``mass`` for a particle; for a body
     the sphere at its centre of mass (``_structure`` adds its rods), or only its axes when
     the model draws other parts (a robot's frame-like links)."""
-    drawn = _has_geometry(part)
+    drawn, drawing = _has_geometry(part), part.part_type.drawing
     specs = []
-    if part.kind != "spring":
-        body = part.kind in BODIES and not drawn
-        default = "particle" if part.kind in POINT_LIKE and not drawn else "com" if body and not model_drawn else None
+    if drawing != LINE:
+        body = drawing == BODY and not drawn
+        default = "particle" if drawing == SPHERE and not drawn else "com" if body and not model_drawn else None
         specs.append(_Spec(part.name, poses.add(part, ORIGIN), _solid(part.geometry), default, color,
-                           (axes or (body and model_drawn)) and part.kind != "lagrangian", mass))
+                           (axes or (body and model_drawn)) and drawing != FRAMES, mass))
     for frame in part.frames.values():
-        default = "sphere" if part.kind == "lagrangian" and not drawn else None
+        default = "sphere" if drawing == FRAMES and not drawn else None
         specs.append(_Spec(f"{part.name}.{frame.name}", poses.add(part, frame), _solid(frame.geometry), default,
-                           color, axes and part.kind != "spring"))
+                           color, axes and drawing != LINE))
     return specs
 
 
 def _part_lines(part, poses):
     """(path, pose A, pose B, colour, radius) of the ``line:`` shapes on a part's frames; a
     spring part is the line between its ends."""
-    if part.kind == "spring":
+    if part.part_type.drawing == LINE:
         return [(f"lines/{part.name}", poses.add(part, part.frames["end1"]), poses.add(part, part.frames["end2"]),
                  LINE_COLOR, LINE_RADIUS)]
     return [(f"lines/{part.name}.{frame.name}-{shape['to']}", poses.add(part, frame),
@@ -326,7 +325,7 @@ def _part_lines(part, poses):
 def _mesh_lines(part, poses, color):
     """(path, pose A, pose B, colour, radius) of the segments between consecutive FE nodes of a
     flexible body without geometry of its own, at ``mesh/<part>.<j>``."""
-    if part.kind != "flexible_body" or part.geometry:
+    if part.part_type.drawing != FE_MESH or part.geometry:
         return []
     reduction = part.reduction
     eta = sp.Matrix(part.q[part.elastic])
@@ -363,7 +362,7 @@ def _structure(system, poses, colors):
                                  {"shape": "box", "size": [2 * R, 0.15 * R, 1.2 * WHEEL_WIDTH * R], "color": ROD_COLOR}]))
     rods = []
     for part in system.parts:
-        if part.kind not in BODIES:
+        if part.part_type.drawing != BODY:
             continue
         centre = poses.add(part, ORIGIN)
         for frame in {**part.frames, **attached.get(part.name, {})}.values():
@@ -378,7 +377,7 @@ def _masses(system, q):
     p, masses, start = system.parameter_values, {}, 0
     for part in system.parts:
         n = len(part.coordinates)
-        if part.kind in BODIES + POINT_LIKE:
+        if part.part_type.drawing in (BODY, SPHERE):
             M, _ = part.evaluate(0.0, q[start:start + n], np.zeros(n), p)
             masses[part.name] = float(M[0, 0])
         start += n
@@ -405,7 +404,7 @@ class _Poses:
         key = (part.name if part is not None else "world", frame.name)
         if key not in self.index:
             p, R = (sp.Matrix(frame.position), sp.Matrix(frame.rotation)) if part is None else part.pose(frame)
-            if part is not None and part.kind == "flexible_body" and self.scale != 1:
+            if part is not None and part.part_type.elastic and self.scale != 1:
                 scaled = {x: self.scale * x for x in part.q[part.elastic]}
                 p, R = p.xreplace(scaled), R.xreplace(scaled)
             self.index[key] = self._append(p, R)
@@ -429,13 +428,13 @@ class _Poses:
 
 
 def normalized_quaternions(system, q):
-    """q with every rigid or flexible body's quaternion (its coordinates qw..qz) scaled to
-    unit norm: R(u) of kinematics.rotation is a rotation only for a unit u."""
+    """q with every part's quaternion (its type's ``quaternion`` coordinates) scaled to unit
+    norm: R(u) of kinematics.rotation is a rotation only for a unit u."""
     q = np.array(q, dtype=float)
     start = 0
     for part in system.parts:
-        if part.kind in ("rigid_body", "flexible_body"):
-            u = slice(start + 3, start + 7)
-            q[u] /= np.linalg.norm(q[u])
+        u = part.part_type.quaternion
+        if u is not None:
+            q[start + u.start:start + u.stop] /= np.linalg.norm(q[start + u.start:start + u.stop])
         start += len(part.coordinates)
     return q

@@ -59,6 +59,7 @@ MODES = {
     "rigid/double_pendulum_spatial.yaml": "rests",
     "rigid/double_pendulum_spatial_angles.yaml": "rests",
     "rigid/free_body.yaml": (["--equilibrium"], 1, "no static equilibrium found"),  # it falls for ever
+    "rigid/solid_pendulum.yaml": "equilibrium",
     "rigid/tennis_racket.yaml": "rests",
     "robots/two_arms_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the wrists turn the hanging bar
     "robots/ur5_holding_bar.yaml": (["--equilibrium"], 1, NOT_ISOLATED),

@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 import mbsynth as mb
-from mbsynth.io.schema import SECTIONS
+from mbsynth.io.part_types import SECTIONS
 
 URDF = """<robot name="arm">
   <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
@@ -71,6 +71,7 @@ HOSTS = {
     "model_part": (("subsystems", "leg"), {"type": "model", "file": "leg.yaml"}, {}),
     "placement": (("subsystems", "leg", "placement"), {}, {("subsystems", "leg"): {"type": "model", "file": "leg.yaml"}}),
     "flexible_body": (("subsystems", "rod"), dict(ROD), {}),
+    "solid": (("subsystems", "block"), {"type": "solid", "shape": {"box": [0.2, 0.1, 0.1]}, "density": 1000}, {}),
     "flexible_beam": (("subsystems", "rod", "beam"), dict(ROD["beam"]), {("subsystems", "rod"): dict(ROD)}),
     "flexible_fe": (("subsystems", "rod", "fe"), {}, {("subsystems", "rod"): {k: v for k, v in ROD.items() if k != "beam"}}),
     "flexible_reduction": (("subsystems", "rod", "reduction"), dict(ROD["reduction"]), {("subsystems", "rod"): dict(ROD)}),

@@ -207,7 +207,7 @@ def test_check_reports_unique_motion(capsys, name, n, m):
     ("{name: c, type: rolling_disk, child: disk}", "missing required key 'radius'"),
     ("{name: c, type: rolling_disk, child: disk, radius: -1}", "radius must be positive"),
     ("{name: c, type: rolling_disk, child: cart, radius: 1}",
-     "a rolling_disk is a frame on a rigid_body, not on a planar_body"),
+     "a rolling_disk is a frame on a rigid_body, robot or solid part, not on a planar_body"),
     ("{name: c, type: knife_edge, child: world}", "not on the world"),
     ("{name: c, type: knife_edge, child: cart, radius: 1}", "unknown key 'radius'"),
 ])

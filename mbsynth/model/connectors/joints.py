@@ -32,8 +32,8 @@ import sympy as sp
 from .base import Connector
 from ...core.joint_kinds import ALIGNED_AXIS, JOINT_KINDS, KINDS, OPERATIONS, ORIENTATION_LOCK
 from ...core.kinematics import quaternion_rotation
-from ..joint_templates import SHARED_PARTS, Templates, joint_coordinates, pose, shared
-from ..parts import Particle, PlanarBody
+from ..joint_templates import Templates, joint_coordinates, pose, shared
+from ..parts.part_type import PLANE, POINT, QUATERNION
 from ...symbolic.cache import placeholder
 from ...symbolic.derive import (compile_function, differentiate, differentiated, jacobian, placed_values, positions,
     time_derivative)
@@ -164,19 +164,22 @@ def _rotation_at(part, frame, values):
     coordinates' values — R(u) R_frame in R(u)'s homogeneous form (kinematics.quaternion_rotation),
     R_z(θ) R_frame, R_frame — not by substitution into the pose's sympy matrices, which grows
     with the model (a robot of many links); other parts by substitution."""
-    if part is not None and not isinstance(part, SHARED_PARTS):
+    if part is not None and not part.part_type.shared_pose:
         return _numeric(pose(part, frame)[1], values)
     own = frame.constant_rotation
     own = _numeric(frame.rotation, values) if own is None else own
-    if own is None or part is None or isinstance(part, Particle):
+    if own is None or part is None or part.part_type.orientation == POINT:
         return own
     if any(x not in values for x in part.q):
         return None
-    if isinstance(part, PlanarBody):
+    if part.part_type.orientation == PLANE:
         theta = float(values[part.q[2]])
         c, s = np.cos(theta), np.sin(theta)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ own
-    return quaternion_rotation([float(values[x]) for x in part.q[3:]]) @ own
+    if part.part_type.orientation == QUATERNION:
+        return quaternion_rotation([float(values[x]) for x in part.q[part.part_type.quaternion]]) @ own
+    raise ValueError(f"a {part.kind} part shares its poses but turns by {part.part_type.orientation}: no rotation "
+                     "from its coordinates here")
 
 
 def _turned(joint, relative):

@@ -4,7 +4,9 @@ A subsystem knows only its own coordinates. It offers
 ``evaluate(t, q, qd, p) -> (M, Q)`` on its own slice of the state (``p``: the
 model's parameter values in the model's order), ``symbolic()`` returning the same
 M and Q as sympy matrices (used to derive closure balances), its energies, and the
-world pose of its named frames for connectors and force elements.
+world pose of its named frames for connectors and force elements. Each part class declares
+its type's record (part_type.py); ``PART_TYPES`` gathers them: a new type of part is a module
+here and its line below.
 """
 
 from .base import LINK_FRAME, Frame, Part
@@ -16,4 +18,14 @@ from .planar_body import PlanarBody
 from .rigid_body import RigidBody
 from .spring import Spring
 
-__all__ = ["LINK_FRAME", "EulerBody", "FlexibleBody", "Frame", "Part", "LagrangianPart", "Particle", "PlanarBody", "RigidBody", "Spring"]
+PART_TYPES = {cls.part_type.name: cls.part_type for cls in (
+    LagrangianPart,
+    RigidBody,
+    EulerBody,
+    Particle,
+    PlanarBody,
+    Spring,
+    FlexibleBody,
+)}
+
+__all__ = ["LINK_FRAME", "PART_TYPES", "EulerBody", "FlexibleBody", "Frame", "Part", "LagrangianPart", "Particle", "PlanarBody", "RigidBody", "Spring"]

@@ -42,12 +42,12 @@ class Part(Keyed):
     """A subsystem given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
     and the model's parameter symbols ``params``.
 
-    Subclasses describe the kind of part; they provide ``pose(frame)`` (world position
-    and rotation of a frame), ``angular_velocity()`` (world) and may add constraints of
-    their own (``own_constraints``) and initial values (``initial``).
+    Subclasses describe a type of part: each declares its type's record ``part_type``
+    (part_type.py: what code outside the class asks of its type) and provides ``pose(frame)``
+    (world position and rotation of a frame), ``angular_velocity()`` (world) and may add
+    constraints of its own (``own_constraints``) and initial values (``initial``).
     """
 
-    kind = "part"
     defaults = {}  # initial coordinate values that are not zero unless the model says otherwise
     # coordinates that move together (a point's x, y, z; a quaternion's four numbers): one
     # scale for all of them in the projection's metric (projection.py); others stand alone
@@ -98,6 +98,11 @@ class Part(Keyed):
     Q = property(lambda self: self._materialized()[1], doc="force vector (2.1), sympy")
     T = property(lambda self: self._materialized()[2], doc="kinetic energy, sympy")
     V = property(lambda self: self._materialized()[3], doc="potential energy, sympy")
+
+    @property
+    def kind(self):
+        """The name of the part's type (its ``part_type``'s)."""
+        return self.part_type.name
 
     def reads(self, symbols):
         """Whether M or Q (2.1) is written in any of ``symbols`` (parameter symbols: whether

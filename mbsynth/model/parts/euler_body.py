@@ -20,6 +20,7 @@ from ...core.tolerances import NEAR_SINGULAR
 from ...symbolic.cache import placeholder, remembered
 from .base import Part
 from ...core.memo import MEMO
+from .part_type import ANGLES, BODY, EXTRA_NODE, PartType, check
 
 SEQUENCES = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx",  # Tait–Bryan: three different axes
              "xyx", "xzx", "yxy", "yzy", "zxz", "zyz")  # proper Euler: the first axis again last
@@ -33,7 +34,9 @@ class EulerBody(Part):
 
     content_fields = ("sequence", "mass", "inertia", "gravity")
 
-    kind = "euler_body"
+    part_type = check(PartType("euler_body", node=EXTRA_NODE, orientation=ANGLES, quaternion=None,
+                               points=(("x", "y", "z"),), elastic=False, body_rates=False, origin=True,
+                               shared_pose=False, drawing=BODY))
     groups = (("x", "y", "z"),)
 
     def __init__(self, name, sequence, q, qd, mass, inertia, gravity, params, frames=(), geometry=(),

@@ -33,6 +33,7 @@ from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import positions
 from ..flexible.invariants import invariants
 from .base import Frame, Part
+from .part_type import EXTRA_NODE, FE_MESH, PartType, QUATERNION, check
 from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
 from ...core.tolerances import GRAM_ZERO_RTOL
 
@@ -50,7 +51,9 @@ class FlexibleBody(Part):
 
     content_fields = ("reduction", "gravity", "damping", "stiffening", "frame_nodes")
 
-    kind = "flexible_body"
+    part_type = check(PartType("flexible_body", node=EXTRA_NODE, orientation=QUATERNION, quaternion=slice(3, 7),
+                               points=(("x", "y", "z"),), elastic=True, body_rates=False, origin=True,
+                               shared_pose=False, drawing=FE_MESH))
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}
 

@@ -4,6 +4,7 @@ import sympy as sp
 
 from ...symbolic.derive import energy_template, lagrange
 from .base import Part
+from .part_type import EXTRA_NODE, FRAMES, OWN, PartType, check
 
 
 class LagrangianPart(Part):
@@ -19,7 +20,9 @@ class LagrangianPart(Part):
 
     content_fields = ("forces",)
 
-    kind = "lagrangian"
+    part_type = check(PartType("lagrangian", node=EXTRA_NODE, orientation=OWN, quaternion=None,
+                               points=(), elastic=False, body_rates=False, origin=False,
+                               shared_pose=False, drawing=FRAMES))
 
     def __init__(self, name, coordinates, q, qd, T, V, forces, params, frames=(), geometry=()):
         self.forces = tuple(sp.sympify(f) for f in forces)  # generalized forces beyond V (they may do work)

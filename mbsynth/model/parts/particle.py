@@ -3,12 +3,15 @@
 import sympy as sp
 
 from .base import Part
+from .part_type import PARTICLE_NODE, POINT, PartType, SPHERE, check
 
 
 class Particle(Part):
     """M = m I₃ (m ≥ 0; a massless particle is legal), Q = m g. Its frames are the point."""
 
-    kind = "particle"
+    part_type = check(PartType("particle", node=PARTICLE_NODE, orientation=POINT, quaternion=None,
+                               points=(("x", "y", "z"),), elastic=False, body_rates=False, origin=True,
+                               shared_pose=True, drawing=SPHERE))
     groups = (("x", "y", "z"),)
 
     def __init__(self, name, q, qd, mass, gravity, params, frames=(), geometry=(), initial=None):

@@ -4,12 +4,15 @@ import sympy as sp
 
 from ...core.kinematics import rotation_z
 from .base import Part
+from .part_type import BODY, EXTRA_NODE, PLANE, PartType, check
 
 
 class PlanarBody(Part):
     """M = diag(m, m, I_zz), Q = (m g_x, m g_y, 0); frames rotate with θ about z."""
 
-    kind = "planar_body"
+    part_type = check(PartType("planar_body", node=EXTRA_NODE, orientation=PLANE, quaternion=None,
+                               points=(), elastic=False, body_rates=False, origin=True,
+                               shared_pose=True, drawing=BODY))
     groups = (("x", "y"),)
 
     def __init__(self, name, q, qd, mass, inertia_zz, gravity, params, frames=(), geometry=(), initial=None):

@@ -10,6 +10,7 @@ from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import differentiate, positions
 from .base import Part
 from ...core.memo import MEMO
+from .part_type import BODY, PartType, QUATERNION, RIGID_NODE, check
 
 COORDINATES = ("x", "y", "z", "qw", "qx", "qy", "qz")
 
@@ -25,7 +26,9 @@ class RigidBody(Part):
 
     content_fields = ("mass", "inertia", "gravity")
 
-    kind = "rigid_body"
+    part_type = check(PartType("rigid_body", node=RIGID_NODE, orientation=QUATERNION, quaternion=slice(3, 7),
+                               points=(("x", "y", "z"),), elastic=False, body_rates=True, origin=True,
+                               shared_pose=True, drawing=BODY))
     COORDINATES = COORDINATES
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}  # the identity orientation

@@ -7,6 +7,7 @@ import sympy as sp
 
 from ...symbolic.derive import generalized_force, time_derivative
 from .base import Frame, Part
+from .part_type import EXTRA_NODE, LINE, POINT, PartType, check
 
 COORDINATES = ("x1", "y1", "z1", "x2", "y2", "z2")
 
@@ -41,7 +42,9 @@ class Spring(Part):
     damper forces on its ends and the consistent gravity load m g/2 per end.
     """
 
-    kind = "spring"
+    part_type = check(PartType("spring", node=EXTRA_NODE, orientation=POINT, quaternion=None,
+                               points=(("x1", "y1", "z1"), ("x2", "y2", "z2")), elastic=False, body_rates=False, origin=False,
+                               shared_pose=False, drawing=LINE))
     COORDINATES = COORDINATES
     groups = (("x1", "y1", "z1"), ("x2", "y2", "z2"))
 
