@@ -54,10 +54,10 @@ def default_path_as(path):
         _default_path.reset(token)
 
 
-def mode():
-    """MBSYNTH_FAST: "on" (unset: the default) or "off"."""
-    value = os.environ.get("MBSYNTH_FAST", "on")
-    value = LEGACY_MODES.get(value, value)
+def mode(value=None):
+    """MBSYNTH_FAST (or ``value``, its text): "on" (unset: the default) or "off"."""
+    value = os.environ.get("MBSYNTH_FAST") if value is None else value
+    value = LEGACY_MODES.get(value, value or "on")
     if value not in MODES:
         raise ValueError(f"MBSYNTH_FAST must be one of {MODES}, got {value!r}")
     return value
@@ -66,11 +66,11 @@ def mode():
 def default_path():
     """The path of a Data made without one: "kkt" where MBSYNTH_FAST=off, else the
     ``default_path_as`` block's where MBSYNTH_FAST is unset, else "compiled"."""
-    if mode() == "off":
+    given = os.environ.get("MBSYNTH_FAST")
+    if mode(given) == "off":
         return "kkt"
-    if "MBSYNTH_FAST" not in os.environ and _default_path.get() is not None:
-        return _default_path.get()
-    return "compiled"
+    block = _default_path.get()
+    return block if given is None and block is not None else "compiled"
 
 
 def template(system, slot):
