@@ -51,6 +51,7 @@ def test_grid_is_every_combination():
     assert len({run_id(r) for r in runs}) == 6
 
 
+@pytest.mark.slow  # 200 simulations on the cluster
 def test_200_runs_recover_the_natural_frequencies(cluster, tmp_path):
     table = sweep(MODEL, {"k1": (40, 160, 10), "k2": (30, 90, 20)}, 1.0, out=tmp_path / "runs.parquet",
                   scheduler=cluster.scheduler_address, trajectories=tmp_path / "traj",
