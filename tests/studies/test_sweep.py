@@ -96,6 +96,7 @@ def test_a_sweep_runs_the_system_it_was_given_with_its_loaded_and_changed_values
         sweep(MODEL, {"k1": [50.0, 120.0]}, 2.0, out=out, scheduler=cluster.scheduler_address, **FAST)
 
 
+@pytest.mark.slow  # 30 runs, a worker process killed midway and started again by its nanny
 def test_a_killed_worker_loses_no_run_and_repeats_none(cluster):
     killed = []
 
