@@ -595,6 +595,7 @@ def test_kernels_imported_first_still_cache_per_version(tmp_path):
         assert Path(path).is_relative_to(tmp_path / "numba" / digest)
 
 
+@pytest.mark.slow  # numba compiles kernel.motion afresh, not from its cache
 @pytest.mark.implementation
 @pytest.mark.parametrize("name", ["rigid tree", "general"])
 def test_helpers_compile_the_argument_types_motion_passes(name, all_joints):
