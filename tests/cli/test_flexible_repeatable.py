@@ -14,13 +14,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.slow  # four processes per model (two fresh runs alike, in make test: test_engine_reuse.py)
+
 MODELS = Path(__file__).resolve().parents[2] / "models" / "flexible"
 # model: (the modes command's flags: at rest as written, or the rest found from it; a short run's end time)
 RUNS = {"cantilever": ([], "0.02"), "slider_crank": (["--equilibrium"], "0.005"), "spin_up_beam": ([], "0.05")}
-SLOW = ("slider_crank", "spin_up_beam")  # tens of seconds each: the rest's search, a spinning beam's run
 
 
-@pytest.mark.parametrize("model", [pytest.param(m, marks=pytest.mark.slow) if m in SLOW else m for m in sorted(RUNS)])
+@pytest.mark.parametrize("model", sorted(RUNS))
 def test_two_processes_give_the_same_modes_and_run(model, tmp_path):
     flags, t_end = RUNS[model]
     path = str(MODELS / f"{model}.yaml")
