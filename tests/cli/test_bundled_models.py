@@ -72,8 +72,8 @@ MODES = {
 }
 
 
-# the models whose three commands take longest (tens of seconds each: robots, legs, a
-# governor's equilibrium search, flexible bodies): run by `make test-slow` and CI
+# the models whose three commands take longest (robots, legs, a governor's equilibrium
+# search, flexible bodies): run by `make test-slow` and CI
 SLOW = {"flexible/slider_crank.yaml", "flexible/spin_up_beam.yaml", "legged/leg.yaml", "legged/quadruped.yaml",
         "mechanisms/flyball_governor.yaml", "robots/two_arms_bar.yaml", "robots/ur5_holding_bar.yaml",
         "robots/ur5_payload.yaml"}
