@@ -7,14 +7,19 @@ TEST_STAMP := $(VENV)/.installed-test
 KERNELS_STAMP := $(VENV)/.compiled
 DOCS_STAMP := $(VENV)/.installed-docs
 
-.PHONY: run test docs install clean
+.PHONY: run test test-slow docs install clean
 
 run: $(STAMP)
 	$(PY) examples/paper_example3.py
 
+# Every test but the long end-to-end ones (marked slow in pyproject.toml); `make test-slow` runs those.
 test: $(TEST_STAMP)
 	bash scripts/install-chromium.sh
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -m "not slow"
+
+test-slow: $(TEST_STAMP)
+	bash scripts/install-chromium.sh
+	$(PY) -m pytest -q -m slow
 
 # The documentation site (Sphinx), warnings as errors; the gallery's scripts run as it builds.
 # Then the checks of the built pages (tests/test_docs.py: MathJax served from the site's _static).

@@ -132,6 +132,7 @@ def workdir(tmp_path_factory):
     return folder
 
 
+@pytest.mark.slow  # every command the pages show, run: simulations, sweeps, robots' validations
 @pytest.mark.parametrize("line", sorted(TO_RUN), ids=sorted(TO_RUN))
 def test_every_command_runs_as_shown(line, workdir, request, monkeypatch, capsys):
     monkeypatch.chdir(workdir)
@@ -180,6 +181,7 @@ def test_the_pages_show_python_blocks():
     assert {page for page, _, _ in SNIPPETS} >= {"README.md", "docs/api.md", "docs/guide.md"}
 
 
+@pytest.mark.slow  # every block the pages show, each in a fresh interpreter
 @pytest.mark.parametrize("page, number, code", SNIPPETS, ids=[f"{page}:{k}" for page, k, _ in SNIPPETS])
 def test_every_python_block_runs_as_shown(page, number, code, workdir):
     if code.startswith(NOT_RUN):

@@ -10,6 +10,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.slow  # each example whole: a UR5's seconds of motion, the demo and its commands
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 

@@ -43,6 +43,7 @@ def module_names():
     return [n for n in names if n != "mbsynth" and not n.endswith("__main__")]
 
 
+@pytest.mark.slow  # each of the package's modules imported first, its dependencies afresh each time
 def test_every_submodule_imports_first_in_a_fresh_interpreter():
     names = module_names()
     assert "mbsynth.model.parts" in names and "mbsynth.model.connectors.joints" in names

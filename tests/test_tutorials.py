@@ -33,6 +33,7 @@ def test_blocks_are_found_in_a_sample(tmp_path):
     assert python_blocks(sample) == ["x = 1\n", "y = x + 1\n"]
 
 
+@pytest.mark.slow  # each tutorial's whole code: simulations, sweeps on a Dask cluster, robots
 @pytest.mark.parametrize("path", TUTORIALS, ids=[p.stem for p in TUTORIALS])
 def test_tutorial_runs(path, monkeypatch):
     monkeypatch.chdir(ROOT)

@@ -335,6 +335,7 @@ constraints:   # the joints about vertical axes at the rest, held (free there: n
 """
 
 
+@pytest.mark.slow  # a UR5's equilibrium search and modes
 def test_ur5_comes_to_rest_where_pinocchio_gravity_torques_vanish():
     """A UR5 released at a bent pose, zero torques, its vertical-axis joints held: the rest
     found is where Pinocchio's generalized gravity (rnea at q̇ = q̈ = 0) is zero at every

@@ -183,6 +183,7 @@ joints:
 """
 
 
+@pytest.mark.slow  # two UR5 arms built from their URDF and derived
 def test_a_loop_at_a_singular_position_is_named_with_the_distance_to_a_closed_one():
     """Two UR5 arms at their zero pose welded to one bar: wrist 1 and wrist 3 turn about one
     axis and the elbows are stretched, so no joint turns the bar about its own axis; the

@@ -10,8 +10,10 @@ import pytest
 from mbsynth.analysis.schedule import Schedule
 
 
-@pytest.mark.parametrize("t0, t_end, dt, h", [(0.0, 2.0, 0.004, 0.01), (0.3, 1.0, 0.1, 0.03), (0.0, 1.0, 0.1, None),
-                                              (-1.0, 1.0, 0.5, 0.5), (0.0, 1.0, 0.25, 0.7)])
+@pytest.mark.parametrize("t0, t_end, dt, h", [
+    (0.0, 0.2, 0.004, 0.01), (0.3, 1.0, 0.1, 0.03), (0.0, 1.0, 0.1, None), (-1.0, 1.0, 0.5, 0.5), (0.0, 1.0, 0.25, 0.7),
+    pytest.param(0.0, 2.0, 0.004, 0.01, marks=pytest.mark.slow),  # 700 stops: every pair of them, seconds of Python
+])
 def test_the_stops_are_the_outputs_and_samples_merged(t0, t_end, dt, h):
     outputs = np.append(np.arange(t0, t_end, dt), t_end)
     samples = [] if h is None else [t0 + h * j for j in range(int(np.ceil((t_end - t0) / h - 1e-9)))]

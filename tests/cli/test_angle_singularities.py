@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from tests.helpers.processes import HANG
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -87,6 +89,7 @@ def test_the_same_orientation_in_another_sequence_is_unique(tmp_path):
     assert "motion: unique" in done.stdout and "singular position" not in done.stdout
 
 
+@pytest.mark.slow  # a 3-second bicycle run in a fresh process, without the kernels
 def test_a_falling_bicycle_stops_at_its_angles_singular_position():
     """The user's command: at 0.5 m/s with a lean kick the bicycle falls, its lean (the zxy
     angles' angle_x) towards π/2, where the steps crawled without end. It stops within the

@@ -73,8 +73,16 @@ MODES = {
 }
 
 
+# the models whose three commands take longest (robots, legs, a governor's equilibrium
+# search, flexible bodies): run by `make test-slow` and CI
+SLOW = {"flexible/slider_crank.yaml", "flexible/spin_up_beam.yaml", "legged/leg.yaml", "legged/quadruped.yaml",
+        "mechanisms/flyball_governor.yaml", "robots/two_arms_bar.yaml", "robots/ur5_holding_bar.yaml",
+        "robots/ur5_payload.yaml"}
+
+
 def test_every_model_file_is_listed():
     assert sorted(str(p.relative_to(MODELS)) for p in MODELS.rglob("*.yaml")) == sorted(MODES)
+    assert SLOW <= set(MODES)
 
 
 def run(capsys, *args):
@@ -83,7 +91,8 @@ def run(capsys, *args):
     return code, out, err
 
 
-@pytest.mark.parametrize("name", sorted(MODES))
+@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow) if name in SLOW else name
+                                  for name in sorted(MODES)])
 def test_model_checks_simulates_and_gives_its_modes(capsys, name):
     path = str(MODELS / name)
     code, out, err = run(capsys, "check", path, "--json")

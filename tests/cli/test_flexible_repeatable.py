@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.slow  # four processes per model (two fresh runs alike, in make test: test_engine_reuse.py)
+
 MODELS = Path(__file__).resolve().parents[2] / "models" / "flexible"
 # model: (the modes command's flags: at rest as written, or the rest found from it; a short run's end time)
 RUNS = {"cantilever": ([], "0.02"), "slider_crank": (["--equilibrium"], "0.005"), "spin_up_beam": ([], "0.05")}

@@ -32,6 +32,7 @@ def benchmark_exponents(v):
     return np.linalg.eigvals(companion)
 
 
+@pytest.mark.slow  # the bicycle's steady motion and its exponents in a fresh process (in-process: test_rolling_stability.py)
 def test_upright_rolling_at_5_m_s_is_stable():
     """Inside the benchmark's self-stable range (4.29 to 6.02 m/s): every exponent beyond the
     six zeros decays; the capsize mode (Table 2: −0.32286642900409) is the slowest."""
@@ -49,6 +50,7 @@ def test_upright_rolling_at_5_m_s_is_stable():
     assert len(heading) == 1 and heading[0].endswith(".angle_z"), result["cyclic"]
 
 
+@pytest.mark.slow  # as at 5 m/s
 def test_upright_rolling_at_2_m_s_is_unstable():
     """Below the weave speed the weave grows: the verdict names it, with the exponent the
     benchmark's equations give."""

@@ -15,6 +15,7 @@ ROOT = Path(__file__).resolve().parents[2]
 STAGE = re.compile(r"^mbsynth: \[(\d+)/(\d+)\] \S")
 
 
+@pytest.mark.slow  # a fresh process that loads every kernel (compiles them all on a cold cache)
 @pytest.mark.timeout(900)  # a cold cache compiles for minutes (the command's own point); a warm one loads in seconds
 def test_compiling_ahead_says_what_and_how_far():
     cold = not background.compiled()

@@ -40,6 +40,7 @@ from tests.helpers.literal import literal_2_14
 from tests.helpers.states import random_state
 
 MODELS = sorted((Path(__file__).resolve().parents[2] / "models").glob("**/*.yaml"))
+SLOW_MODELS = ("quadruped.yaml",)  # the longest case (the largest model): run by make test-slow and CI
 TREE = "tree (Baraff)"
 
 # Every joint kind (core/joint_kinds.py) once, between bodies, a particle and the world, with
@@ -282,7 +283,8 @@ def test_all_joints_and_a_loop_agree_with_the_reference(all_joints):
         assert_same_motion(all_joints, 0.0, q, qd)
 
 
-@pytest.mark.parametrize("path", MODELS, ids=[f"{p.parent.name}/{p.name}" for p in MODELS])
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.name in SLOW_MODELS else p for p in MODELS],
+                         ids=[f"{p.parent.name}/{p.name}" for p in MODELS])
 def test_every_model_file(path):
     """Wherever the kernels cover a model: at its initial state and nearby states, the same
     acceleration as (2.15) when that is unique, the same verdict or error when not."""
@@ -609,6 +611,7 @@ def test_kernels_imported_first_still_cache_per_version(tmp_path):
         assert Path(path).is_relative_to(tmp_path / "numba" / digest)
 
 
+@pytest.mark.slow  # numba compiles kernel.motion afresh, not from its cache
 @pytest.mark.implementation
 @pytest.mark.parametrize("name", ["rigid tree", "general"])
 def test_helpers_compile_the_argument_types_motion_passes(name, all_joints):

@@ -98,6 +98,7 @@ def test_quadruped_stands_and_the_ground_carries_its_weight(quadruped):
     standing_still(quadruped, feet, (p["m_torso"] + 4 * p["m_leg"]) * p["g"])
 
 
+@pytest.mark.slow  # six legs of two nested files, derived
 def test_hexapod_of_six_placed_copies_stands():
     """data/legged/hexapod.yaml: six copies (``count: 6``, placed by ``index``) of a file that includes
     leg.yaml in turn (two levels deep, its ankle a placed world frame) stand still on their
@@ -236,6 +237,7 @@ def flat():
     return mb.loads(flat_twin(), name="quadruped_flat.yaml", parameters=STANCE)
 
 
+@pytest.mark.slow  # a second quadruped, written flat, derived
 def test_composed_quadruped_equals_its_flat_twin(quadruped, flat):
     """Same coordinates in the same order (``front_left.thigh.x`` ↔ ``front_left_thigh.x``),
     the same initial state (the hind legs' parts are half-turned: their quaternions have w = 0

@@ -3,14 +3,15 @@ by ``mbsynth check`` with exit 2 and one line naming FILE:LINE of the including 
 the included file's own line where the problem is inside it, with the chain of entries that
 led there."""
 
-import os
+import contextlib
+import io
 import subprocess
-import sys
-from pathlib import Path
+import warnings
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+from mbsynth.cli import main
+
 BAD_INPUT = 2  # the CLI's exit status for a bad model file
 
 CELL = """\
@@ -159,8 +160,18 @@ CASES = {
 
 
 def check(folder, top):
-    return subprocess.run([sys.executable, "-m", "mbsynth.cli", "check", top], cwd=folder, capture_output=True,
-                          text=True, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    """``mbsynth check TOP`` from ``folder``, in this process (main, as ``python -m mbsynth.cli``
+    calls it): its exit status, stdout and stderr, where the warnings a fresh process would
+    print (Python's default filters) follow the command's own lines."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.chdir(folder), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), \
+            warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+            warnings.simplefilter("ignore", category)  # put before "default": these a process hides
+        code = main(["check", top])
+    shown = "".join(warnings.formatwarning(w.message, w.category, w.filename, w.lineno) for w in caught)
+    return subprocess.CompletedProcess(["mbsynth", "check", top], code, out.getvalue(), err.getvalue() + shown)
 
 
 @pytest.mark.parametrize("case", CASES)

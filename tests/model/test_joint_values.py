@@ -92,6 +92,7 @@ def test_joint_values_and_reactions_equal_pinocchio(ur5):
             assert np.abs(reactions[c.name].torque - f.angular).max() < 1e-9 * scale
 
 
+@pytest.mark.slow  # a UR5's motion under six servo rows, simulated
 def test_servo_constraints_give_the_inverse_dynamics(floating_ur5):
     """Every joint angle of the UR5 prescribed by a holonomic constraint (Udwadia's servo
     constraints) θ_i(t) = θ0_i + 0.3 (sin(2t + i) − sin i), no torques applied: along the simulated

@@ -39,7 +39,7 @@ def panda():
     return mb.from_robot("panda", floating=True)
 
 
-@pytest.mark.parametrize("name", ["ur5", "panda"])
+@pytest.mark.parametrize("name", ["ur5", pytest.param("panda", marks=pytest.mark.slow)])  # panda: the larger build
 def test_joint_accelerations_equal_pinocchio_aba(name, request):
     """ur5 (revolute), panda (revolute and prismatic fingers, a branched tree), each
     floating and fixed: v̇ from (2.14) in 7 coordinates per link equals pinocchio.aba.
@@ -52,7 +52,7 @@ def test_joint_accelerations_equal_pinocchio_aba(name, request):
         assert result.passed and result.max_rel_error <= VALIDATION_RTOL, result
 
 
-@pytest.mark.parametrize("name", ["ur5", "panda"])
+@pytest.mark.parametrize("name", ["ur5", pytest.param("panda", marks=pytest.mark.slow)])
 def test_tree_path_equals_pinocchio_aba(name, request):
     """The compiled tree path (mbsynth.compiled) itself, floating and fixed base, against aba:
     panda's fingers are prismatic joints (a rigid transport of rows invariant under

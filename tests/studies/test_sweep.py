@@ -51,6 +51,7 @@ def test_grid_is_every_combination():
     assert len({run_id(r) for r in runs}) == 6
 
 
+@pytest.mark.slow  # 200 simulations on the cluster
 def test_200_runs_recover_the_natural_frequencies(cluster, tmp_path):
     table = sweep(MODEL, {"k1": (40, 160, 10), "k2": (30, 90, 20)}, 1.0, out=tmp_path / "runs.parquet",
                   scheduler=cluster.scheduler_address, trajectories=tmp_path / "traj",
@@ -95,6 +96,7 @@ def test_a_sweep_runs_the_system_it_was_given_with_its_loaded_and_changed_values
         sweep(MODEL, {"k1": [50.0, 120.0]}, 2.0, out=out, scheduler=cluster.scheduler_address, **FAST)
 
 
+@pytest.mark.slow  # 30 runs, a worker process killed midway and started again by its nanny
 def test_a_killed_worker_loses_no_run_and_repeats_none(cluster):
     killed = []
 

@@ -5,6 +5,7 @@ about the pin, every DOF's kinetic energy weighed by the full FE mass matrix, gr
 first moment, Lagrange's equations integrated by scipy."""
 
 import numpy as np
+import pytest
 import scipy.integrate
 
 import mbsynth as mb
@@ -88,6 +89,7 @@ def reduced_tip(modes):
     return np.array([run.column("tip[x]")[-1], run.column("tip[y]")[-1]])
 
 
+@pytest.mark.slow  # four 1-second runs, the unreduced model's among them
 def test_a_pinned_flexible_pendulum_converges_to_the_unreduced_model():
     """With 1, 2 and 3 in-plane bending modes the tip's distance at 1 s (the rod swung to the
     other side, nearly horizontal) from the unreduced model's falls at least 2× per mode

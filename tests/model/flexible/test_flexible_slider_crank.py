@@ -7,6 +7,7 @@ closed-form position."""
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import mbsynth as mb
 from mbsynth.core.kinematics import quaternion_matrix
@@ -24,6 +25,7 @@ def node_places(rod, q):
     return np.array([q[:3] + A @ (nodes[j] + basis[rod.reduction.node_rows(j)[:3]] @ q[7:]) for j in (0, 4, 8)])
 
 
+@pytest.mark.slow  # 0.8 s of the flexible slider-crank at rtol 1e-6
 def test_the_rods_bending_is_the_beams_quasi_static_deflection_under_its_load():
     """Over 0.8 s (rtol 1e-6) the middle node's distance δ from the chord rings about
     5 w L⁴/(384 EI), the simply supported beam's middle deflection under the rod's mean

@@ -124,6 +124,7 @@ def hub_angle(t):
     return WS / TS * (t**2 / 2 + (TS / (2 * np.pi)) ** 2 * (np.cos(2 * np.pi * t / TS) - 1))
 
 
+@pytest.mark.slow  # 10 s of the spin-up beam, with and without stiffening, and the bar chains
 def test_the_spin_up_beam_with_stiffening_follows_the_exact_beam_and_without_it_diverges():
     """models/flexible/spin_up_beam.yaml (10 elements, 6 Craig–Bampton modes, stiffening on)
     against the bar chain of 10 and 20 links, extrapolated to zero link length (Richardson,
