@@ -32,14 +32,14 @@ from ..core.joint_kinds import COMPONENT, KINDS, MAX_ROWS
 from .banded import band_order
 from .joints import PARTICLE, RIGID, WORLD
 from .tree import GENERAL, RIGID_COMPONENTS, RIGID_INVARIANT
+from .nodes import EXTRA_NODE, PARTICLE_NODE, RIGID_NODE
 
 # a System with no kernel node is one Schur system (kernel.py), its extra coordinates and rows: up to this size it
 # is dense (Jacobi's eigendecomposition, O(p³)); beyond it, where the extra coordinates' mass is diagonal, the
 # rows' Schur matrix is banded (banded.py), else the System is left to the KKT path
 DENSE_SCHUR_MAX = 64
-# what a part is to the kernels, its type's ``node`` (model/parts/part_type.py): the model is read through its
-# parts' and joints' attributes (``part_type.node``, ``joint_kind``, masses, frames), not their classes
-RIGID_NODE, PARTICLE_NODE, EXTRA_NODE = "rigid", "particle", "extra"  # extra: coordinates of the Schur system
+# what a part is to the kernels is its type's ``node`` (nodes.py, model/parts/part_type.py): the model is read
+# through its parts' and joints' attributes (``part_type.node``, ``joint_kind``, masses, frames), not their classes
 
 
 def _node(part):

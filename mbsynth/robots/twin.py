@@ -37,7 +37,7 @@ from ..model.connectors.joints import Joint
 from ..core.errors import ModelError
 from ..core.joint_kinds import KINDS, WELD
 from ..core.kinematics import body_rate_matrix, rotation
-from ..compiled.layout import RIGID_NODE
+from ..compiled.nodes import RIGID_NODE
 from ..model.parts import LINK_FRAME, Frame
 from ..model.parts.base import frame_velocity
 from ..symbolic.derive import compile_function, jacobian

@@ -75,7 +75,7 @@ def test_a_damaged_entry_is_derived_again_and_rewritten(tmp_path):
 
 
 def test_a_derivation_holding_a_dummy_is_not_stored(tmp_path, monkeypatch):
-    monkeypatch.setattr(derivation_cache, "_folder", tmp_path)
+    monkeypatch.setattr(derivation_cache, "_cache_folder", lambda: tmp_path)
     x, d = sp.Symbol("x"), sp.Dummy("d")
     calls = []
     for _ in range(2):

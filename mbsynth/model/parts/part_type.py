@@ -20,7 +20,7 @@ a model file is a module in io/ and its line in io/part_types.py FILE_TYPES.
 
 from typing import NamedTuple
 
-from ...compiled.layout import EXTRA_NODE, PARTICLE_NODE, RIGID_NODE
+from ...compiled.nodes import EXTRA_NODE, PARTICLE_NODE, RIGID_NODE
 
 # how a part's coordinates turn it (``orientation``)
 QUATERNION = "quaternion"  # a unit quaternion among its coordinates (``quaternion``)
