@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-LINES = 150  # the compiled function's length: its compilation takes seconds, far longer than STARTED
+LINES = 600  # the compiled function's length: its compilation takes seconds, far longer than twice STARTED
 STARTED = 0.3  # seconds the script gives its thread to enter the compilation before it exits
 HEAVY = "import math\nfrom numba import njit\n\n\n@njit(cache=True)\ndef f(x):\n    y = 0.0\n" + "".join(
     f"    y += math.sin(x * {i}.5) * math.cos(y + {i})\n" for i in range(LINES)) + "    return y\n"
