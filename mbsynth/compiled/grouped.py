@@ -31,7 +31,7 @@ class Batch:
         self.functions, self.slots = list(functions), slots
         self.indices = [np.asarray(i, dtype=int) for i in indices]
         self.layout = None
-        self.kernels = "wait" if compiled else "never"
+        self.compiled = compiled
 
     def __call__(self, t, q, qd, p):
         t = np.float64(t)
@@ -64,7 +64,7 @@ class Batch:
             group = None
             if isinstance(self.functions[members[0]], Compiled):
                 group = _Group([self.functions[i] for i in members], np.array([self.indices[i] for i in members]),
-                               np.array([dests[i] for i in members]).T, self.kernels)
+                               np.array([dests[i] for i in members]).T, self.compiled)
                 if not group.reproduces(t, q, qd, p, expected):
                     group = None
             if group is None:
@@ -92,11 +92,11 @@ def _values_key(values):
 
 class _Group:
     """Functions sharing one raw function: evaluated by its numba kernel
-    (compiled/structures.py, built at the first call) where ``kernels`` is "wait", else by one
+    (compiled/structures.py, built at the first call) where ``compiled``, else by one
     stacked numpy call when there are at least STACK_MIN of them, else one by one. ``dest``
     (outputs × members): where each output of each member goes in the flat result."""
 
-    def __init__(self, functions, indices, dest, kernels):
+    def __init__(self, functions, indices, dest, compiled):
         first = functions[0]
         self.raw, self.dest = first.raw, dest
         self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
@@ -111,7 +111,7 @@ class _Group:
                           for n, (k, a, i) in enumerate(first.values.picks)]
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
         self.kernel = None  # the numba kernel once it is ready and checked
-        self.refused = kernels == "never"  # numpy for good (also when the kernel disagreed with numpy)
+        self.refused = not compiled  # numpy for good (also when the kernel disagreed with numpy)
 
     def __call__(self, t, q, qd, p):
         if self.picks is None:
