@@ -173,7 +173,7 @@ def andrews_by_hand(text):
     import sympy as sp
     import yaml
     spec = yaml.safe_load(text)
-    part = spec["subsystems"]["sq"]
+    part = spec["parts"]["sq"]
     names = part["coordinates"]
     q, qd = sp.symbols(names), sp.symbols([f"{c}_dot" for c in names])
     numbers = {sp.Symbol(k): v for k, v in spec["parameters"].items()}

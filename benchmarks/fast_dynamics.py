@@ -58,7 +58,7 @@ def axis(i):
 def chain_yaml(count):
     """N links of length LENGTH hanging from the world, revolute joints about x, y, x, ..."""
     lines = [f"name: chain_{count}", f"parameters: {{m: {MASS}, L: {LENGTH}}}", "gravity: [0, 0, -9.81]",
-             f"world: {{frames: {{pivot: {{position: [0, 0, 0], axis: {axis(0)}}}}}}}", "subsystems:"]
+             f"world: {{frames: {{pivot: {{position: [0, 0, 0], axis: {axis(0)}}}}}}}", "parts:"]
     for i in range(count):
         lines.append(f"  link{i}: {{type: rigid_body, mass: m, inertia: [m*L**2/12, m*L**2/12, m*L**2/40], "
                      f"frames: {{top: {{position: [0, 0, L/2], axis: {axis(i)}}}, "

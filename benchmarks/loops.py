@@ -409,7 +409,7 @@ CART_POLE = """\
 # A cart of almost no mass on a spring, carrying a pole: two coordinates, one energy-defined part.
 name: cart_pole_light
 parameters: {M: 0.001, m: 1.0, l: 0.5, I: 0.0833333333333333, k: 10.0, g: 9.81}
-subsystems:
+parts:
   cp:
     type: lagrangian
     coordinates: [x, theta]

@@ -62,7 +62,7 @@ def renamed(text, names):
 
 def copy_names(cell, i):
     """{cell name: copy i's name}: its parts and its parameters."""
-    names = {p: f"cell_{i}_{p}" for p in cell["subsystems"]}
+    names = {p: f"cell_{i}_{p}" for p in cell["parts"]}
     names.update({p: f"{p}_{i}" for p in cell["parameters"]})
     return names
 
@@ -71,15 +71,15 @@ def flat_model(count, cell_path=CELL):
     """The flat model file (a dict) of ``count`` copies of the cell: copy i's parts and
     parameters renamed (``copy_names``), its initial angle theta0_i spread over the copies."""
     cell = yaml.safe_load(Path(cell_path).read_text())
-    model = {"name": f"{cell['name']}_x{count}", "parameters": {}, "subsystems": {}, "constraints": [],
+    model = {"name": f"{cell['name']}_x{count}", "parameters": {}, "parts": {}, "constraints": [],
              "initial": {}}
     for i in range(count):
         names = copy_names(cell, i)
         for key, value in cell["parameters"].items():
             model["parameters"][names[key]] = value
         model["parameters"][names["theta0"]] = round(0.1 + 0.4 * i / max(count - 1, 1), 6)
-        for part, spec in cell["subsystems"].items():
-            model["subsystems"][names[part]] = {k: ([renamed(x, names) for x in v] if k == "coordinates" else
+        for part, spec in cell["parts"].items():
+            model["parts"][names[part]] = {k: ([renamed(x, names) for x in v] if k == "coordinates" else
                                                     renamed(v, names) if k in ("T", "V") else v)
                                                 for k, v in spec.items()}
         for constraint in cell.get("constraints", []):
@@ -93,7 +93,7 @@ def composed_model(count, cell_path=CELL):
     """The model file (a dict) of ``count`` copies of the cell as one ``type: model`` entry."""
     spread = f"0.1 + 0.4*index/{max(count - 1, 1)}"
     return {"name": f"pendulum_cell_x{count}", "parameters": {"N": count},
-            "subsystems": {"cell": {"type": "model", "file": str(cell_path), "count": "N",
+            "parts": {"cell": {"type": "model", "file": str(cell_path), "count": "N",
                                     "parameters": {"theta0": spread}}}}
 
 

@@ -78,7 +78,7 @@ def say(line):
 WARM_TREE = """
 name: warm_up
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   link: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5]}},
          initial: {angular_velocity: [0.1, 0.2, 0.3]}}
   bob: {type: particle, mass: 0.5, initial: {position: [0, 0, -0.5]}}
@@ -91,7 +91,7 @@ WARM_RIGID = """
 name: warm_up_rigid
 gravity: [0, 0, -9.81]
 world: {frames: {pivot: {position: [0, 0, 0], axis: [1, 0, 0]}}}
-subsystems:
+parts:
   upper: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5],
           axis: [1, 0, 0]}, low: {position: [0, 0, -0.5]}}, initial: {angular_velocity: [0.3, 0, 0]}}
   lower: {type: rigid_body, mass: 0.5, inertia: [0.05, 0.05, 0.01], frames: {top: {position: [0, 0, 0.3]}}}

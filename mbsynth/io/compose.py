@@ -15,6 +15,7 @@ are relative to ``folder`` (default: the working folder). Its error messages nam
 text it wrote (``System.source`` holds it).
 """
 
+import warnings
 from pathlib import Path
 
 import yaml
@@ -36,17 +37,23 @@ def substructure(file, parameters=None, placement=None, count=None):
     return entry
 
 
-def compose(subsystems, joints=None, *, name="composed", folder=None, load_parameters=None, **keys):
-    """The System of a model whose top level is ``subsystems`` ({name: part or
+def compose(parts=None, joints=None, *, name="composed", folder=None, load_parameters=None, **keys):
+    """The System of a model whose top level is ``parts`` ({name: part or
     ``substructure(...)``}), ``joints`` and the other top-level keys of a model file
     (``parameters``, ``gravity``, ``world``, ``constraints``, ``closure``, ``initial``,
     ``initial_fixed``, ``forces``, ``outputs``, ``ports``); ``load_parameters``: as
-    ``parameters=`` of ``mb.load``."""
+    ``parameters=`` of ``mb.load``. ``subsystems=``: the old name of ``parts``
+    (a DeprecationWarning)."""
+    if "subsystems" in keys:
+        warnings.warn("compose(subsystems=) is the old name of compose(parts=)", DeprecationWarning, stacklevel=2)
+        if parts is not None:
+            raise ModelError("compose(): parts and its old name subsystems= given both; give parts only")
+        parts = keys.pop("subsystems")
     unknown = sorted(set(keys) - set(TOP_KEYS))
     if unknown:
         raise ModelError(f"compose(): unknown model key(s) {unknown}; allowed: {', '.join(TOP_KEYS)}")
     model = {"name": name, **{key: keys[key] for key in TOP_KEYS if keys.get(key) is not None},
-             "subsystems": subsystems}
+             "parts": parts}
     if joints is not None:
         model["joints"] = joints
     try:

@@ -1,6 +1,6 @@
 """Model files as parts of other model files: ``type: model`` entries and ``ports:``.
 
-    subsystems:
+    parts:
       left_leg:
         type: model
         file: leg.yaml                  # relative to this file
@@ -60,11 +60,11 @@ class Include:
 def read_includes(builder):
     """[(entry name, [child builders, one per copy])] of the file's ``type: model``
     entries, each child's parameters read (and its own included files, depth first)."""
-    node = builder.root.get("subsystems")
+    node = builder.root.get("parts")
     children = []
     for name, spec in (node.items() if isinstance(node, dict) else ()):
         if isinstance(spec, dict) and spec.get("type") == "model":
-            children.append((name, _read_entry(builder, name, spec, ("subsystems", name))))
+            children.append((name, _read_entry(builder, name, spec, ("parts", name))))
     return children
 
 

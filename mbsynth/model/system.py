@@ -45,7 +45,7 @@ class Closure:
 class Substructure:
     """A model file included in another (``type: model``): ``name`` its prefix in the
     model's names (``robot.left_leg``), ``file`` its path, ``parts`` the full names of the
-    parts its own ``subsystems:`` give, ``children`` the substructures it includes."""
+    parts its own ``parts:`` give, ``children`` the substructures it includes."""
 
     name: str
     file: str
@@ -83,7 +83,7 @@ class System:
     """An assembled model. Build it with ``mbsynth.load`` or ``System.build``."""
 
     name: str
-    parts: tuple  # the model file's ``subsystems:``
+    parts: tuple  # the model file's ``parts:``
     connectors: tuple  # the model file's ``constraints:`` and ``joints:``, and the parts' own rows
     coordinates: tuple
     q_symbols: tuple
@@ -97,7 +97,8 @@ class System:
     initial_fixed: frozenset = frozenset()
     definitions: dict = None  # parameter name -> sympy expression of earlier parameters
     initial_definitions: dict = None  # initial value name -> sympy expression of parameters
-    source: str = ""  # the model file's text, for workers that rebuild the System
+    source: str = field(default="", compare=False)  # the model file's text, for workers that rebuild
+    # the System (no part of its value: a comment or a key's old name changes no model)
     source_folder: str = ""  # the folder its file names (meshes, URDFs) are relative to
     source_file: str = ""  # the model file it was read from (mbsynth.load), its absolute path
     substructures: tuple = ()  # Substructure: the model files this one includes, as a tree
@@ -132,7 +133,7 @@ class System:
         put("coulomb", any(getattr(con, "coulomb", None) for con in self.connectors))
 
     def _content(self):
-        return tuple(getattr(self, f.name) for f in fields(self) if f.init)
+        return tuple(getattr(self, f.name) for f in fields(self) if f.init and f.compare)
 
     def __eq__(self, other):
         if self is other:
@@ -311,9 +312,9 @@ class System:
             with np.errstate(all="ignore"):
                 M, Q = part.evaluate(0.0, q[start:stop], qd[start:stop], p)
             if not (np.all(np.isfinite(M)) and np.all(np.isfinite(Q))):
-                problems.append((part.name, f"subsystem '{part.name}': M or Q is not finite at the initial state"))
+                problems.append((part.name, f"part '{part.name}': M or Q is not finite at the initial state"))
             elif np.linalg.eigvalsh(M).min() < -MASS_NEGATIVE_RTOL * max(np.abs(M).max(), DIVISION_GUARD):
-                problems.append((part.name, f"subsystem '{part.name}': the mass matrix is not positive "
+                problems.append((part.name, f"part '{part.name}': the mass matrix is not positive "
                                             "semi-definite at the initial state (a negative mass or inertia, "
                                             "or a T that is no kinetic energy)"))
             start = stop

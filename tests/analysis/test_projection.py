@@ -83,7 +83,7 @@ def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
     import mbsynth as mb
     from mbsynth.analysis.projection import project_positions
 
-    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+    system = mb.loads("name: spinner\nparts:\n  body: {type: rigid_body, mass: 1.0, "
                       "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
     q = system.initial_state()[0]
     u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
@@ -101,7 +101,7 @@ def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near
     import mbsynth as mb
     from mbsynth.analysis.projection import project_velocities
 
-    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+    system = mb.loads("name: spinner\nparts:\n  body: {type: rigid_body, mass: 1.0, "
                       "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
     q, qd = system.initial_state()
     u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
@@ -116,7 +116,7 @@ def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near
 def test_a_pendulum_bob_near_the_vertical_is_moved_along_its_rod():
     """A01's bob (an energy-defined part, T = ½ m (ẋ² + ẏ²)) near the bottom, x = −0.0127,
     its rod 1e-9 too long: x and y have equal M_ii, hence the same units, and share one
-    scale (subsystems.lagrangian.same_units), so the least change moves the bob along the
+    scale (parts/lagrangian.py, same_units), so the least change moves the bob along the
     rod, Δ ∥ (x, y). With a scale per coordinate the step went on x almost alone, by
     φ/(2 ∂φ/∂x) ≈ 20 φ, and its velocity projection changed the energy by 4e-7 of mg L."""
     import mbsynth as mb
@@ -135,9 +135,9 @@ def test_coordinates_of_equal_mass_entries_share_a_scale_and_others_do_not():
     """same_units: x, y under ½ m (ẋ² + ẏ²) together; r, θ under ½ m (ṙ² + r² θ̇²) apart."""
     import mbsynth as mb
 
-    cartesian = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x, y], "
+    cartesian = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [x, y], "
                          "T: 0.5*(x_dot**2 + y_dot**2)}\n")
-    polar = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [r, th], "
+    polar = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [r, th], "
                      "T: 0.5*(r_dot**2 + r**2*th_dot**2)}\n")
     assert len(set(cartesian.coordinate_groups)) == 1
     assert len(set(polar.coordinate_groups)) == 2
@@ -166,7 +166,7 @@ TWO_ARMS_AT_ZERO = """
 name: two_arms_at_zero
 parameters: {m: 1.5, L: 0.6, r: 0.02, g: 9.81}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   left: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}
   right: {type: robot, robot: ur5, base: {position: [1.6345, 0.3829 + L, 1], rpy: [0, 0, pi]}}
   bar:
@@ -210,7 +210,7 @@ def test_a_servo_beyond_the_joints_range_is_named(tmp_path, capsys):
     exit 2 naming the servo, unmet from the start, not the joint rows Newton's steps break."""
     path = tmp_path / "servo.yaml"
     path.write_text("name: ur5_servo\nparameters: {g: 9.81}\ngravity: [0, 0, -g]\n"
-                    "subsystems:\n  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}\n"
+                    "parts:\n  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}\n"
                     "constraints:\n  - {name: elbow_servo, holonomic: arm_elbow_joint.angle - 4}\n")
     assert main(["simulate", str(path), "--t-end", "0.1"]) == 2
     err = capsys.readouterr().err
@@ -230,7 +230,7 @@ def test_a_row_out_of_reach_says_it_is_at_its_least():
 PENDULUM = """\
 name: pendulum
 parameters: {m: 1.0, L: 2.0, g: 9.81}
-subsystems:
+parts:
   bob: {type: lagrangian, coordinates: [x, y], T: 0.5*m*(x_dot**2 + y_dot**2), V: m*g*y}
 constraints:
   - {name: rod, holonomic: bob.x**2 + bob.y**2 - L**2}

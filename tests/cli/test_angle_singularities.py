@@ -21,7 +21,7 @@ BODY = """
 name: lock
 parameters: {{m: 1.0, g: 9.81}}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   body:
     type: rigid_body
     rotation: {rotation}

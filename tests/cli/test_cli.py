@@ -95,7 +95,7 @@ def test_text_report_and_console_script(tmp_path):
 
 def test_model_error_is_one_line_and_exit_2(capsys, tmp_path):
     bad = tmp_path / "bad.yaml"
-    bad.write_text("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
+    bad.write_text("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
     assert main(["check", str(bad)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: {bad}:2:") and "\n" not in err
@@ -128,7 +128,7 @@ LEAF = """
 name: massless_leaf
 gravity: [0, 0, -9.81]
 world: {frames: {pivot: {axis: [0, 1, 0]}}}
-subsystems:
+parts:
   rod: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.01], initial: {position: [0, 0, -0.5]},
         frames: {top: {position: [0, 0, 0.5], axis: [0, 1, 0]}, bottom: {position: [0, 0, -0.5], axis: [0, 1, 0]}}}
   leaf: {type: rigid_body, mass: 0, inertia: [0, 0, 0], initial: {position: [0, 0, -1.2]},

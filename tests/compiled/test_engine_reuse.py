@@ -36,7 +36,7 @@ gravity: [0.3, -0.2, -g]
 world:
   frames:
     pivot: {position: [0.1, -0.2, 1.5], rpy: [0.3, -0.2, 0.5]}
-subsystems:
+parts:
   b0: {type: rigid_body, mass: m, inertia: [0.05, 0.04, 0.03], initial: {position: [0.1, -0.2, 1.1]},
        frames: {top: {position: [0, 0, L]}, low: {position: [0.1, 0, -L], rpy: [0.2, 0, 0]}}}
   b1: {type: rigid_body, mass: mb, inertia: [Ib, Ib, 2*Ib], initial: {position: [0.15, -0.25828, 0.48412], rpy: [0.2, 0, 0]},
@@ -131,7 +131,7 @@ def test_parameters_written_into_a_data_give_a_loaded_systems_arrays(model):
     parts = {p.name: p for p in model.parts}
     m, k = sp.Symbol("m"), sp.Symbol("k")
     assert parts["b0"].reads({m}) and not parts["b1"].reads({m}) and not parts["b0"].reads({k})
-    with pytest.raises(mb.ModelError, match="subsystem 'b0': the mass matrix is not positive semi-definite"):
+    with pytest.raises(mb.ModelError, match="part 'b0': the mass matrix is not positive semi-definite"):
         data.set_parameters({"m": -1.0})
     with pytest.raises(mb.ModelError, match=r"no parameter\(s\) \['mass'\]"):
         data.set_parameters({"mass": 1.0})

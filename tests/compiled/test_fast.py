@@ -54,7 +54,7 @@ world:
   frames:
     pivot: {position: [0.1, -0.2, 1.5], rpy: [0.3, -0.2, 0.5]}
     hook: {position: [0.7, 0.4, 0.2], axis: [1, 1, 0]}
-subsystems:
+parts:
   b0: {type: rigid_body, mass: m, inertia: [[0.05, 0.01, 0], [0.01, 0.04, 0.002], [0, 0.002, 0.03]],
        frames: {top: {position: [0, 0, L], rpy: [0.1, 0.2, 0.3]}, low: {position: [0.1, 0, -L], axis: [0, 1, 1]}}}
   b1: {type: rigid_body, mass: 0.7, inertia: [0.02, 0.03, 0.04],
@@ -382,7 +382,7 @@ def numbers(values):
 def chain(count, kinds, masses, rng, loop=None):
     """A random open chain of rigid bodies hanging from the world; ``loop``: a distance rod
     (or a second spherical joint, 'redundant') from the last body back to the world."""
-    lines = ["name: chain", "gravity: [0, 0, -9.81]", "subsystems:"]
+    lines = ["name: chain", "gravity: [0, 0, -9.81]", "parts:"]
     for i in range(count):
         moments = np.sort(rng.uniform(0.01, 0.05, 3))
         moments[2] = min(moments[2], 0.9 * (moments[0] + moments[1]))
@@ -433,7 +433,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
     the range of two equal unit rows by 1/√2; the force 1 on the massless dot."""
     free = loads("""
         name: free_spin
-        subsystems:
+        parts:
           heavy: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1], frames: {tip: {position: [0, 0, -0.5]}}}
           ghost: {type: rigid_body, mass: 0.0, inertia: [0, 0, 0]}
         gravity: [0, 0, -9.81]
@@ -457,7 +457,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
 
     contradiction = loads("""
         name: contradiction
-        subsystems:
+        parts:
           block: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1]}
         joints:
           - {name: weld, type: fixed, parent: world, child: block}
@@ -466,7 +466,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
         """)
     pushed = loads("""
         name: pushed
-        subsystems:
+        parts:
           dot: {type: particle, mass: 0.0}
         forces:
           - {name: shove, type: force, at: dot, value: [1, 0, 0]}

@@ -31,7 +31,7 @@ def rigid_n_four_bar(N, L=1.0, m=1.0):
     lines = [f"name: rigid_n_four_bar_{N}", f"parameters: {{L: {L!r}, m: {m!r}, g: 9.81, speed: 1.0}}",
              "gravity: [0, -g, 0]", "world:", "  frames:"]
     lines += [f"    p{i}: {{position: [{i}*L, 0, 0]}}" for i in range(N + 1)]
-    lines.append("subsystems:")
+    lines.append("parts:")
     for i in range(N + 1):
         lines.append(f"  v{i}: {{type: rigid_body, mass: m, inertia: [{rod}, {small}, {rod}], "
                      "frames: {bottom: {position: [0, -L/2, 0]}, top: {position: [0, L/2, 0]}}, "

@@ -24,7 +24,7 @@ closure: auto
 world:
   frames:
     anchor: {position: [0.1, -0.2, -0.3]}
-subsystems:
+parts:
   arm:
     type: rigid_body
     mass: m
@@ -53,7 +53,7 @@ parameters: {m: 1.0, L: 0.5, k: 50.0}
 world:
   frames:
     socket: {}
-subsystems:
+parts:
   plate:
     type: rigid_body
     mass: 3*m
@@ -79,7 +79,7 @@ TOP = """\
 name: top
 parameters: {m0: 1.2, L0: 0.6, k0: 30.0, g: 9.81}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   left:
     type: model
     file: mid.yaml
@@ -186,7 +186,7 @@ def flat_twin():
     forces.append("  - {name: tether, type: spring, between: [hub, left_ball], stiffness: k0, rest_length: 0.3}")
     lines = ["name: flat", "closure: auto", "gravity: [0, 0, -g]", "parameters:",
              *(f"  {key}: {text}" for key, text in parameters.items()), "world:", "  frames:", *world,
-             "subsystems:", *parts, "joints:", *joints, "forces:", *forces, "initial:", *initial]
+             "parts:", *parts, "joints:", *joints, "forces:", *forces, "initial:", *initial]
     return "\n".join(lines) + "\n"
 
 
@@ -280,14 +280,14 @@ def test_placed_orientation_keeps_its_sign(tmp_path):
     coordinates and accelerations as the flat file."""
     body = "{type: rigid_body, mass: 1, inertia: [1, 2, 3], frames: {end: {position: [1, 0, 0]}}, initial: {%s}}"
     pin = "joints:\n  - {name: pin, type: spherical, parent: world, child: %s.end}\n"
-    (tmp_path / "child.yaml").write_text(f"subsystems:\n  b: {body % 'rpy: [0, 0, 0.3], angular_velocity: [0, 1, 1]'}\n")
-    (tmp_path / "top.yaml").write_text("gravity: [0, 0, -9.81]\nsubsystems:\n"
+    (tmp_path / "child.yaml").write_text(f"parts:\n  b: {body % 'rpy: [0, 0, 0.3], angular_velocity: [0, 1, 1]'}\n")
+    (tmp_path / "top.yaml").write_text("gravity: [0, 0, -9.81]\nparts:\n"
                                        "  c: {type: model, file: child.yaml, placement: {rpy: [0, 0, 3.0]}}\n"
                                        + pin % "c.b")
     turn = Rotation.from_euler("z", 3.0)
     start = (f"quaternion: {quaternion(turn * Rotation.from_euler('z', 0.3))}, "
              f"angular_velocity: {numbers(turn.apply([0, 1, 1]))}")
-    flat = f"gravity: [0, 0, -9.81]\nsubsystems:\n  b: {body % start}\n" + pin % "b"
+    flat = f"gravity: [0, 0, -9.81]\nparts:\n  b: {body % start}\n" + pin % "b"
     composed, flat = mb.load(tmp_path / "top.yaml"), mb.loads(flat)
     assert composed.initial_q[3] > 0.07  # cos(3.3 / 2) is −0.079: the sign a product of turns gives
     for a, b in zip(composed.initial_state(), flat.initial_state()):

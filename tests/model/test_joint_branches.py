@@ -23,7 +23,7 @@ gravity: [0, 0, -9.81]
 world:
   frames:
     mount: {{position: [0, 0, 1]}}
-subsystems:
+parts:
   block:
     type: rigid_body
     mass: 1.0
@@ -64,7 +64,7 @@ def test_the_refused_poses_meet_every_row_of_the_joint(kind, rotation):
     joint = textwrap.dedent(f"""\
         name: rows_only
         world: {{frames: {{mount: {{position: [0, 0, 1]}}}}}}
-        subsystems:
+        parts:
           block: {{type: rigid_body, mass: 1.0, inertia: [0.1, 0.2, 0.3], frames: {{top: {{position: [0, 0, 0.5]}}}}}}
         joints:
           - {{name: hinge, type: {kind}, parent: world.mount, child: block.top}}

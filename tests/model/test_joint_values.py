@@ -175,7 +175,7 @@ def test_redundant_loop_multipliers():
 SPATIAL_CHAIN = """
 name: spatial_chain
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   a: {type: rigid_body, mass: 1.0, inertia: [0.02, 0.03, 0.04], frames: {top: {position: [0, 0, 0.3]}, bottom: {position: [0, 0, -0.3]}},
       initial: {position: [0, 0, -0.3], velocity: [0.2, -0.1, 0], angular_velocity: [0.3, -0.5, 0]}}
   b: {type: rigid_body, mass: 0.7, inertia: [0.01, 0.02, 0.015], frames: {top: {position: [0, 0, 0.25]}, bottom: {position: [0, 0, -0.25]}},
@@ -202,7 +202,7 @@ def value_chain():
                        for i in range(len(kinds)))
     joints = "\n".join(f"  - {{name: j_{kind}, type: {kind}, parent: {'world' if i == 0 else f'b{i - 1}.bottom'}, "
                        f"child: b{i}.{'cross' if kind == 'universal' else 'top'}}}" for i, kind in enumerate(kinds))
-    return mb.loads(f"name: value_chain\ngravity: [1.5, -0.8, -9.81]\nsubsystems:\n{bodies}\njoints:\n{joints}\n")
+    return mb.loads(f"name: value_chain\ngravity: [1.5, -0.8, -9.81]\nparts:\n{bodies}\njoints:\n{joints}\n")
 
 
 @pytest.mark.parametrize("model, sizes", [

@@ -31,7 +31,7 @@ def model(count, first=0):
                           for i in range(first, first + count))
     initial = ", ".join(f"cell_{i}.r: {0.6 + 0.01 * i}, cell_{i}.th: {(0.6 + 0.01 * i) * (0.5 + 0.01 * i)}, "
                         f"cell_{i}.r_dot: 0.1" for i in range(first, first + count))
-    return (f"name: cells\nparameters: {{{parameters}}}\nsubsystems:\n{cells}constraints:\n{constraints}"
+    return (f"name: cells\nparameters: {{{parameters}}}\nparts:\n{cells}constraints:\n{constraints}"
             f"initial: {{{initial}}}\n")
 
 

@@ -39,7 +39,7 @@ class Frame:
 
 
 class Part(Keyed):
-    """A subsystem given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
+    """A part given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
     and the model's parameter symbols ``params``.
 
     Subclasses describe a type of part: each declares its type's record ``part_type``
