@@ -312,13 +312,13 @@ def finite_state(system, q, qd):
 def time_rows(system):
     """The names of the rows whose constraint holds t explicitly (a servo's θ(t)): their
     manifold moves with time."""
-    return _time_rows(system.connectors)
+    return _time_rows(system.constraints)
 
 
 @MEMO.function(_CACHE_SIZE)
-def _time_rows(connectors):
+def _time_rows(constraints):
     found = []
-    for con in connectors:
+    for con in constraints:
         own = con.phi if con.phi is not None else con.psi if con.psi is not None else con.b
         found += [name for name, x in zip(con.row_names, own) if x.has(T_SYMBOL)]
     return tuple(found)
@@ -336,7 +336,7 @@ def prescribed_motion(system, t, q, qd):
 
 def _refuse_unsupported(system, t, q, qd):
     """SolveError for what the linearization does not cover (module docstring)."""
-    friction = [c.name for c in system.connectors if getattr(c, "coulomb", None)]
+    friction = [c.name for c in system.constraints if getattr(c, "coulomb", None)]
     if friction:
         raise SolveError(f"model '{system.name}': Coulomb friction at {friction} is not differentiable; "
                          "no linearization", constraints=friction)
@@ -485,7 +485,7 @@ class BlockFunction:
 class Derivatives:
     """The exact Jacobians the linearization needs, block by block as ``System.evaluate``
     assembles M, Q, A, b, C: each part's M q̈ − Q, each force element's −Q, each
-    connector's −C, Aᵀλ, A q̈ − b and ψ, over its own coordinates (``BlockFunction``).
+    constraint's −C, Aᵀλ, A q̈ − b and ψ, over its own coordinates (``BlockFunction``).
     Compiled once per model structure; parameters stay arguments, so ``with_parameters``
     reuses them."""
 
@@ -501,7 +501,7 @@ class Derivatives:
             indices = [int(i) for i in element.indices]
             self._add_force(indices, None, -element.symbolic().extract(indices, [0]), system, p)
         row = 0
-        for con in system.connectors:
+        for con in system.constraints:
             indices, k = [int(i) for i in con.indices], con.size
             q, qd = [system.q_symbols[i] for i in indices], [system.qd_symbols[i] for i in indices]
             qdd, lam = _dummies("qdd", len(indices)), _dummies("lam", k)

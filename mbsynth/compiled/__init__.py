@@ -18,7 +18,7 @@ parts' and joints' attributes (layout.py) and imports nothing of model/.
     threads.py     the threads compiled kernels share (motion_batch, corrections)
     background.py  building Templates off the caller's thread; MBSYNTH_FAST
     worker.py      the daemon thread such builds run on, and what leaving Python does to them
-    structures.py  a numba kernel per shared structure of connector or part expressions
+    structures.py  a numba kernel per shared structure of constraint or part expressions
     grouped.py     the instances of one structure evaluated together (model/evaluation.py)
     ahead.py       a cold compile's largest parts in helper processes, on the other core
     cache.py       where compiled code is kept

@@ -1,6 +1,6 @@
-"""One numba function per shared structure of connector or part expressions.
+"""One numba function per shared structure of constraint or part expressions.
 
-``symbolic.compile_function`` compiles the expressions of connectors (and parts) alike
+``symbolic.compile_function`` compiles the expressions of constraints (and parts) alike
 once, in placeholder form (``symbolic.canonical``); grouped.py evaluates the instances of
 one structure together. ``kernel(raw)`` turns that structure into
 
@@ -58,7 +58,7 @@ def _build(raw):
         evaluate = load(source(*raw.structure()), prefix="mbsynth_structure").evaluate
         evaluate.compile(SIGNATURE)  # here, not at the first call
     except Exception as err:  # noqa: BLE001 - numpy serves
-        log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
+        log.warning("a constraint structure stays on numpy (%s: %s)", type(err).__name__, err)
         return None
     return evaluate
 

@@ -9,8 +9,8 @@ from dataclasses import replace
 import sympy as sp
 
 from ..core.joint_kinds import JOINT_KINDS, KINDS
-from ..model.connectors.joints import Joint
-from ..model.connectors.rolling import KnifeEdge, RollingDisk
+from ..model.constraints.joints import Joint
+from ..model.constraints.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from ..model.parts.part_type import ANGLES, PLANE, QUATERNION
 from .joint_forces import read_friction, read_joint_forces

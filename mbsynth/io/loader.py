@@ -15,8 +15,8 @@ import numpy as np
 import sympy as sp
 
 from ..model.balances import close
-from ..model.connectors.joints import Joint
-from ..model.connectors.base import Connector
+from ..model.constraints.joints import Joint
+from ..model.constraints.base import Constraint
 from ..model.joint_values import constraint_symbols, value_expressions, value_names
 from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..core.errors import ModelError
@@ -473,7 +473,7 @@ class _Builder:
             kpath = path + (kind,)
             if kind == "acceleration":
                 a, b = self.read_acceleration_row(spec[kind], kpath)
-                constraints.append(Connector.acceleration(name, a, b, *args, C=C))
+                constraints.append(Constraint.acceleration(name, a, b, *args, C=C))
                 continue
             expr = self.expression(spec[kind], kpath, self.constraint_symbols)
             self.differentiable(expr, kpath, None if kind == "holonomic" else ())
@@ -487,7 +487,7 @@ class _Builder:
             if kind == "nonholonomic" and not has_qd:
                 self.fail(kpath, f"constraint '{name}' involves no velocity (name_dot); "
                                  "a constraint on positions is 'holonomic:'")
-            make = getattr(Connector, kind)
+            make = getattr(Constraint, kind)
             constraints.append(make(name, [expr], *args, C=C))
         return constraints
 

@@ -16,7 +16,7 @@ import scipy.linalg
 import sympy as sp
 
 from .angle_singularity import AngleParts
-from .connectors.base import Connector
+from .constraints.base import Constraint
 from .data import workspace
 from ..core.equations import rank_report
 from ..core.errors import ModelError
@@ -234,5 +234,5 @@ def _as_constraint(system, name, bal):
                          "that direction: the model admits no motion")
     args = (system.q_symbols, system.qd_symbols, system.parameter_symbols)
     if expression.free_symbols & set(system.qd_symbols):
-        return Connector.nonholonomic(name, [expression], *args)
-    return Connector.holonomic(name, [expression], *args)
+        return Constraint.nonholonomic(name, [expression], *args)
+    return Constraint.holonomic(name, [expression], *args)

@@ -158,7 +158,7 @@ class Data:
         return arrays.A, arrays.b
 
     def constraint_arrays(self, t, q, qd, sparse=True):
-        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the constraints
         (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
         dense where that is faster (sparse=None: few rows and coordinates)."""
         q, qd = self._state(q, qd)
@@ -229,7 +229,7 @@ class Data:
             return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=system.coordinates,
                                    constraints=system.constraint_names, drift=off_manifold)
         if system.coulomb:  # C depends on q̈ (friction.py)
-            return friction.coulomb_motion(system.connectors, arrays, solve, t, q, qd, self.p)
+            return friction.coulomb_motion(system.constraints, arrays, solve, t, q, qd, self.p)
         return solve(arrays.C)
 
     def stage_motion(self, baumgarte=None, drift=False, compiled=True):
@@ -300,7 +300,7 @@ class Data:
         return self._joint_values(t, q, qd, qdd, self.p)
 
     def reactions(self, t, q, qd, motion=None):
-        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default this
+        """{constraint name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default this
         Data's motion there): ``System.reactions`` says what they hold."""
         q, qd = self._state(q, qd)
         motion = self.motion(t, q, qd) if motion is None else motion
@@ -308,7 +308,7 @@ class Data:
         lam, dependent = self._multipliers(t, q, qd, motion, arrays)
         kinematics, p = self.system.joint_kinematics(), self.p
         out, row = {}, 0
-        for con in self.system.connectors:
+        for con in self.system.constraints:
             rows = slice(row, row + con.size)
             force = torque = None
             if con.name in kinematics:

@@ -63,7 +63,7 @@ class JointKinematics:
     frame on the child with B's origin: B itself, or a robot's link frame). Joints alike
     (kind, types of parts, frames fixed on them) share one derivation and one compiled
     function (``TEMPLATES``, joint_templates.py), their frames' values passed in, as
-    connectors.joints does."""
+    constraints.joints does."""
 
     def __init__(self, name, kind, parent, frame_a, child, frame_b, report_frame, system):
         self.name, self.kind = name, kind

@@ -14,12 +14,13 @@ parameter values, each through the Data of the default path.
 import functools
 import math
 import numbers
+import warnings
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 import sympy as sp
 
-from .connectors.joints import Joint
+from .constraints.joints import Joint
 from ..compiled.background import default_path
 from .data import Data, shared
 from ..core.errors import ModelError
@@ -61,20 +62,20 @@ class Structure:
     force elements and parameter names, equal by content (``core.values``); the key of
     the one cache's ``model structures`` table (data.py)."""
 
-    __slots__ = ("parts", "connectors", "forces", "names", "_hash")
+    __slots__ = ("parts", "constraints", "forces", "names", "_hash")
 
-    def __init__(self, parts, connectors, forces, names):
-        self.parts, self.connectors, self.forces, self.names = parts, connectors, forces, names
+    def __init__(self, parts, constraints, forces, names):
+        self.parts, self.constraints, self.forces, self.names = parts, constraints, forces, names
         self._hash = None
 
     def __eq__(self, other):
         return self is other or (isinstance(other, Structure) and hash(self) == hash(other) and
-                                 (self.parts, self.connectors, self.forces, self.names) ==
-                                 (other.parts, other.connectors, other.forces, other.names))
+                                 (self.parts, self.constraints, self.forces, self.names) ==
+                                 (other.parts, other.constraints, other.forces, other.names))
 
     def __hash__(self):
         if self._hash is None:  # a hash of immutable content, kept as str keeps its own
-            self._hash = hash((self.parts, self.connectors, self.forces, self.names))
+            self._hash = hash((self.parts, self.constraints, self.forces, self.names))
         return self._hash
 
 
@@ -84,7 +85,7 @@ class System:
 
     name: str
     parts: tuple  # the model file's ``parts:``
-    connectors: tuple  # the model file's ``constraints:`` and ``joints:``, and the parts' own rows
+    constraints: tuple  # the model file's ``constraints:`` and ``joints:``, and the parts' own rows
     coordinates: tuple
     q_symbols: tuple
     qd_symbols: tuple
@@ -123,14 +124,14 @@ class System:
             put(name, frozen_mapping(getattr(self, name)))
         put("initial_q", read_only(self.initial_q))
         put("initial_qd", read_only(self.initial_qd))
-        put("structure", Structure(self.parts, self.connectors, self.forces, tuple(self.parameters)))
+        put("structure", Structure(self.parts, self.constraints, self.forces, tuple(self.parameters)))
         put("coordinate_groups", read_only(_coordinate_groups(self.parts)))
         # one name per row of A (a joint with k rows names them ``joint[label]``)
-        put("constraint_names", tuple(row for c in self.connectors for row in c.row_names))
+        put("constraint_names", tuple(row for c in self.constraints for row in c.row_names))
         put("parameter_index", frozen_mapping({name: i for i, name in enumerate(self.parameters)}))
         put("parameter_symbols", tuple(sp.Symbol(name) for name in self.parameters))
         # whether a constraint has Coulomb friction (its C depends on q̈)
-        put("coulomb", any(getattr(con, "coulomb", None) for con in self.connectors))
+        put("coulomb", any(getattr(con, "coulomb", None) for con in self.constraints))
 
     def _content(self):
         return tuple(getattr(self, f.name) for f in fields(self) if f.init and f.compare)
@@ -151,7 +152,7 @@ class System:
         return found
 
     @classmethod
-    def build(cls, name, parts, connectors, q_symbols, qd_symbols, parameters, initial=None, forces=(),
+    def build(cls, name, parts, constraints, q_symbols, qd_symbols, parameters, initial=None, forces=(),
               initial_fixed=()):
         """Lay out the parts' coordinates in order, check names, set the initial state.
 
@@ -163,7 +164,7 @@ class System:
         coordinates = tuple(f"{s.name}.{c}" for s in parts for c in s.coordinates)
         if len(set(coordinates)) != len(coordinates):
             raise ModelError(f"model '{name}': duplicate coordinate names in {coordinates}")
-        names = [c.name for c in connectors]
+        names = [c.name for c in constraints]
         duplicates = sorted({x for x in names if names.count(x) > 1})
         if duplicates:
             raise ModelError(f"model '{name}': duplicate constraint names {duplicates}")
@@ -177,13 +178,19 @@ class System:
                 qd0[index[key[:-4]]] = value
             else:
                 raise ModelError(f"model '{name}': initial value for unknown coordinate '{key}'")
-        return cls(name, tuple(parts), tuple(connectors), coordinates, tuple(q_symbols),
+        return cls(name, tuple(parts), tuple(constraints), coordinates, tuple(q_symbols),
                    tuple(qd_symbols), dict(parameters), q0, qd0, tuple(forces),
                    initial_given=frozenset(initial or ()), initial_fixed=frozenset(initial_fixed))
 
     @property
     def n(self):
         return len(self.coordinates)
+
+    @property
+    def connectors(self):
+        """``constraints`` under its old name (a DeprecationWarning)."""
+        warnings.warn("System.connectors is the old name of System.constraints", DeprecationWarning, stacklevel=2)
+        return self.constraints
 
     @property
     def parameter_values(self):
@@ -323,12 +330,12 @@ class System:
     def branch_problems(self, q=None, t=0.0, p=None):
         """[(joint name, message)] for each joint whose frames meet its rows at ``q`` (the
         initial state by default) in a pose it does not mean: a fixed joint's frames turned
-        180° (connectors/joints.py). ``p``: the parameter values (default: the model's)."""
+        180° (constraints/joints.py). ``p``: the parameter values (default: the model's)."""
         q = self.initial_q if q is None else q
         values = dict(zip(self.q_symbols, np.asarray(q, dtype=float)))
         values.update(zip(self.parameter_symbols, self.parameter_values if p is None else p))
         values[T_SYMBOL] = t
-        return [(c.name, message) for c in self.connectors if (message := c.wrong_branch(values))]
+        return [(c.name, message) for c in self.constraints if (message := c.wrong_branch(values))]
 
     def check_branches(self, q, t=0.0):
         """Raise SolveError naming the first joint whose frames, at the state q, are in a
@@ -337,7 +344,7 @@ class System:
 
     def with_constraints(self, extra, closures=()):
         """A new System with ``extra`` constraints appended (the original is unchanged)."""
-        return replace(self, connectors=self.connectors + tuple(extra),
+        return replace(self, constraints=self.constraints + tuple(extra),
                        closures=self.closures + tuple(closures))
 
     def _state(self, q, qd):
@@ -357,7 +364,7 @@ class System:
         return self._data.constraint_rows(t, q, qd)
 
     def constraint_arrays(self, t, q, qd, sparse=True):
-        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the constraints
         (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
         dense where that is faster (sparse=None: few rows and coordinates)."""
         return self._data.constraint_arrays(t, q, qd, sparse)
@@ -398,9 +405,9 @@ class System:
         M = sp.diag(*[blk[0] for blk in blocks]) if blocks else sp.zeros(0, 0)
         Q = sum((f.symbolic() for f in self.forces), sp.Matrix.vstack(*[blk[1] for blk in blocks]))
         n = self.n
-        A = sp.Matrix.vstack(sp.zeros(0, n), *[con.a for con in self.connectors])
-        b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.connectors])
-        C = sum((con.C for con in self.connectors), sp.zeros(n, 1))
+        A = sp.Matrix.vstack(sp.zeros(0, n), *[con.a for con in self.constraints])
+        b = sp.Matrix.vstack(sp.zeros(0, 1), *[con.b for con in self.constraints])
+        C = sum((con.C for con in self.constraints), sp.zeros(n, 1))
         return M, Q, A, b, C
 
     def joint_kinematics(self):
@@ -420,8 +427,8 @@ class System:
         return self._data.joint_values(t, q, qd, qdd)
 
     def reactions(self, t, q, qd, motion=None):
-        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default
-        ``self.motion(t, q, qd)``): the multipliers of each connector's rows, and for each
+        """{constraint name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default
+        ``self.motion(t, q, qd)``): the multipliers of each constraint's rows, and for each
         joint the wrench (``force``, ``torque``) the parent exerts on the child through it —
         its rows, its friction, its actuation and spring — at the child's reaction frame
         (the frame B of the joint; a robot's child link frame), in that frame's axes."""
@@ -434,7 +441,7 @@ class System:
         named like a part has none)."""
         names = {"t": T_SYMBOL, **{str(s): s for s in (*self.parameter_symbols, *self.q_symbols, *self.qd_symbols)}}
         parts = {p.name for p in self.parts}
-        for con in self.connectors:
+        for con in self.constraints:
             if isinstance(con, Joint) and con.name not in parts:
                 names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
         return names
@@ -447,7 +454,7 @@ class System:
         and its change along a run is drift."""
         found = [e.name for e in self.forces if not e.conservative or T_SYMBOL in e.V.free_symbols]
         found += [part.name for part in self.parts if part.working or _time_in_part(part)]
-        found += [con.name for con in self.connectors
+        found += [con.name for con in self.constraints
                   if getattr(con, "coulomb", None) or any(x != 0 for x in con.C.values()) or _time_in_rows(con)]
         return found
 
@@ -457,7 +464,7 @@ class System:
         and Coulomb friction (its force depends on q̈)."""
         found = [e.name for e in self.forces if T_SYMBOL in e.V.free_symbols]
         found += [part.name for part in self.parts if _time_in_part(part)]
-        found += [con.name for con in self.connectors if getattr(con, "coulomb", None) or _time_in_rows(con)]
+        found += [con.name for con in self.constraints if getattr(con, "coulomb", None) or _time_in_rows(con)]
         return found
 
 
@@ -468,7 +475,7 @@ def _joint_kinematics(system):
     """``System.joint_kinematics`` made anew."""
     found = {c.name: JointKinematics(c.name, c.joint_kind, *c.parts[:1], c.frames[0], c.parts[1], c.frames[1],
                                      c.report_frame, system)
-             for c in system.connectors if isinstance(c, Joint)}
+             for c in system.constraints if isinstance(c, Joint)}
     parts = {p.name: p for p in system.parts}
     for robot in system.robots:
         if robot.floating:
@@ -498,7 +505,7 @@ def _time_in_part(part):
 
 
 def _time_in_rows(con):
-    """Whether the connector's b or velocity residual ψ holds t: a prescribed motion
+    """Whether the constraint's b or velocity residual ψ holds t: a prescribed motion
     (placed joint rows hold neither)."""
     own = con.__dict__.get("_symbolic")
     return bool(own) and any(T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ())))

@@ -171,7 +171,7 @@ def test_a_structural_replace_gets_a_cache_of_its_own(model):
     values keep them."""
     assert shared(replace(model, parameters={**model.parameters, "m": 2.0})) is shared(model)
     assert shared(model.with_constraints([])) is shared(model)  # nothing appended: the same structure
-    assert shared(replace(model, connectors=model.connectors[:-1])) is not shared(model)
+    assert shared(replace(model, constraints=model.constraints[:-1])) is not shared(model)
     renamed = {("mass" if k == "m" else k): v for k, v in model.parameters.items()}
     assert shared(replace(model, parameters=renamed)) is not shared(model)
 

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.model.connectors.joints import Joint
+from mbsynth.model.constraints.joints import Joint
 from mbsynth.core.equations import constrained_acceleration, equilibrate_rows
 from mbsynth.core.joint_kinds import JOINT_KINDS, KINDS
 from mbsynth.core.tolerances import RANK_RTOL
@@ -93,7 +93,7 @@ def test_joint_rows_equal_the_sympy_rows(all_joints):
     of the table, at random states with quaternions of any length (the forms are homogeneous)."""
     system = all_joints
     L = build_layout(system)[0]
-    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
     assert len(L.joint_k) == len(kernel_joints) == 8
     assert sorted({c.joint_kind for c in kernel_joints}) == sorted(JOINT_KINDS)  # a new kind joins ALL_JOINTS
     V, R, Jt = vector_work()
@@ -123,7 +123,7 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
     without a particle, quaternions of any length."""
     system = all_joints
     L = build_layout(system)[0]
-    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
     A, b = np.zeros((6, 14)), np.zeros(6)
     Rs = make_work(L).Rs  # with the world's slot
     rng = np.random.default_rng(4)
@@ -167,7 +167,7 @@ def test_every_kind_agrees_in_every_interpreter(all_joints):
     along) and its joint values, one entry per position and rate its record names."""
     system = all_joints
     L = build_layout(system)[0]
-    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
     assert sorted({c.joint_kind for c in kernel_joints}) == sorted(JOINT_KINDS)  # a new kind joins ALL_JOINTS
     rows = Rows(L, pack(L), int(L.sizes[1]))
     rng = np.random.default_rng(61)

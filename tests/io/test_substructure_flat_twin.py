@@ -222,8 +222,8 @@ def test_same_parameters_passed_down(twins):
 
 def test_same_constraints_and_closures(twins):
     composed, flat = twins
-    assert [c.name.replace(".", "_") for c in composed.connectors] == [c.name.replace(".", "_")
-                                                                        for c in flat.connectors]
+    assert [c.name.replace(".", "_") for c in composed.constraints] == [c.name.replace(".", "_")
+                                                                        for c in flat.constraints]
     assert len(composed.closures) == len(flat.closures) == 6  # each massless bead's three balances (5.40)
 
 
