@@ -5,7 +5,7 @@ The motion q̈ = f(q, q̇, t) of (2.14) lives on the manifold of the position-le
 independent coordinates of that manifold's tangent space, so redundant coordinates (a
 rigid body's four quaternion numbers: each body's ``<body>.unit_quaternion`` is a row),
 dependent loop coordinates and massless coordinates fixed by a holonomic balance
-(``closure: auto``, model/balances.py, or a model's own, as models/paper/example3_m1_zero.yaml's
+(``balances: auto``, model/balances.py, or a model's own, as models/paper/example3_m1_zero.yaml's
 ``node_balance``) all drop out by themselves:
 
 - positions: the k independent coordinates u are k of the model's coordinates, picked by
@@ -39,7 +39,7 @@ accuracy next to the zeros.
 
 Massless parts. The independent state is that of the masses: a massless coordinate is
 fixed, at every instant, by its balance wᵀ(Q + C) = 0 (model/balances.py). Written as a
-holonomic row (``closure: auto`` appends it so when it involves no velocities), the
+holonomic row (``balances: auto`` appends it so when it involves no velocities), the
 balance is one of the rows of Φ_q and removes the massless coordinate from the tangent
 space: in example 3 with m1 = 0 the node x1 follows from (5.40) and (5.32), and the state
 is (q2, q̇2), one mode. A balance with velocities (a damper at a massless node) is a
@@ -224,7 +224,7 @@ def linearize(system, t, q, qd, inputs=None, speeds=None):
         moving = _named(system.coordinates, np.abs(motion.nullspace).max(axis=1))
         raise SolveError(f"model '{system.name}': the motion is not unique at this state "
                          f"({motion.nullspace.shape[1]} indeterminate direction(s) in {moving}): "
-                         "no linearization (add the massless parts' balances: closure: auto)",
+                         "no linearization (add the massless parts' force balances with balances: auto)",
                          coordinates=moving)
     derivatives = derivatives_of(system)
     arrays = system.evaluate(t, q, qd)
@@ -346,7 +346,7 @@ def _refuse_unsupported(system, t, q, qd):
         raise SolveError(f"model '{system.name}': rows {acceleration_only} restrict accelerations only (a balance "
                          "with velocities, a servo's acceleration row): they are first-order equations of their own, "
                          "outside the state (q, speeds) the linearization takes (write a massless part's balance as "
-                         "a holonomic row, or use closure: auto)", constraints=acceleration_only)
+                         "a holonomic row, or use balances: auto)", constraints=acceleration_only)
     moving = prescribed_motion(system, t, q, qd)
     if moving:
         why = "q̇ ≠ 0" if np.any(qd) else f"∂φ/∂t ≠ 0 at t = {t:g}"

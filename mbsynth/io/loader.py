@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from ..model.balances import close
+from ..model.balances import append_balances
 from ..model.constraints.joints import Joint
 from ..model.constraints.base import Constraint
 from ..model.joint_values import constraint_symbols, value_expressions, value_names
@@ -306,8 +306,8 @@ class _Builder:
                          substructures=self.substructures())
         self.check_parts(system)
         self.check_branches(system)
-        closures = [builder for builder in self.builders if builder.read_closure() == "auto"]
-        return close(system) if closures else system
+        auto = [builder for builder in self.builders if builder.read_balances() == "auto"]
+        return append_balances(system) if auto else system
 
     def plan(self):
         """This file's parameters, robots and included files (theirs in turn), before any
@@ -435,11 +435,11 @@ class _Builder:
         joints, joint_forces = read_joints(self)
         return robot_joints + self.read_constraints() + joints, robot_forces + read_forces(self) + joint_forces
 
-    def read_closure(self):
-        closure = self.root.get("closure", "none")
-        if closure not in ("auto", "none"):
-            self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
-        return closure
+    def read_balances(self):
+        balances = self.root.get("balances", "none")
+        if balances not in ("auto", "none"):
+            self.fail(("balances",), f"expected 'auto' or 'none', got {balances!r}")
+        return balances
 
     def substructures(self):
         """The tree of files this model is made of (model/system.py's Substructure)."""

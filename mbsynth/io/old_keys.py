@@ -4,7 +4,7 @@ A file may use either name of a key, not both (``ModelError`` at the old one's l
 
 from ..core.errors import ModelError
 
-OLD_KEYS = {"subsystems": "parts"}  # old name -> the key's name
+OLD_KEYS = {"subsystems": "parts", "closure": "balances"}  # old name -> the key's name
 
 
 def renamed(root, name):

@@ -107,7 +107,7 @@ SECTIONS = {section.name: section for section in (
              Key("joints", "list of joints (sections *joint*, *rolling_disk*, *knife_edge*)",
                  "joints between named frames and ground contacts", "[{name: pin, type: revolute, parent: world, child: link.top}]",
                  default="[]"),
-             Key("closure", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
+             Key("balances", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
                  "part whose motion the model leaves open (model/balances.py)", "auto", default="none"),
              Key("initial", "mapping coordinate → " + _EXPR, "initial values by coordinate name "
                  "(``part.c``, velocities ``part.c_dot``)", "{wheel.theta: 0.0, wheel.theta_dot: 1.0}",

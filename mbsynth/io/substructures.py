@@ -13,7 +13,7 @@ initial values, parameters) joins the model under its entry's name as a prefix: 
 ``thigh`` becomes ``left_leg.thigh``, its coordinate ``left_leg.thigh.x``, the parameter
 ``L`` ``left_leg.L``; ``count: N`` makes copies ``cell[0]`` … ``cell[N-1]`` (``index`` is
 their number in ``parameters`` and ``placement``). The file's ``ports: {hip: pelvis.hip}``
-names frames the including file joins to as ``left_leg.hip``. The paper's sub-systems
+names frames the including file joins to as ``left_leg.hip``. The paper's sub-systems (parts)
 (section 2): each file is a system with its own equation of motion, and the composite is
 one again, so it may be included in turn.
 

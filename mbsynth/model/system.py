@@ -33,8 +33,8 @@ from ..core.tolerances import DIVISION_GUARD, MASS_NEGATIVE_RTOL
 
 
 @dataclass(frozen=True)
-class Closure:
-    """A force balance wᵀ(Q + C) = 0 appended by ``closure: auto`` (see model/balances.py)."""
+class AppendedBalance:
+    """A force balance wᵀ(Q + C) = 0 appended by ``balances: auto`` (see model/balances.py)."""
 
     constraint: str
     equation: str
@@ -93,7 +93,7 @@ class System:
     initial_q: np.ndarray
     initial_qd: np.ndarray
     forces: tuple = ()
-    closures: tuple = ()
+    appended_balances: tuple = ()
     initial_given: frozenset = frozenset()
     initial_fixed: frozenset = frozenset()
     definitions: dict = None  # parameter name -> sympy expression of earlier parameters
@@ -204,7 +204,7 @@ class System:
         """A new System with some parameter values changed (the original is unchanged).
 
         Parameters defined by expressions of others, and initial values written as
-        expressions of parameters, follow the new values. Closure balances appended at
+        expressions of parameters, follow the new values. Balances appended at
         load time are kept as derived; they stay valid while the masses that were zero
         stay zero. A parameter the file built something from at load (``fixed_parameters``:
         a flexible body's FE model) cannot change here: ModelError naming where (load the
@@ -342,10 +342,10 @@ class System:
         pose the joint does not mean (``branch_problems``)."""
         self._data.check_branches(q, t)
 
-    def with_constraints(self, extra, closures=()):
+    def with_constraints(self, extra, balances=()):
         """A new System with ``extra`` constraints appended (the original is unchanged)."""
         return replace(self, constraints=self.constraints + tuple(extra),
-                       closures=self.closures + tuple(closures))
+                       appended_balances=self.appended_balances + tuple(balances))
 
     def _state(self, q, qd):
         q, qd = np.asarray(q, dtype=float).ravel(), np.asarray(qd, dtype=float).ravel()

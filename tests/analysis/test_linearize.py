@@ -53,9 +53,9 @@ def test_example3_massless_spring_end():
 
 
 def test_massless_node_without_its_balance_is_refused():
-    """Without closure the massless node is indeterminate: a verdict, no spectrum."""
+    """Without the balance the massless node is indeterminate: a verdict, no spectrum."""
     with open("models/paper/example3_m1_zero_auto.yaml") as f:
-        text = f.read().replace("closure: auto", "")
+        text = f.read().replace("balances: auto", "")
     system = mb.loads(text)
     q = np.array([1.0, 1.2, 0.8])
     with pytest.raises(mb.SolveError, match="not unique|no motion|balance"):

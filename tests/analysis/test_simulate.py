@@ -45,7 +45,7 @@ def test_example3_matches_the_exact_modal_solution_over_10_s():
 
 
 def test_massless_node_closed_by_auto_balance_equals_series_spring():
-    """Case 5.2 (m1 = 0, closure: auto): m2 oscillates on k1 k2/(k1 + k2) (springs in series)."""
+    """Case 5.2 (m1 = 0, balances: auto): m2 oscillates on k1 k2/(k1 + k2) (springs in series)."""
     system = mb.load(PAPER / "example3_m1_zero_auto.yaml")
     p = system.parameters
     traj = simulate(system, 5.0)

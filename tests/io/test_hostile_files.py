@@ -199,7 +199,7 @@ def test_random_yaml_documents(document):
 
 
 TOP = ["name", "description", "parameters", "gravity", "world", "parts", "constraints", "joints",
-       "closure", "initial", "initial_fixed", "forces"]
+       "balances", "initial", "initial_fixed", "forces"]
 PART_KEYS = ["mass", "inertia", "coordinates", "T", "V", "forces", "frames", "geometry", "initial",
              "stiffness", "rest_length", "description", "color"]
 TYPES = st.sampled_from(["lagrangian", "rigid_body", "particle", "planar_body", "spring", "robot"]) | SCALARS
@@ -295,7 +295,7 @@ DEFECTS = [
     (("parts", "cart", "coordinates"), ["x_dot"]), (("parts", "cart", "T"), "0.5*m*y_dot**2"),
     (("parts", "cart", "V"), "x_dot**2"), (("parts", "plate", "type"), "planar"),
     (("parts", "plate", "type"), ["planar_body"]), (("parts", "bob", "frames", "c"), {"position": [1, 0, 0]}),
-    (("closure",), "sometimes"), (("closure",), ["auto"]), (("parts", "m"), {"type": "particle", "mass": 1}),
+    (("balances",), "sometimes"), (("balances",), ["auto"]), (("parts", "m"), {"type": "particle", "mass": 1}),
     (("parameters", "t"), 1.0), (("parameters", "sin"), 1.0), (("parameters", "k"), "k + 1"),
     (("parts", "world"), {"type": "particle", "mass": 1}), (("name",), ["a"]), (("gravity",), [0, 0]),
 ]
@@ -422,7 +422,7 @@ def test_deep_nesting_is_refused(depth, kind):
 
 @budget(150)
 @given(width=st.integers(2, 12), levels=st.integers(2, 12),
-       place=st.sampled_from(["closure", "initial_fixed", "name", "gravity", "parts", "parameters", None]))
+       place=st.sampled_from(["balances", "initial_fixed", "name", "gravity", "parts", "parameters", None]))
 def test_alias_bombs_are_refused_quickly(width, levels, place):
     """A "billion laughs": anchors &l0 ... &lN in ``description``, each level repeating the
     one before ``width`` times, the last one used at ``place``."""

@@ -154,7 +154,7 @@ ERRORS = [
     ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2\n", 3, "not valid YAML"),
     ("- just\n- a list\n", 1, "must be a mapping"),
     ("parameters: {t: 1}\nparts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\n", 1, "reserved"),
-    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nclosure: yes\n", 3,
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nbalances: yes\n", 3,
      "expected 'auto' or 'none'"),
     ("parts: {}\n", 1, "the mapping is empty: a model needs at least one part"),
     (f"{HINGED}outputs: {{d: hinge.displacement}}\n", 7,

@@ -40,3 +40,37 @@ def test_compose_takes_subsystems_as_the_old_name_of_parts():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert mb.compose(parts) == old
+
+
+AUTO = Path(__file__).parents[2] / "models" / "paper" / "example3_m1_zero_auto.yaml"
+
+
+def test_a_file_with_closure_auto_loads_equal_to_the_file_with_balances_auto():
+    text = AUTO.read_text()
+    assert re.search(r"^balances: auto$", text, re.M)
+    old = re.sub(r"^balances: auto$", "closure: auto", text, flags=re.M)
+    new, aliased = mb.loads(text, name="m.yaml"), mb.loads(old, name="m.yaml")
+    assert aliased == new
+    assert [b.constraint for b in aliased.appended_balances] == ["balance_1"]
+
+
+def test_closure_and_balances_in_one_file_are_refused_at_the_old_key():
+    text = "name: both\nbalances: auto\nparts:\n  a: {type: particle, mass: 1}\nclosure: none\n"
+    with pytest.raises(mb.ModelError, match=r"^both\.yaml:5: at closure: 'closure' is the old name of 'balances' "
+                                            r"\(line 2\); give one of them$"):
+        mb.loads(text, name="both.yaml")
+
+
+def test_a_message_about_closure_names_it_balances():
+    with pytest.raises(mb.ModelError, match=r"^m\.yaml:2: at balances: expected 'auto' or 'none', got 'yes'$"):
+        mb.loads("name: m\nclosure: yes\nparts:\n  a: {type: particle, mass: 1}\n", name="m.yaml")
+
+
+def test_compose_takes_closure_as_the_old_name_of_balances():
+    parts = {"a": {"type": "particle", "mass": 1}}
+    with pytest.warns(DeprecationWarning, match=r"compose\(closure=\) is the old name of compose\(balances=\)"):
+        old = mb.compose(parts, closure="auto")
+    assert old == mb.compose(parts, balances="auto")
+    with pytest.raises(mb.ModelError, match=r"balances= and its old name closure= given both"), \
+            pytest.warns(DeprecationWarning):
+        mb.compose(parts, closure="auto", balances="auto")

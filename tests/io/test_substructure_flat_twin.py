@@ -4,7 +4,7 @@ The composed model nests two deep: ``top.yaml`` includes ``mid.yaml`` twice (pla
 by a quaternion, both with a translation), each ``mid.yaml`` includes ``link.yaml`` (placed by
 rpy and a translation); parameters are overridden at both levels by expressions of the
 including file's parameters. ``link.yaml`` holds a rigid arm on a revolute joint reached
-through a port and a massless bead between two springs, closed by ``closure: auto`` (the
+through a port and a massless bead between two springs, closed by ``balances: auto`` (the
 paper's example 3: the bead's force balance (5.40) is appended). The flat twin is written
 here by hand, every placed pose and velocity computed with scipy's Rotation (not the
 loader's placement code), with the same parts in the same order."""
@@ -20,7 +20,7 @@ AGREE = 1e-12  # the twins' initial states and accelerations agree to rounding
 LINK = """\
 name: link
 parameters: {m: 1.0, L: 0.5, k1: 40.0, k2: 60.0, w: 1.5, alpha: 0.3}
-closure: auto
+balances: auto
 world:
   frames:
     anchor: {position: [0.1, -0.2, -0.3]}
@@ -184,7 +184,7 @@ def flat_twin():
                    f"stiffness: {p}link_k2, rest_length: 0}}"]
     joints.append("  - {name: leash, type: distance, parent: right_ball, child: hub, length: 0.5}")
     forces.append("  - {name: tether, type: spring, between: [hub, left_ball], stiffness: k0, rest_length: 0.3}")
-    lines = ["name: flat", "closure: auto", "gravity: [0, 0, -g]", "parameters:",
+    lines = ["name: flat", "balances: auto", "gravity: [0, 0, -g]", "parameters:",
              *(f"  {key}: {text}" for key, text in parameters.items()), "world:", "  frames:", *world,
              "parts:", *parts, "joints:", *joints, "forces:", *forces, "initial:", *initial]
     return "\n".join(lines) + "\n"
@@ -220,11 +220,11 @@ def test_same_parameters_passed_down(twins):
     assert composed.parameters["right.link.k2"] == pytest.approx(100.0, rel=AGREE)
 
 
-def test_same_constraints_and_closures(twins):
+def test_same_constraints_and_appended_balances(twins):
     composed, flat = twins
     assert [c.name.replace(".", "_") for c in composed.constraints] == [c.name.replace(".", "_")
                                                                         for c in flat.constraints]
-    assert len(composed.closures) == len(flat.closures) == 6  # each massless bead's three balances (5.40)
+    assert len(composed.appended_balances) == len(flat.appended_balances) == 6  # each massless bead's three balances (5.40)
 
 
 def test_same_initial_state(twins):
@@ -244,7 +244,7 @@ def test_initial_state_is_assembled(twins):
     phi, phid = (np.asarray(r) for r in composed.constraint_residuals(0.0, q, qd))
     names = composed.constraint_names
     held = [i for i, name in enumerate(names) if not name.startswith("leash")]
-    joints = [i for i in held if not name_of(names[i]).startswith("closure")]
+    joints = [i for i in held if not name_of(names[i]).startswith("balances")]
     assert len(joints) < len(held)
     assert np.abs(phi[held]).max() < 1e-12
     assert np.abs(phid[joints]).max() < 1e-12

@@ -110,11 +110,11 @@ def test_example3_case_5_3_matches_5_56(name, method):
         np.testing.assert_allclose(motion.qdd, [a, a, 0.0], rtol=1e-10, atol=1e-12 * abs(a))
 
 
-def test_closure_auto_appends_the_papers_balances():
-    """closure: auto derives (5.40) for m1 = 0 and (5.49) for m2 = 0 (up to a factor)."""
+def test_balances_auto_appends_the_papers_balances():
+    """balances: auto derives (5.40) for m1 = 0 and (5.49) for m2 = 0 (up to a factor)."""
     m1_zero = load("example3_m1_zero_auto.yaml")
     m2_zero = load("example3_m2_zero_auto.yaml")
-    assert len(m1_zero.closures) == len(m2_zero.closures) == 1
+    assert len(m1_zero.appended_balances) == len(m2_zero.appended_balances) == 1
     q = np.array([1.3, 0.4, 0.7])
     for system, expected in ((m1_zero, lambda p: p["k1"] * (q[0] - p["l10"]) - p["k2"] * (q[2] - p["l20"])),
                              (m2_zero, lambda p: p["k2"] * (q[2] - p["l20"]))):
