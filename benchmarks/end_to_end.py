@@ -24,7 +24,7 @@ model with a free-flyer root, the chain's joints) and start both codes from the 
 (``Twin.to_maximal`` of Pinocchio's); the table gives the largest difference of their final
 positions of the bodies. Each figure is the best of ``--rounds`` runs, the two codes alternating;
 the ratio is to Pinocchio's time in the same run. mbsynth runs twice a round: as a user
-gets it, the corrections of the output rows a step passed split among the cores
+gets it, the projections of the output rows a step passed split among the cores
 (mbsynth/compiled/threads.py), and on one thread, as Pinocchio runs. Also: the evaluations of the right-hand
 side, and for mbsynth the largest position residual of the outputs and the spread of the
 total energy (zero for the exact motion). Model building is not timed in that table; the
@@ -239,7 +239,7 @@ def reference_run(case):
 
 def mbsynth_run(case, cores=None):
     """(seconds, evaluations, largest position residual, energy spread, final q) of
-    mb.simulate; ``cores``: the threads its corrections may take (default: one per core)."""
+    mb.simulate; ``cores``: the threads its projections may take (default: one per core)."""
     default, threads.THREADS = threads.THREADS, cores or threads.THREADS
     try:
         started = time.perf_counter()

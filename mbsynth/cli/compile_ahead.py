@@ -4,7 +4,7 @@ kernels (mbsynth.compiled) into the cache ahead of use, on warm-up models read a
 
 On two cores: first the kernel's largest parts for both variants of ``kernel.motion`` in
 helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
-correction) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
+projection) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
 general ones; then each warm-up model here, loading what is missing from the cache (all of
 it, unless a helper failed). Each stage says on stderr what it compiles and how far it is
 (``[k/N]``); when the cache holds the kernels already, it says so and only loads them.
@@ -30,11 +30,11 @@ def warm(texts):
         engine = background.build(system)
         q, qd = system.initial_state()
         engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
-        correction = engine.correction()
-        if correction is not None:  # simulate's rows and corrections, one by one and fitted (row_fit.py)
-            correction(q, qd)
+        projection = engine.projection()
+        if projection is not None:  # simulate's rows and projections, one by one and fitted (row_fit.py)
+            projection(q, qd)
             count = row_fit.MIN_ROWS
-            correction.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
+            projection.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
 
 
 def main():
@@ -73,7 +73,7 @@ def say(line):
 
 
 # A body on a spherical joint with a particle on a rod, without and with a loop (a second,
-# redundant hinge) and a generated force: every kernel runs, and the correction's (the
+# redundant hinge) and a generated force: every kernel runs, and the projection's (the
 # kernel at rest, the compiled rows) on the tree.
 WARM_TREE = """
 name: warm_up

@@ -1,4 +1,4 @@
-"""projection._correction: the least-norm step of a sparse J, checked against dense least
+"""projection._least_change: the least-norm step of a sparse J, checked against dense least
 squares (numpy's SVD-based lstsq, an independent computation); a projection that fails
 names the rows at fault (a servo no configuration meets, a loop at a singular position)."""
 
@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse
 
 import mbsynth as mb
-from mbsynth.analysis.projection import _correction, consistent_initial_state
+from mbsynth.analysis.projection import _least_change, consistent_initial_state
 from mbsynth.cli import main
 
 RNG = np.random.default_rng(3)
@@ -29,7 +29,7 @@ def tree_rows(count, width=5):
 
 def weighted_least_norm(J, r):
     """numpy's minimum of ‖diag(c) Δ‖ subject to J Δ = r, c_j = ‖J_:j‖ (the metric of
-    projection._correction): Δ = D (J D)⁺ r with D = diag(1/c)."""
+    projection._least_change): Δ = D (J D)⁺ r with D = diag(1/c)."""
     J = J.toarray()
     D = 1.0 / np.linalg.norm(J, axis=0)
     return D * np.linalg.lstsq(J * D, r, rcond=1e-12)[0]
@@ -39,7 +39,7 @@ def test_independent_rows_give_the_least_norm_step():
     J = tree_rows(40)
     J = (J @ scipy.sparse.diags(RNG.uniform(1e-3, 1e3, size=J.shape[1]))).tocsr()  # coordinates in mixed units
     r = RNG.normal(size=J.shape[0])
-    step = _correction(J, r, np.arange(J.shape[1]))
+    step = _least_change(J, r, np.arange(J.shape[1]))
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-10 * np.linalg.norm(expected)
 
@@ -50,16 +50,16 @@ def test_the_step_does_not_depend_on_the_coordinates_units():
     J = tree_rows(10)
     r = RNG.normal(size=J.shape[0])
     units = RNG.uniform(1e-3, 1e3, size=J.shape[1])
-    scaled = _correction((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r,
+    scaled = _least_change((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r,
                          np.arange(J.shape[1]))  # coordinate j counted in 1/units_j
-    np.testing.assert_allclose(scaled / units, _correction(J, r, np.arange(J.shape[1])), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(scaled / units, _least_change(J, r, np.arange(J.shape[1])), rtol=1e-9, atol=1e-12)
 
 
 def test_dependent_rows_still_give_the_least_norm_step():
     J = tree_rows(10)
     J = scipy.sparse.vstack([J, J[3] + 2 * J[17]]).tocsr()  # a redundant row, as a planar loop in 3D has
     r = J @ RNG.normal(size=J.shape[1])  # consistent right side
-    step = _correction(J, r, np.arange(J.shape[1]))
+    step = _least_change(J, r, np.arange(J.shape[1]))
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-9 * np.linalg.norm(expected)
     assert np.linalg.norm(J @ step - r) < 1e-9 * np.linalg.norm(r)
@@ -72,7 +72,7 @@ def test_a_small_system_takes_the_dense_route_to_the_same_step():
     assert J.shape[0] * J.shape[1] <= DENSE_ENTRIES
     r = RNG.normal(size=J.shape[0])
     expected = weighted_least_norm(J, r)
-    assert np.linalg.norm(_correction(J, r, np.arange(J.shape[1])) - expected) < 1e-10 * np.linalg.norm(expected)
+    assert np.linalg.norm(_least_change(J, r, np.arange(J.shape[1])) - expected) < 1e-10 * np.linalg.norm(expected)
 
 
 def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
@@ -93,9 +93,9 @@ def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
     assert np.abs(projected - q).max() < 1e-11
 
 
-def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near_zero():
+def test_a_quaternion_rate_is_projected_by_a_small_move_when_a_component_is_near_zero():
     """The velocity row u·u̇ = 0 of a body with u = (0.6, 0.8, 0, 1e-8) and ψ = 1e-9: a scale
-    of u_z's column alone (2u_z) would take the correction almost entirely on u̇_z, about
+    of u_z's column alone (2u_z) would take the projection almost entirely on u̇_z, about
     ψ/(3 u_z) = 0.03 rad/s, a kick to the spin. The quaternion's four columns share one
     scale (System.coordinate_groups), so u̇ moves along u by ψ/|u|² and no more."""
     import mbsynth as mb

@@ -93,7 +93,7 @@ def test_example3_case_5_2_matches_5_47(name, method):
         expected = np.array([-k1 * k2**2 * s, -k1 * k2**2 * s, -k1**2 * k2 * s]) / (p["m2"] * (k1 + k2) ** 2)
         assert motion.unique
         np.testing.assert_allclose(motion.qdd, expected, rtol=1e-9, atol=1e-12 * np.abs(expected).max())
-        # (5.48) with its sign corrected: m2 ẍ2 = −k1 k2 / (k1 + k2) · (x̄1 + q̄2), springs in series
+        # (5.48) with its sign projected: m2 ẍ2 = −k1 k2 / (k1 + k2) · (x̄1 + q̄2), springs in series
         np.testing.assert_allclose(motion.qdd[1] + motion.qdd[2], -k1 * k2 / (k1 + k2) * s / p["m2"], rtol=1e-9)
 
 
