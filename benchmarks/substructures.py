@@ -100,7 +100,7 @@ def composed_model(count, cell_path=CELL):
 def run(path, simulate=False):
     """One fresh interpreter loading (and simulating) the model at ``path``, cold derivation cache."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
-               MBSYNTH_DERIVATION_CACHE="off", **({"MBSYNTH_FAST": "wait"} if simulate else {}))
+               MBSYNTH_DERIVATION_CACHE="off", **({"MBSYNTH_COMPILED": "wait"} if simulate else {}))
     result = subprocess.run([sys.executable, "-c", PROBE, str(path), "simulate" if simulate else "load"],
                             cwd=ROOT, env=env, capture_output=True, text=True, check=False)
     if result.returncode:
@@ -144,7 +144,7 @@ def main(argv=None):
         f"that process); medians of {args.runs} runs; ratios to one composed copy (the bar: at most 5×).", "",
         *rows, "",
         f"The {args.copies}-copy model on the compiled path (asserted): its Template built and its generated",
-        f"function compiled (`system.data()`, MBSYNTH_FAST=wait) in {simulated['build']:.1f} s, then",
+        f"function compiled (`system.data()`, MBSYNTH_COMPILED=wait) in {simulated['build']:.1f} s, then",
         f"`mb.simulate` for {SIM_T_END} s of motion in {simulated['simulate']:.2f} s ({simulated['steps']} recorded steps).", "",
         f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()};",
         "shared with other work: compare figures within one table, CPU times are the steadier.", ""])

@@ -12,7 +12,7 @@ from ..core.tolerances import CHECK_RESIDUAL_TOL
 
 def run(args):
     # a handful of evaluations at one state: the KKT path, no kernels to compile (a path the
-    # user set with MBSYNTH_FAST is kept)
+    # user set with MBSYNTH_COMPILED is kept)
     with default_path_as("kkt"):
         system = model_of(args)
         report = diagnose(system)

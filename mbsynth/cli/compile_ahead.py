@@ -1,4 +1,4 @@
-"""``python -m mbsynth.cli.compile_ahead`` (run by ``make install``): compile the fast path's
+"""``python -m mbsynth.cli.compile_ahead`` (run by ``make install``): compile the compiled path's
 kernels (mbsynth.compiled) into the cache ahead of use, on warm-up models read as model files
 (hence here, on the floor that may read them).
 
@@ -46,10 +46,10 @@ def main():
     cold = not background.compiled()
     where = os.environ.get("NUMBA_CACHE_DIR") or cache.cache_dir()
     if cold:
-        say(f"compiling the fast path's kernels once ({COLD_TIME}); every later run loads them "
+        say(f"compiling the compiled path's kernels once ({COLD_TIME}); every later run loads them "
             f"from the cache ({where}) in about a second instead of compiling for tens of seconds")
     else:
-        say(f"the fast path's kernels are compiled already ({where}): loading them to check (seconds)")
+        say(f"the compiled path's kernels are compiled already ({where}): loading them to check (seconds)")
     stages = ([("the kernel's largest parts, in helper processes", None)] if cold else []) + [
         (f"the general kernel on warm-up model {k} of {len(WARM_MODELS)}", text)
         for k, text in enumerate(WARM_MODELS, start=1)] + [("the rigid tree's kernel", WARM_RIGID)]
@@ -64,7 +64,7 @@ def main():
         if text is WARM_RIGID:
             ahead.wait(rigid)
         warm([text])
-    print(f"mbsynth fast path compiled into {where} in {time.perf_counter() - started:.1f} s")
+    print(f"mbsynth: the compiled path's kernels compiled into {where} in {time.perf_counter() - started:.1f} s")
 
 
 def say(line):

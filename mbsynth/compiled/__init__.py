@@ -16,7 +16,7 @@ parts' and joints' attributes (layout.py) and imports nothing of model/.
     rows.py        φ, φ̇ of the kernel's rows and its nodes' energies (simulate's rows)
     projection.py  states put back on the constraints by the kernel, in the mass metric
     threads.py     the threads compiled kernels share (motion_batch, projections)
-    background.py  building Templates off the caller's thread; MBSYNTH_FAST
+    background.py  building Templates off the caller's thread; MBSYNTH_COMPILED
     worker.py      the daemon thread such builds run on, and what leaving Python does to them
     structures.py  a numba kernel per shared structure of constraint or part expressions
     grouped.py     the instances of one structure evaluated together (model/evaluation.py)

@@ -79,7 +79,7 @@ class Template:
 
 
 class Engine:
-    """The fast path for one System at its parameter values ``p`` (Layout ``L``)."""
+    """The compiled path for one System at its parameter values ``p`` (Layout ``L``)."""
 
     def __init__(self, template, L, p):
         self.template, self.L, self.p = template, L, p

@@ -1,4 +1,4 @@
-"""The fast path's whole evaluation, in numba: assemble, factor the tree, close the loops,
+"""The compiled path's whole evaluation, in numba: assemble, factor the tree, close the loops,
 recover q̈ and Qc, check.
 
 Extra rows (loop joints, other constraints) and extra coordinates (other parts) join the

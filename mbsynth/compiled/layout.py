@@ -1,4 +1,4 @@
-"""What the fast path computes where: a System turned, once, into index and number arrays.
+"""What the compiled path computes where: a System turned, once, into index and number arrays.
 
 Kernel nodes are the rigid bodies (with their own ``<body>.unit_quaternion`` row) and the
 particles (their type's ``node``); kernel joints are the holonomic joints (of a kind whose

@@ -12,7 +12,7 @@ one structure together. ``kernel(raw)`` turns that structure into
 written into the cache under the hash of its text and compiled by numba (``cache=True``:
 a structure seen before, by any model, loads its machine code from disk). A Data on the
 compiled path (grouped.Batch with ``compiled``) builds it at its first call, waiting;
-``MBSYNTH_FAST=off`` never builds it (grouped.py then uses numpy).
+``MBSYNTH_COMPILED=off`` never builds it (grouped.py then uses numpy).
 """
 
 import logging
@@ -43,7 +43,7 @@ UNSET = "unset"  # a raw function's ``kernel`` before its build
 
 def kernel(raw):
     """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
-    symbolic.derive._lambdified), built now if it is not yet, or None: MBSYNTH_FAST=off,
+    symbolic.derive._lambdified), built now if it is not yet, or None: MBSYNTH_COMPILED=off,
     or not compilable. Kept on ``raw`` itself (its attribute ``kernel``)."""
     if mode() == "off" or not hasattr(raw, "structure"):
         return None

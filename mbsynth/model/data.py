@@ -9,7 +9,7 @@ in a Data made from it (``data.model`` is that System):
 - its path, chosen when it is made: "compiled" (the kernels of mbsynth.compiled where they
   cover the model, built at the first use and waited for) or "kkt" ((2.14) in its KKT form
   throughout); by default ``mbsynth.compiled.background.default_path()`` ("compiled";
-  "kkt" where MBSYNTH_FAST=off). The path never depends on what a background build or a
+  "kkt" where MBSYNTH_COMPILED=off). The path never depends on what a background build or a
   file on disk happens to have finished, so equal models give equal results;
 - the Evaluator of the constraints and parts (evaluation.py) and the compiled Engine at
   its parameter values.
@@ -24,6 +24,7 @@ joint kinematics, linearize's derivatives) is kept in the one cache (core/memo.p
 changes how fast a Data is made, never what it computes.
 """
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,7 +40,9 @@ from .joint_values import JointValuesBatch
 UNSET = object()  # a Data's engine before its first use
 PATHS = ("compiled", "kkt")  # the compiled kernels (mbsynth.compiled) where they cover the model, or (2.14)'s KKT form
 STRUCTURES_KEPT = 16  # model structures whose compiled Template and evaluators MEMO keeps
-METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
+# the KKT form of (2.14), solved on the Data's path, or the literal pseudo-inverse of (2.14)
+METHODS = {"kkt": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
+OLD_METHODS = {"fast": "kkt"}  # old name -> the method's name (a DeprecationWarning)
 
 
 @dataclass(frozen=True)
@@ -197,9 +200,13 @@ class Data:
 
     # ---- the motion (2.14)
 
-    def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
+    def motion(self, t, q, qd, method="kkt", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (``System.motion`` says
         what each argument means); its ``lam`` is computed when first read."""
+        if method in OLD_METHODS:
+            warnings.warn(f"method={method!r} is the old name of method={OLD_METHODS[method]!r}", DeprecationWarning,
+                          stacklevel=2)
+            method = OLD_METHODS[method]
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
@@ -208,7 +215,7 @@ class Data:
 
     def _solved(self, t, q, qd, method, baumgarte, drift):
         """The Motion of ``motion``, without its multipliers."""
-        if method == "fast":
+        if method == "kkt":
             engine = self.engine
             if engine is not None:
                 shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
@@ -239,13 +246,13 @@ class Data:
         False: the KKT path alone (for stages the engine has declined already)."""
         engine = self.engine
         if not compiled:
-            return lambda t, q, qd: self._kkt_motion(t, *self._state(q, qd), "fast", baumgarte, drift)
+            return lambda t, q, qd: self._kkt_motion(t, *self._state(q, qd), "kkt", baumgarte, drift)
         if engine is None or baumgarte is not None:
-            return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
+            return lambda t, q, qd: self._solved(t, *self._state(q, qd), "kkt", baumgarte, drift)
 
         def stage(t, q, qd):
             found = engine.motion(t, q, qd, None, drift)
-            return found if found is not None else self._kkt_motion(t, q, qd, "fast", None, drift)
+            return found if found is not None else self._kkt_motion(t, q, qd, "kkt", None, drift)
         return stage
 
     def motion_batch(self, t, q_batch, qd_batch):

@@ -369,12 +369,13 @@ class System:
         dense where that is faster (sparse=None: few rows and coordinates)."""
         return self._data.constraint_arrays(t, q, qd, sparse)
 
-    def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
+    def motion(self, t, q, qd, method="kkt", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (qdd, unique, nullspace,
-        Qc, residual). ``method``: "fast" or "reference" (the literal pseudo-inverse of
-        (2.14)). "fast" is the Data's path (data.py: by default the linear-time compiled path of
-        ``mbsynth.compiled`` where it covers the model and its checks pass, else the KKT
-        path); both fall back to the exact treatment when the problem is not well posed.
+        Qc, residual). ``method``: "kkt" or "reference" (the literal pseudo-inverse of
+        (2.14); "fast" is the old name of "kkt"). "kkt" solves the KKT form of (2.14) on the
+        Data's path (data.py: by default the linear-time compiled path of ``mbsynth.compiled``
+        where it covers the model and its checks pass, else a factorization of the KKT
+        matrix); both fall back to the exact treatment when the problem is not well posed.
         ``baumgarte=(α, β)`` replaces b by b − 2α φ̇ − β² φ on the rows that have those
         residuals (drift control during integration; b itself when they are zero).
         Coulomb friction at joints makes C depend on q̈: then ``friction.coulomb_motion``

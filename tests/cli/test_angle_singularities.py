@@ -95,10 +95,10 @@ def test_a_falling_bicycle_stops_at_its_angles_singular_position():
     angles' angle_x) towards π/2, where the steps crawled without end. It stops within the
     bound with exit 1 (the run had to stop) and one line naming the parts (a wheel file's part
     by its full name, rear.wheel), their angles by the names within a part and their singular
-    value. Without the compiled kernels (MBSYNTH_FAST=off): the same path in every process."""
+    value. Without the compiled kernels (MBSYNTH_COMPILED=off): the same path in every process."""
     started = time.monotonic()
     done = mbsynth("simulate", ROOT / "models/rolling/bicycle.yaml", "--set", "v=0.5", "--set", "kick=0.3",
-                   "--t-end", "4", env=dict(os.environ, MBSYNTH_FAST="off"))
+                   "--t-end", "4", env=dict(os.environ, MBSYNTH_COMPILED="off"))
     assert time.monotonic() - started < HANG
     assert done.returncode == 1, done.stderr
     [line] = done.stderr.splitlines()

@@ -39,18 +39,18 @@ def test_unique_models(capsys, name, n, m, rank_M, rank_A):
 
 
 def test_check_compiles_nothing_and_leaves_the_default_path_as_it_was(capsys, monkeypatch):
-    """``check`` computes on the KKT path where the user left MBSYNTH_FAST unset, and only
+    """``check`` computes on the KKT path where the user left MBSYNTH_COMPILED unset, and only
     while it runs: the models simulated after it in the same process (as in this test
     session) still get the compiled path; a value the user set is kept."""
     from mbsynth.compiled import background
-    monkeypatch.delenv("MBSYNTH_FAST", raising=False)
+    monkeypatch.delenv("MBSYNTH_COMPILED", raising=False)
     seen = []  # Templates put to build
     monkeypatch.setattr(background, "_submit", lambda *args: seen.append("engine"))
     assert main(["check", str(MODELS.parent / "robots" / "ur5_payload.yaml")]) == 0
-    assert "MBSYNTH_FAST" not in os.environ and background.default_path() == "compiled" and seen == []
+    assert "MBSYNTH_COMPILED" not in os.environ and background.default_path() == "compiled" and seen == []
     with background.default_path_as("kkt"):
         assert background.default_path() == "kkt"
-        monkeypatch.setenv("MBSYNTH_FAST", "on")
+        monkeypatch.setenv("MBSYNTH_COMPILED", "on")
         assert background.default_path() == "compiled"
 
 

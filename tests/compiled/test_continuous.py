@@ -27,7 +27,7 @@ EXTRA = ["mechanisms/andrews.yaml", "mechanisms/four_bar.yaml", "mechanisms/slid
 
 @pytest.fixture(autouse=True)
 def compiled_path(monkeypatch):
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
 
 
 def projection_of(system):

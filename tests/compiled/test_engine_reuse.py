@@ -283,7 +283,7 @@ def test_runs_are_bit_identical(tmp_path):
     """Two runs of one model in fresh processes, each compiling in the background: 4 s are
     long enough that a run switching paths when its compilation finished (as they did) would
     switch at a different step each time, and differ by about 1e-12."""
-    env = {**os.environ, "MBSYNTH_FAST": "background"}
+    env = {**os.environ, "MBSYNTH_COMPILED": "background"}
     results = []
     for k in range(2):
         out = tmp_path / f"run{k}.npy"

@@ -1,4 +1,4 @@
-"""The fast path (mbsynth.compiled): its hand-differentiated rows and body blocks against the
+"""The compiled path (mbsynth.compiled): its hand-differentiated rows and body blocks against the
 sympy-compiled ones, its accelerations against the reference (2.14) on every model file and
 on random chains, trees and loops, its fallback to the exact treatment, and the batch.
 
@@ -241,7 +241,7 @@ def test_body_blocks_equal_the_sympy_blocks(all_joints):
 
 
 def assert_same_motion(system, t, q, qd, *, rtol=1e-10):
-    """The fast path answers, and as (2.15) does."""
+    """The compiled path answers, and as (2.15) does."""
     engine = engine_for(system)
     assert engine is not None
     fast = engine.motion(t, q, qd)
@@ -545,7 +545,7 @@ def test_baumgarte_and_parameters(all_joints):
 def test_compiled_code_is_kept_per_version_of_the_sources(tmp_path):
     """numba checks only the file of the function it loads from its cache, so a kernel built
     against an older module it calls would come back stale: the cache directory is named by
-    a digest of all the fast path's sources, which any edit changes."""
+    a digest of all the compiled path's sources, which any edit changes."""
     import shutil
 
     from mbsynth.compiled import cache
@@ -708,7 +708,7 @@ def test_kernel_views_are_the_packed_fields():
 
 @pytest.mark.implementation
 def test_motion_made_is_the_frozen_dataclass():
-    """Motion.made (the fast path's constructor) gives the same fields as Motion(...) and
+    """Motion.made (the compiled path's constructor) gives the same fields as Motion(...) and
     the same frozen object."""
     import dataclasses
 

@@ -72,7 +72,7 @@ def test_off_the_manifold_the_kernel_gives_the_drift_rules_motion(name):
         q, qd = drifted(system, rng, 1e-9)
         compiled = engine.motion(0.0, q, qd, None, True)
         assert compiled is not None  # served by the kernel, not handed to the KKT path
-        exact = data._kkt_motion(0.0, q, qd, "fast", None, True)
+        exact = data._kkt_motion(0.0, q, qd, "kkt", None, True)
         scale = np.abs(exact.qdd).max()
         assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-6 * scale
 
@@ -191,7 +191,7 @@ def test_a_model_of_extra_coordinates_keeps_its_stages_where_no_direction_is_nea
         qd = qd0 + 1e-9 * rng.standard_normal(q0.size)
         compiled = engine.motion(0.0, q, qd, None, True)
         assert compiled is not None
-        exact = data._kkt_motion(0.0, q, qd, "fast", None, True)
+        exact = data._kkt_motion(0.0, q, qd, "kkt", None, True)
         assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-9 * np.abs(exact.qdd).max()
 
 

@@ -18,7 +18,7 @@ LOOPS = ["bricard.yaml", "bennett.yaml", "sarrus.yaml", "four_bar_3d.yaml"]
 
 @pytest.fixture(autouse=True)
 def compiled_path(monkeypatch):
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
 
 
 @pytest.fixture(scope="module")

@@ -20,3 +20,29 @@ def test_system_connectors_is_the_old_name_of_constraints(pendulum):
         old = pendulum.connectors
     assert old is pendulum.constraints
     assert [c.name for c in old] == ["link1.unit_quaternion", "link2.unit_quaternion", "shoulder", "elbow"]
+
+
+def test_mbsynth_fast_is_read_where_mbsynth_compiled_is_not_set(monkeypatch):
+    from mbsynth.compiled import background
+    monkeypatch.delenv("MBSYNTH_COMPILED", raising=False)
+    monkeypatch.setenv("MBSYNTH_FAST", "off")
+    assert background.default_path() == "kkt"
+    monkeypatch.setenv("MBSYNTH_COMPILED", "on")  # the variable's name wins over its old one
+    assert background.default_path() == "compiled"
+    monkeypatch.setenv("MBSYNTH_COMPILED", "sometimes")
+    with pytest.raises(ValueError, match=r"^MBSYNTH_COMPILED must be one of \('on', 'off'\), got 'sometimes'$"):
+        background.default_path()
+    monkeypatch.delenv("MBSYNTH_COMPILED")
+    monkeypatch.setenv("MBSYNTH_FAST", "sometimes")
+    with pytest.raises(ValueError, match=r"^MBSYNTH_FAST must be one of"):
+        background.default_path()
+
+
+def test_method_fast_is_the_old_name_of_kkt(pendulum):
+    data = pendulum.data(path="kkt")
+    q, qd = pendulum.initial_state()
+    with pytest.warns(DeprecationWarning, match=r"method='fast' is the old name of method='kkt'"):
+        old = data.motion(0.0, q, qd, method="fast")
+    assert old.qdd.tolist() == data.motion(0.0, q, qd, method="kkt").qdd.tolist()
+    with pytest.raises(ValueError, match=r"method must be one of \['kkt', 'reference'\]"):
+        data.motion(0.0, q, qd, method="quick")
