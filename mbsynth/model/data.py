@@ -92,7 +92,8 @@ _STRUCTURES = MEMO.table("model structures", STRUCTURES_KEPT)
 
 
 class Data:
-    """The workspace of computations on ``system`` at parameter values ``p``, on the
+    """The workspace of computations on ``system`` at its ``parameter_values`` (an array in
+    the model's parameter order; ``parameters``: the same as {name: value}), on the
     ``path`` "compiled" or "kkt" (``PATHS``; None: ``background.default_path()``)."""
 
     def __init__(self, system, path=None):
@@ -101,7 +102,7 @@ class Data:
             raise ValueError(f"path must be one of {PATHS}, got {path!r}")
         self.system = self.model = system
         self.path = path
-        self.p = system.parameter_values.copy()
+        self.parameter_values = system.parameter_values.copy()
         self._shared = shared(system)
         self._evaluator = None  # made on first use: a compiled run may never need it
         self._joint_values = None  # joint_values.JointValuesBatch, made on first use
@@ -113,11 +114,7 @@ class Data:
     @property
     def parameters(self):
         """{name: value} at this Data's parameter values."""
-        return dict(zip(self.system.parameters, self.p.tolist()))
-
-    @property
-    def parameter_values(self):
-        return self.p
+        return dict(zip(self.system.parameters, self.parameter_values.tolist()))
 
     @property
     def evaluator(self):
@@ -132,7 +129,7 @@ class Data:
         cover."""
         if self._engine is UNSET:
             template = None if self.path == "kkt" else background.template(self.system, self._shared.compiled)
-            self._engine = None if template is None else template.engine(self.p)
+            self._engine = None if template is None else template.engine(self.parameter_values)
         return self._engine
 
     def set_parameters(self, values):
@@ -140,9 +137,9 @@ class Data:
         those defined by expressions of others follow. Raises ModelError for an unknown
         name, a non-finite value, or a part whose M or Q the values make unusable
         (``System.resolved_parameters``)."""
-        self.p = self.system.resolved_parameters(values, self.p)
+        self.parameter_values = self.system.resolved_parameters(values, self.parameter_values)
         if self._engine is not None and self._engine is not UNSET:
-            self._engine = self._engine.template.engine(self.p)
+            self._engine = self._engine.template.engine(self.parameter_values)
 
     def _state(self, q, qd):
         return self.system._state(q, qd)
@@ -153,7 +150,8 @@ class Data:
         """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
         q, qd = self._state(q, qd)
         evaluator = self.evaluator
-        return Assembly(*evaluator.parts(t, q, qd, self.p), *evaluator.dense_rows(t, q, qd, self.p))
+        p = self.parameter_values
+        return Assembly(*evaluator.parts(t, q, qd, p), *evaluator.dense_rows(t, q, qd, p))
 
     def constraint_rows(self, t, q, qd):
         """A (m × n, scipy.sparse CSR) and b at (t, q, q̇): the rows alone, without M."""
@@ -165,31 +163,31 @@ class Data:
         (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
         dense where that is faster (sparse=None: few rows and coordinates)."""
         q, qd = self._state(q, qd)
-        return self.evaluator.constraints(t, q, qd, self.p, sparse)
+        return self.evaluator.constraints(t, q, qd, self.parameter_values, sparse)
 
     def constraint_residuals(self, t, q, qd):
         """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
         q, qd = self._state(q, qd)
-        return self.evaluator.residuals(t, q, qd, self.p)
+        return self.evaluator.residuals(t, q, qd, self.parameter_values)
 
     def energy(self, t, q, qd):
         """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
         q, qd = self._state(q, qd)
-        return self.evaluator.energies(t, q, qd, self.p)
+        return self.evaluator.energies(t, q, qd, self.parameter_values)
 
     def power(self, t, q, qd):
         """The power of the forces that derive from no potential (``Evaluator.power``): the
         rate at which they change T + V."""
         q, qd = self._state(q, qd)
-        return self.evaluator.power(t, q, qd, self.p)
+        return self.evaluator.power(t, q, qd, self.parameter_values)
 
     def branch_problems(self, q=None, t=0.0):
         """``System.branch_problems`` at this Data's parameter values."""
-        return self.system.branch_problems(q, t, self.p)
+        return self.system.branch_problems(q, t, self.parameter_values)
 
     def part_problems(self, parameters=None):
         """``System.part_problems`` at this Data's parameter values."""
-        return self.system.part_problems(parameters, self.p)
+        return self.system.part_problems(parameters, self.parameter_values)
 
     def check_branches(self, q, t=0.0):
         """Raise SolveError naming the first joint whose frames, at the state q, are in a
@@ -236,7 +234,7 @@ class Data:
             return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=system.coordinates,
                                    constraints=system.constraint_names, drift=off_manifold)
         if system.coulomb:  # C depends on q̈ (friction.py)
-            return friction.coulomb_motion(system.constraints, arrays, solve, t, q, qd, self.p)
+            return friction.coulomb_motion(system.constraints, arrays, solve, t, q, qd, self.parameter_values)
         return solve(arrays.C)
 
     def stage_motion(self, baumgarte=None, drift=False, compiled=True):
@@ -304,7 +302,7 @@ class Data:
         if self._joint_values is None:
             self._joint_values = JointValuesBatch((k for k in self.system.joint_kinematics().values()
                                                    if k.position_names), self.path == "compiled")
-        return self._joint_values(t, q, qd, qdd, self.p)
+        return self._joint_values(t, q, qd, qdd, self.parameter_values)
 
     def reactions(self, t, q, qd, motion=None):
         """{constraint name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default this
@@ -313,7 +311,7 @@ class Data:
         motion = self.motion(t, q, qd) if motion is None else motion
         arrays = self.evaluate(t, q, qd)
         lam, dependent = self._multipliers(t, q, qd, motion, arrays)
-        kinematics, p = self.system.joint_kinematics(), self.p
+        kinematics, p = self.system.joint_kinematics(), self.parameter_values
         out, row = {}, 0
         for con in self.system.constraints:
             rows = slice(row, row + con.size)
@@ -330,7 +328,7 @@ class Data:
     def _joint_force(self, joint, lam, t, q, qd):
         """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the
         load λ gives, Coulomb friction: friction.py) and its force elements."""
-        p = self.p
+        p = self.parameter_values
         g = np.zeros(self.system.n)
         a, _, c = joint.evaluate(t, q, qd, p)
         g[joint.indices] += a.T @ lam + c

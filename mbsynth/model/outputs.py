@@ -106,7 +106,7 @@ class OutputEvaluator:
     def evaluate(self, t, q, qd, motion=None):
         """One row: every output's columns at (t, q, q̇); ``motion`` (System.motion at that
         state) for reactions, computed when not given."""
-        data, p = self.data, self.data.p
+        data, p = self.data, self.data.parameter_values
         compiled = iter(self._compiled(t, q, qd, p)[0].ravel()) if self._compiled else iter(())
         reactions = None
         if self.needs_reactions:

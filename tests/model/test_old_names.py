@@ -46,3 +46,12 @@ def test_method_fast_is_the_old_name_of_kkt(pendulum):
     assert old.qdd.tolist() == data.motion(0.0, q, qd, method="kkt").qdd.tolist()
     with pytest.raises(ValueError, match=r"method must be one of \['kkt', 'reference'\]"):
         data.motion(0.0, q, qd, method="quick")
+
+
+def test_a_data_has_parameter_values_in_the_models_order_and_parameters_by_name(pendulum):
+    data = pendulum.data(path="kkt")
+    data.set_parameters({"m2": 0.5})
+    assert list(pendulum.parameters) == ["m1", "m2", "L1", "L2", "r", "g"]
+    assert data.parameter_values.tolist() == [1.0, 0.5, 1.0, 0.7, 0.03, 9.81]
+    assert data.parameters == {"m1": 1.0, "m2": 0.5, "L1": 1.0, "L2": 0.7, "r": 0.03, "g": 9.81}
+    assert not hasattr(data, "p")  # one name for the array

@@ -38,7 +38,7 @@ def test_a_value_written_into_a_runs_data_stays_through_a_later_write_of_another
     data = system.data()
     data.set_parameters({"m1": 0.5})
     data.set_parameters({"k1": 50.0})
-    values = dict(zip(system.parameters, data.p))
+    values = dict(zip(system.parameters, data.parameter_values))
     assert values["m1"] == 0.5 and values["k1"] == 50.0
 
 
