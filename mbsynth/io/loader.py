@@ -380,11 +380,11 @@ class _Builder:
                 for child in included[name]:
                     parts += child.read_parts()
                 continue
-            kind = spec.get("type")
-            if kind not in FILE_TYPES:
-                self.fail(path + ("type",), f"unknown part type {kind!r}; known: "
+            type_name = spec.get("type")
+            if type_name not in FILE_TYPES:
+                self.fail(path + ("type",), f"unknown part type {type_name!r}; known: "
                                             f"{', '.join((*FILE_TYPES, 'model'))}")
-            made = FILE_TYPES[kind].read(self, self.full_name(name), spec, path)
+            made = FILE_TYPES[type_name].read(self, self.full_name(name), spec, path)
             made = made if isinstance(made, list) else [made]  # a robot gives one part per link
             for part in made:
                 self.assembly.parts[part.name] = part

@@ -132,7 +132,7 @@ def test_without_the_balance_each_knee_link_is_indeterminate(unbalanced):
     q, qd = system.initial_state()
     fast, reference = system.motion(0.0, q, qd), system.motion(0.0, q, qd, method="reference")
     assert not fast.unique and not reference.unique
-    massless = [part.name for part in system.parts if part.kind == "rigid_body" and part.name.endswith(".link")]
+    massless = [part.name for part in system.parts if part.type_name == "rigid_body" and part.name.endswith(".link")]
     assert massless == [f"{leg}.link" for leg in LEGS]
     N = reference.nullspace
     assert N.shape[1] == len(massless) == 4

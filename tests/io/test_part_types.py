@@ -95,7 +95,7 @@ CASES = [(name, i, text) for name, texts in EXAMPLES.items() for i, text in enum
 @pytest.mark.parametrize("name, i, text", CASES, ids=[f"{name}-{i}" for name, i, _ in CASES])
 def test_each_type_is_read_drawn_linearized_and_compiled(name, i, text):
     system = mb.loads(textwrap.dedent(text), name=f"{name}.yaml")
-    assert {p.kind for p in system.parts} <= {t.name for t in FILE_TYPES[name].builds}
+    assert {p.type_name for p in system.parts} <= {t.name for t in FILE_TYPES[name].builds}
     q, qd = system.initial_state()
     # drawn: every part has a node at its own pose or its frames (a spring: its line)
     rows = np.array([q, q + 0.01])

@@ -78,7 +78,7 @@ def test_parts_are_the_links_with_their_masses(ur5):
     masses add up to Pinocchio's total mass of the floating robot."""
     description = ur5.robots[0].description
     assert [p.name for p in ur5.parts] == list(description.links)
-    assert all(p.kind == "rigid_body" for p in ur5.parts)
+    assert all(p.type_name == "rigid_body" for p in ur5.parts)
     model = pin.buildModelFromUrdf(description.path, pin.JointModelFreeFlyer())
     assert sum(float(p.mass) for p in ur5.parts) == pytest.approx(pin.computeTotalMass(model), rel=1e-12)
     q, qd = ur5.initial_state()

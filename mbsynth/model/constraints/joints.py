@@ -178,7 +178,7 @@ def _rotation_at(part, frame, values):
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ own
     if part.part_type.orientation == QUATERNION:
         return quaternion_rotation([float(values[x]) for x in part.q[part.part_type.quaternion]]) @ own
-    raise ValueError(f"a {part.kind} part shares its poses but turns by {part.part_type.orientation}: no rotation "
+    raise ValueError(f"a {part.type_name} part shares its poses but turns by {part.part_type.orientation}: no rotation "
                      "from its coordinates here")
 
 
