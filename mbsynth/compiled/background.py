@@ -57,8 +57,8 @@ def default_path_as(path):
 
 
 def given():
-    """(name, text) of the environment's choice: MBSYNTH_COMPILED, else its old name
-    MBSYNTH_FAST; (MBSYNTH_COMPILED, None) where neither is set."""
+    """(name, text) of the environment's choice: MBSYNTH_COMPILED, else OLD_VARIABLE (its
+    old name); (MBSYNTH_COMPILED, None) where neither is set."""
     for name in (VARIABLE, OLD_VARIABLE):
         if os.environ.get(name) is not None:
             return name, os.environ[name]

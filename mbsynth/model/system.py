@@ -187,7 +187,7 @@ class System:
         return len(self.coordinates)
 
     @property
-    def connectors(self):
+    def connectors(self):  # the old name of constraints
         """``constraints`` under its old name (a DeprecationWarning)."""
         warnings.warn("System.connectors is the old name of System.constraints", DeprecationWarning, stacklevel=2)
         return self.constraints
