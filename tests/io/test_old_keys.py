@@ -62,8 +62,8 @@ def test_closure_and_balances_in_one_file_are_refused_at_the_old_key():
 
 
 def test_a_message_about_closure_names_it_balances():
-    with pytest.raises(mb.ModelError, match=r"^m\.yaml:2: at balances: expected 'auto' or 'none', got 'yes'$"):
-        mb.loads("name: m\nclosure: yes\nparts:\n  a: {type: particle, mass: 1}\n", name="m.yaml")
+    with pytest.raises(mb.ModelError, match=r"^m\.yaml:2: at balances: expected 'auto' or 'none', got 'sometimes'$"):
+        mb.loads("name: m\nclosure: sometimes\nparts:\n  a: {type: particle, mass: 1}\n", name="m.yaml")
 
 
 def test_compose_takes_closure_as_the_old_name_of_balances():
