@@ -90,7 +90,8 @@ SHARED_KEYS = {key.name: key for key in (_DESCRIPTION, _FRAMES, _GEOMETRY)}
 
 SECTIONS = {section.name: section for section in (
     Section("model", "the top level of a model file",
-            "A model file is one mapping. Only ``parts`` is required.",
+            "A model file is one mapping. Only ``parts`` is required. A key under its old name is read "
+            "as the key: ``subsystems`` (old name of ``parts``), ``closure`` (old name of ``balances``).",
             (Key("name", "string", "the model's name", "example1_wheel", default="the file name"),
              _DESCRIPTION,
              Key("parameters", "mapping name → expression", "named constants; each may use those before it",

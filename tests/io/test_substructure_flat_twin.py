@@ -244,7 +244,7 @@ def test_initial_state_is_assembled(twins):
     phi, phid = (np.asarray(r) for r in composed.constraint_residuals(0.0, q, qd))
     names = composed.constraint_names
     held = [i for i, name in enumerate(names) if not name.startswith("leash")]
-    joints = [i for i in held if not name_of(names[i]).startswith("balances")]
+    joints = [i for i in held if not name_of(names[i]).startswith("balance_")]
     assert len(joints) < len(held)
     assert np.abs(phi[held]).max() < 1e-12
     assert np.abs(phid[joints]).max() < 1e-12
