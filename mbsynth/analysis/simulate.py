@@ -80,7 +80,7 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
         for name, (given, new) in changes.items():
             log.info("initial %s: %.12g -> %.12g (made consistent with the constraints)", name, given, new)
     else:
-        start_q, start_qd = system.initial_state()
+        start_q, start_qd = data.initial_state()
         q = start_q if q0 is None else np.asarray(q0, dtype=float)
         qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
         changes = {}
