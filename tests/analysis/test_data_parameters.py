@@ -84,3 +84,19 @@ def test_steady_motion_at_a_datas_parameters(values):
     assert found[spin] == pytest.approx(changed.parameters["spin"], rel=1e-9)
     assert default[spin] == pytest.approx(system.parameters["spin"], rel=1e-9)
     assert abs(changed.parameters["spin"] - system.parameters["spin"]) > 1e-3 * abs(system.parameters["spin"])
+
+
+def test_simulate_at_a_datas_parameters():
+    """A pendulum released from θ0 on a rod of length L, run in a Data set to both: its
+    initial state, motion and recorded parameters are those of the model built with them;
+    the Data runs on its own path only."""
+    values = {"L": 2.0, "theta0": 0.5}
+    system, data, changed = _both("mechanisms/simple_pendulum.yaml", values)
+    found, expected, default = (mb.simulate(x, 0.5, dt=0.1) for x in (data, changed, system))
+    assert rel(found.q, expected.q) < SAME and rel(found.qd, expected.qd) < SAME
+    assert np.abs(np.hypot(found.q[:, 0], found.q[:, 1]) - 2.0).max() < 1e-9
+    assert np.abs(default.q[:, 0] - found.q[:, 0]).max() > 0.1
+    assert {name: found.parameters[name] for name in values} == values
+    other = "kkt" if data.path == "compiled" else "compiled"
+    with pytest.raises(ValueError, match=f"path='{other}': the Data given runs on its own path, '{data.path}'"):
+        mb.simulate(data, 0.5, path=other)
