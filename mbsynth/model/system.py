@@ -302,10 +302,10 @@ class System:
         positive semi-definite, at the initial state — a model no equation of motion fits.
         ``parameters``: only the parts written in these parameter symbols (those whose values
         changed: ``with_parameters``); every part by default. ``p``: the parameter values
-        (default: the model's)."""
+        (default: the model's), at which the initial state is taken too."""
         if parameters is not None and not any(part.reads(parameters) for part in self.parts):
             return []  # a controller's torques: read by forces alone
-        q, qd = self.initial_state()
+        q, qd = self.initial_state(p)
         p = self.parameter_values if p is None else p
         problems, start = [], 0
         for part in self.parts:
