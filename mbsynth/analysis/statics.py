@@ -100,17 +100,17 @@ def equilibrium(model, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iterations
                              "velocities only (its steps move along every direction the holonomic rows allow)")
         K = lin.A[k:, :k]
         resolution = tolerance * (1.0 + np.abs(K).max())
-        model = None
+        quadratic = None
         if np.abs(lin.qdd).max() <= resolution:
-            model = None if nearest else _Model(data, t, q, lin, K, nearest, resolution)
-            if model is None or not model.unstable:
+            quadratic = None if nearest else _Model(data, t, q, lin, K, nearest, resolution)
+            if quadratic is None or not quadratic.unstable:
                 _check_isolated(data, t, q, lin, K)
                 return q
-            model.downhill()  # a maximum or saddle (the start, or where the steps came to): on down from it
-        model = model or _Model(data, t, q, lin, K, nearest, resolution)
+            quadratic.downhill()  # a maximum or saddle (the start, or where the steps came to): on down from it
+        quadratic = quadratic or _Model(data, t, q, lin, K, nearest, resolution)
         if radius is None:
-            radius = model.first_radius(lin.basis, limit)
-        q, radius = _step(data, t, q, lin, model, merit, radius, limit, elastic)
+            radius = quadratic.first_radius(lin.basis, limit)
+        q, radius = _step(data, t, q, lin, quadratic, merit, radius, limit, elastic)
     worst = int(np.argmax(np.abs(lin.qdd)))
     raise NoEquilibrium(f"model '{system.name}': no static equilibrium found from the given configuration: after "
                         f"{max_iterations} steps down the potential it still accelerates (largest q̈ "
