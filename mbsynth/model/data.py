@@ -15,9 +15,10 @@ in a Data made from it (``data.model`` is that System):
   its parameter values.
 
 The algorithms compute with a Data (``data.motion``, ``data.reactions``, …; the run loop,
-projection.py, outputs.py): they read the model's description from ``data.model`` and the
-parameter values from the Data, never from the model. ``workspace`` gives a model's
-default-path Data where a function is handed a model.
+projection.py, outputs.py, linearize, equilibrium, modes and steady motions): they read the
+model's description from ``data.model`` and the parameter values from the Data, never from
+the model. ``workspace`` gives a model's default-path Data where a function is handed a
+model, ``model_of`` the model of either.
 
 What models of one structure share (``Shared``: the compiled Template, the Evaluators, the
 joint kinematics, linearize's derivatives) is kept in the one cache (core/memo.py): it
