@@ -67,7 +67,7 @@ def diagnose(data, t=0.0, q=None, qd=None):
     default-path Data) at (t, q, q̇), by default its initial state."""
     data = workspace(data)
     system = data.model
-    q0, qd0 = system.initial_state()
+    q0, qd0 = data.initial_state()
     q = q0 if q is None else np.asarray(q, dtype=float)
     qd = qd0 if qd is None else np.asarray(qd, dtype=float)
     arrays = data.evaluate(t, q, qd)

@@ -82,7 +82,7 @@ import scipy.sparse.csgraph
 import sympy as sp
 
 from ..core.errors import SolveError
-from ..model.data import shared
+from ..model.data import shared, workspace
 from .projection import relative_drift
 from ..symbolic.derive import T_SYMBOL, compile_function, jacobian
 from ..core.tolerances import (CHANGE_POINT_RTOL, COMPLEX_STEP, NAME_RTOL, NEAR_SINGULAR, ON_MANIFOLD_RTOL, RANK_RTOL,
@@ -205,8 +205,9 @@ def _combination(names, direction):
     return text
 
 
-def linearize(system, t, q, qd, inputs=None, speeds=None):
-    """The ``Linearization`` of ``system``'s motion about (t, q, q̇) (module docstring).
+def linearize(model, t, q, qd, inputs=None, speeds=None):
+    """The ``Linearization`` of the motion of ``model`` (a System, at its parameter values,
+    or a Data, at its own) about (t, q, q̇) (module docstring).
 
     ``inputs``: parameter names B is taken for (they must enter only the forces Q + C);
     by default the robots' joint torques ``tau_*`` and the parameters named ``tau_*`` or
@@ -215,11 +216,13 @@ def linearize(system, t, q, qd, inputs=None, speeds=None):
     them (``<coordinate>_dot``); by default picked by coordinate partitioning. Both are lists
     of names (TypeError for one string). Raises SolveError where no linearization on the
     manifold exists."""
+    data = workspace(model)
+    system = data.model
     q, qd = finite_state(system, q, qd)
     inputs = default_inputs(system) if inputs is None else names_of(inputs, "inputs")
     speeds = None if speeds is None else names_of(speeds, "speeds")
-    _refuse_unsupported(system, t, q, qd)
-    motion = system.motion(t, q, qd)
+    _refuse_unsupported(data, t, q, qd)
+    motion = data.motion(t, q, qd)
     if not motion.unique:
         moving = _named(system.coordinates, np.abs(motion.nullspace).max(axis=1))
         raise SolveError(f"model '{system.name}': the motion is not unique at this state "
@@ -227,10 +230,10 @@ def linearize(system, t, q, qd, inputs=None, speeds=None):
                          "no linearization (add the massless parts' force balances with balances: auto)",
                          coordinates=moving)
     derivatives = derivatives_of(system)
-    arrays = system.evaluate(t, q, qd)
-    held = derivatives.rows(system, t, q, qd)
+    arrays = data.evaluate(t, q, qd)
+    held = derivatives.rows(data, t, q, qd)
     N, pivots = tangent_basis(system, held.Phi_q, held.position_rows)
-    _check_change_point(system, derivatives, t, q, qd, held, N)
+    _check_change_point(data, derivatives, t, q, qd, held, N)
     n, k = system.n, N.shape[1]
     S, speeds = _speeds(system, held, N, pivots, speeds)
     s = S.shape[1]
@@ -241,7 +244,7 @@ def linearize(system, t, q, qd, inputs=None, speeds=None):
     dependent = np.setdiff1d(np.arange(n), speeds)
     if W.size and dependent.size:
         T[n + dependent, :k] = -np.linalg.lstsq(W[:, dependent], Psi_q @ N, rcond=None)[0]
-    R_q, R_qd, S_q, S_qd, F_p = derivatives.motion(system, t, q, qd, motion.qdd, motion.lam, inputs)
+    R_q, R_qd, S_q, S_qd, F_p = derivatives.motion(data, t, q, qd, motion.qdd, motion.lam, inputs)
     m = arrays.A.shape[0]
     kkt = np.block([[arrays.M, -arrays.A.T], [arrays.A, np.zeros((m, m))]])
     right = np.hstack([-np.vstack([np.hstack([R_q, R_qd]), np.hstack([S_q, S_qd])]) @ T,
@@ -324,30 +327,34 @@ def _time_rows(constraints):
     return tuple(found)
 
 
-def prescribed_motion(system, t, q, qd):
+def prescribed_motion(model, t, q, qd):
     """The rows that depend on time (``time_rows``) where the state (t, q, q̇) moves: all of
-    them where q̇ ≠ 0, else those whose ∂φ/∂t (their ψ at q̇ = 0) is not zero; [] elsewhere."""
+    them where q̇ ≠ 0, else those whose ∂φ/∂t (their ψ at q̇ = 0, at the parameter values of
+    ``model``, a System or a Data) is not zero; [] elsewhere."""
+    data = workspace(model)
+    system = data.model
     rows = time_rows(system)
     if not rows or np.any(qd):
         return list(rows)
-    _, rate = system.constraint_residuals(t, q, np.zeros_like(q))
+    _, rate = data.constraint_residuals(t, q, np.zeros_like(q))
     return [name for name, x in zip(system.constraint_names, rate) if name in rows and abs(x) > ON_MANIFOLD_RTOL]
 
 
-def _refuse_unsupported(system, t, q, qd):
+def _refuse_unsupported(data, t, q, qd):
     """SolveError for what the linearization does not cover (module docstring)."""
+    system = data.model
     friction = [c.name for c in system.constraints if getattr(c, "coulomb", None)]
     if friction:
         raise SolveError(f"model '{system.name}': Coulomb friction at {friction} is not differentiable; "
                          "no linearization", constraints=friction)
-    phi, psi = system.constraint_residuals(t, q, qd)
+    phi, psi = data.constraint_residuals(t, q, qd)
     acceleration_only = [name for name, x, y in zip(system.constraint_names, phi, psi) if np.isnan(x) and np.isnan(y)]
     if acceleration_only:
         raise SolveError(f"model '{system.name}': rows {acceleration_only} restrict accelerations only (a balance "
                          "with velocities, a servo's acceleration row): they are first-order equations of their own, "
                          "outside the state (q, speeds) the linearization takes (write a massless part's balance as "
                          "a holonomic row, or use balances: auto)", constraints=acceleration_only)
-    moving = prescribed_motion(system, t, q, qd)
+    moving = prescribed_motion(data, t, q, qd)
     if moving:
         why = "q̇ ≠ 0" if np.any(qd) else f"∂φ/∂t ≠ 0 at t = {t:g}"
         raise SolveError(f"model '{system.name}': rows {moving} depend on time (a prescribed "
@@ -355,7 +362,7 @@ def _refuse_unsupported(system, t, q, qd):
                          "whose eigenvalues at one instant say nothing of its stability; linearize where the rows "
                          "hold still (q̇ = 0 and ∂φ/∂t = 0), or with the prescribed motion held at a constant",
                          constraints=moving)
-    drift = relative_drift(system, t, q, qd)
+    drift = relative_drift(data, t, q, qd)
     if drift > ON_MANIFOLD_RTOL:
         worst = system.constraint_names[int(np.nanargmax(np.abs(np.concatenate([phi, psi]))) % len(phi))]
         raise SolveError(f"model '{system.name}': the state is off the constraints (relative residual {drift:.2g}, "
@@ -394,10 +401,11 @@ def tangent_basis(system, Phi_q, position_rows=None):
     return N, pivots
 
 
-def _check_change_point(system, derivatives, t, q, qd, held, N):
+def _check_change_point(data, derivatives, t, q, qd, held, N):
     """SolveError at a singular position: a dependency wᵀΦ_q = 0 of the position rows whose
     second derivative wᵀφ_qq is not zero on the tangent space (a dependency that holds all
     along the manifold, such as a spatial loop's redundant rows, has it zero)."""
+    system = data.model
     Phi_q = held.Phi_q
     if Phi_q.shape[0] == 0 or N.shape[1] == 0:
         return
@@ -409,9 +417,9 @@ def _check_change_point(system, derivatives, t, q, qd, held, N):
         return
     Nn = N / np.linalg.norm(N, axis=0)
     generic = np.ones(Phi_q.shape[0]) / norms / np.sqrt(Phi_q.shape[0])
-    reference = np.abs(derivatives.hessian(system, t, q, qd, generic, held.position_rows)).max()
+    reference = np.abs(derivatives.hessian(data, t, q, qd, generic, held.position_rows)).max()
     for w in U[:, rank:].T:
-        curvature = Nn.T @ derivatives.hessian(system, t, q, qd, w / norms, held.position_rows) @ Nn
+        curvature = Nn.T @ derivatives.hessian(data, t, q, qd, w / norms, held.position_rows) @ Nn
         if np.abs(curvature).max() > CHANGE_POINT_RTOL * max(reference, np.finfo(float).tiny):
             rows = _named(np.array(system.constraint_names)[held.position_rows], np.abs(w))
             raise SolveError(f"model '{system.name}': the constraints are at a singular position here (rows {rows} "
@@ -486,8 +494,8 @@ class Derivatives:
     """The exact Jacobians the linearization needs, block by block as ``System.evaluate``
     assembles M, Q, A, b, C: each part's M q̈ − Q, each force element's −Q, each
     constraint's −C, Aᵀλ, A q̈ − b and ψ, over its own coordinates (``BlockFunction``).
-    Compiled once per model structure; parameters stay arguments, so ``with_parameters``
-    reuses them."""
+    Compiled once per model structure; the parameter values are arguments (a Data's
+    ``parameter_values`` at each call), so the models and Data of one structure share them."""
 
     def __init__(self, system):
         p = list(system.parameter_symbols)
@@ -522,22 +530,24 @@ class Derivatives:
         G = G if M is None else M * qdd + G
         self._forces.append((np.array(indices, dtype=int), BlockFunction(q, qd, qdd, [], p, G)))
 
-    def rows(self, system, t, q, qd):
-        """``HeldRows`` at (t, q, q̇)."""
-        phi, psi = system.constraint_residuals(t, q, qd)
+    def rows(self, data, t, q, qd):
+        """``HeldRows`` at (t, q, q̇) and the parameter values of ``data``."""
+        phi, psi = data.constraint_residuals(t, q, qd)
         position, velocity = ~np.isnan(phi), np.isnan(phi) & ~np.isnan(psi)
-        A = system.evaluate(t, q, qd).A
-        Psi_q = np.zeros((len(phi), system.n))
-        p = system.parameter_values
+        A = data.evaluate(t, q, qd).A
+        Psi_q = np.zeros((len(phi), data.model.n))
+        p = data.parameter_values
         for i, rows, f in self._rows:
             k = rows.stop - rows.start
             Psi_q[rows, i] = f.jacobians(t, q[i], qd[i], np.zeros(len(i)), np.zeros(k), p)[0][len(i) + k:]
         return HeldRows(position, A[position], Psi_q[position], velocity, A[velocity], Psi_q[velocity])
 
-    def motion(self, system, t, q, qd, qdd, lam, inputs):
+    def motion(self, data, t, q, qd, qdd, lam, inputs):
         """(R_q, R_q̇, S_q, S_q̇, F_u): the derivatives of R = Mq̈ − Q − C − Aᵀλ and S = Aq̈ − b
-        by q and q̇, and of Q + C by the ``inputs`` (which must not enter A or b)."""
-        n, m, p = system.n, len(system.constraint_names), system.parameter_values
+        by q and q̇, and of Q + C by the ``inputs`` (which must not enter A or b), at the
+        parameter values of ``data``."""
+        system = data.model
+        n, m, p = system.n, len(system.constraint_names), data.parameter_values
         lam = np.zeros(m) if lam is None else np.asarray(lam, dtype=float)
         columns = [self.parameters.index(u) for u in inputs]
         R_q, R_qd, F_u = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, len(columns)))
@@ -559,11 +569,13 @@ class Derivatives:
                              "not only the forces; they cannot be inputs of B")
         return R_q, R_qd, S_q, S_qd, F_u
 
-    def hessian(self, system, t, q, qd, w, position_rows):
-        """∂(Φ_qᵀ w)/∂q: the second derivative of the combination wᵀφ of the position rows."""
+    def hessian(self, data, t, q, qd, w, position_rows):
+        """∂(Φ_qᵀ w)/∂q: the second derivative of the combination wᵀφ of the position rows,
+        at the parameter values of ``data``."""
         lam = np.zeros(len(position_rows))
         lam[position_rows] = w
-        H, p = np.zeros((system.n, system.n)), system.parameter_values
+        n = data.model.n
+        H, p = np.zeros((n, n)), data.parameter_values
         for i, rows, f in self._rows:
             if np.any(lam[rows]):
                 H[np.ix_(i, i)] += f.jacobians(t, q[i], qd[i], np.zeros(len(i)), lam[rows], p)[0][:len(i)]

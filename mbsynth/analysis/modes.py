@@ -18,6 +18,7 @@ import numpy as np
 import scipy.linalg
 
 from ..core.errors import NoEquilibrium
+from ..model.data import workspace
 from .linearization import finite_state, linearize, prescribed_motion
 from .projection import project_positions
 from .statics import equilibrium as find_equilibrium
@@ -124,8 +125,9 @@ class Verdict:
     margin: float
 
 
-def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, qd=None, steady=False):
-    """The ``Modes`` of ``system`` at rest at ``q`` (default: the initial positions); with
+def modes(model, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, qd=None, steady=False):
+    """The ``Modes`` of ``model`` (a System, at its parameter values, or a Data, at its own)
+    at rest at ``q`` (default: the initial positions); with
     ``equilibrium=True`` at the static equilibrium found from there (statics.py); with
     ``steady=True`` about the steady motion (q, q̇) (default: the initial state; a bicycle
     rolling upright, a disk rolling in a circle): its eigenvalues are the motion's stability
@@ -133,17 +135,19 @@ def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, 
     exact zeros that are not listed as modes. Raises NoEquilibrium when the model does not
     rest at q (q̈ ≠ 0 at q̇ = 0), or the motion is not steady, or no equilibrium is found;
     SolveError where the linearization is refused (linearization.py)."""
-    q0, qd0 = system.initial_state()
+    data = workspace(model)
+    system = data.model
+    q0, qd0 = data.initial_state()
     q = q0 if q is None else np.array(q, dtype=float)
     if equilibrium:
-        q = find_equilibrium(system, q, t)
+        q = find_equilibrium(data, q, t)
     qd = (qd0 if qd is None else np.array(qd, dtype=float)) if steady else np.zeros(system.n)
     q, qd = finite_state(system, q, qd)
-    moving = [] if steady else prescribed_motion(system, t, q, qd)
+    moving = [] if steady else prescribed_motion(data, t, q, qd)
     if moving:
         raise NoEquilibrium(f"model '{system.name}' does not rest at this configuration: rows {moving} prescribe a "
                             f"motion at t = {t:g} (∂φ/∂t ≠ 0); modes are taken at rest", constraints=moving)
-    lin = linearize(system, t, q, qd)
+    lin = linearize(data, t, q, qd)
     _check_rest_or_steady(system, lin, tolerance, steady)
     k = lin.k
     values = lin.eigenvalues
@@ -154,11 +158,11 @@ def modes(system, q=None, t=0.0, equilibrium=False, tolerance=ACCELERATION_TOL, 
     free = np.abs(values) <= MODE_ZERO_RTOL * scale if rest else values == 0
     found = []
     if rest:
-        found = [_mode(system, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
+        found = [_mode(data, t, q, lin, 0j, x, scale) for x in _free_directions(lin, (int(free.sum()) + 1) // 2)]
     upper = [s for s in values[~free] if s.imag >= -MODE_ZERO_RTOL * scale]  # one of each conjugate pair
     for group in _degenerate_groups(upper):
         for s, x in zip(group, _eigenspace(lin.A, group, k)):
-            found.append(_mode(system, t, q, lin, s, x, scale))
+            found.append(_mode(data, t, q, lin, s, x, scale))
     found.sort(key=lambda m: (m.frequency, m.eigenvalue.real))
     cyclic = () if rest else lin.zero_states
     return Modes(system.name, system.coordinates, float(t), q, tuple(found), lin, qd, cyclic, len(cyclic))
@@ -224,12 +228,12 @@ def _free_directions(lin, count):
     return np.linalg.svd(lin.A[k:, :k])[2][k - count:] if count else []
 
 
-def _mode(system, t, q, lin, s, x, scale):
+def _mode(data, t, q, lin, s, x, scale):
     """The Mode of eigenvalue s with the independent coordinates' motion x."""
     shape = lin.basis @ x
     shape = shape / shape[np.argmax(np.abs(shape))]
     return Mode(complex(s), float(abs(s) / (2 * np.pi)), _damping(s, scale), _kind(s, scale), shape,
-                _joint_shape(system, t, q, shape), _node_shapes(system, shape))
+                _joint_shape(data, t, q, shape), _node_shapes(data.model, shape))
 
 
 def _damping(s, scale):
@@ -247,10 +251,10 @@ def _kind(s, scale):
     return "overdamped" if s.real < 0 else "unstable"
 
 
-def _joint_shape(system, t, q, shape):
+def _joint_shape(data, t, q, shape):
     """{joint: complex array}: the change of each joint's positions along ``shape``."""
-    real = system.joint_values(t, q, shape.real)
-    imag = system.joint_values(t, q, shape.imag)
+    real = data.joint_values(t, q, shape.real)
+    imag = data.joint_values(t, q, shape.imag)
     return {name: real[name].rate + 1j * imag[name].rate for name in real}
 
 
@@ -270,16 +274,18 @@ def _node_shapes(system, shape):
     return found
 
 
-def mode_motion(system, result, index, amplitude=0.05, periods=2, frames=60):
-    """A Trajectory that shows mode ``index`` of ``result`` (for the viewer: one per mode):
+def mode_motion(model, result, index, amplitude=0.05, periods=2, frames=60):
+    """A Trajectory that shows mode ``index`` of ``result`` (the ``Modes`` of ``model``, a
+    System or a Data; for the viewer: one per mode):
     q(t) = q₀ + amplitude · Re(shape · e^{iωt}) over ``periods`` periods (1 s each for a
     mode of frequency 0), put back on the constraints at each frame (a finite amplitude
     leaves the tangent plane). ``amplitude`` is the largest coordinate's excursion, in its
     units. Energies and residuals are not computed (NaN)."""
+    data = workspace(model)
     mode = result.modes[index]
     omega = 2 * np.pi * (mode.frequency or 1.0)
     t = np.linspace(0.0, periods * 2 * np.pi / omega, frames)
-    q = np.array([project_positions(system, result.t, result.q + amplitude * (mode.shape * np.exp(1j * omega * x)).real)
+    q = np.array([project_positions(data, result.t, result.q + amplitude * (mode.shape * np.exp(1j * omega * x)).real)
                   for x in t])
     nan = np.full(frames, np.nan)
     return Trajectory(result.coordinates, t, q, np.gradient(q, t, axis=0), nan, nan, nan, nan)

@@ -237,7 +237,7 @@ def consistent_initial_state(data, t=0.0):
     Returns (q, q̇, changes) with changes = {name: (given, new)} for the values that
     moved. Raises SolveError when no consistent state keeps the fixed values."""
     data = workspace(data)
-    q0, qd0 = data.model.initial_state()
+    q0, qd0 = data.initial_state()
     try:
         q, qd = _project_keeping(data, t, q0, qd0, data.model.initial_given)
     except SolveError:

@@ -35,6 +35,7 @@ import scipy.integrate
 
 from .control import SampledControl
 from ..core.errors import ControlError, SimulationError, SolveError
+from ..model.data import Data
 from . import stepper
 from .continuous import ContinuousIntegration
 from .cut import CutIntegration
@@ -50,12 +51,14 @@ STABILIZATIONS = ("projection", "baumgarte", "none")
 DEFAULT_OUTPUTS = 500
 
 
-def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=INTEGRATION_RTOL,
+def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853", rtol=INTEGRATION_RTOL,
              atol=INTEGRATION_ATOL,
              stabilization="projection", baumgarte=(10.0, 10.0), out=None, progress=None, controller=None,
              control_dt=None, path=None):
-    """Integrate ``system`` from t0 to t_end; returns a Trajectory with one row per output time
-    (and the model's declared outputs: mbsynth.model.outputs).
+    """Integrate ``model`` from t0 to t_end; returns a Trajectory with one row per output time
+    (and the model's declared outputs: mbsynth.model.outputs). ``model``: a System (run in
+    a new Data of ``path``, at its parameter values) or a Data (run at its parameter values
+    and on its path; a controller's values are written into it).
 
     q0, qd0: the initial state (default: the model's, made consistent by projection
     keeping every value the model sets; the changes are logged and kept in
@@ -66,7 +69,8 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     controller: ``f(t, joint_values) -> {parameter: value}``, called at t0 and every
     ``control_dt`` (default: the output interval), its values held in between (sampled
     control, mbsynth.analysis.control).
-    path: the run's path, "compiled" or "kkt" (``System.data``; None: the default).
+    path: the run's path, "compiled" or "kkt" (``System.data``; None: the default, or the
+    path of the Data given).
     Raises SimulationError (with the partial trajectory) when the run cannot go on.
     """
     if stabilization not in STABILIZATIONS:
@@ -74,13 +78,13 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     method = _integrator(method)
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end > t0):
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0}), both finite")
-    data = system.data(path)  # the run's workspace: one motion path (compiled or KKT) for the whole run
+    data = _run_data(model, path)
     if q0 is None and qd0 is None:
         q, qd, changes = consistent_initial_state(data, t0)
         for name, (given, new) in changes.items():
             log.info("initial %s: %.12g -> %.12g (made consistent with the constraints)", name, given, new)
     else:
-        start_q, start_qd = system.initial_state()
+        start_q, start_qd = data.initial_state()
         q = start_q if q0 is None else np.asarray(q0, dtype=float)
         qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
         changes = {}
@@ -135,6 +139,16 @@ def simulate(system, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP85
     traj = _trajectory(recorder, run, status)
     traj.stats.update(wall_time=time.perf_counter() - started, initial_changes=changes)
     return traj
+
+
+def _run_data(model, path):
+    """The run's workspace, one motion path (compiled or KKT) for the whole run: a new Data
+    of ``path`` for a model, a Data itself (ValueError for a ``path`` other than its own)."""
+    if not isinstance(model, Data):
+        return model.data(path)
+    if path not in (None, model.path):
+        raise ValueError(f"path={path!r}: the Data given runs on its own path, {model.path!r}")
+    return model
 
 
 def _record_ready(run, recorder, schedule, progress, q, qd):

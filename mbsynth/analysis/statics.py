@@ -49,6 +49,7 @@ import numpy as np
 import scipy.optimize
 
 from ..core.errors import NoEquilibrium, SolveError
+from ..model.data import workspace
 from .linearization import finite_state, linearize, prescribed_motion
 from .projection import project_positions
 from ..core.tolerances import ACCELERATION_TOL, FREE_SHOWN_RTOL, ISOLATED_RTOL, TRUST_CURVATURE_RTOL, V_ROUNDING
@@ -62,8 +63,9 @@ EXPAND = 3.0  # Δ after a good step that reached the boundary, times Δ
 GOOD = 0.75
 
 
-def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iterations=MAX_ITERATIONS, nearest=False):
-    """The static equilibrium of ``system`` found from ``q`` (default: the initial positions),
+def equilibrium(model, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iterations=MAX_ITERATIONS, nearest=False):
+    """The static equilibrium of ``model`` (a System, at its parameter values, or a Data, at
+    its own) found from ``q`` (default: the initial positions),
     an array in the model's coordinates: by default a stable rest, a minimum of the potential
     on the constraints that steps down from q reach (in a model with one, the rest; with
     several, mostly the one the damped motion from q comes to, not always), or q itself
@@ -73,20 +75,22 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
     when no rest is found from q, or when the rest found is not isolated (the coordinates
     along its free directions are named); SolveError for a q that is not finite or cannot
     be put on the constraints."""
-    q = system.initial_state()[0] if q is None else np.array(q, dtype=float)
+    data = workspace(model)
+    system = data.model
+    q = data.initial_state()[0] if q is None else np.array(q, dtype=float)
     zero = np.zeros(system.n)
     q, _ = finite_state(system, q, zero)
     limit = STEP_LIMIT * max(1.0, np.abs(q).max())
-    moving = prescribed_motion(system, t, q, zero)
+    moving = prescribed_motion(data, t, q, zero)
     if moving:
         raise NoEquilibrium(f"model '{system.name}': no static equilibrium at t = {t:g}: rows {moving} prescribe a "
                             "motion then (∂φ/∂t ≠ 0)", constraints=moving)
-    merit = _Merit(system, t, nearest)
+    merit = _Merit(data, t, nearest)
     elastic = _elastic_coordinates(system)
-    q = project_positions(system, t, q)
+    q = project_positions(data, t, q)
     radius = None
     for iteration in range(max_iterations):
-        lin = linearize(system, t, q, zero, inputs=())
+        lin = linearize(data, t, q, zero, inputs=())
         k = lin.k
         if k == 0:
             return q
@@ -96,17 +100,17 @@ def equilibrium(system, q=None, t=0.0, tolerance=ACCELERATION_TOL, max_iteration
                              "velocities only (its steps move along every direction the holonomic rows allow)")
         K = lin.A[k:, :k]
         resolution = tolerance * (1.0 + np.abs(K).max())
-        model = None
+        quadratic = None
         if np.abs(lin.qdd).max() <= resolution:
-            model = None if nearest else _Model(system, t, q, lin, K, nearest, resolution)
-            if model is None or not model.unstable:
-                _check_isolated(system, t, q, lin, K)
+            quadratic = None if nearest else _Model(data, t, q, lin, K, nearest, resolution)
+            if quadratic is None or not quadratic.unstable:
+                _check_isolated(data, t, q, lin, K)
                 return q
-            model.downhill()  # a maximum or saddle (the start, or where the steps came to): on down from it
-        model = model or _Model(system, t, q, lin, K, nearest, resolution)
+            quadratic.downhill()  # a maximum or saddle (the start, or where the steps came to): on down from it
+        quadratic = quadratic or _Model(data, t, q, lin, K, nearest, resolution)
         if radius is None:
-            radius = model.first_radius(lin.basis, limit)
-        q, radius = _step(system, t, q, lin, model, merit, radius, limit, elastic)
+            radius = quadratic.first_radius(lin.basis, limit)
+        q, radius = _step(data, t, q, lin, quadratic, merit, radius, limit, elastic)
     worst = int(np.argmax(np.abs(lin.qdd)))
     raise NoEquilibrium(f"model '{system.name}': no static equilibrium found from the given configuration: after "
                         f"{max_iterations} steps down the potential it still accelerates (largest q̈ "
@@ -127,10 +131,10 @@ class _Model:
     below the stopping rule's ``resolution`` (a tenth of it, all together) are rounding, and
     zero: along a free direction (zero curvature) they would take the whole trust region."""
 
-    def __init__(self, system, t, q, lin, K, nearest, resolution):
+    def __init__(self, data, t, q, lin, K, nearest, resolution):
         N = lin.basis
         a = np.linalg.lstsq(N, lin.qdd, rcond=None)[0]
-        M = system.evaluate(t, q, np.zeros(system.n)).M
+        M = data.evaluate(t, q, np.zeros(data.model.n)).M
         mass = N.T @ (M @ N)
         L = np.linalg.cholesky((mass + mass.T) / 2)
         J = L.T @ np.linalg.solve(L, K.T).T  # Lᵀ K L⁻ᵀ
@@ -195,11 +199,12 @@ def _trust_region(c, d, radius):
     return y(max(shift, np.nextafter(low, np.inf)))
 
 
-def _step(system, t, q, lin, model, merit, radius, limit, elastic):
+def _step(data, t, q, lin, model, merit, radius, limit, elastic):
     """(q moved by the trust-region step p of the largest radius, from ``radius`` down
     (shortened where its move N p exceeds ``limit`` in a coordinate), that can be put back on
     the constraints (``_retract``, holding ``elastic``) and along which Ψ falls by at least ETA
     of the predicted fall; the radius for the next step)."""
+    system = data.model
     here = merit.at(q, lin.qdd)
     for _ in range(HALVINGS):
         y = _trust_region(model.c, model.d, radius)
@@ -212,8 +217,8 @@ def _step(system, t, q, lin, model, merit, radius, limit, elastic):
         if not predicted > 0:
             break
         try:
-            moved = _retract(system, t, q + move, elastic)
-            there = merit.at(moved, system.motion(t, moved, np.zeros(system.n)).qdd)
+            moved = _retract(data, t, q + move, elastic)
+            there = merit.at(moved, data.motion(t, moved, np.zeros(system.n)).qdd)
         except SolveError:
             there = None
         if there is not None and np.all(np.isfinite(there.qdd)):
@@ -241,31 +246,31 @@ def _elastic_coordinates(system):
     return found
 
 
-def _retract(system, t, q, elastic):
+def _retract(data, t, q, elastic):
     """q put back on the constraints, the coordinates ``elastic`` held where the others can
     close them (else all move)."""
     if elastic:
         try:
-            return project_positions(system, t, q, fixed=elastic)
+            return project_positions(data, t, q, fixed=elastic)
         except SolveError:
             pass
-    return project_positions(system, t, q)
+    return project_positions(data, t, q)
 
 
 class _Merit:
     """Ψ of the module docstring at a configuration on the constraints, and its fall along a
     step: V, the forces' work or ½ q̈ᵀ M q̈."""
 
-    def __init__(self, system, t, nearest):
-        self.system, self.t, self.nearest = system, t, nearest
-        self.potential = not nearest and not system.working_forces()
+    def __init__(self, data, t, nearest):
+        self.data, self.t, self.nearest = data, t, nearest
+        self.potential = not nearest and not data.model.working_forces()
         self.name = "force balance's residual" if nearest else "potential"
 
     def at(self, q, qdd):
         """A _Point: q, q̈, F = M q̈ and V (where V is Ψ) there."""
-        zero = np.zeros(self.system.n)
-        force = self.system.evaluate(self.t, q, zero).M @ qdd
-        V = self.system.energy(self.t, q, zero)[1] if self.potential else None
+        zero = np.zeros(self.data.model.n)
+        force = self.data.evaluate(self.t, q, zero).M @ qdd
+        V = self.data.energy(self.t, q, zero)[1] if self.potential else None
         return _Point(q, qdd, force, V)
 
     def fall(self, here, there):
@@ -287,13 +292,14 @@ class _Point:
     V: float
 
 
-def _check_isolated(system, t, q, lin, K):
+def _check_isolated(data, t, q, lin, K):
     """NoEquilibrium when K is singular at the equilibrium: rest is possible along a direction."""
+    system = data.model
     _, s, Vt = np.linalg.svd(K)
     free = Vt[s <= ISOLATED_RTOL * max(s[0], np.finfo(float).tiny)] if s.size else Vt[:0]
     if len(free):
         moves = [lin.basis @ v for v in free]
-        directions = [_described(system, t, q, dq) for dq in moves]
+        directions = [_described(data, t, q, dq) for dq in moves]
         coordinates = sorted({system.coordinates[i] for dq in moves
                               for i in np.flatnonzero(np.abs(dq) > FREE_SHOWN_RTOL * np.abs(dq).max())})
         raise NoEquilibrium(f"model '{system.name}': the equilibrium is not isolated: it rests as well after a move "
@@ -302,14 +308,15 @@ def _check_isolated(system, t, q, lin, K):
 
 
 
-def _described(system, t, q, dq):
+def _described(data, t, q, dq):
     """{name: component} of the direction dq, largest 1: the rates of the joints that have
-    values (System.joint_values) and the coordinates of the parts no such joint holds."""
+    values (Data.joint_values) and the coordinates of the parts no such joint holds."""
+    system = data.model
     entries = {}
     held = set()
     for name, joint in system.joint_kinematics().items():
         held.update(int(i) for i in joint.indices)
-    for name, value in system.joint_values(t, q, dq).items():
+    for name, value in data.joint_values(t, q, dq).items():
         rates = np.atleast_1d(value.rate)
         entries.update({name if len(rates) == 1 else f"{name}[{i}]": x for i, x in enumerate(rates)})
     entries.update({c: x for i, (c, x) in enumerate(zip(system.coordinates, dq)) if i not in held})

@@ -15,6 +15,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..core.errors import NoEquilibrium, SolveError
+from ..model.data import model_of, workspace
 from ..core.tolerances import ACCELERATION_TOL, ON_MANIFOLD_RTOL, RANK_RTOL, STEADY_FIT_TOL
 from .linearization import finite_state, linearize
 from .projection import project_positions
@@ -22,43 +23,46 @@ from .projection import project_positions
 QUATERNION = ("qw", "qx", "qy", "qz")  # the coordinates of a part turned by a unit quaternion (Part.groups)
 
 
-def steady_motion(system, rates, q=None, t=0.0, solve=(), tolerance=ACCELERATION_TOL):
-    """(q, q̇) of a steady motion of ``system``: ``q`` (default its initial positions) put on
+def steady_motion(model, rates, q=None, t=0.0, solve=(), tolerance=ACCELERATION_TOL):
+    """(q, q̇) of a steady motion of ``model`` (a System, at its parameter values, or a Data,
+    at its own): ``q`` (default its initial positions) put on
     its position rows, q̇ with the given ``rates`` ({coordinate: rate}, e.g. a wheel's
     spin rate v/R for a forward speed v), every velocity row met, and the rest of q̇ the
     one of least kinetic energy (no lean or steer rate where nothing asks for one).
     ``solve``: names of coordinates or of ``<coordinate>_dot`` rates (one of ``rates``)
     adjusted so that the motion is steady (a disk's spin rate for its lean and turning
     rate). Raises NoEquilibrium when the state found is not steady (``check_steady``)."""
-    q0, _ = system.initial_state()
-    q = project_positions(system, t, q0 if q is None else np.array(q, dtype=float))
+    data = workspace(model)
+    system = data.model
+    q0, _ = data.initial_state()
+    q = project_positions(data, t, q0 if q is None else np.array(q, dtype=float))
     index = {c: i for i, c in enumerate(system.coordinates)}
     unknown = [c for c in list(rates) + [s.removesuffix("_dot") for s in solve] if c not in index]
     if unknown:
         raise SolveError(f"model '{system.name}': unknown coordinate(s) {unknown}", coordinates=unknown)
     given = {index[c]: float(x) for c, x in rates.items()}
     if solve:
-        q, given = _solved(system, t, q, given, solve, index)
-    qd = _least_energy_velocities(system, t, q, given)
-    check_steady(system, linearize(system, t, q, qd), tolerance)
+        q, given = _solved(data, t, q, given, solve, index)
+    qd = _least_energy_velocities(data, t, q, given)
+    check_steady(system, linearize(data, t, q, qd), tolerance)
     return finite_state(system, q, qd)
 
 
-def _least_energy_velocities(system, t, q, given):
+def _least_energy_velocities(data, t, q, given):
     """q̇ at q with q̇[j] = given[j], every velocity row met (A q̇ + ψ(q, 0) = 0 over the rows
     with a velocity form), and the least ½ q̇ᵀ M q̇ over the freedom left."""
-    n = system.n
-    arrays = system.constraint_arrays(t, q, np.zeros(n), sparse=False)
+    n = data.model.n
+    arrays = data.constraint_arrays(t, q, np.zeros(n), sparse=False)
     rows = np.isfinite(arrays.psi)
     fix = np.zeros((len(given), n))
     fix[np.arange(len(given)), list(given)] = 1.0
     W = np.vstack([arrays.A[rows], fix])
     right = np.concatenate([-arrays.psi[rows], list(given.values())])
     particular = np.linalg.lstsq(W, right, rcond=None)[0]
-    _check_rates(system, arrays, rows, given, W, right, particular)
+    _check_rates(data.model, arrays, rows, given, W, right, particular)
     _, s, Vt = np.linalg.svd(W)
     free = Vt[int(np.sum(s > RANK_RTOL * s[0])):].T if s.size else np.eye(n)
-    M = system.evaluate(t, q, particular).M
+    M = data.evaluate(t, q, particular).M
     y = np.linalg.lstsq(free.T @ M @ free, -free.T @ M @ particular, rcond=None)[0] if free.size else []
     return particular + free @ y if free.size else particular
 
@@ -92,10 +96,10 @@ def _check_rates(system, arrays, rows, given, W, right, x):
                      "the rows allow (those of independent ones; the others follow)", constraints=names)
 
 
-def _solved(system, t, q, given, solve, index):
+def _solved(data, t, q, given, solve, index):
     """(q, given) with the ``solve`` entries adjusted (least squares) so that q̈ = 0 along the
     speeds of the linearization at the first guess."""
-    start = linearize(system, t, q, _least_energy_velocities(system, t, q, given))
+    start = linearize(data, t, q, _least_energy_velocities(data, t, q, given))
     speeds = [index[c.removesuffix("_dot")] for c in start.state_names[start.k:]]
 
     def state(x):
@@ -105,12 +109,12 @@ def _solved(system, t, q, given, solve, index):
                 moved[index[name.removesuffix("_dot")]] = value
             else:
                 moved_q[index[name]] = value
-        moved_q = project_positions(system, t, moved_q)
+        moved_q = project_positions(data, t, moved_q)
         return moved_q, moved
 
     def residual(x):
         moved_q, moved = state(x)
-        return system.motion(t, moved_q, _least_energy_velocities(system, t, moved_q, moved)).qdd[speeds]
+        return data.motion(t, moved_q, _least_energy_velocities(data, t, moved_q, moved)).qdd[speeds]
 
     guess = [given[index[c.removesuffix("_dot")]] if c.endswith("_dot") else q[index[c]] for c in solve]
     fit = scipy.optimize.least_squares(residual, guess, xtol=STEADY_FIT_TOL, ftol=STEADY_FIT_TOL,
@@ -118,10 +122,11 @@ def _solved(system, t, q, given, solve, index):
     return state(fit.x)
 
 
-def check_steady(system, lin, tolerance=ACCELERATION_TOL):
-    """NoEquilibrium unless the state of ``lin`` is a steady motion: the speeds do not change
-    (q̈ along them within ``tolerance`` of the stiffness scale) and no independent
-    coordinate moves but the cyclic ones."""
+def check_steady(model, lin, tolerance=ACCELERATION_TOL):
+    """NoEquilibrium unless the state of ``lin`` (a linearization of ``model``, a System or
+    a Data) is a steady motion: the speeds do not change (q̈ along them within ``tolerance``
+    of the stiffness scale) and no independent coordinate moves but the cyclic ones."""
+    system = model_of(model)
     k = lin.k
     size = 1 + np.abs(lin.A[k:, :k]).max(initial=0.0)
     index = {c: i for i, c in enumerate(system.coordinates)}

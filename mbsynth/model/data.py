@@ -15,9 +15,10 @@ in a Data made from it (``data.model`` is that System):
   its parameter values.
 
 The algorithms compute with a Data (``data.motion``, ``data.reactions``, …; the run loop,
-projection.py, outputs.py): they read the model's description from ``data.model`` and the
-parameter values from the Data, never from the model. ``workspace`` gives a model's
-default-path Data where a function is handed a model.
+projection.py, outputs.py, linearize, equilibrium, modes and steady motions): they read the
+model's description from ``data.model`` and the parameter values from the Data, never from
+the model. ``workspace`` gives a model's default-path Data where a function is handed a
+model, ``model_of`` the model of either.
 
 What models of one structure share (``Shared``: the compiled Template, the Evaluators, the
 joint kinematics, linearize's derivatives) is kept in the one cache (core/memo.py): it
@@ -83,6 +84,12 @@ def workspace(model_or_data):
     return model_or_data if isinstance(model_or_data, Data) else model_or_data._data
 
 
+def model_of(model_or_data):
+    """The model (System) of ``model_or_data``, a System or a Data: for what reads the
+    model's description alone (coordinates, parts, names)."""
+    return model_or_data.model if isinstance(model_or_data, Data) else model_or_data
+
+
 def shared(system):
     """The Shared of ``system``'s structure (``System.structure``), from ``MEMO``."""
     return _STRUCTURES.get(system.structure, lambda: Shared(system))
@@ -140,6 +147,11 @@ class Data:
         self.parameter_values = self.system.resolved_parameters(values, self.parameter_values)
         if self._engine is not None and self._engine is not UNSET:
             self._engine = self._engine.template.engine(self.parameter_values)
+
+    def initial_state(self):
+        """(q, q̇) from the model's ``initial:`` mapping at this Data's parameter values
+        (``System.initial_state``)."""
+        return self.system.initial_state(self.parameter_values)
 
     def _state(self, q, qd):
         return self.system._state(q, qd)

@@ -20,7 +20,8 @@ are atan2 in (−π, π] at one state; ``unwrap`` makes them continuous along a 
 Fixed and distance joints have no values. The names per kind are those of its record in
 core/joint_kinds.py, the formulas its entry of ``VALUES``, a table that must name every kind
 (``NO_VALUES`` for one without values) and agree with its record, or this module is
-refused at import.
+refused at import. A joint's free motions, along which its actuation, spring and friction
+act (constraints/joints.py), are its first values, from the same formulas (``free_motions``).
 
 The same compiled function gives the pose of the joint's reaction frame (the child frame
 B, or a robot's child link frame) and its Jacobian, which turn the generalized force a
@@ -313,15 +314,35 @@ VALUES = {  # per kind of core/joint_kinds.KINDS (module docstring)
 
 def values_agree(record, values):
     """Whether ``values`` (a ``VALUES`` entry) are what ``record`` names: formulas exactly for
-    a kind with joint values, positions from the matrices exactly for ``matrix_positions``."""
+    a kind with joint values, positions from the matrices exactly for ``matrix_positions``,
+    its free motions first among its positions (``free_motions`` reads them there)."""
     if (values.expressions is None) == bool(record.rates):
         return "joint values where the record names none, or none where it names some"
     if (values.from_matrices is None) == record.matrix_positions:
         return "positions from the frames' rotations exactly when the record says matrix_positions"
+    if record.motions and (record.matrix_positions or record.positions[:len(record.motions)] != record.motions):
+        return "its free motions as its first positions (compiled scalars), in the order of its motions"
     return None
 
 
 check_table("model/joint_values.VALUES", VALUES, agrees=values_agree)
+
+
+MOTION_NAMES = ("angle", "angle_rate", "displacement", "displacement_rate")  # what ``free_motions`` gives
+
+
+def free_motions(kind, parent, child, frames, pA, RA, pB, RB, q, qd):
+    """(angle, angle rate, displacement, displacement rate) of a joint of ``kind`` between
+    ``frames`` (``MOTION_NAMES``; None where it has none): its joint values' formulas
+    (``VALUES``) for the free motions of its record (``JointKind.motions``, its first
+    positions and rates), which actuation, joint springs and friction act along."""
+    found = dict.fromkeys(MOTION_NAMES)
+    motions = KINDS[kind].motions
+    if motions:
+        positions, rates = _relative(kind, parent, child, frames, pA, RA, pB, RB, q, qd)
+        for motion, position, rate in zip(motions, positions, rates):
+            found[motion], found[f"{motion}_rate"] = position, rate
+    return tuple(found.values())
 
 
 def _relative(kind, parent, child, frames, pA, RA, pB, RB, q, qd):

@@ -196,9 +196,19 @@ class System:
     def parameter_values(self):
         return np.array(list(self.parameters.values()), dtype=float)
 
-    def initial_state(self):
-        """(q, q̇) from the model's ``initial:`` mapping (copies)."""
-        return self.initial_q.copy(), self.initial_qd.copy()
+    def initial_state(self, p=None):
+        """(q, q̇) from the model's ``initial:`` mapping (copies); ``p``: parameter values (an
+        array in the model's order) at which the initial values written as expressions of
+        parameters are taken (default: the model's own)."""
+        q0, qd0 = self.initial_q.copy(), self.initial_qd.copy()
+        if p is None or not self.initial_definitions:
+            return q0, qd0
+        subs = {sp.Symbol(name): sp.Float(float(value)) for name, value in zip(self.parameters, p)}
+        index = {c: i for i, c in enumerate(self.coordinates)}
+        for key, expr in self.initial_definitions.items():
+            target, i = (qd0, index[key[:-4]]) if key not in index else (q0, index[key])
+            target[i] = float(expr.xreplace(subs))
+        return q0, qd0
 
     def with_parameters(self, **values):
         """A new System with some parameter values changed (the original is unchanged).
@@ -212,12 +222,7 @@ class System:
         parameters are arguments of its code), so a sweep compiles once."""
         p = self.resolved_parameters(values, check_parts=False)
         new = dict(zip(self.parameters, p.tolist()))
-        subs = {sp.Symbol(name): sp.Float(value) for name, value in new.items()}
-        q0, qd0 = self.initial_state()
-        index = {c: i for i, c in enumerate(self.coordinates)}
-        for key, expr in (self.initial_definitions or {}).items():
-            target, i = (qd0, index[key[:-4]]) if key not in index else (q0, index[key])
-            target[i] = float(expr.xreplace(subs))
+        q0, qd0 = self.initial_state(p)
         changed = replace(self, parameters=new, initial_q=q0, initial_qd=qd0)
         same_start = np.array_equal(q0, self.initial_q) and np.array_equal(qd0, self.initial_qd)
         moved = {sp.Symbol(name) for name, value in new.items() if value != self.parameters[name]}
@@ -305,10 +310,10 @@ class System:
         positive semi-definite, at the initial state — a model no equation of motion fits.
         ``parameters``: only the parts written in these parameter symbols (those whose values
         changed: ``with_parameters``); every part by default. ``p``: the parameter values
-        (default: the model's)."""
+        (default: the model's), at which the initial state is taken too."""
         if parameters is not None and not any(part.reads(parameters) for part in self.parts):
             return []  # a controller's torques: read by forces alone
-        q, qd = self.initial_state()
+        q, qd = self.initial_state(p)
         p = self.parameter_values if p is None else p
         problems, start = [], 0
         for part in self.parts:

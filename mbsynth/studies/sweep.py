@@ -7,8 +7,8 @@ metrics asked for. Runs go to a Dask cluster — a local one that mbsynth starts
 user's (``scheduler``). Each worker builds the model from its text once (file names in
 it relative to the model file's folder), with the values it was loaded with and changed
 to since (``load(path, parameters=)``, ``with_parameters``: the System the sweep was
-given), and reuses it for every run it gets (``System.with_parameters`` only changes
-numbers). Results are one table row per
+given), and reuses it for every run it gets, each run in a Data set to its values
+(``Data.set_parameters`` only changes numbers). Results are one table row per
 run, failures included with their error; the table is written to ``out`` (.parquet or
 .csv) atomically as runs finish and, with every row gathered, when the sweep stops for
 any reason (an interruption, a failure), and a sweep restarted with the same ``out``
@@ -40,6 +40,7 @@ from ..core.files import file_format, write_atomically
 from ..core.memo import MEMO
 from ..io import load, loads
 from ..analysis.simulate import simulate
+from ..model.data import workspace
 from ..symbolic.derive import T_SYMBOL
 from ..core.tolerances import ELAPSED_FLOOR
 
@@ -77,13 +78,16 @@ class Metric:
         except ExpressionError as err:
             raise ModelError(f"metric {self.spec!r}: {err}") from None
 
-    def evaluate(self, system, traj):
+    def evaluate(self, model, traj):
+        """The metric of the run ``traj`` of ``model`` (a System, or a Data: at its parameter values)."""
+        data = workspace(model)
+        system = data.model
         kind, expr = self.parse(system)
         if expr is None:
             return getattr(traj, kind)
         args = [T_SYMBOL, *system.q_symbols, *system.qd_symbols, *system.parameter_symbols]
         f = sp.lambdify(args, expr, modules="numpy")
-        params = [np.full(traj.t.size, v) for v in system.parameters.values()]
+        params = [np.full(traj.t.size, v) for v in data.p]
         values = np.broadcast_to(f(traj.t, *traj.q.T, *traj.qd.T, *params), traj.t.shape)
         return float({"final": lambda v: v[-1], "max": np.max, "min": np.min, "mean": np.mean}[kind](values))
 
@@ -201,10 +205,11 @@ def run_one(model, values, t_end, metrics, options, keep_trajectory=False):
     started = time.perf_counter()
     traj = None
     try:
-        system = model.system().with_parameters(**values)  # the sweep's values over the model's
-        traj = simulate(system, t_end, **options)
+        data = model.system().data(options.get("path"))
+        data.set_parameters(values)  # the sweep's values over the model's
+        traj = simulate(data, t_end, **options)
         for metric in metrics:
-            row[metric.name] = metric.evaluate(system, traj)
+            row[metric.name] = metric.evaluate(data, traj)
     except Exception as err:  # noqa: BLE001  (every failure is the run's row; the sweep goes on)
         traj = getattr(err, "trajectory", traj)  # a SimulationError's run up to the failure
         row.update(status="failed", error=error_text(err))

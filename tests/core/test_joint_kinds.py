@@ -3,7 +3,8 @@ freedoms, its records against themselves, the row operations' φ̇ against φ di
 the import-time checks refusing a table that lacks an entry. That every consumer reads it
 alike is held by tests driven by the table: the compiled rows, φ and φ̇ against the sympy
 rows for every kind (tests/compiled/test_fast.py), the joint values of every kind that has
-them (tests/model/test_joint_values.py)."""
+them (tests/model/test_joint_values.py), the efforts along every kind's free motions
+(tests/model/test_joint_efforts.py)."""
 
 import numpy as np
 import pytest
@@ -135,6 +136,10 @@ def test_a_consumer_table_lacking_a_kind_is_refused():
         check_table("joint values", silent, agrees=joint_values.values_agree)
     with pytest.raises(KindTableError, match="has an entry for 'helical', which is no joint kind"):
         check_table("joint values", {**complete, "helical": joint_values.NO_VALUES})
+    # the efforts read a kind's free motions from its first joint values (joint_values.free_motions)
+    swapped = {**KINDS, "cylindrical": KINDS["cylindrical"]._replace(positions=("displacement", "angle"))}
+    with pytest.raises(KindTableError, match="'cylindrical': its free motions as its first positions"):
+        check_table("joint values", complete, kinds=swapped, agrees=joint_values.values_agree)
 
 
 @pytest.mark.parametrize("name", list(KINDS))

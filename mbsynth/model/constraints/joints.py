@@ -33,10 +33,10 @@ from .base import Constraint
 from ...core.joint_kinds import ALIGNED_AXIS, JOINT_KINDS, KINDS, OPERATIONS, ORIENTATION_LOCK
 from ...core.kinematics import quaternion_rotation
 from ..joint_templates import Templates, joint_coordinates, pose, shared
+from ..joint_values import MOTION_NAMES, free_motions
 from ..parts.part_type import PLANE, POINT, QUATERNION
 from ...symbolic.cache import placeholder
-from ...symbolic.derive import (compile_function, differentiate, differentiated, jacobian, placed_values, positions,
-    time_derivative)
+from ...symbolic.derive import compile_function, differentiate, differentiated, jacobian, placed_values, positions
 
 from ...core.memo import MEMO
 
@@ -60,7 +60,8 @@ class Joint(Constraint):
     bodies has no z or axis rows) are left out. Besides its rows it knows, where it has them, its free
     motions: ``angle`` about z_A with rate ``angle_rate`` = z_A·(ω_B − ω_A) (revolute,
     cylindrical), and ``displacement`` z_A·(p_B − p_A) along z_A with its rate
-    (prismatic, cylindrical) — what actuation, joint springs and friction act on."""
+    (prismatic, cylindrical), its joint values' formulas (joint_values.free_motions) — what
+    actuation, joint springs and friction act on."""
 
     content_fields = ("joint_kind", "frames", "part_names", "report_frame", "length", "friction")
 
@@ -84,8 +85,8 @@ class Joint(Constraint):
         kept = [i for i, phi in enumerate(phis) if sp.sympify(phi) != 0]  # e.g. z rows of planar parts
         phis, labels = [phis[i] for i in kept], [labels[i] for i in kept]
         a, b, psi = differentiated(phis, q, qd)
-        self._motions, self._motion_put = _free_motions(kind, parent, child, (frame_a, frame_b), pA, RA, pB, RB, q,
-                                                        qd), None
+        self._motions, self._motion_put = free_motions(kind, parent, child, (frame_a, frame_b), pA, RA, pB, RB, q,
+                                                       qd), None
         C = sp.SparseMatrix(len(q), 1, {}) if friction is None else friction.viscous_force(self, qd)
         super().__init__(name, "holonomic", a, b, C, phis, psi, q, qd, params, labels)
         self.coulomb = None if friction is None else friction.coulomb_force(self, q, qd, params)
@@ -114,7 +115,7 @@ class Joint(Constraint):
         """∂rate/∂q̇ over the velocity slots of the joint's template (``placed``) of ``rate``
         ("angle_rate" or "displacement_rate"); None for a joint without a template or
         without that motion."""
-        return None if self._motion_put is None else self._template.gradients[_MOTION_NAMES.index(rate)]
+        return None if self._motion_put is None else self._template.gradients[MOTION_NAMES.index(rate)]
 
     placed = property(lambda self: self._motion_put,
                       doc="(slots, coordinates, constants, q, q̇) of the joint's template, or None")
@@ -216,22 +217,6 @@ def _named(parts):
     return " or ".join(f"'{p.name}'" for p in parts if p is not None)
 
 
-def _free_motions(kind, parent, child, frames, pA, RA, pB, RB, q, qd):
-    """(angle, angle rate, displacement, displacement rate) of a joint between ``frames``, None
-    where it has none."""
-    xa, za = RA[:, 0], RA[:, 2]
-    motions = [None] * 4
-    if KINDS[kind].turns:
-        xb = RB[:, 0]
-        omega_a = parent.frame_angular_velocity(frames[0]) if parent else sp.zeros(3, 1)
-        motions[0] = sp.atan2(xa.cross(xb).dot(za), xa.dot(xb))
-        motions[1] = za.dot(child.frame_angular_velocity(frames[1]) - omega_a)
-    if KINDS[kind].slides:
-        motions[2] = za.dot(pB - pA)
-        motions[3] = time_derivative(motions[2], q, qd)
-    return motions
-
-
 def _kept_rows(template, constants):
     """The rows of ``template`` that do not vanish identically with the frames' values
     ``constants`` put in (planar parts have no z rows): a row nonzero at a random state is
@@ -263,11 +248,8 @@ class _Template(NamedTuple):
     a: tuple      # per row, its entries over the slots' coordinates
     b: tuple
     psi: tuple
-    motions: tuple    # angle, its rate, displacement, its rate (None where the kind has none)
+    motions: tuple    # joint_values.free_motions: angle, its rate, displacement, its rate (None: none)
     gradients: tuple  # per motion: ∂/∂q̇ over the velocity slots of a rate, else None
-
-
-_MOTION_NAMES = ("angle", "angle_rate", "displacement", "displacement_rate")
 
 
 def _derive_template(kind, parent, child, at, has_length):
@@ -279,7 +261,7 @@ def _derive_template(kind, parent, child, at, has_length):
     phis, labels = joint_equations(kind, pA, RA, pB, RB, _LENGTH if has_length else None)
     phis = [sp.sympify(phi) for phi in phis]
     rows = [differentiate(phi, list(slots[0]), list(slots[1])) for phi in phis]
-    motions = _free_motions(kind, parent, child, at.frames[:2], pA, RA, pB, RB, list(slots[0]), list(slots[1]))
+    motions = free_motions(kind, parent, child, at.frames[:2], pA, RA, pB, RB, list(slots[0]), list(slots[1]))
     motions = tuple(None if m is None else sp.sympify(m).xreplace(to_slots) for m in motions)
     gradients = tuple(None if m is None or k % 2 == 0 else tuple(jacobian([m], slots[1])) for k, m in enumerate(motions))
     return (slots, tuple(phis), tuple(labels), tuple(tuple(r[0]) for r in rows), tuple(r[1] for r in rows),
