@@ -6,6 +6,9 @@ STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 KERNELS_STAMP := $(VENV)/.compiled
 DOCS_STAMP := $(VENV)/.installed-docs
+# pytest-xdist workers: one per core, at most 4 (each holds its own compiled kernels, about 1.5 GB)
+WORKERS ?= $(shell $(PYTHON) -c "import os; print(min(4, len(os.sched_getaffinity(0))))")
+PYTEST := $(PY) -m pytest -q -n $(WORKERS) --dist loadfile
 
 .PHONY: run test test-slow docs install clean
 
@@ -13,13 +16,14 @@ run: $(STAMP)
 	$(PY) examples/paper_example3.py
 
 # Every test but the long end-to-end ones (marked slow in pyproject.toml); `make test-slow` runs those.
+# The tests of one file run in one worker, in order (their module fixtures are made once).
 test: $(TEST_STAMP)
 	bash scripts/install-chromium.sh
-	$(PY) -m pytest -q -m "not slow"
+	$(PYTEST) -m "not slow"
 
 test-slow: $(TEST_STAMP)
 	bash scripts/install-chromium.sh
-	$(PY) -m pytest -q -m slow
+	$(PYTEST) -m slow
 
 # The documentation site (Sphinx), warnings as errors; the gallery's scripts run as it builds.
 # Then the checks of the built pages (tests/test_docs.py: MathJax served from the site's _static).
