@@ -103,6 +103,7 @@ class System:
     substructures: tuple = ()  # Substructure: the model files this one includes, as a tree
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
+    unilaterals: tuple = ()  # unilateral.Unilateral: joint limits and contacts, gaps g(q) ≥ 0 (analysis/impacts.py)
     fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load
     load_parameters: dict = None  # the values given to ``load`` (``parameters=``), built in at load
     built_parameters: dict = None  # every parameter's value as the model was built at load
