@@ -213,3 +213,28 @@ def test_a_jump_with_a_massless_coordinate_held_by_a_row_is_unique():
                          np.array([0.0, -e * v]))
     assert np.abs(jump.qd - [-e * v, -e * v]).max() < 1e-14
     assert abs(jump.impulses[1] - 2.0 * (1 + e) * -v) < 1e-12
+
+
+def test_a_resting_contact_holds_until_its_force_would_pull_and_then_releases():
+    """A ball resting on the floor, lifted by a force k t: the floor holds it (λ = m g − k t)
+    until t_r = m g / k, then it rises as z = r + k (t − t_r)³ / (6 m)."""
+    m, r, g, k = 0.5, 0.1, 9.81, 3.0
+    system = mb.loads(f"""
+name: lift
+parameters: {{m: {m}, r: {r}, g: {g}, k: {k}}}
+gravity: [0, 0, -g]
+subsystems:
+  ball: {{type: particle, mass: m, initial: {{position: [0, 0, r]}}}}
+forces:
+  - {{name: lift, type: force, at: ball, value: [0, 0, k*t]}}
+contacts:
+  - {{name: floor, type: plane, child: ball, radius: r}}
+""")
+    traj = mb.simulate(system, 2.5)
+    t_r = m * g / k
+    assert [(ev.name, ev.kind) for ev in traj.events] == [("floor", "contact"), ("floor", "release")]
+    assert traj.events[0].t == 0.0 and abs(traj.events[1].t - t_r) < 1e-12
+    held = traj.t <= t_r
+    assert np.abs(traj.q[held, 2] - r).max() < 1e-14
+    risen = ~held
+    assert np.abs(traj.q[risen, 2] - (r + k * (traj.t[risen] - t_r) ** 3 / (6 * m))).max() < 1e-10
