@@ -64,14 +64,14 @@ class EventIntegration(ContinuousIntegration):
 
     def __init__(self, *args):
         self.active = frozenset()  # the held gaps (indices)
+        self.started = False  # whether the state at the start is settled (``advance``)
         super().__init__(*args)
         self.base = self.data  # the run's Data: the model without held gaps
         system = self.base.system
-        self.gaps = Gaps(system.unilaterals, system.n)
+        self.gaps = Gaps(system, self.base.p)
         self.phases = {frozenset(): self.base}  # active set -> its Data
         self.pending = None
         self.events = []  # trajectory.Event (simulate hands the recorder's list)
-        self.started = False
         self.idle = 0  # events in a row that changed nothing
 
     # ---- the phases: the System with the held rows appended
@@ -90,6 +90,8 @@ class EventIntegration(ContinuousIntegration):
     def restart(self):
         if self.active:  # new parameter values at a control sample: the phase's Data follows the run's
             self.data = self.f.data = self._phase(self.active)
+        if self.started:  # and the restitutions
+            self.gaps = Gaps(self.base.system, self.base.p)
         super().restart()
 
     def _switch(self, active):

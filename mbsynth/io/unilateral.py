@@ -104,10 +104,11 @@ def _radius(builder, text, path):
 
 
 def _restitution(builder, spec, path):
-    """The entry's coefficient of restitution e (0 ≤ e ≤ 1; 0 by default), a number."""
-    e = builder.value(builder.constant(spec.get("restitution", 0), path + ("restitution",)))
-    if not 0 <= e <= 1:
-        builder.fail(path + ("restitution",), f"restitution must be between 0 and 1, got {e:g}")
+    """The entry's coefficient of restitution e (0 ≤ e ≤ 1; 0 by default), an expression of
+    parameters."""
+    e = builder.constant(spec.get("restitution", 0), path + ("restitution",))
+    if not 0 <= builder.value(e) <= 1:
+        builder.fail(path + ("restitution",), f"restitution must be between 0 and 1, got {builder.value(e):g}")
     return e
 
 

@@ -463,7 +463,7 @@ class System:
 
     def _inelastic(self):
         """The names of the limits and contacts whose impacts lose energy (restitution below 1)."""
-        return [u.name for u in self.unilaterals if u.restitution < 1]
+        return [u.name for u in self.unilaterals if u.restitution_at(self, self.parameter_values) < 1]
 
 
 _DEFAULT_DATA = MEMO.table("default data", DEFAULT_DATA_KEPT)

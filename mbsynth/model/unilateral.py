@@ -15,19 +15,29 @@ followed by the active rows), which the run loop switches between (analysis/impa
 from dataclasses import dataclass
 
 import numpy as np
+import sympy as sp
 
 from .connectors.base import Connector
+from ..core.errors import ModelError
 
 
 @dataclass(frozen=True)
 class Unilateral:
-    """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), restitution e, its
-    holonomic ``row`` (φ = g)."""
+    """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), its restitution e (a
+    sympy expression of the parameters), its holonomic ``row`` (φ = g)."""
 
     name: str
     kind: str
-    restitution: float
+    restitution: sp.Expr
     row: Connector
+
+    def restitution_at(self, system, p):
+        """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
+        e = float(sp.sympify(self.restitution).xreplace(dict(zip(system.parameter_symbols, p))))
+        if not 0 <= e <= 1:
+            raise ModelError(f"model '{system.name}': the restitution of '{self.name}' is {e:g} at these parameter "
+                             f"values; it must be between 0 and 1")
+        return e
 
 
 def gap_row(name, gap, q, qd, params):
@@ -44,12 +54,13 @@ def with_active(system, names):
 
 
 class Gaps:
-    """The gaps of ``unilaterals`` over n coordinates, evaluated together."""
+    """The gaps of ``system``'s unilaterals, evaluated together; ``restitution`` at the
+    parameter values ``p``."""
 
-    def __init__(self, unilaterals, n):
-        self.unilaterals, self.n = tuple(unilaterals), n
+    def __init__(self, system, p):
+        self.unilaterals, self.n = tuple(system.unilaterals), system.n
         self.names = tuple(u.name for u in self.unilaterals)
-        self.restitution = np.array([u.restitution for u in self.unilaterals], dtype=float)
+        self.restitution = np.array([u.restitution_at(system, p) for u in self.unilaterals], dtype=float)
 
     def __len__(self):
         return len(self.unilaterals)

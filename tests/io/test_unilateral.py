@@ -4,11 +4,14 @@ one line)."""
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import mbsynth as mb
+
+MODELS = Path(__file__).resolve().parents[2] / "models" / "contact"
 
 PENDULUM = """name: stop
 parameters: {{m: 1.0, L: 0.8}}
@@ -37,7 +40,7 @@ contacts:
 
 def test_limits_and_contacts_build_their_gaps():
     system = mb.loads(PENDULUM.format(kind="revolute", limits="limits: [-0.5, 0.4], restitution: 0.3"))
-    assert [(u.name, u.kind, u.restitution) for u in system.unilaterals] == \
+    assert [(u.name, u.kind, u.restitution_at(system, system.parameter_values)) for u in system.unilaterals] == \
         [("hinge.lower", "limit", 0.3), ("hinge.upper", "limit", 0.3)]
     q, qd = system.initial_state()
     gaps = [u.row.residuals(0.0, q, qd, system.parameter_values)[0][0] for u in system.unilaterals]
@@ -94,3 +97,13 @@ def test_a_run_with_contacts_needs_an_explicit_runge_kutta_method():
     system = mb.loads(BALL.format(z=0.5, contact="{name: floor, type: plane, child: ball, radius: r}"))
     with pytest.raises(ValueError, match="limits or contacts: its run needs an explicit Runge–Kutta method"):
         mb.simulate(system, 0.1, method="Radau")
+
+
+def test_restitution_follows_the_parameters_and_is_refused_outside_0_1():
+    system = mb.load(MODELS / "pendulum_stop.yaml")
+    assert system.unilaterals[0].restitution_at(system, system.parameter_values) == 1.0
+    half = system.with_parameters(e=0.5)
+    assert [u.restitution_at(half, half.parameter_values) for u in half.unilaterals] == [0.5, 0.5]
+    assert half.unaccounted_work() == ["hinge.lower", "hinge.upper"]  # impacts that lose energy
+    with pytest.raises(mb.ModelError, match="the restitution of 'hinge.lower' is 2 at these parameter values"):
+        mb.simulate(system.with_parameters(e=2.0), 0.1)
