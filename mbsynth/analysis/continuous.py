@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from . import stepper
-from ..core.errors import SolveError
+from ..core.errors import EventError, SolveError
 from .crossing import NAMED_SHARE, Crossing
 from .cut import CutIntegration
 from .derivative import Crawl
@@ -81,6 +81,8 @@ class ContinuousIntegration(CutIntegration):
         try:
             y, corrected, bounded = self._reach(t_next, q, qd, t_stop)
         except (Crawl, SolveError) as stop:
+            if isinstance(stop, EventError):  # found where it happens: no cut interval avoids it
+                raise
             self.solver = None  # stopped within a step
             q, qd = super().advance(t_next, q, qd, loosen=isinstance(stop, Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next

@@ -25,7 +25,8 @@ the state there is ``settle``d:
    falls to zero.
 
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
-A state with no consistent contact mode (Painlevé-type) raises SolveError naming the time.
+A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
+EventError (a SolveError) naming the time and the gaps: the run stops there.
 """
 
 import itertools
@@ -39,7 +40,7 @@ from . import stepper
 from .continuous import ContinuousIntegration
 from .impulse import velocity_jump
 from .trajectory import Event
-from ..core.errors import SolveError
+from ..core.errors import EventError, SolveError
 from ..core.solvers import kkt_acceleration
 from ..core.tolerances import COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP, SPEED_ROUNDING
 from ..model.reactions import multipliers
@@ -119,7 +120,7 @@ class EventIntegration(ContinuousIntegration):
         passed = [self.gaps.names[i] for i in self._open() if g[i] < -self.atol]
         if passed:  # an interval integrated cut (cut.py) sees no events
             self.f.t_failed = t_next
-            raise SolveError(f"the run passed through {', '.join(passed)} without its event (an interval "
+            raise EventError(f"the run passed through {', '.join(passed)} without its event (an interval "
                              f"integrated cut near a singular position)", constraints=passed)
         return q, qd
 
@@ -142,7 +143,7 @@ class EventIntegration(ContinuousIntegration):
         if self.idle > IDLE_EVENTS:
             self.f.t_failed = t
             names = [self.gaps.names[i] for i in sorted(pending.closing | pending.released)]
-            raise SolveError(f"the gaps {', '.join(names)} chatter at t = {t:.9g}: {IDLE_EVENTS} events in a row "
+            raise EventError(f"the gaps {', '.join(names)} chatter at t = {t:.9g}: {IDLE_EVENTS} events in a row "
                              f"changed nothing", constraints=names)
         if changed:
             y = self.form.to_integrator(q, qd_new)
@@ -282,7 +283,7 @@ class EventIntegration(ContinuousIntegration):
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
-            self.events.append(Event(t, self.gaps.names[i], "release", 0.0))
+            self.events.append(Event(float(t), self.gaps.names[i], "release", 0.0))
         changed |= active != self.active
         self._switch(active)
         return q, qd, changed
@@ -311,8 +312,8 @@ class EventIntegration(ContinuousIntegration):
         for chosen in _subsets(rows):
             target = np.array([-e[i] * gd[i] if i in striking else 0.0 for i in chosen])
             A = np.vstack([A_b, A_gaps[list(chosen)]])
-            jump = velocity_jump(M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
-                                 constraints=names_b + [self.gaps.names[i] for i in chosen])
+            jump = self._jump(t, chosen or rows, M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
+                              constraints=names_b + [self.gaps.names[i] for i in chosen])
             impulses = jump.impulses[len(v_b):]
             after = A_gaps @ jump.qd
             others = [i for i in rows if i not in chosen]
@@ -320,7 +321,7 @@ class EventIntegration(ContinuousIntegration):
                     all(after[i] + e[i] * gd[i] >= -COMPLEMENTARITY_RTOL * abs(gd[i]) - floor[i] for i in others):
                 for i, impulse in zip(chosen, impulses):
                     if i in striking:
-                        self.events.append(Event(t, self.gaps.names[i], "impact", float(impulse)))
+                        self.events.append(Event(float(t), self.gaps.names[i], "impact", float(impulse)))
                 return jump.qd
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
 
@@ -345,18 +346,27 @@ class EventIntegration(ContinuousIntegration):
         A_b, v_b, names_b = self._bilateral(t, q, qd)
         A_gaps = self.gaps.rows(t, q, qd, self.base.p)[0]
         rows = sorted(active)
-        jump = velocity_jump(self.base.evaluate(t, q, qd).M, qd, np.vstack([A_b, A_gaps[rows]]),
-                             np.concatenate([v_b, np.zeros(len(rows))]), coordinates=self.base.system.coordinates,
-                             constraints=names_b + [self.gaps.names[i] for i in rows])
+        jump = self._jump(t, rows, self.base.evaluate(t, q, qd).M, qd, np.vstack([A_b, A_gaps[rows]]),
+                          np.concatenate([v_b, np.zeros(len(rows))]), coordinates=self.base.system.coordinates,
+                          constraints=names_b + [self.gaps.names[i] for i in rows])
         for i, impulse in zip(rows, jump.impulses[len(v_b):]):
             if i not in self.active:
-                self.events.append(Event(t, self.gaps.names[i], "contact", float(impulse)))
+                self.events.append(Event(float(t), self.gaps.names[i], "contact", float(impulse)))
         return jump.qd
 
-    def _fail(self, t, rows, why):
+    def _fail(self, t, rows, why, coordinates=()):
+        """The EventError at t of the gaps ``rows``."""
         self.f.t_failed = t
         names = [self.gaps.names[i] for i in rows]
-        return SolveError(f"at t = {t:.9g}, {', '.join(names)}: {why}", constraints=names)
+        return EventError(f"at t = {t:.9g}, {', '.join(names)}: {why}", constraints=names, coordinates=coordinates)
+
+    def _jump(self, t, rows, *args, **kwargs):
+        """``velocity_jump(*args, **kwargs)`` of the impact of the gaps ``rows`` at t; its
+        SolveError (a jump that is not unique, contradictory rows) as an EventError there."""
+        try:
+            return velocity_jump(*args, **kwargs)
+        except SolveError as err:
+            raise self._fail(t, rows, str(err), err.coordinates) from None
 
 
 def _subsets(rows):

@@ -238,3 +238,42 @@ contacts:
     assert np.abs(traj.q[held, 2] - r).max() < 1e-14
     risen = ~held
     assert np.abs(traj.q[risen, 2] - (r + k * (traj.t[risen] - t_r) ** 3 / (6 * m))).max() < 1e-10
+
+
+def test_a_jump_left_free_by_a_massless_link_stops_the_run_naming_it():
+    """The massless link of models/mechanisms/massless_link.yaml hangs between two spherical
+    joints: its spin about itself is free (Result 3 fails for the jump as for the motion).
+    Its bob strikes the ground: the run stops at the impact, naming the link's coordinates."""
+    text = (Path(__file__).resolve().parents[2] / "models" / "mechanisms" / "massless_link.yaml").read_text()
+    system = mb.loads(text + "contacts:\n  - {name: floor, type: plane, child: bob, "
+                             "ground: 2 - L*cos(0.3)*cos(0.5) - 0.01}\n")
+    with pytest.raises(mb.SimulationError, match=r"floor: the velocity jump of the impact is not unique .*Result 3"
+                                                 r"\): free in link\.qw, link\.qx, link\.qy, link\.qz") as caught:
+        mb.simulate(system, 1.0)
+    t_hit = caught.value.time
+    assert 0 < t_hit < 0.2 and caught.value.constraints == ("floor",)
+    assert caught.value.coordinates == ("link.qw", "link.qx", "link.qy", "link.qz")
+
+
+def test_a_slider_strikes_the_end_of_its_rail():
+    """A block on a horizontal prismatic rail at speed v strikes its upper limit at
+    (hi − x0)/v and comes back at e v."""
+    v, hi, e = 0.8, 0.3, 0.5
+    system = mb.loads(f"""
+name: rail
+world: {{frames: {{rail: {{axis: [1, 0, 0]}}}}}}
+subsystems:
+  block:
+    type: rigid_body
+    mass: 2.0
+    inertia: [0.1, 0.1, 0.1]
+    frames: {{slot: {{axis: [1, 0, 0]}}}}
+    initial: {{velocity: [{v}, 0, 0]}}
+joints:
+  - {{name: slide, type: prismatic, parent: world.rail, child: block.slot, limits: [-1, {hi}], restitution: {e}}}
+""")
+    traj = mb.simulate(system, 1.0)
+    (impact,) = traj.events
+    assert impact.name == "slide.upper" and abs(impact.t - hi / v) < 1e-12
+    assert abs(impact.impulse - 2.0 * (1 + e) * v) < 1e-10
+    assert abs(traj.qd[-1, 0] + e * v) < 1e-12 and abs(traj.q[-1, 0] - (hi - e * v * (1.0 - hi / v))) < 1e-12
