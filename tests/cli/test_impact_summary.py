@@ -1,5 +1,6 @@
-"""``mbsynth simulate`` of a model with contacts: its summary counts the run's events, and
-the .npz it writes keeps them."""
+"""The command line on a model with contacts: ``mbsynth simulate``'s summary counts the
+run's events, and the .npz it writes keeps them; ``mbsynth check`` lists the gaps and the
+ones touching at the initial state."""
 
 import json
 import subprocess
@@ -30,3 +31,16 @@ def test_the_bouncing_ball_counts_its_impacts_to_rest(tmp_path):
     text = subprocess.run([sys.executable, "-m", "mbsynth.cli", "simulate", str(BALL), "--t-end", "2"],
                           capture_output=True, text=True, timeout=300).stdout
     assert f"events: {rebounds + 1} impacts, 1 contact, 0 releases" in text
+
+
+def test_check_lists_the_gaps_and_those_touching(tmp_path):
+    path = tmp_path / "resting.yaml"
+    path.write_text(BALL.read_text().replace("position: [0, 0, h0]", "position: [0, 0, r]"))
+    done = subprocess.run([sys.executable, "-m", "mbsynth.cli", "check", str(path)], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "limits and contacts (gap, e): floor 0 (e = 0.5)" in done.stdout
+    assert "touching at the initial state: floor" in done.stdout
+    report = json.loads(subprocess.run([sys.executable, "-m", "mbsynth.cli", "check", str(BALL), "--json"],
+                                       capture_output=True, text=True, timeout=300).stdout)
+    assert report["gaps"] == {"floor": {"kind": "contact", "gap": 0.95, "rate": 0.0, "restitution": 0.5}}
