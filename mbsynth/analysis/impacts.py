@@ -233,8 +233,11 @@ class EventIntegration(ContinuousIntegration):
     # ---- the motion with some gaps held
 
     def _held_motion(self, t, q, qd, rows):
-        """(q̈, λ of the gap rows ``rows``, g̈ of every gap) of (2.14) with the gaps ``rows``
-        held beside the model's rows (its KKT form, solvers.py)."""
+        """(q̈, λ of the gap rows ``rows``, g̈ of every gap, the size of each g̈'s terms, the
+        size of the forces) of (2.14) with the gaps ``rows`` held beside the model's rows (its
+        KKT form, solvers.py). The sizes judge signs: a gap's acceleration is measured against
+        its row times the larger of q̈ and the forces over the largest mass (a state at rest has
+        q̈ = 0 to rounding), a multiplier against the largest |Q + C| and |λ|."""
         arrays = self.base.evaluate(t, q, qd)
         A_gaps, b_gaps = self.gaps.rows(t, q, qd, self.base.p)
         rows = list(rows)
@@ -245,8 +248,11 @@ class EventIntegration(ContinuousIntegration):
                                   constraints=names)
         lam = multipliers(A, arrays.M @ motion.qdd - arrays.Q - arrays.C)[0]
         gdd = A_gaps @ motion.qdd - b_gaps
-        scale = np.abs(A_gaps) @ np.abs(motion.qdd) + np.abs(b_gaps)
-        return motion.qdd, lam[len(arrays.b):], gdd, scale
+        force = np.abs(arrays.Q + arrays.C).max(initial=0.0)
+        acceleration = max(np.abs(motion.qdd).max(initial=0.0), force / (np.abs(arrays.M).max(initial=0.0) +
+                                                                           DIVISION_GUARD))
+        scale = np.abs(A_gaps).sum(axis=1) * acceleration + np.abs(b_gaps)
+        return motion.qdd, lam[len(arrays.b):], gdd, scale, force + np.abs(lam).max(initial=0.0)
 
     def _forces(self, t, q, qd):
         """{held gap: its force λ} at (t, q, q̇) (λ > 0 pushes the gap open)."""
@@ -262,7 +268,7 @@ class EventIntegration(ContinuousIntegration):
         p, changed = self.base.p, False
         for _ in range(ROUNDS):
             g, gd = self.gaps.values(t, q, qd, p)
-            _, _, gdd, _ = self._held_motion(t, q, qd, sorted(self.active))
+            gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
             rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
             floor = self._rounding(t, q, qd)
             striking = [i for i in self._open() if g[i] <= self.atol and gd[i] < -max(rest[i], floor[i])]
@@ -275,7 +281,7 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, striking, f"{ROUNDS} impacts at one instant")
         g, gd = self.gaps.values(t, q, qd, p)
         floor = self._rounding(t, q, qd)
-        _, _, gdd, _ = self._held_motion(t, q, qd, sorted(self.active))
+        gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
         rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
@@ -332,9 +338,9 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
         for chosen in _subsets(candidates):
-            _, lam, gdd, scale = self._held_motion(t, q, qd, chosen)
+            _, lam, gdd, scale, force = self._held_motion(t, q, qd, chosen)
             others = [i for i in candidates if i not in chosen]
-            if (lam >= -COMPLEMENTARITY_RTOL * np.abs(lam).max(initial=0.0)).all() and \
+            if (lam >= -COMPLEMENTARITY_RTOL * force).all() and \
                     all(gdd[i] >= -COMPLEMENTARITY_RTOL * scale[i] for i in others):
                 return frozenset(chosen)
         raise self._fail(t, candidates, "no consistent contact mode (Painlevé-type: no active set of the "

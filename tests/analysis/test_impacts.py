@@ -277,3 +277,17 @@ joints:
     assert impact.name == "slide.upper" and abs(impact.t - hi / v) < 1e-12
     assert abs(impact.impulse - 2.0 * (1 + e) * v) < 1e-10
     assert abs(traj.qd[-1, 0] + e * v) < 1e-12 and abs(traj.q[-1, 0] - (hi - e * v * (1.0 - hi / v))) < 1e-12
+
+
+def test_a_hanging_cradle_strikes_at_the_quarter_periods_of_its_swing():
+    """models/contact/newtons_cradle.yaml: the first ball, let go at theta0, strikes at a
+    quarter period of its swing, K(k) √(L/g) (k = sin(theta0/2)); the third swings out and
+    back and strikes again half a period later, the velocity passing back down the row."""
+    system = mb.load(MODELS / "newtons_cradle.yaml")
+    quarter = ellipk(np.sin(0.25) ** 2) * np.sqrt(0.3 / 9.81)
+    traj = mb.simulate(system, 4 * quarter - 0.01, rtol=1e-12, atol=1e-12)
+    assert [(ev.name, ev.kind) for ev in traj.events] == [("c01", "impact"), ("c12", "impact"),
+                                                          ("c12", "impact"), ("c01", "impact")]
+    times = np.array([ev.t for ev in traj.events])
+    assert np.abs(times - quarter * np.array([1, 1, 3, 3])).max() < 1e-10
+    assert np.ptp(traj.energy) < 1e-10 * abs(traj.energy).max()
