@@ -30,7 +30,6 @@ EventError (a SolveError) naming the time and the gaps: the run stops there.
 """
 
 import itertools
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -116,9 +115,11 @@ class EventIntegration(ContinuousIntegration):
             self.started = True
             q, qd, _ = self.settle(self.t_now, q, qd)
         q, qd = super().advance(t_next, q, qd, t_stop)
+        if self.solver is not None:  # integrated continuously, its events found
+            return q, qd
         g = self.gaps.values(t_next, q, qd, self.base.p)[0]
         passed = [self.gaps.names[i] for i in self._open() if g[i] < -self.atol]
-        if passed:  # an interval integrated cut (cut.py) sees no events
+        if passed:  # an interval integrated cut (cut.py, near a singular position) sees no events
             self.f.t_failed = t_next
             raise EventError(f"the run passed through {', '.join(passed)} without its event (an interval "
                              f"integrated cut near a singular position)", constraints=passed)
@@ -307,7 +308,9 @@ class EventIntegration(ContinuousIntegration):
     def _impact(self, t, q, qd, striking, e, gd, floor):
         """q̇⁺ of the impact of the ``striking`` gaps (their restitution ``e``, rates ``gd``)
         with the held ones (e = 0): the complementarity problem over them solved by
-        enumeration, the first consistent active set in order (smallest first) taken."""
+        enumeration, the first consistent active set in order (smallest first) taken; an
+        active set whose jump is not unique (Result 3) is none, and where every one is
+        such, the largest one's SolveError is raised."""
         rows = sorted(set(striking) | self.active)
         if len(rows) > ENUMERATED:
             raise self._fail(t, rows, f"{len(rows)} gaps strike at once (at most {ENUMERATED} are solved exactly)")
@@ -315,11 +318,16 @@ class EventIntegration(ContinuousIntegration):
         A_gaps = self.gaps.rows(t, q, qd, self.base.p)[0]
         M = self.base.evaluate(t, q, qd).M
         coordinates = self.base.system.coordinates
+        failed = None
         for chosen in _subsets(rows):
             target = np.array([-e[i] * gd[i] if i in striking else 0.0 for i in chosen])
             A = np.vstack([A_b, A_gaps[list(chosen)]])
-            jump = self._jump(t, chosen or rows, M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
-                              constraints=names_b + [self.gaps.names[i] for i in chosen])
+            try:
+                jump = velocity_jump(M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
+                                     constraints=names_b + [self.gaps.names[i] for i in chosen])
+            except SolveError as err:
+                failed = err
+                continue
             impulses = jump.impulses[len(v_b):]
             after = A_gaps @ jump.qd
             others = [i for i in rows if i not in chosen]
@@ -329,6 +337,8 @@ class EventIntegration(ContinuousIntegration):
                     if i in striking:
                         self.events.append(Event(float(t), self.gaps.names[i], "impact", float(impulse)))
                 return jump.qd
+        if failed is not None:
+            raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
 
     def _contact_set(self, t, q, qd, candidates):
@@ -383,9 +393,9 @@ def _subsets(rows):
 
 
 def _root(f, t0, t1, f0, f1):
-    """The root of f in [t0, t1] (f0 = f(t0) ≥ 0 > f1 = f(t1)) by Brent's method, to rounding."""
+    """The root of f in [t0, t1] (f0 = f(t0) ≥ 0 > f1 = f(t1), given) by Brent's method, to
+    rounding."""
     if f0 == 0:
         return t0
-    values = {t0: f0, t1: f1}
-    return brentq(lambda t: values[t] if t in values else f(t), t0, t1, xtol=DIVISION_GUARD,
-                  rtol=EVENT_TIME_RTOL) if math.isfinite(f0) else t0
+    known = {t0: f0, t1: f1}
+    return brentq(lambda t: known[t] if t in known else f(t), t0, t1, xtol=DIVISION_GUARD, rtol=EVENT_TIME_RTOL)
