@@ -72,7 +72,7 @@ def _plane_gap(builder, spec, path):
         builder.fail(path + ("normal",), "the plane's normal is zero")
     radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
     ground = builder.constant(spec.get("ground", 0), path + ("ground",))
-    unit = normal / sp.sqrt(sum(x**2 for x in normal))
+    unit = (normal / sp.sqrt(sum(x**2 for x in normal))).evalf()  # a number's root as a float, not an integer's
     return unit.dot(p) - ground - radius
 
 

@@ -291,3 +291,31 @@ def test_a_hanging_cradle_strikes_at_the_quarter_periods_of_its_swing():
     times = np.array([ev.t for ev in traj.events])
     assert np.abs(times - quarter * np.array([1, 1, 3, 3])).max() < 1e-10
     assert np.ptp(traj.energy) < 1e-10 * abs(traj.energy).max()
+
+
+def test_a_ball_bounces_to_rest_on_a_tilted_plane_and_slides_on_in_contact():
+    """On a frictionless plane tilted by α the normal motion is the bouncing ball's under
+    g cos α, the motion along the slope free fall under g sin α throughout: impacts do not
+    touch it, and once the ball rests on the plane the held contact lets it slide."""
+    g, r, e, alpha, d0 = 9.81, 0.05, 0.5, 0.3, 0.4  # d0: the centre's height above the plane
+    n = np.array([np.sin(alpha), 0.0, np.cos(alpha)])
+    along = np.array([np.cos(alpha), 0.0, -np.sin(alpha)])  # down the slope
+    start = (d0 + r) * n
+    system = mb.loads(f"""
+name: slope
+parameters: {{m: 0.2, r: {r}, g: {g}}}
+gravity: [0, 0, -g]
+subsystems:
+  ball: {{type: particle, mass: m, initial: {{position: {start.tolist()}}}}}
+contacts:
+  - {{name: slope, type: plane, child: ball, radius: r, normal: {n.tolist()}, restitution: {e}}}
+""")
+    traj = mb.simulate(system, 2.0)
+    impacts = [ev for ev in traj.events if ev.kind == "impact"]
+    times, _, t_rest = _ball_closed_form(d0 + r, r, g * np.cos(alpha), e, len(impacts))
+    assert np.abs(np.array([ev.t for ev in impacts]) - times).max() < 1e-10
+    assert [ev.kind for ev in traj.events[len(impacts):]] == ["contact"]
+    slide = (traj.q - start) @ along
+    assert np.abs(slide - 0.5 * g * np.sin(alpha) * traj.t**2).max() < 1e-9
+    after = traj.t > t_rest
+    assert np.abs(traj.q[after] @ n - r).max() < 1e-12
