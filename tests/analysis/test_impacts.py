@@ -319,3 +319,31 @@ contacts:
     assert np.abs(slide - 0.5 * g * np.sin(alpha) * traj.t**2).max() < 1e-9
     after = traj.t > t_rest
     assert np.abs(traj.q[after] @ n - r).max() < 1e-12
+
+
+def test_a_body_landing_flat_on_two_points_strikes_on_both_at_once():
+    """A body falling flat (no rotation) onto two points at distances a and b either side of
+    its centre: the two impacts are simultaneous, the complementarity problem's solution
+    holds both (Newton's law at each): it rebounds at e v without turning, the impulses
+    P₁ = m (1 + e) v b/(a + b), P₂ = m (1 + e) v a/(a + b) (their moments balance)."""
+    m, a, b, v, e = 1.5, 0.3, 0.1, 2.0, 0.6
+    system = mb.loads(f"""
+name: plank
+subsystems:
+  plank:
+    type: rigid_body
+    mass: {m}
+    inertia: [0.01, 0.08, 0.08]
+    frames: {{left: {{position: [{-a}, 0, -0.02]}}, right: {{position: [{b}, 0, -0.02]}}}}
+    initial: {{position: [0, 0, 0.22], velocity: [0, 0, {-v}]}}
+contacts:
+  - {{name: left, type: plane, child: plank.left, restitution: {e}}}
+  - {{name: right, type: plane, child: plank.right, restitution: {e}}}
+""")
+    traj = mb.simulate(system, 0.2)
+    impacts = {ev.name: ev for ev in traj.events}
+    assert sorted(impacts) == ["left", "right"] and impacts["left"].t == impacts["right"].t
+    assert abs(impacts["left"].t - 0.2 / v) < 1e-12
+    assert abs(impacts["left"].impulse - m * (1 + e) * v * b / (a + b)) < 1e-10
+    assert abs(impacts["right"].impulse - m * (1 + e) * v * a / (a + b)) < 1e-10
+    assert np.abs(traj.qd[-1] - np.r_[0, 0, e * v, np.zeros(4)]).max() < 1e-10
