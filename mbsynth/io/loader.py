@@ -91,7 +91,7 @@ class _Builder:
         self.chain = include.chain if include else ()  # (file, line) of the entries that include this file
         self.bound = {}  # the extra_names in effect: {name: value}
         self.values = assembly.known  # expression of parameters -> its value, each found once (``checked``)
-        self.limited = []  # (entry, path, Joint, name in the file) of the file's joints, for their limits
+        self.limited = []  # (entry, path, Joint, name in the file, its for: names) of the file's joints, for their limits
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
@@ -443,7 +443,10 @@ class _Builder:
 
     def unilaterals(self):
         """(Unilateral, path of its entry) of this file's joint limits and contacts."""
-        limits = [found for spec, path, joint, own in self.limited for found in read_limits(self, spec, path, joint, own)]
+        limits = []
+        for spec, path, joint, own, loop in self.limited:
+            with self.extra_names(loop):
+                limits += read_limits(self, spec, path, joint, own)
         return limits + read_contacts(self)
 
     def read_closure(self):

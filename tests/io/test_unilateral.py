@@ -107,3 +107,14 @@ def test_restitution_follows_the_parameters_and_is_refused_outside_0_1():
     assert half.unaccounted_work() == ["hinge.lower", "hinge.upper"]  # impacts that lose energy
     with pytest.raises(mb.ModelError, match="the restitution of 'hinge.lower' is 2 at these parameter values"):
         mb.simulate(system.with_parameters(e=2.0), 0.1)
+
+
+
+def test_the_limits_of_a_for_entrys_joints_may_use_its_name():
+    path = Path(__file__).resolve().parents[2] / "models" / "mechanisms" / "n_four_bar.yaml"
+    text = path.read_text().replace("    child: cell[i].right\n", "    child: cell[i].right\n    limits: [-1 - i, 1 + i]\n")
+    system = mb.loads(text, folder=path.parent, parameters={"N": 3})
+    q, qd = system.initial_state()
+    gaps = {u.name: u.row.residuals(0.0, q, qd, system.parameter_values)[0][0] for u in system.unilaterals}
+    assert list(gaps) == ["right[0].lower", "right[0].upper", "right[1].lower", "right[1].upper"]
+    assert np.allclose(list(gaps.values()), [1, 1, 2, 2], atol=1e-12)  # the bars start square: angle 0
