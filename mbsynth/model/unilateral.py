@@ -70,13 +70,11 @@ class Gaps:
         found = [u.row.residuals(t, q, qd, p) for u in self.unilaterals]
         return (np.array([phi[0] for phi, _ in found]), np.array([psi[0] for _, psi in found]))
 
-    def rows(self, t, q, qd, p, which=None):
-        """(A, b) of the gaps ``which`` (indices; all by default): A's row i is ∂g_i/∂q over
-        all n coordinates, and g̈_i = A_i q̈ − b_i."""
-        which = range(len(self.unilaterals)) if which is None else which
-        A, b = np.zeros((len(which), self.n)), np.zeros(len(which))
-        for k, i in enumerate(which):
-            row = self.unilaterals[i].row
-            a, b_row, _ = row.evaluate(t, q, qd, p)
-            A[k, row.indices], b[k] = a[0], b_row[0]
+    def rows(self, t, q, qd, p):
+        """(A, b) of the gaps: A's row i is ∂g_i/∂q over all n coordinates, and
+        g̈_i = A_i q̈ − b_i."""
+        A, b = np.zeros((len(self.unilaterals), self.n)), np.zeros(len(self.unilaterals))
+        for i, u in enumerate(self.unilaterals):
+            a, b_row, _ = u.row.evaluate(t, q, qd, p)
+            A[i, u.row.indices], b[i] = a[0], b_row[0]
         return A, b
