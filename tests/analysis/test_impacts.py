@@ -347,3 +347,25 @@ contacts:
     assert abs(impacts["left"].impulse - m * (1 + e) * v * b / (a + b)) < 1e-10
     assert abs(impacts["right"].impulse - m * (1 + e) * v * a / (a + b)) < 1e-10
     assert np.abs(traj.qd[-1] - np.r_[0, 0, e * v, np.zeros(4)]).max() < 1e-10
+
+
+def test_a_controller_that_lifts_a_resting_ball_releases_its_contact_at_the_sample():
+    """Sampled control (its values jump at a sample): a force of 2 m g switched on at 0.5 s
+    lifts a ball resting on the floor there, z = r + g (t − 0.5)²/2 after."""
+    m, r, g = 0.5, 0.1, 9.81
+    system = mb.loads(f"""
+name: lift
+parameters: {{m: {m}, r: {r}, g: {g}, F: 0.0}}
+gravity: [0, 0, -g]
+subsystems:
+  ball: {{type: particle, mass: m, initial: {{position: [0, 0, r]}}}}
+forces:
+  - {{name: lift, type: force, at: ball, value: [0, 0, F]}}
+contacts:
+  - {{name: floor, type: plane, child: ball, radius: r}}
+""")
+    traj = mb.simulate(system, 1.0, dt=0.01, control_dt=0.25,
+                       controller=lambda t, joints: {"F": 2 * m * g if t >= 0.5 else 0.0})
+    assert [(ev.t, ev.kind) for ev in traj.events] == [(0.0, "contact"), (0.5, "release")]
+    expected = np.where(traj.t > 0.5, r + g * (traj.t - 0.5) ** 2 / 2, r)
+    assert np.abs(traj.q[:, 2] - expected).max() < 1e-12
