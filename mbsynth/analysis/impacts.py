@@ -39,9 +39,10 @@ from . import stepper
 from .continuous import ContinuousIntegration
 from .impulse import velocity_jump
 from .trajectory import Event
-from ..core.errors import EventError, SolveError
+from ..core.errors import EventError, ModelError, SolveError
 from ..core.solvers import kkt_acceleration
-from ..core.tolerances import COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP, SPEED_ROUNDING
+from ..core.tolerances import (ASSEMBLED_TOL, COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP,
+                               SPEED_ROUNDING)
 from ..model.reactions import multipliers
 from ..model.unilateral import Gaps, with_active
 
@@ -112,6 +113,7 @@ class EventIntegration(ContinuousIntegration):
 
     def advance(self, t_next, q, qd, t_stop):
         if not self.started:
+            self._check_start(self.t_now, q, qd)
             self.started = True
             q, qd, _ = self.settle(self.t_now, q, qd)
         q, qd = super().advance(t_next, q, qd, t_stop)
@@ -124,6 +126,16 @@ class EventIntegration(ContinuousIntegration):
             raise EventError(f"the run passed through {', '.join(passed)} without its event (an interval "
                              f"integrated cut near a singular position)", constraints=passed)
         return q, qd
+
+    def _check_start(self, t, q, qd):
+        """ModelError where the state the run starts from penetrates a gap by more than
+        ASSEMBLED_TOL (io/unilateral.py's check of a model file's initial state, for a state
+        given otherwise: ``q0``, other parameter values)."""
+        g = self.gaps.values(t, q, qd, self.base.p)[0]
+        deep = [(name, -x) for name, x in zip(self.gaps.names, g) if x < -ASSEMBLED_TOL]
+        if deep:
+            raise ModelError(f"model '{self.base.system.name}': the state at t = {t:g} penetrates "
+                             + ", ".join(f"'{name}' by {depth:.6g}" for name, depth in deep) + " (gaps must be ≥ 0)")
 
     def _step(self, solver, t_next):
         if self.pending is None:

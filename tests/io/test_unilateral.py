@@ -118,3 +118,9 @@ def test_the_limits_of_a_for_entrys_joints_may_use_its_name():
     gaps = {u.name: u.row.residuals(0.0, q, qd, system.parameter_values)[0][0] for u in system.unilaterals}
     assert list(gaps) == ["right[0].lower", "right[0].upper", "right[1].lower", "right[1].upper"]
     assert np.allclose(list(gaps.values()), [1, 1, 2, 2], atol=1e-12)  # the bars start square: angle 0
+
+
+def test_a_run_from_a_state_that_penetrates_is_refused_saying_by_how_much():
+    system = mb.load(MODELS / "bouncing_ball.yaml")  # r = 0.05
+    with pytest.raises(mb.ModelError, match=r"the state at t = 0 penetrates 'floor' by 0.02 \(gaps must be ≥ 0\)"):
+        mb.simulate(system, 0.1, q0=[0.0, 0.0, 0.03])
