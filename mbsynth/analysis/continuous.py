@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from . import stepper
-from ..core.errors import SolveError
+from ..core.errors import EventError, SolveError
 from .crossing import NAMED_SHARE, Crossing
 from .cut import CutIntegration
 from .derivative import Crawl
@@ -81,6 +81,8 @@ class ContinuousIntegration(CutIntegration):
         try:
             y, projected, bounded = self._reach(t_next, q, qd, t_stop)
         except (Crawl, SolveError) as stop:
+            if isinstance(stop, EventError):  # found where it happens: no cut interval avoids it
+                raise
             self.solver = None  # stopped within a step
             q, qd = super().advance(t_next, q, qd, loosen=isinstance(stop, Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next
@@ -193,6 +195,10 @@ class ContinuousIntegration(CutIntegration):
             stepper.rewind(solver, start, cap)
             self.steps -= 1
             return
+        if self.event_in(solver, start, target):  # taken again up to the event (impacts.py)
+            stepper.rewind(solver, start, solver.max_step)
+            self.steps -= 1
+            return
         stepper.cap(solver, cap)
         times = self.schedule.between(t_next, solver.t)
         states = np.empty((len(times) + 1, solver.y.size))
@@ -211,6 +217,11 @@ class ContinuousIntegration(CutIntegration):
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
             y = self.form.to_integrator(q_on, qd_on)
             stepper.move(solver, y, None if solver.status == "finished" else self.f(solver.t, y))
+
+    def event_in(self, solver, start, target):
+        """Whether the step just taken from ``start`` (aimed at ``target`` or None) passed an
+        event it must stop at, to be taken again up to it: never here (impacts.py's runs)."""
+        return False
 
     def _watch_from(self, t, q, qd):
         """Watch for the singular positions passed between stages from the state (t, q, q̇)

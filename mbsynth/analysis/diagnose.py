@@ -53,6 +53,8 @@ class Diagnosis:
     angle_singularities: list = field(default_factory=list)
     # the model files it includes, as a tree: coordinates, rows and degrees of freedom of each (substructure_counts)
     substructures: list = field(default_factory=list)
+    # the limits and contacts (model/unilateral.py): name -> {kind, gap, rate, restitution} at the state
+    gaps: dict = field(default_factory=dict)
 
     @property
     def consistent(self):
@@ -94,7 +96,18 @@ def diagnose(data, t=0.0, q=None, qd=None):
         rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report),
         joints=_joints(data, t, q, qd, motion), free_joints=_moved_joints(data, t, q, report.nullspace),
         angle_singularities=[a.to_dict() for a in AngleParts(system).set_aside(q, report.nullspace)[0]],
-        substructures=substructure_counts(system, arrays.M, arrays.A))
+        substructures=substructure_counts(system, arrays.M, arrays.A), gaps=_gaps(data, t, q, qd))
+
+
+def _gaps(data, t, q, qd):
+    """{limit or contact: {kind, gap g, rate ġ, restitution}} at (t, q, q̇)."""
+    system = data.model
+    found = {}
+    for u in system.unilaterals:
+        (g,), (rate,) = u.row.residuals(t, q, qd, data.parameter_values)
+        found[u.name] = {"kind": u.kind, "gap": float(g), "rate": float(rate),
+                         "restitution": u.restitution_at(system, data.parameter_values)}
+    return found
 
 
 def _joints(data, t, q, qd, motion):

@@ -32,6 +32,7 @@ class Recorder:
                             power=np.empty(rows), kinetic=np.empty(rows), residual_position=np.empty(rows),
                             residual_velocity=np.empty(rows), outputs=np.empty((rows, m)))
         self.writer = None
+        self.events = []  # trajectory.Event, appended by a run with unilateral constraints (impacts.py)
 
     def open(self):
         """Start the file, if one was asked for (a path that cannot be written fails here)."""
@@ -102,7 +103,8 @@ class Recorder:
         c = {name: column[rows] for name, column in self.columns.items()}
         return Trajectory(tuple(self.data.model.coordinates), c["t"], c["q"], c["qd"], c["energy"], c["kinetic"],
                           c["residual_position"], c["residual_velocity"], status, outputs=c["outputs"],
-                          output_names=tuple(self.outputs.names), power=c["power"], **self.run)
+                          output_names=tuple(self.outputs.names), power=c["power"], events=tuple(self.events),
+                          **self.run)
 
 
 def run_of(data):

@@ -24,6 +24,10 @@ There a tolerance tighter than the stages' noise makes the integrator crawl; a c
 run whose watch sees a singular position coming steps across it in one planned step
 (crossing.py), and a span that crawls still is integrated again more loosely (cut.py) and
 listed in ``stats["relaxed_spans"]``.
+
+A model with joint limits or contacts runs event-driven (impacts.py): the gaps' closing
+and the held ones' release found on the steps' dense output, impacts as velocity jumps of
+the impulse form of (2.14), the events in ``Trajectory.events``.
 """
 
 import logging
@@ -39,6 +43,7 @@ from ..model.data import Data
 from . import stepper
 from .continuous import ContinuousIntegration
 from .cut import CutIntegration
+from .impacts import EventIntegration
 from .projection import consistent_initial_state
 from .recording import Recorder
 from .schedule import Schedule
@@ -93,8 +98,9 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
     control = None if controller is None else \
         SampledControl(controller, times[1] - times[0] if control_dt is None else control_dt)
     schedule = Schedule(times, None if control is None else control.dt)
-    strategy = ContinuousIntegration if ContinuousIntegration.fits(method, stabilization) else CutIntegration
-    run = strategy(data, method, rtol, atol, stabilization, baumgarte, schedule)
+    run = _strategy(data.model, method, stabilization)(data, method, rtol, atol, stabilization, baumgarte, schedule)
+    if isinstance(run, EventIntegration):
+        run.events = recorder.events
     recorder.open()
     started = time.perf_counter()
     status = "stopped"
@@ -149,6 +155,19 @@ def _run_data(model, path):
     if path not in (None, model.path):
         raise ValueError(f"path={path!r}: the Data given runs on its own path, {model.path!r}")
     return model
+
+
+def _strategy(system, method, stabilization):
+    """The Integration class of the run: with events where the model has limits or
+    contacts (impacts.py), else continuous where it can be, else cut."""
+    continuous = ContinuousIntegration.fits(method, stabilization)
+    if system.unilaterals:
+        if not continuous:
+            raise ValueError(f"model '{system.name}' has limits or contacts: its run needs an explicit "
+                             f"Runge–Kutta method ({', '.join(k.__name__ for k in stepper.RESUMABLE)}) and "
+                             f"stabilization='projection'")
+        return EventIntegration
+    return ContinuousIntegration if continuous else CutIntegration
 
 
 def _record_ready(run, recorder, schedule, progress, q, qd):

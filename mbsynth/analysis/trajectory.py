@@ -9,6 +9,8 @@ declared ``outputs`` (one column per name in ``output_names``: mbsynth.model.out
   ``residual_position``, ``residual_velocity``, ``status``, ``outputs``, ``output_names``,
   and the run's model: ``model`` (its name), ``model_file``, ``parameter_names``,
   ``parameter_values``: the values of its parameters not defined by others, at the start);
+  and the run's events (impacts, contacts that close or open: analysis/impacts.py) as
+  ``event_t``, ``event_name``, ``event_kind``, ``event_impulse``;
 - ``.csv``: a header ``t, <coordinate>..., <coordinate>_dot..., energy, <output>...`` and
   one row per time.
 
@@ -29,6 +31,7 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import scipy.interpolate
@@ -38,6 +41,17 @@ from ..core.files import file_format, unwritable, write_atomically
 
 FORMATS = (".npz", ".csv")
 COMPLETED = "completed"
+
+
+class Event(NamedTuple):
+    """What happened at a unilateral constraint (analysis/impacts.py) at time ``t``: ``kind``
+    "impact" (a velocity jump, ``impulse`` its Λ), "contact" (the gap closed and holds: a
+    persistent contact, ``impulse`` what brought it to rest) or "release" (it opened)."""
+
+    t: float
+    name: str
+    kind: str
+    impulse: float
 
 
 @dataclass
@@ -58,6 +72,7 @@ class Trajectory:
     model: str = ""  # the name of the model run
     model_file: str = ""  # its file ("" where it was not read from one)
     parameters: dict = field(default_factory=dict)  # its parameters not defined by others, at the start
+    events: tuple = ()  # Event: impacts, contacts closing and opening, in time order
 
     def __post_init__(self):
         if self.outputs is None:
@@ -146,7 +161,8 @@ def load_trajectory(path):
                           get.get("kinetic", nan), get.get("residual_position", nan), get.get("residual_velocity", nan),
                           str(get.get("status", COMPLETED)), outputs=get.get("outputs"), output_names=names,
                           power=get.get("power", nan), model=str(get.get("model", "")),
-                          model_file=str(get.get("model_file", "")), parameters=parameters)
+                          model_file=str(get.get("model_file", "")), parameters=parameters,
+                          events=_events(get))
     if file_format(path) == ".csv" or path.name.lower().endswith(".csv.partial"):
         with path.open(newline="") as f:
             header = next(csv.reader(f))
@@ -161,6 +177,14 @@ def load_trajectory(path):
                           data[:, energy], nan, nan, nan, outputs=data[:, energy + 1:],
                           output_names=tuple(header[energy + 1:]), power=nan)
     raise ModelError(f"{path}: unknown trajectory format (use {' or '.join(FORMATS)})")
+
+
+def _events(columns):
+    """The Events of an .npz file's columns (none where it has no event columns)."""
+    if "event_t" not in columns:
+        return ()
+    return tuple(Event(float(t), str(name), str(kind), float(impulse)) for t, name, kind, impulse in
+                 zip(columns["event_t"], columns["event_name"], columns["event_kind"], columns["event_impulse"]))
 
 
 def run_of(traj):
@@ -265,6 +289,11 @@ class TrajectoryWriter:
                        model_file=np.array(self.run["model_file"]),
                        parameter_names=np.array(list(self.run["parameters"]), dtype=str),
                        parameter_values=np.array(list(self.run["parameters"].values()), dtype=float))
+        events = chunks[-1].events if chunks else ()
+        columns.update(event_t=np.array([e.t for e in events], dtype=float),
+                       event_name=np.array([e.name for e in events], dtype=str),
+                       event_kind=np.array([e.kind for e in events], dtype=str),
+                       event_impulse=np.array([e.impulse for e in events], dtype=float))
         try:
             write_atomically(self.path, lambda temporary: np.savez(temporary, **columns))
         except OSError as err:

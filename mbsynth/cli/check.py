@@ -68,6 +68,11 @@ def format_check(report, path, coordinates="joints"):
     else:
         accelerations = ", ".join(f"{c} = {x:.6g}" for c, x in report.qdd.items())
         lines.append(f"  accelerations at the initial state{'' if report.unique else ' (η = 0)'}: {accelerations}")
+    if report.gaps:
+        touching = [name for name, gap in report.gaps.items() if gap["gap"] <= CHECK_RESIDUAL_TOL]
+        lines.append("  limits and contacts (gap, e): " + ", ".join(
+            f"{name} {gap['gap']:.6g} (e = {gap['restitution']:g})" for name, gap in report.gaps.items()))
+        lines.append(f"  touching at the initial state: {', '.join(touching) or 'none'}")
     violated = [name for name, r in report.constraint_residuals.items()
                 if any(v is not None and abs(v) > CHECK_RESIDUAL_TOL for v in r.values())]
     if violated:

@@ -46,6 +46,7 @@ def run(args):
                "singular_positions": [{"t_from": float(e["t_from"]), "t_to": float(e["t_to"]), "rows": e["rows"]}
                                       for e in traj.stats.get("singular_positions", [])],
                "relaxed_spans": [{k: float(v) for k, v in e.items()} for e in traj.stats.get("relaxed_spans", [])],
+               "events": {kind: sum(e.kind == kind for e in traj.events) for kind in ("impact", "contact", "release")},
                "out": args.out and str(output_file(args.out, completed=error is None)), "plot": args.plot,
                "status": "completed" if error is None else "failed"}
     if error:
@@ -94,6 +95,9 @@ def format_summary(s):
         lines.append(f"  integrated at rtol up to {max(e['rtol'] for e in spans):.3g} near them: {len(spans)} "
                      f"span(s) of {sum(e['t_to'] - e['t_from'] for e in spans):.3g} s in all, the first from "
                      f"t = {spans[0]['t_from']:.6g} (the requested tolerance crawled there)")
+    if any(s["events"].values()):
+        lines.append("  events: " + ", ".join(f"{count} {kind}{'s' if count != 1 else ''}"
+                                             for kind, count in s["events"].items()))
     for key in ("out", "plot"):
         if s[key]:
             lines.append(f"  wrote {s[key]}")

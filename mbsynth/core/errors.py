@@ -21,6 +21,12 @@ class SolveError(ArithmeticError):
         self.coordinates = tuple(coordinates)
 
 
+class EventError(SolveError):
+    """No motion through an event of a limit or contact (analysis/impacts.py): a velocity
+    jump that is not unique, no consistent impact or contact mode, gaps that chatter. Found
+    at its time, it stops the run there (an interval integrated again cannot avoid it)."""
+
+
 class NoEquilibrium(SolveError):
     """A verdict, not a fault: the model has no rest where one is asked for — no static
     equilibrium found from the given configuration, one that is not isolated

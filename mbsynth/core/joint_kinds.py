@@ -156,6 +156,12 @@ class JointKind(NamedTuple):
         return ("angle",) * self.turns + ("displacement",) * self.slides
 
     @property
+    def limited(self):
+        """The joint value a ``limits: [lo, hi]`` bounds (model/unilateral.py): its one free
+        motion ("angle" or "displacement"), or None where it has none or two."""
+        return self.motions[0] if len(self.motions) == 1 else None
+
+    @property
     def effort(self):
         """What acts along its one free motion (``EFFORTS``: "torque" when it turns, "force"
         when it slides), else None (none, or two: a cylindrical joint's actuation names both)."""

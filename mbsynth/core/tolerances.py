@@ -158,6 +158,13 @@ MODE_SHOWN_RTOL = 1e-6  # modes.py: a shape's component below this share of its 
 IMAGINARY_SHOWN_RTOL = 1e-9  # modes.py: an imaginary part below this share of |z| is not printed
 SHAPE_ENTRY_ZERO = 1e-12  # modes.py: a mode shape's entry below this (its largest is 1) is left out of the JSON
 COMPLEX_SHAPE_TOL = 1e-9  # modes.py: a mode shape whose imaginary parts exceed this (its largest is 1) is complex
+REST_HOP = 1.0  # impacts.py: a rebound whose hop height v²/(2|g̈|) is below this times the run's atol (a hop its
+# position accuracy cannot resolve) ends the bouncing: the gap comes to rest, no accumulation of impacts to chase
+SPEED_ROUNDING = 1e3 * EPS  # impacts.py: a gap's rate within this times ‖a‖₁ max |q̇| of zero is rounding (of the
+# jumps before it at that instant): neither striking nor separating
+EVENT_TIME_RTOL = 4 * EPS  # impacts.py: an event's time is found to this relative accuracy (Brent's least: rounding)
+COMPLEMENTARITY_RTOL = 1e-9  # impacts.py: an impulse or contact force above −this × the largest, and a gap's rate or
+# acceleration above −this × its terms' size, meets its sign condition (the KKT solve's rounding)
 CHECK_RESIDUAL_TOL = 1e-9  # cli/check.py: an initial constraint residual beyond this (SI units) is a violation
 
 # ---- validation against Pinocchio (robots/)

@@ -130,6 +130,7 @@ def read_joints(builder):
         joints.append(joint)
         if isinstance(joint, Joint):
             forces.append((spec, ("joints", i), joint))
+            builder.limited.append((spec, ("joints", i), joint, spec["name"] + suffix, loop))
     builder.register_joints(joints)  # joint values in the expressions of actuation and springs
     elements = [e for spec, path, joint in forces for e in read_joint_forces(builder, spec, path, joint)]
     return joints, elements

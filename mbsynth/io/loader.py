@@ -28,6 +28,7 @@ from .outputs import read_outputs
 from .part_types import FILE_TYPES, SECTIONS
 from .robot import connect_robots, read_robots
 from .placement import Placement, place_initial
+from .unilateral import check_initial, read_contacts, read_limits
 from .source import Document, LineDict, LineList, read_document
 from .substructures import Scoped, included_from, read_includes
 from ..core.tolerances import ASSEMBLED_TOL
@@ -90,6 +91,7 @@ class _Builder:
         self.chain = include.chain if include else ()  # (file, line) of the entries that include this file
         self.bound = {}  # the extra_names in effect: {name: value}
         self.values = assembly.known  # expression of parameters -> its value, each found once (``checked``)
+        self.limited = []  # (entry, path, Joint, name in the file, its for: names) of the file's joints, for their limits
 
     # -- generic checks -------------------------------------------------------------
     def fail(self, path, message):
@@ -304,8 +306,12 @@ class _Builder:
                          outputs=tuple(outputs), fixed_parameters=dict(model.fixed),
                          load_parameters=dict(model.overrides), built_parameters=dict(system.parameters),
                          substructures=self.substructures())
+        unilaterals = [(u, path, builder) for builder in self.included_first for u, path in builder.unilaterals()]
+        if unilaterals:
+            system = replace(system, unilaterals=tuple(u for u, _, _ in unilaterals))
         self.check_parts(system)
         self.check_branches(system)
+        check_initial(system, unilaterals)
         auto = [builder for builder in self.builders if builder.read_balances() == "auto"]
         return append_balances(system) if auto else system
 
@@ -434,6 +440,14 @@ class _Builder:
         self.register_joints(robot_joints, robot=True)
         joints, joint_forces = read_joints(self)
         return robot_joints + self.read_constraints() + joints, robot_forces + read_forces(self) + joint_forces
+
+    def unilaterals(self):
+        """(Unilateral, path of its entry) of this file's joint limits and contacts."""
+        limits = []
+        for spec, path, joint, own, loop in self.limited:
+            with self.extra_names(loop):
+                limits += read_limits(self, spec, path, joint, own)
+        return limits + read_contacts(self)
 
     def read_balances(self):
         balances = self.root.get("balances", "none")

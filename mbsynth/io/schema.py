@@ -108,6 +108,9 @@ SECTIONS = {section.name: section for section in (
              Key("joints", "list of joints (sections *joint*, *rolling_disk*, *knife_edge*)",
                  "joints between named frames and ground contacts", "[{name: pin, type: revolute, parent: world, child: link.top}]",
                  default="[]"),
+             Key("contacts", "list of contacts (sections *contact_plane*, *contact_spheres*)",
+                 "unilateral contacts that strike, rest and lift off (docs/guide.md, impacts)",
+                 "[{name: floor, type: plane, child: ball, radius: r, restitution: 0.8}]", default="[]"),
              Key("balances", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
                  "part whose motion the model leaves open (model/balances.py)", "auto", default="none"),
              Key("initial", "mapping coordinate → " + _EXPR, "initial values by coordinate name "
@@ -382,7 +385,31 @@ SECTIONS = {section.name: section for section in (
              Key("spring", "mapping (section *joint_spring*)", "torsional or linear spring and damper "
                  "at a revolute or prismatic joint", "{stiffness: k, rest: 0.1}"),
              Key("friction", "mapping (section *joint_friction*)", "viscous and Coulomb friction at a "
-                 "revolute or prismatic joint (non-ideal C)", "{viscous: 0.05}"))),
+                 "revolute or prismatic joint (non-ideal C)", "{viscous: 0.05}"),
+             Key("limits", "list of 2 " + _EXPRS + ", lo ≤ hi", "stops on the angle (revolute) or displacement "
+                 "(prismatic): unilateral rows ``<joint>.lower``, ``<joint>.upper``", "[-0.5, 0.5]"),
+             Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution at the limits",
+                 "0.5", default="0"))),
+    Section("contact_plane", "an entry of ``contacts:`` with ``type: plane``",
+            "A point (radius 0) or sphere on a part's frame against the plane n·x = ground (n the unit "
+            "normal): the gap n·p − ground − radius stays ≥ 0.",
+            (_required("name", "plain name", "the contact's name", "floor"),
+             _required("type", "string", "``plane``", "plane"),
+             _required("child", "frame", "the sphere's centre: a frame on a part", "ball"),
+             Key("radius", _EXPR + ", ≥ 0", "the sphere's radius (0: a point)", "r", default="0"),
+             Key("ground", _EXPR, "the plane's offset along its normal", "0", default="0"),
+             Key("normal", "list of 3 " + _EXPRS, "the plane's normal, pointing out of the ground", "[0, 0, 1]",
+                 default="[0, 0, 1]"),
+             Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution", "0.8", default="0"),
+             _DESCRIPTION)),
+    Section("contact_spheres", "an entry of ``contacts:`` with ``type: spheres``",
+            "Two spheres on two parts: the gap |p_B − p_A| − r_A − r_B stays ≥ 0.",
+            (_required("name", "plain name", "the contact's name", "c12"),
+             _required("type", "string", "``spheres``", "spheres"),
+             _required("between", "list of 2 frames", "the spheres' centres, on two parts", "[ball1, ball2]"),
+             _required("radius", "list of 2 " + _EXPRS + ", ≥ 0", "their radii", "[r, r]"),
+             Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution", "1", default="0"),
+             _DESCRIPTION)),
     Section("rolling_disk", "an entry of ``joints:`` with ``type: rolling_disk``",
             "A disk rolling without slipping on the plane z = ground.",
             (_required("name", "plain name", "the contact's name", "roll"),

@@ -105,6 +105,7 @@ class System:
     substructures: tuple = ()  # Substructure: the model files this one includes, as a tree
     robots: tuple = ()  # robots.Robot: the robots decomposed into parts, for validate.py
     outputs: tuple = ()  # outputs.Output: named quantities evaluated along a run
+    unilaterals: tuple = ()  # unilateral.Unilateral: joint limits and contacts, gaps g(q) ≥ 0 (analysis/impacts.py)
     fixed_parameters: dict = None  # parameter name -> where the model file built something from it at load
     load_parameters: dict = None  # the values given to ``load`` (``parameters=``), built in at load
     built_parameters: dict = None  # every parameter's value as the model was built at load
@@ -187,9 +188,9 @@ class System:
         return len(self.coordinates)
 
     @property
-    def connectors(self):  # the old name of constraints
+    def constraints(self):  # the old name of constraints
         """``constraints`` under its old name (a DeprecationWarning)."""
-        warnings.warn("System.connectors is the old name of System.constraints", DeprecationWarning, stacklevel=2)
+        warnings.warn("System.constraints is the old name of System.constraints", DeprecationWarning, stacklevel=2)
         return self.constraints
 
     @property
@@ -456,22 +457,27 @@ class System:
         """The names of what can change the total energy T + V: force elements with efforts
         (actuation, dampers), parts with forces beyond T and V (generalized forces, modal or
         Rayleigh damping, a spring's damper) or an explicit t, constraints with a non-ideal C
-        (friction) or an explicit t (a prescribed motion). Empty: the energy is conserved,
-        and its change along a run is drift."""
+        (friction) or an explicit t (a prescribed motion), limits and contacts whose impacts
+        lose energy (restitution below 1). Empty: the energy is conserved, and its change
+        along a run is drift."""
         found = [e.name for e in self.forces if not e.conservative or T_SYMBOL in e.V.free_symbols]
         found += [part.name for part in self.parts if part.working or _time_in_part(part)]
         found += [con.name for con in self.constraints
                   if getattr(con, "coulomb", None) or any(x != 0 for x in con.C.values()) or _time_in_rows(con)]
-        return found
+        return found + self._inelastic()
 
     def unaccounted_work(self):
         """The names among ``working_forces`` whose work a run does not integrate
         (``Data.power``): an explicit t in a potential, a kinetic energy or a constraint,
-        and Coulomb friction (its force depends on q̈)."""
+        Coulomb friction (its force depends on q̈) and inelastic impacts (their loss is a jump)."""
         found = [e.name for e in self.forces if T_SYMBOL in e.V.free_symbols]
         found += [part.name for part in self.parts if _time_in_part(part)]
         found += [con.name for con in self.constraints if getattr(con, "coulomb", None) or _time_in_rows(con)]
-        return found
+        return found + self._inelastic()
+
+    def _inelastic(self):
+        """The names of the limits and contacts whose impacts lose energy (restitution below 1)."""
+        return [u.name for u in self.unilaterals if u.restitution_at(self, self.parameter_values) < 1]
 
 
 _DEFAULT_DATA = MEMO.table("default data", DEFAULT_DATA_KEPT)

@@ -1,0 +1,413 @@
+"""Event-driven motion with unilateral constraints (model/unilateral.py): joint limits and
+contacts that strike, rest and lift off.
+
+``EventIntegration`` is the continuous strategy (continuous.py) with events. After each
+accepted step it looks at the gaps g ≥ 0 that are open and at the forces λ ≥ 0 of those
+that hold; where one changes sign within the step its time is found by Brent's method on
+the step's dense output (no step-size crawl), the step is taken again up to that time, and
+the state there is ``settle``d:
+
+1. impacts: the open gaps that touch (g ≤ the run's atol) and close faster than they could
+   rest strike. Their velocity jump is the impulse form of the singular-mass equation
+   (impulse.py: M Δq̇ = AᵀΛ with the bilateral rows kept, Newton's law on the striking
+   rows), Result 3 deciding whether it is unique. Simultaneous impacts are a linear
+   complementarity problem 0 ≤ Λ ⊥ ġ⁺ + e ġ⁻ ≥ 0 over the striking rows and the held
+   ones (e = 0 there), solved exactly by enumerating its active sets; a row the jump
+   leaves closing strikes in the next round at the same instant (sequential impacts:
+   Newton's cradle exchanges its velocities so). A rebound whose hop height v²/(2|g̈|) is
+   below REST_HOP × atol is not followed: the row takes e = 0 and comes to rest (a bouncing
+   ball's accumulation of impacts ends after finitely many; the remaining flights, at most
+   2v/(|g̈|(1 − e)), are within the run's accuracy).
+2. persistent contact: the touching gaps at rest and the held ones form the acceleration
+   complementarity problem 0 ≤ λ ⊥ g̈ ≥ 0, again solved by enumeration; the rows of its
+   solution hold (a System with them appended: unilateral.with_active), each newly held
+   one brought to rest first (an e = 0 jump). A held row is released where its force
+   falls to zero.
+
+Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
+A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
+EventError (a SolveError) naming the time and the gaps: the run stops there.
+"""
+
+import itertools
+from typing import NamedTuple
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import stepper
+from .continuous import ContinuousIntegration
+from .impulse import velocity_jump
+from .trajectory import Event
+from ..core.errors import EventError, ModelError, SolveError
+from ..core.solvers import kkt_acceleration
+from ..core.tolerances import (ASSEMBLED_TOL, COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP,
+                               SPEED_ROUNDING)
+from ..model.reactions import multipliers
+from ..model.unilateral import Gaps, with_active
+
+ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once is chattering (no hang)
+IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
+ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
+
+
+class Pending(NamedTuple):
+    """The next event: at ``t`` the open gaps ``closing`` touch, the held ``released`` ones
+    lose their force (indices into Gaps)."""
+
+    t: float
+    closing: frozenset
+    released: frozenset
+
+
+class EventIntegration(ContinuousIntegration):
+    """The continuous strategy with the events of unilateral constraints (module docstring)."""
+
+    def __init__(self, *args):
+        self.active = frozenset()  # the held gaps (indices)
+        self.started = False  # whether the state at the start is settled (``advance``)
+        super().__init__(*args)
+        self.base = self.data  # the run's Data: the model without held gaps
+        system = self.base.system
+        self.gaps = Gaps(system, self.base.parameter_values)
+        self.phases = {frozenset(): self.base}  # active set -> its Data
+        self.pending = None
+        self.events = []  # trajectory.Event (simulate hands the recorder's list)
+        self.idle = 0  # events in a row that changed nothing
+
+    # ---- the phases: the System with the held rows appended
+
+    def _phase(self, active):
+        """The Data of the active set, at the run's parameter values."""
+        data = self.phases.get(active)
+        if data is None:
+            names = {self.gaps.names[i] for i in active}
+            data = self.phases[active] = with_active(self.base.system, names).data(self.base.path)
+        if not np.array_equal(data.parameter_values, self.base.parameter_values):
+            defined = self.base.system.definitions or {}
+            data.set_parameters({k: v for k, v in self.base.parameters.items() if k not in defined})
+        return data
+
+    def restart(self):
+        if self.active:  # new parameter values at a control sample: the phase's Data follows the run's
+            self.data = self.f.data = self._phase(self.active)
+        if self.started:  # and the restitutions
+            self.gaps = Gaps(self.base.system, self.base.parameter_values)
+        super().restart()
+
+    def _switch(self, active):
+        """Integrate with the rows of ``active`` held from here (the solver's f is given anew
+        by the caller)."""
+        if active == self.active:
+            return
+        self.active = active
+        self.data = self.f.data = self._phase(active)
+        engine = self.data.engine
+        self.f.use(engine)
+        self.projection = None if engine is None else engine.projection()
+        self.compiled_energy = self.projection is not None and self.projection.energies and self.potential_free
+        self.has_rows = len(self.data.system.constraint_names) > 0
+        self.watch = self.crossing = None
+
+    # ---- the run loop's calls
+
+    def advance(self, t_next, q, qd, t_stop):
+        if not self.started:
+            self._check_start(self.t_now, q, qd)
+            self.started = True
+            q, qd, _ = self.settle(self.t_now, q, qd)
+        q, qd = super().advance(t_next, q, qd, t_stop)
+        if self.solver is not None:  # integrated continuously, its events found
+            return q, qd
+        g = self.gaps.values(t_next, q, qd, self.base.parameter_values)[0]
+        passed = [self.gaps.names[i] for i in self._open() if g[i] < -self.atol]
+        if passed:  # an interval integrated cut (cut.py, near a singular position) sees no events
+            self.f.t_failed = t_next
+            raise EventError(f"the run passed through {', '.join(passed)} without its event (an interval "
+                             f"integrated cut near a singular position)", constraints=passed)
+        return q, qd
+
+    def _check_start(self, t, q, qd):
+        """ModelError where the state the run starts from penetrates a gap by more than
+        ASSEMBLED_TOL (io/unilateral.py's check of a model file's initial state, for a state
+        given otherwise: ``q0``, other parameter values)."""
+        g = self.gaps.values(t, q, qd, self.base.parameter_values)[0]
+        deep = [(name, -x) for name, x in zip(self.gaps.names, g) if x < -ASSEMBLED_TOL]
+        if deep:
+            raise ModelError(f"model '{self.base.system.name}': the state at t = {t:g} penetrates "
+                             + ", ".join(f"'{name}' by {depth:.6g}" for name, depth in deep) + " (gaps must be ≥ 0)")
+
+    def _step(self, solver, t_next):
+        if self.pending is None:
+            super()._step(solver, t_next)
+            return
+        if solver.t < self.pending.t:
+            self._take(solver, t_next, stepper.saved(solver), self.pending.t, False)
+        if self.pending is not None and solver.t == self.pending.t:
+            self._at_event(solver)
+
+    def _at_event(self, solver):
+        """Settle the state the step reached at the pending event; go on from the new one."""
+        pending, self.pending = self.pending, None
+        t = solver.t
+        q, qd = self.form.to_state(solver.y)
+        q, qd_new, changed = self.settle(t, q, qd, pending.released)
+        self.idle = 0 if changed else self.idle + 1
+        if self.idle > IDLE_EVENTS:
+            self.f.t_failed = t
+            names = [self.gaps.names[i] for i in sorted(pending.closing | pending.released)]
+            raise EventError(f"the gaps {', '.join(names)} chatter at t = {t:.9g}: {IDLE_EVENTS} events in a row "
+                             f"changed nothing", constraints=names)
+        if changed:
+            y = self.form.to_integrator(q, qd_new)
+            stepper.move(solver, y, self.f(t, y))
+
+    def stats(self):
+        counts = super().stats()
+        counts["events"] = len(self.events)
+        return counts
+
+    # ---- finding events within a step
+
+    def event_in(self, solver, start, target):
+        """Whether the step from ``start`` passed an event (an open gap closing, a held one's
+        force turning negative): then ``pending`` holds the earliest, found by Brent's
+        method on the step's dense output. A step aimed at the pending event ignores its
+        rows and gaps that touch (within atol) at its end: ``settle`` takes them there."""
+        t0, t1 = start[0], solver.t
+        aiming = self.pending is not None and target == self.pending.t
+        ignore = (self.pending.closing | self.pending.released) if aiming else frozenset()
+        q1, qd1 = self.form.to_state(solver.y)
+        p = self.base.parameter_values
+        g1 = self.gaps.values(t1, q1, qd1, p)[0]
+        limit = -self.atol if aiming else 0.0
+        closing = [i for i in self._open() if i not in ignore and g1[i] < limit]
+        held = sorted(self.active - ignore)
+        force1 = self._forces(t1, q1, qd1) if held else {}
+        released = [i for i in held if force1[i] < 0]
+        if not closing and not released:
+            return False
+        dense = solver.dense_output()
+        q0, qd0 = self.form.to_state(start[1])
+        g0, gd0 = self.gaps.values(t0, q0, qd0, p)
+        floor = self._rounding(t0, q0, qd0)
+        roots = {i: self._closing(dense, i, t0, t1, g0[i], gd0[i], g1[i], floor[i]) for i in closing}
+        roots = {i: t for i, t in roots.items() if t is not None}
+        if released:
+            force0 = self._forces(t0, q0, qd0)
+            roots.update({i: self._releasing(dense, i, t0, t1, force0[i], force1[i]) for i in released})
+        if not roots:
+            return False
+        t_event = min(roots.values())
+        at = frozenset(i for i, t in roots.items() if t == t_event)
+        self.pending = Pending(t_event, frozenset(i for i in at if i not in self.active) | (ignore & self._open_set()),
+                               frozenset(i for i in at if i in self.active) | (ignore & self.active))
+        return True
+
+    def _open(self):
+        return [i for i in range(len(self.gaps)) if i not in self.active]
+
+    def _open_set(self):
+        return frozenset(self._open())
+
+    def _gap_at(self, dense, i, t):
+        q, qd = self.form.to_state(dense(t))
+        return self.gaps.values(t, q, qd, self.base.parameter_values)[0][i]
+
+    def _rounding(self, t, q, qd):
+        """Per gap, the rate within which it is rounding (SPEED_ROUNDING × ‖a‖₁ max |q̇|)."""
+        return SPEED_ROUNDING * np.abs(self.gaps.rows(t, q, qd, self.base.parameter_values)[0]).sum(axis=1) * \
+            np.abs(qd).max(initial=0.0)
+
+    def _closing(self, dense, i, t0, t1, g0, gd0, g1, floor):
+        """When the open gap i, g0 at t0 and g1 < 0 at t1, closes within the step: where g
+        falls to zero from above; from a touching start (g0 ≤ atol) moving apart, where g
+        returns to g0 ((g − g0)/(t − t0), ġ0 at t0, changes sign); from a touching start at
+        rest or closing, where it sinks atol below (there settle finds it). None where
+        the gap ends above where it started touching."""
+        if g0 > self.atol:
+            return _root(lambda t: self._gap_at(dense, i, t), t0, t1, g0, g1)
+        if gd0 > floor:
+            if not g1 < min(g0, 0.0):
+                return None
+            return _root(lambda t: (self._gap_at(dense, i, t) - g0) / (t - t0), t0, t1, gd0, (g1 - g0) / (t1 - t0))
+        if not g1 < -self.atol:
+            return None
+        if g0 <= -self.atol:
+            return t0
+        return _root(lambda t: self._gap_at(dense, i, t) + self.atol, t0, t1, g0 + self.atol, g1 + self.atol)
+
+    def _releasing(self, dense, i, t0, t1, f0, f1):
+        """Where the held gap i's force, f0 at t0 and f1 < 0 at t1, falls to zero."""
+        if f0 <= 0:
+            return t0
+        return _root(lambda t: self._forces(t, *self.form.to_state(dense(t)))[i], t0, t1, f0, f1)
+
+    # ---- the motion with some gaps held
+
+    def _held_motion(self, t, q, qd, rows):
+        """(q̈, λ of the gap rows ``rows``, g̈ of every gap, the size of each g̈'s terms, the
+        size of the forces) of (2.14) with the gaps ``rows`` held beside the model's rows (its
+        KKT form, solvers.py). The sizes judge signs: a gap's acceleration is measured against
+        its row times the larger of q̈ and the forces over the largest mass (a state at rest has
+        q̈ = 0 to rounding), a multiplier against the largest |Q + C| and |λ|."""
+        arrays = self.base.evaluate(t, q, qd)
+        A_gaps, b_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)
+        rows = list(rows)
+        A = np.vstack([arrays.A, A_gaps[rows]])
+        b = np.concatenate([arrays.b, b_gaps[rows]])
+        names = list(self.base.system.constraint_names) + [self.gaps.names[i] for i in rows]
+        motion = kkt_acceleration(arrays.M, arrays.Q, A, b, arrays.C, coordinates=self.base.system.coordinates,
+                                  constraints=names)
+        lam = multipliers(A, arrays.M @ motion.qdd - arrays.Q - arrays.C)[0]
+        gdd = A_gaps @ motion.qdd - b_gaps
+        force = np.abs(arrays.Q + arrays.C).max(initial=0.0)
+        acceleration = max(np.abs(motion.qdd).max(initial=0.0), force / (np.abs(arrays.M).max(initial=0.0) +
+                                                                           DIVISION_GUARD))
+        scale = np.abs(A_gaps).sum(axis=1) * acceleration + np.abs(b_gaps)
+        return motion.qdd, lam[len(arrays.b):], gdd, scale, force + np.abs(lam).max(initial=0.0)
+
+    def _forces(self, t, q, qd):
+        """{held gap: its force λ} at (t, q, q̇) (λ > 0 pushes the gap open)."""
+        held = sorted(self.active)
+        return dict(zip(held, self._held_motion(t, q, qd, held)[1]))
+
+    # ---- settling the state at an event
+
+    def settle(self, t, q, qd, released=frozenset()):
+        """(q, q̇⁺, whether anything changed) at an event at t: the impacts, then the
+        persistent contacts (module docstring); ``released``: held gaps whose force fell
+        to zero here (they open). Records the events."""
+        p, changed = self.base.parameter_values, False
+        for _ in range(ROUNDS):
+            g, gd = self.gaps.values(t, q, qd, p)
+            gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
+            rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
+            floor = self._rounding(t, q, qd)
+            striking = [i for i in self._open() if g[i] <= self.atol and gd[i] < -max(rest[i], floor[i])]
+            if not striking:
+                break
+            e = np.where(self.gaps.restitution * -gd > rest, self.gaps.restitution, 0.0)
+            qd = self._impact(t, q, qd, striking, e, gd, floor)
+            changed = True
+        else:
+            raise self._fail(t, striking, f"{ROUNDS} impacts at one instant")
+        g, gd = self.gaps.values(t, q, qd, p)
+        floor = self._rounding(t, q, qd)
+        gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
+        rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
+        resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
+                   and i not in released]
+        active = self._contact_set(t, q, qd, sorted((self.active - released) | set(resting)))
+        if active - self.active:
+            qd = self._come_to_rest(t, q, qd, active)
+        for i in sorted(self.active - active):
+            self.events.append(Event(float(t), self.gaps.names[i], "release", 0.0))
+        changed |= active != self.active
+        self._switch(active)
+        return q, qd, changed
+
+    def _bilateral(self, t, q, qd):
+        """(A, target, names) of the model's velocity-level rows at (t, q, q̇): A q̇ = target
+        keeps them holding through a jump (target = A q̇ − ψ; acceleration-level rows,
+        which have no velocity form, are left out)."""
+        arrays = self.base.constraint_arrays(t, q, qd, sparse=False)
+        keep = np.isfinite(arrays.psi)
+        A = arrays.A[keep]
+        names = [n for n, k in zip(self.base.system.constraint_names, keep) if k]
+        return A, A @ qd - arrays.psi[keep], names
+
+    def _impact(self, t, q, qd, striking, e, gd, floor):
+        """q̇⁺ of the impact of the ``striking`` gaps (their restitution ``e``, rates ``gd``)
+        with the held ones (e = 0): the complementarity problem over them solved by
+        enumeration, the first consistent active set in order (smallest first) taken; an
+        active set whose jump is not unique (Result 3) is none, and where every one is
+        such, the largest one's SolveError is raised."""
+        rows = sorted(set(striking) | self.active)
+        if len(rows) > ENUMERATED:
+            raise self._fail(t, rows, f"{len(rows)} gaps strike at once (at most {ENUMERATED} are solved exactly)")
+        A_b, v_b, names_b = self._bilateral(t, q, qd)
+        A_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)[0]
+        M = self.base.evaluate(t, q, qd).M
+        coordinates = self.base.system.coordinates
+        failed = None
+        for chosen in _subsets(rows):
+            target = np.array([-e[i] * gd[i] if i in striking else 0.0 for i in chosen])
+            A = np.vstack([A_b, A_gaps[list(chosen)]])
+            try:
+                jump = velocity_jump(M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
+                                     constraints=names_b + [self.gaps.names[i] for i in chosen])
+            except SolveError as err:
+                failed = err
+                continue
+            impulses = jump.impulses[len(v_b):]
+            after = A_gaps @ jump.qd
+            others = [i for i in rows if i not in chosen]
+            if (impulses >= -COMPLEMENTARITY_RTOL * np.abs(impulses).max(initial=0.0)).all() and \
+                    all(after[i] + e[i] * gd[i] >= -COMPLEMENTARITY_RTOL * abs(gd[i]) - floor[i] for i in others):
+                for i, impulse in zip(chosen, impulses):
+                    if i in striking:
+                        self.events.append(Event(float(t), self.gaps.names[i], "impact", float(impulse)))
+                return jump.qd
+        if failed is not None:
+            raise self._fail(t, rows, str(failed), failed.coordinates)
+        raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
+
+    def _contact_set(self, t, q, qd, candidates):
+        """The gaps among ``candidates`` (touching, at rest or held) that hold from t: the
+        first active set, smallest first, with λ ≥ 0 on its rows and g̈ ≥ 0 on the others."""
+        if len(candidates) > ENUMERATED:
+            raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
+                                            f"exactly)")
+        for chosen in _subsets(candidates):
+            _, lam, gdd, scale, force = self._held_motion(t, q, qd, chosen)
+            others = [i for i in candidates if i not in chosen]
+            if (lam >= -COMPLEMENTARITY_RTOL * force).all() and \
+                    all(gdd[i] >= -COMPLEMENTARITY_RTOL * scale[i] for i in others):
+                return frozenset(chosen)
+        raise self._fail(t, candidates, "no consistent contact mode (Painlevé-type: no active set of the "
+                                        "complementarity problem)")
+
+    def _come_to_rest(self, t, q, qd, active):
+        """q̇⁺ with the newly held gaps of ``active`` brought to rest (an e = 0 jump, every
+        held row at zero rate), their events recorded."""
+        A_b, v_b, names_b = self._bilateral(t, q, qd)
+        A_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)[0]
+        rows = sorted(active)
+        jump = self._jump(t, rows, self.base.evaluate(t, q, qd).M, qd, np.vstack([A_b, A_gaps[rows]]),
+                          np.concatenate([v_b, np.zeros(len(rows))]), coordinates=self.base.system.coordinates,
+                          constraints=names_b + [self.gaps.names[i] for i in rows])
+        for i, impulse in zip(rows, jump.impulses[len(v_b):]):
+            if i not in self.active:
+                self.events.append(Event(float(t), self.gaps.names[i], "contact", float(impulse)))
+        return jump.qd
+
+    def _fail(self, t, rows, why, coordinates=()):
+        """The EventError at t of the gaps ``rows``."""
+        self.f.t_failed = t
+        names = [self.gaps.names[i] for i in rows]
+        return EventError(f"at t = {t:.9g}, {', '.join(names)}: {why}", constraints=names, coordinates=coordinates)
+
+    def _jump(self, t, rows, *args, **kwargs):
+        """``velocity_jump(*args, **kwargs)`` of the impact of the gaps ``rows`` at t; its
+        SolveError (a jump that is not unique, contradictory rows) as an EventError there."""
+        try:
+            return velocity_jump(*args, **kwargs)
+        except SolveError as err:
+            raise self._fail(t, rows, str(err), err.coordinates) from None
+
+
+def _subsets(rows):
+    """The subsets of ``rows``, smallest first, each in order: the active sets enumerated (a
+    row that needs no force or impulse is not held)."""
+    rows = list(rows)
+    return [chosen for size in range(len(rows) + 1) for chosen in itertools.combinations(rows, size)]
+
+
+def _root(f, t0, t1, f0, f1):
+    """The root of f in [t0, t1] (f0 = f(t0) ≥ 0 > f1 = f(t1), given) by Brent's method, to
+    rounding."""
+    if f0 == 0:
+        return t0
+    known = {t0: f0, t1: f1}
+    return brentq(lambda t: known[t] if t in known else f(t), t0, t1, xtol=DIVISION_GUARD, rtol=EVENT_TIME_RTOL)

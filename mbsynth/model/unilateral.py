@@ -1,0 +1,80 @@
+"""Unilateral constraints: gaps g(q) ≥ 0 that may open, close and strike.
+
+A ``Unilateral`` is one gap with Newton's restitution coefficient e (0 ≤ e ≤ 1): a joint's
+limit (``hinge.lower``: g = angle − lo; ``hinge.upper``: g = hi − angle) or a contact (a
+point or sphere on a part's frame against a ground plane, g = n·p − h − r; two spheres,
+g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Constraint with φ = g, so that its
+row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
+machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
+
+While a gap is open the row is no constraint; while it holds (persistent contact) it is one
+of the System's rows: ``with_active`` makes the System of an active set (its ``constraints``
+followed by the active rows), which the run loop switches between (analysis/impacts.py).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from .constraints.base import Constraint
+from ..core.errors import ModelError
+
+
+@dataclass(frozen=True)
+class Unilateral:
+    """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), its restitution e (a
+    sympy expression of the parameters), its holonomic ``row`` (φ = g)."""
+
+    name: str
+    kind: str
+    restitution: sp.Expr
+    row: Constraint
+
+    def restitution_at(self, system, p):
+        """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
+        e = float(sp.sympify(self.restitution).xreplace(dict(zip(system.parameter_symbols, p))))
+        if not 0 <= e <= 1:
+            raise ModelError(f"model '{system.name}': the restitution of '{self.name}' is {e:g} at these parameter "
+                             f"values; it must be between 0 and 1")
+        return e
+
+
+def gap_row(name, gap, q, qd, params):
+    """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed)."""
+    return Constraint.holonomic(name, [gap], q, qd, params)
+
+
+def with_active(system, names):
+    """``system`` with the rows of its unilaterals named in ``names`` appended to its
+    constraints, in the order of ``system.unilaterals``: the System of that active set."""
+    if not names:
+        return system
+    return system.with_constraints(u.row for u in system.unilaterals if u.name in names)
+
+
+class Gaps:
+    """The gaps of ``system``'s unilaterals, evaluated together; ``restitution`` at the
+    parameter values ``p``."""
+
+    def __init__(self, system, p):
+        self.unilaterals, self.n = tuple(system.unilaterals), system.n
+        self.names = tuple(u.name for u in self.unilaterals)
+        self.restitution = np.array([u.restitution_at(system, p) for u in self.unilaterals], dtype=float)
+
+    def __len__(self):
+        return len(self.unilaterals)
+
+    def values(self, t, q, qd, p):
+        """(g, ġ) per gap at (t, q, q̇)."""
+        found = [u.row.residuals(t, q, qd, p) for u in self.unilaterals]
+        return (np.array([phi[0] for phi, _ in found]), np.array([psi[0] for _, psi in found]))
+
+    def rows(self, t, q, qd, p):
+        """(A, b) of the gaps: A's row i is ∂g_i/∂q over all n coordinates, and
+        g̈_i = A_i q̈ − b_i."""
+        A, b = np.zeros((len(self.unilaterals), self.n)), np.zeros(len(self.unilaterals))
+        for i, u in enumerate(self.unilaterals):
+            a, b_row, _ = u.row.evaluate(t, q, qd, p)
+            A[i, u.row.indices], b[i] = a[0], b_row[0]
+        return A, b
