@@ -188,9 +188,9 @@ class System:
         return len(self.coordinates)
 
     @property
-    def constraints(self):  # the old name of constraints
+    def connectors(self):  # the old name of constraints
         """``constraints`` under its old name (a DeprecationWarning)."""
-        warnings.warn("System.constraints is the old name of System.constraints", DeprecationWarning, stacklevel=2)
+        warnings.warn("System.connectors is the old name of System.constraints", DeprecationWarning, stacklevel=2)
         return self.constraints
 
     @property
