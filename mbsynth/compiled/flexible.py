@@ -12,9 +12,10 @@ energies: T = ½ νᵀ M(η) ν). Cost O(r²): W P(η) is formed on the three ω
 at the ω rows). q, q̇, g and the outputs may be complex (the complex step of a
 linearization: every operation is analytic); the invariants are real.
 
-``fill(t, q, qd, out, ...)`` writes the M_q and Q_q of the flexible parts of a model into
-the outputs of its generated function (codegen.py: layout.py leaves their places to it),
-``fill_rows`` the same per row of a batch, without the GIL.
+``fill(q, qd, out, ...)`` writes the M_q and Q_q of one flexible part of a model into the
+outputs of its generated function (codegen.py: layout.py leaves their places to it; ``Filled``
+calls it after that function), ``fill_rows`` the same per row of a batch, without the GIL.
+Compiled ahead with the kernels (ahead.PARTS).
 """
 
 import numpy as np
@@ -224,10 +225,21 @@ def _mapped(A, E, Mnu, f, mass, M, Q):
 def fill(q, qd, out, start, m0, q0, g0, W, s0, K, D, S):
     """One flexible part's M_q (row by row from out[m0]) and Q_q (from out[q0]) at its
     coordinates from ``start``, its gravity read from out[g0:g0 + 3] (the generated
-    function's inputs)."""
+    function's inputs), made positive definite: the part's unit-norm row holds uᵀq̈ = −u̇ᵀu̇,
+    so c u uᵀ q̈ = −c (u̇ᵀu̇) u added to both sides (c: M_q's quaternion block's trace over
+    uᵀu) changes no motion, only that row's multiplier off the manifold, and the kernel
+    then solves the extra coordinates through their mass (kernel._close_reduced)."""
     n = 7 + K.shape[0]
     M, Q, Mnu, nu = np.zeros((n, n)), np.zeros(n), np.zeros((n - 1, n - 1)), np.zeros(n - 1)
+    u, u_dot = q[start + 3:start + 7], qd[start + 3:start + 7]
     equations(q[start:start + n], qd[start:start + n], out[g0:g0 + 3], W, s0, K, D, S, M, Q, Mnu, nu)
+    norm = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]
+    c = (M[3, 3] + M[4, 4] + M[5, 5] + M[6, 6]) / norm
+    rate = u_dot[0] * u_dot[0] + u_dot[1] * u_dot[1] + u_dot[2] * u_dot[2] + u_dot[3] * u_dot[3]
+    for a in range(4):
+        Q[3 + a] -= c * rate * u[a]
+        for b in range(4):
+            M[3 + a, 3 + b] += c * u[a] * u[b]
     for i in range(n):
         out[q0 + i] = Q[i]
         for j in range(n):

@@ -147,8 +147,8 @@ class FlexibleBody(Part):
         position = sp.Matrix(self.reduction.fe.nodes[node]) + _combination(Phi[:3], eta)
         if len(rows) == 6:
             half, half_rate = _combination(Phi[3:] / 2, eta), _combination(Phi[3:] / 2, eta_dot)
-            scale = 1 + sum(x * x for x in half)
-            elastic = rotation([1, *half]) / scale
+            scale = 1 + sp.Add(*(x * x for x in half))
+            elastic = _cayley(half, scale)
             # the Cayley map's angular velocity (Rodrigues parameters g = θ/2): 2(ġ + g × ġ)/(1 + gᵀg)
             self._turn_rates[label] = 2 * (half_rate + half.cross(half_rate)) / scale
         else:
@@ -165,7 +165,7 @@ class FlexibleBody(Part):
 
     def pose(self, frame):
         A = rotation(self.q[3:7])
-        return sp.Matrix(self.q[:3]) + A * frame.position, A * frame.rotation
+        return sp.Matrix(self.q[:3]) + _product(A, frame.position), _product(A, frame.rotation)
 
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:7]) * sp.Matrix(self.qd[3:7])
@@ -211,9 +211,23 @@ def _gram(inv):
     return np.ascontiguousarray(np.where(np.abs(inv.gram) > GRAM_ZERO_RTOL * np.abs(inv.gram).max(), inv.gram, 0.0))
 
 
+def _cayley(g, scale):
+    """((1 − gᵀg) I + 2 g gᵀ + 2 [g]×) / ``scale`` (= 1 + gᵀg) in sympy, entry by entry:
+    core/kinematics.py's ``rotation`` of (1, g) over its norm, without sympy's matrix
+    products (slow on sums of many terms)."""
+    g = list(g)
+    diagonal = 2 - scale  # 1 − gᵀg
+
+    def entry(i, j):
+        k = 3 - i - j  # the third axis, for i ≠ j
+        turn = 0 if i == j else sp.Mul(2 if (j - i) % 3 == 1 else -2, g[k])  # 2[g]×: (0, 1) holds −2 g_z
+        return sp.Add(diagonal if i == j else 0, sp.Mul(2, g[i], g[j]), -turn) / scale
+    return sp.Matrix(3, 3, entry)
+
+
 def _combination(matrix, symbols):
     """The sympy column Σ_k matrix[:, k] symbols[k] (float coefficients, zeros left out)."""
-    return sp.Matrix([sp.Add(*(sp.Float(c) * x for c, x in zip(row, symbols) if c != 0)) for row in matrix])
+    return sp.Matrix([sp.Add(*(sp.Mul(sp.Float(c), x) for c, x in zip(row, symbols) if c != 0)) for row in matrix])
 
 
 def _numbers(array):
