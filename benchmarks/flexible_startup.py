@@ -100,7 +100,8 @@ def main():
     lines = [f"# Load + first 0.1 s of a {args.modes}-mode Craig–Bampton beam, new process",
              "",
              f"`benchmarks/flexible_startup.py --runs {args.runs} --modes {args.modes}`, "
-             f"{datetime.date.today()}, {platform.machine()}, {os.cpu_count()} cores (shared: compare within one table), "
+             f"{datetime.date.today()}, {platform.machine()}, {os.cpu_count()} cores (shared: compare within one "
+             "table), "
              f"Python {platform.python_version()}. Median of {args.runs} runs; the model is "
              "models/flexible/cantilever.yaml with its modes raised (40 elements, clamped at node 0, four node frames, "
              "an output at the tip); `mb.load` then `mb.simulate(model, 0.1)` on the default path.",

@@ -416,7 +416,8 @@ class _Builder:
             if part.kernel_arrays is not None:
                 own.append((part, int(start), len(M), len(own_q)))
                 own_q += range(int(start), int(start) + count)
-                M += [(x_index[int(start) + a], x_index[int(start) + b], None) for a in range(count) for b in range(count)]
+                M += [(x_index[int(start) + a], x_index[int(start) + b], None)
+                      for a in range(count) for b in range(count)]
                 continue
             for a in range(len(part.coordinates)):
                 if part.Q[a] != 0:

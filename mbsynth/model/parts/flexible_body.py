@@ -42,7 +42,6 @@ from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
 from ...core.tolerances import COMPLEX_STEP, GRAM_ZERO_RTOL
 
 
-
 class PartArrays(NamedTuple):
     """What compiled/flexible.py's kernel reads of a flexible part (``kernel_arrays``)."""
 
@@ -94,12 +93,14 @@ class FlexibleBody(Part):
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
         self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
         made = [self._node_frame(name, label, spec, q[self.elastic], qd[self.elastic]) for label, spec in named.items()]
-        self.kernel_arrays = PartArrays(
-            _gram(self.invariants), np.array(self.invariants.first_moment, float), np.ascontiguousarray(reduction.stiffness, float),
-            np.ascontiguousarray(self.damping), np.ascontiguousarray(self.stiffening), self.gravity)
+        self.kernel_arrays = PartArrays(_gram(self.invariants), np.array(self.invariants.first_moment, float),
+                                        np.ascontiguousarray(reduction.stiffness, float),
+                                        np.ascontiguousarray(self.damping), np.ascontiguousarray(self.stiffening),
+                                        self.gravity)
         self._params = list(params)
         self._gravity = compile_function((T_SYMBOL, list(q), list(qd), self._params), [self.gravity],
                                          picked=PARAMETERS)
+        self._gravity_last = None  # (p, the gravity vector at p), ``gravity_at``
         super().__init__(name, coordinates(r), q, qd, None, None, None, None, params, made, geometry, initial)
 
     def reference(self):
@@ -108,8 +109,15 @@ class FlexibleBody(Part):
                           self.qd, self.gravity)
 
     def gravity_at(self, t, p):
-        """The gravity vector (world) at parameter values p."""
-        return np.ascontiguousarray(self._gravity(t, np.zeros(len(self.q)), np.zeros(len(self.q)), p)[0], float).ravel()
+        """The gravity vector (world) at parameter values p (the last one kept while t does not enter)."""
+        last = self._gravity_last
+        if last is not None and np.array_equal(last[0], p):
+            return last[1]
+        rest = np.zeros(len(self.q))
+        g = np.ascontiguousarray(self._gravity(t, rest, rest, p)[0], float).ravel()
+        if T_SYMBOL not in self.gravity.free_symbols:
+            self._gravity_last = (np.array(p, float), g)
+        return g
 
     def evaluate(self, t, q, qd, p):
         """(M, Q) at the part's coordinates (2.1), by the compiled kernel."""
@@ -307,7 +315,8 @@ def equations(q, qd, g, arrays):
 
     dtype = np.result_type(q, qd, g, float)
     n = len(q)
-    M, Q, Mnu, nu = np.zeros((n, n), dtype), np.zeros(n, dtype), np.zeros((n - 1, n - 1), dtype), np.zeros(n - 1, dtype)
+    M, Q = np.zeros((n, n), dtype), np.zeros(n, dtype)
+    Mnu, nu = np.zeros((n - 1, n - 1), dtype), np.zeros(n - 1, dtype)
     flexible.equations(*(np.ascontiguousarray(x, dtype) for x in (q, qd, g)), *arrays[:5], M, Q, Mnu, nu)
     return M, Q, Mnu, nu
 

@@ -12,6 +12,7 @@ import sympy as sp
 import mbsynth as mb
 from tests.helpers.flexible_beams import strip
 from mbsynth.analysis.linearization import BlockFunction
+from mbsynth.compiled import ahead, flexible
 from mbsynth.model.data import Data
 from mbsynth.model.flexible.reduction import craig_bampton
 from mbsynth.model.parts.flexible_body import FlexibleBody, coordinates, rayleigh_damping
@@ -102,8 +103,10 @@ def without_sympy_form(monkeypatch):
 def test_a_flexible_model_runs_and_linearizes_on_both_paths_without_its_sympy_form(without_sympy_form):
     """The clamped strip (models/flexible/cantilever.yaml) is built, run 0.01 s on the compiled
     path and on the KKT path, and linearized, its part's sympy form never made; both paths'
-    q̈ agree to 1e-9 and the linearization's lowest frequency is the clamped–free strip's
-    (βL)² √(EI/ρAL⁴) with βL = 1.8751 to 1e-4 (the 40-element mesh and 4 modes)."""
+    q̈ agree to 1e-9 (one state alone and in a batch) and the linearization's lowest frequency
+    is the clamped–free strip's (βL)² √(EI/ρAL⁴) with βL = 1.8751 to 1e-4 (the 40-element mesh
+    and 4 modes). The kernel's functions were called with the argument types compile-ahead
+    compiles them for (ahead.PARTS)."""
     model = mb.load(MODELS / "cantilever.yaml")
     q, qd = model.initial_state()
     fast = Data(model, "compiled")
@@ -111,9 +114,13 @@ def test_a_flexible_model_runs_and_linearizes_on_both_paths_without_its_sympy_fo
     compiled = fast.motion(0.0, q, qd).qdd
     kkt = Data(model, "kkt").motion(0.0, q, qd).qdd
     assert relative(compiled, kkt) < 1e-9
+    batch, status = fast.engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
+    assert (status == 0).all() and relative(batch[1], kkt) < 1e-9
     run = mb.simulate(model, 0.01)
     assert run.status == "completed"
     lin = mb.linearize(model, 0.0, q, np.zeros_like(qd))
     omega = np.sort(np.abs(np.linalg.eigvals(lin.A).imag))
     expected = 1.8751041 ** 2 * np.sqrt(2.1e11 * 1e-9 / (7850 * 1e-4 * 2.0 ** 4))
     assert omega[omega > 1.0][0] == pytest.approx(expected, rel=1e-4)
+    for module, name, spec in ahead.PARTS:
+        assert ahead.argument_types(spec, None) in getattr(flexible, name).overloads, (name, spec)
