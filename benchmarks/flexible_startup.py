@@ -14,7 +14,8 @@ outside (the whole process, interpreter start included).
   installed mbsynth;
 - warm: the same folders again, as the cold run left them.
 
-Figures are medians of --runs (each cold run on new folders). Writes
+Figures are medians of --runs (each cold run on new folders); on a shared machine the CPU time
+(user + system) is the steadier figure. Writes
 benchmarks/flexible_startup_results.md unless --out.
 """
 
@@ -22,6 +23,7 @@ import argparse
 import datetime
 import os
 import platform
+import resource
 import shutil
 import statistics
 import subprocess
@@ -43,6 +45,38 @@ run = mb.simulate(model, 0.1)
 done = time.perf_counter()
 assert run.status == "completed", run.status
 print(f"{loaded - started:.3f} {done - loaded:.3f} {len(run.t)}")
+"""
+
+# µs per call on benchmarks/flexible.py's pinned pendulum (8 modes), best of 7 rounds, warm caches
+PER_CALL = """\
+import sys, time
+import numpy as np
+sys.path.insert(0, "benchmarks")
+import mbsynth as mb
+from flexible import pendulum_yaml
+from mbsynth.compiled import flexible
+from mbsynth.model.data import Data
+system = mb.loads(pendulum_yaml(8), name="flexible_pendulum")
+q, qd = system.initial_state()
+engine = Data(system, "compiled").engine
+y = np.concatenate([q, qd])
+part = system.parts[0]
+n = len(part.q)
+M, Q, Mnu, nu = np.zeros((n, n)), np.zeros(n), np.zeros((n - 1, n - 1)), np.zeros(n - 1)
+g = part.gravity_at(0.0, system.parameter_values)
+arrays = part.kernel_arrays[:5]
+def best(f, count):
+    f()
+    rounds = []
+    for _ in range(7):
+        started = time.perf_counter()
+        for _ in range(count):
+            f()
+        rounds.append((time.perf_counter() - started) / count * 1e6)
+    return min(rounds)
+assert engine.derivative(0.0, y) is not None
+print(best(lambda: flexible.equations(q[:n], qd[:n], g, *arrays, M, Q, Mnu, nu), 20000),
+      best(lambda: engine.motion(0.0, q, qd), 5000), best(lambda: engine.derivative(0.0, y), 5000))
 """
 
 
@@ -68,14 +102,18 @@ def installed_kernels():
 
 
 def timed(path, cache, numba):
-    """(process wall, load, simulate [s], output rows) of one new process."""
+    """(process wall, its CPU time (user + system, its helpers included), load, simulate [s],
+    output rows) of one new process."""
     env = dict(os.environ, PYTHONPATH=str(ROOT), MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", CHILD, str(path)], env=env, cwd=ROOT, check=True,
                          capture_output=True, text=True)
     wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
     load, simulate, rows = out.stdout.split()
-    return wall, float(load), float(simulate), int(rows)
+    return wall, cpu, float(load), float(simulate), int(rows)
 
 
 def main():
@@ -95,7 +133,8 @@ def main():
             shutil.copytree(kernels, numba)
             cold.append(timed(path, cache, numba))
             warm.append(timed(path, cache, numba))
-            print(f"run {k + 1}: cold {cold[-1][0]:.2f} s, warm {warm[-1][0]:.2f} s", flush=True)
+            print(f"run {k + 1}: cold {cold[-1][0]:.2f} s ({cold[-1][1]:.2f} s CPU), warm {warm[-1][0]:.2f} s "
+                  f"({warm[-1][1]:.2f} s CPU)", flush=True)
     rows = [("cold (model caches empty, kernels as installed)", cold), ("warm (the same caches again)", warm)]
     lines = [f"# Load + first 0.1 s of a {args.modes}-mode Craig–Bampton beam, new process",
              "",
@@ -104,13 +143,21 @@ def main():
              "table), "
              f"Python {platform.python_version()}. Median of {args.runs} runs; the model is "
              "models/flexible/cantilever.yaml with its modes raised (40 elements, clamped at node 0, four node frames, "
-             "an output at the tip); `mb.load` then `mb.simulate(model, 0.1)` on the default path.",
+             "an output at the tip); `mb.load` then `mb.simulate(model, 0.1)` on the default path. Load and simulate: "
+             "wall time inside the process (interpreter start and imports of mbsynth's floors included in load).",
              "",
-             "| caches | process wall [s] | load [s] | simulate 0.1 s [s] | rows |",
-             "|---|---|---|---|---|"]
+             "| caches | process wall [s] | process CPU [s] | load [s] | simulate 0.1 s [s] | output rows |",
+             "|---|---|---|---|---|---|"]
     for name, found in rows:
-        medians = [statistics.median(x[i] for x in found) for i in range(3)]
-        lines.append(f"| {name} | {medians[0]:.2f} | {medians[1]:.2f} | {medians[2]:.2f} | {found[0][3]} |")
+        medians = [statistics.median(x[i] for x in found) for i in range(4)]
+        lines.append(f"| {name} | " + " | ".join(f"{m:.2f}" for m in medians) + f" | {found[0][4]} |")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    kernel, motion, stage = map(float, subprocess.run([sys.executable, "-c", PER_CALL], env=env, cwd=ROOT, check=True,
+                                                      capture_output=True, text=True).stdout.split())
+    lines += ["", "Per call on benchmarks/flexible.py's pinned pendulum (8 modes, 15 coordinates), best of 7 rounds: "
+              f"the part's kernel (compiled/flexible.py `equations`, M and Q) {kernel:.1f} µs; `Engine.motion` "
+              f"(the compiled path's motion(), the part's kernel included) {motion:.1f} µs; `Engine.derivative` "
+              f"(an integrator's stage, off the manifold) {stage:.1f} µs."]
     text = "\n".join(lines) + "\n"
     print(text)
     Path(args.out).write_text(text)
