@@ -503,6 +503,10 @@ class Derivatives:
         self._rows = []  # (indices, rows, BlockFunction of [Aᵀλ; A q̈ − b; ψ])
         where = {s: i for i, s in enumerate(system.q_symbols)}
         for part in system.parts:
+            own = part.derivatives()  # a part that evaluates (2.1) itself gives its own exact Jacobians
+            if own is not None:
+                self._forces.append((np.array([where[s] for s in part.q], dtype=int), own))
+                continue
             M, Q = part.symbolic()
             self._add_force([where[s] for s in part.q], M, -Q, system, p)
         for element in system.forces:

@@ -6,8 +6,9 @@ On two cores: first the kernel's largest parts for both variants of ``kernel.mot
 helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
 projection) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
 general ones; then each warm-up model here, loading what is missing from the cache (all of
-it, unless a helper failed). Each stage says on stderr what it compiles and how far it is
-(``[k/N]``); when the cache holds the kernels already, it says so and only loads them.
+it, unless a helper failed); then the flexible parts' kernel (ahead.PARTS). Each stage says
+on stderr what it compiles and how far it is (``[k/N]``); when the cache holds the kernels
+already, it says so and only loads them.
 """
 
 import os
@@ -52,7 +53,8 @@ def main():
         say(f"the compiled path's kernels are compiled already ({where}): loading them to check (seconds)")
     stages = ([("the kernel's largest parts, in helper processes", None)] if cold else []) + [
         (f"the general kernel on warm-up model {k} of {len(WARM_MODELS)}", text)
-        for k, text in enumerate(WARM_MODELS, start=1)] + [("the rigid tree's kernel", WARM_RIGID)]
+        for k, text in enumerate(WARM_MODELS, start=1)] + [("the rigid tree's kernel", WARM_RIGID),
+                                                            ("the flexible parts' kernel", PARTS)]
     rigid = []
     for k, (what, text) in enumerate(stages, start=1):
         say(f"[{k}/{len(stages)}] {what} ({time.perf_counter() - started:.0f} s so far)")
@@ -61,10 +63,16 @@ def main():
             ahead.finish()
             rigid = ahead.spawn(__spec__.name, "rigid")  # beside the general models
             continue
+        if text is PARTS:
+            ahead.compile_parts()
+            continue
         if text is WARM_RIGID:
             ahead.wait(rigid)
         warm([text])
     print(f"mbsynth: the compiled path's kernels compiled into {where} in {time.perf_counter() - started:.1f} s")
+
+
+PARTS = "parts"  # the stage that compiles ahead.PARTS
 
 
 def say(line):

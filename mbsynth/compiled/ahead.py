@@ -12,7 +12,7 @@ earlier, beside the derivation (background.compile_ahead). The groups are balanc
 cores. A helper that fails costs time only: numba compiles whatever the cache lacks.
 
 Each function is named with the types of its arguments in a short notation: ``f2`` a
-C-contiguous 2-d float64 array, ``i1`` a 1-d int64 array, ``(...)`` a tuple, ``int64``,
+C-contiguous 2-d float64 array, ``i1`` a 1-d int64 array, ``c1`` a 1-d complex128 array, ``(...)`` a tuple, ``int64``,
 ``float64`` and ``boolean`` scalars, ``general`` the type of ``motion``'s last argument for the variant
 (kernel.RIGID_TREE: none; kernel.GENERAL: bool). ``test_fast`` checks that they are the
 types ``motion`` passes.
@@ -47,6 +47,14 @@ GENERAL_ONLY = (  # what a rigid tree's motion leaves out, per group
     (("assembly", "extra_rows", "f1 f1 f1 f1 i1 i1 f1 f1 f4 (i3 i1 i2 i2 f3 f4 f1 i2) i1 i2 i1 i1 i1 "
                                 f"{SEGMENTS} i1 i1 (f3 f3 f2 f2 f1) f2 f2 f1 f1 f2"),),
 )
+# the kernels of parts that evaluate their own M and Q (flexible.py), one for every model: compiled
+# with the others by ``python -m mbsynth.cli.compile_ahead`` (``compile_parts``), else at first use
+PARTS = (
+    ("flexible", "fill", "f1 f1 f1 int64 int64 int64 int64 f2 f1 f2 f2 f4"),
+    ("flexible", "fill_rows", "f2 f2 f2 int64 int64 int64 int64 f2 f1 f2 f2 f4"),
+    ("flexible", "equations", "f1 f1 f1 f2 f1 f2 f2 f4 f2 f1 f2 f1"),
+    ("flexible", "equations", "c1 c1 c1 f2 f1 f2 f2 f4 c2 c1 c2 c1"),  # complex: a linearization's complex step
+)
 VARIANTS = {"rigid_tree": None, "general": True}  # kernel.RIGID_TREE, kernel.GENERAL
 TIMEOUT = 600  # seconds a helper may take before it is stopped
 _started = set()  # the variants whose helpers this process has started
@@ -72,7 +80,7 @@ def argument_types(spec, general):
             return typeof(general), at + 1
         if token in ("int64", "float64", "boolean"):
             return getattr(types, token), at + 1
-        dtype = {"i": types.int64, "f": types.float64}[token[0]]
+        dtype = {"i": types.int64, "f": types.float64, "c": types.complex128}[token[0]]
         return types.Array(dtype, int(token[1:]), "C"), at + 1
 
     found, at = [], 0
@@ -95,6 +103,12 @@ def compile_group(group, variants):
     for variant in variants:
         for dispatcher, types in functions(group, VARIANTS[variant]):
             dispatcher.compile(types)
+
+
+def compile_parts():
+    """Compile PARTS into numba's cache (load them where it holds them)."""
+    for module, name, spec in PARTS:
+        getattr(importlib.import_module(f"{__package__}.{module}"), name).compile(argument_types(spec, None))
 
 
 def start(*generals):

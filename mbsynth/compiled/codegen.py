@@ -71,13 +71,15 @@ def _forms(exprs, q, qd, p):
     """({(form, kinds): [(output, positions)]}, the outputs left alone): each expression
     written with its symbols of q, q̇, p replaced by slots ``_s0, _s1, …`` (ordered by
     kind, then by position: copies read theirs in the same order), grouped by that form
-    where GROUP_MIN or more share it."""
-    if len(exprs) < GROUP_MIN:
-        return {}, list(range(len(exprs)))
+    where GROUP_MIN or more share it. An expression None is an output another kernel writes
+    (flexible.py): none of either."""
+    placed = [k for k, e in enumerate(exprs) if e is not None]
+    if len(placed) < GROUP_MIN:
+        return {}, placed
     where = {s: (kind, i) for kind, symbols in enumerate((q, qd, p)) for i, s in enumerate(symbols)}
     found = {}
-    for k, e in enumerate(exprs):
-        e = sp.sympify(e)
+    for k in placed:
+        e = sp.sympify(exprs[k])
         read = sorted((where[s] for s in e.free_symbols if s in where))
         form = e.xreplace({s: _SLOTS[j] for j, s in enumerate(sorted((s for s in e.free_symbols if s in where),
                                                                          key=where.__getitem__))})

@@ -23,7 +23,7 @@ import sympy as sp
 
 from ..core.equations import Motion
 from ..symbolic.derive import T_SYMBOL
-from . import ahead, codegen, kernel, layout
+from . import ahead, codegen, flexible, kernel, layout
 from .assembly import Work, make_work
 from .projection import Projection
 from .extra_projection import ExtraProjection
@@ -39,18 +39,20 @@ class Template:
     """What the Systems with one structure share: the Layout (with the numbers of the System
     it was built from, at parameter values ``p``) and the compiled generated function."""
 
-    def __init__(self, system, L, exprs, phi_outputs):
+    def __init__(self, system, L, exprs, phi_outputs, own):
         self.L, self.n, self.p = L, system.n, system.parameter_values
         self.phi_outputs = phi_outputs  # the generated function's last outputs: φ of the extra rows
         self.names = tuple(system.parameters)
         self.sources = layout.sources(L, system)  # the parts and joints its numbers are read from
         self.outputs = len(exprs)
-        self.module = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
-                                                  system.parameter_symbols) if exprs else None
+        generated = codegen.compile_expressions(exprs, system.q_symbols, system.qd_symbols,
+                                                system.parameter_symbols) if any(e is not None for e in exprs) else None
+        # the flexible parts' M and Q written after the generated function (layout.Own, flexible.py)
+        self.module = flexible.Filled(generated, own) if own else generated
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
         # the generated masses, rows and φ (all but the Q additions and C) depend on t: no projection without t
         self.rows_depend_on_time = any(T_SYMBOL in sp.sympify(expr).free_symbols
-                                       for expr in exprs[L.gen_q.size + L.gen_c.size:])
+                                       for expr in exprs[L.gen_q.size + L.gen_c.size:] if expr is not None)
         self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
         used = layout.number_parameters(L, self.sources, system.parameters)
         # the parameters the Layout's numbers use: values that differ only in others share L as it is

@@ -49,7 +49,7 @@ class ExtraProjection:
         self.forces = slice(0, int(starts[2]))  # Q additions and C
         self.entries = slice(int(starts[3]), int(starts[4]))  # the rows' entries
         self.rights = slice(int(starts[4]), int(starts[5]))  # their b
-        self.phi = slice(int(starts[5]), engine.outputs)
+        self.phi = slice(engine.outputs - engine.template.phi_outputs, engine.outputs)
         self.rows, self.columns = L.gen_arow, L.x_coord[L.gen_acol]
         self.xrow_row, self.m = L.xrow_row, int(L.sizes[1])
         self.gen = np.zeros(engine.outputs)

@@ -10,10 +10,14 @@ joint path reaches) picks each node's parent joint: those joints form the tree
 Everything else enters through ONE generated function (codegen.py) of (t, q, q̇, p):
 the force elements' Q, every constraint's C, the M and Q of the other parts (their
 coordinates are the *extra coordinates*), and the rows a, b of the other constraints
-(extra rows too; rows that vanish identically are left out). ``build`` returns the Layout
-and that function's expressions, in the order of its outputs: Q additions, C, M entries of
-the extra coordinates, entries of extra rows, b of extra rows, φ of extra rows (for the
-relative drift off the manifold, Engine.relative_drift).
+(extra rows too; rows that vanish identically are left out). ``build`` returns the Layout,
+that function's expressions, in the order of its outputs: Q additions, C, M entries of
+the extra coordinates, entries of extra rows, b of extra rows, inputs of the flexible
+parts' kernel, φ of extra rows (for the relative drift off the manifold,
+Engine.relative_drift), how many are φ, and the flexible parts (``Own``). A part with
+``kernel_arrays`` (a flexible body) has its M (every entry, row by row) and Q among those
+outputs as None: flexible.py's kernel writes them after the generated function, its gravity
+vector read from the inputs.
 
 Masses, inertias, gravity forces, frame offsets and rotations and rod lengths are the
 *numbers* of a Layout, evaluated at the System's parameter values; every other array
@@ -45,6 +49,18 @@ DENSE_SCHUR_MAX = 64
 def _node(part):
     """The kernel node kind of a part's type, None for the world (a joint's missing end)."""
     return None if part is None else part.part_type.node
+
+
+class Own(NamedTuple):
+    """A part whose M and Q flexible.py's kernel writes into the generated outputs: its first
+    coordinate, the outputs of its M (row by row) and Q, of its gravity vector (inputs), and
+    its arrays (W, s0, K, D, S: the part's ``kernel_arrays``)."""
+
+    start: int
+    m0: int
+    q0: int
+    g0: int
+    arrays: tuple
 
 
 class Layout(NamedTuple):
@@ -149,8 +165,8 @@ class _Symbols(_Numbers):
 
 
 def build(system):
-    """(Layout, generated expressions, how many of the last are φ of extra rows) of
-    ``system``, or None when a joint has Coulomb friction (its C depends on q̈:
+    """(Layout, generated expressions, how many of the last are φ of extra rows, the
+    flexible parts' ``Own``) of ``system``, or None when a joint has Coulomb friction (its C depends on q̈:
     system.motion iterates) or no part is a kernel node and the dense Schur system of its
     coordinates and rows would exceed DENSE_SCHUR_MAX."""
     if any(getattr(con, "coulomb", None) for con in system.constraints):
@@ -161,7 +177,8 @@ def build(system):
     quat = {c.name: r for c, r in zip(system.constraints, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.parts, starts)
              if (_node(part) == RIGID_NODE and f"{part.name}.unit_quaternion" in quat) or _node(part) == PARTICLE_NODE]
-    if not nodes and system.n > DENSE_SCHUR_MAX and not all(part.M.is_diagonal() for part in system.parts):
+    if not nodes and system.n > DENSE_SCHUR_MAX and not all(part.kernel_arrays is None and part.M.is_diagonal()
+                                                            for part in system.parts):
         return None  # its Schur system has at least its n coordinates, and cannot be banded
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
     quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _node(part) == RIGID_NODE}
@@ -316,7 +333,7 @@ class _Builder:
             for r in range(con.size):
                 xrow_row.append(row + r)
                 segs.append(ends)
-        exprs, gen, phi_outputs = self._generated(xrow_row, segs)
+        exprs, gen, phi_outputs, own = self._generated(xrow_row, segs)
         seg_ptr = np.cumsum([0] + [len(s) for s in segs])
         patterns = _patterns(gen, len(xrow_row), len(self.x_coord))
         band = dict(band_pos=_ints([]), band_width=_ints([]))
@@ -344,7 +361,7 @@ class _Builder:
             quat_row=_ints([self.quat[f"{part.name}.unit_quaternion"] if r else -1
                             for (part, _), r in zip(nodes, rigid)]),
             sizes=_ints(sizes), **numbers, **gen, **patterns, **band)
-        return layout, exprs, phi_outputs
+        return layout, exprs, phi_outputs, own
 
     def _end_of(self, i, j):
         if j < 0:
@@ -391,9 +408,16 @@ class _Builder:
             for i in con.indices:
                 if con.C[i] != 0:
                     C[int(i)] = C.get(int(i), 0) + con.C[i]
-        M = []
+        M, own_q, own = [], [], []  # own: (part, its first coordinate, its first M entry, its first Q output)
         for part, start in zip(system.parts, self.starts):
             if int(start) in node_at:
+                continue
+            count = len(part.coordinates)
+            if part.kernel_arrays is not None:
+                own.append((part, int(start), len(M), len(own_q)))
+                own_q += range(int(start), int(start) + count)
+                M += [(x_index[int(start) + a], x_index[int(start) + b], None)
+                      for a in range(count) for b in range(count)]
                 continue
             for a in range(len(part.coordinates)):
                 if part.Q[a] != 0:
@@ -425,10 +449,15 @@ class _Builder:
                     b.append((xr, con.b[r]))
                 if con.phi is not None and con.phi[r] != 0 and con.phi[r] is not sp.nan:
                     phi.append(con.phi[r])
-        exprs = (list(Q.values()) + list(C.values()) + [e for *_, e in M] + [e for *_, e in rows]
-                 + [e for _, e in b] + phi)
-        gen = dict(gen_q=_ints(list(Q)), gen_c=_ints(list(C)), gen_mi=_ints([x[0] for x in M]),
+        inputs = [g for part, *_ in own for g in part.kernel_arrays.gravity]
+        exprs = (list(Q.values()) + [None] * len(own_q) + list(C.values()) + [e for *_, e in M]
+                 + [e for *_, e in rows] + [e for _, e in b] + inputs + phi)
+        m_start = len(Q) + len(own_q) + len(C)
+        g_start = m_start + len(M) + len(rows) + len(b)
+        own = [Own(start, m_start + m0, len(Q) + q0, g_start + 3 * k, tuple(part.kernel_arrays[:5]))
+               for k, (part, start, m0, q0) in enumerate(own)]
+        gen = dict(gen_q=_ints(list(Q) + own_q), gen_c=_ints(list(C)), gen_mi=_ints([x[0] for x in M]),
                    gen_mj=_ints([x[1] for x in M]), gen_arow=_ints([x[0] for x in rows]),
                    gen_aseg=_ints([x[1] for x in rows]), gen_acol=_ints([x[2] for x in rows]),
                    gen_brow=_ints([x[0] for x in b]))
-        return exprs, gen, len(phi)
+        return exprs, gen, len(phi), own

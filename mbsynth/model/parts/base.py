@@ -57,18 +57,28 @@ class Part(Keyed):
     power_expression = sp.S.Zero
     # attributes beyond the base's that define a part of a subclass (``content``)
     content_fields = ()
+    # the arrays from which one compiled kernel evaluates the part's (2.1) (compiled/flexible.py's
+    # PartArrays), or None: its M and Q are sympy expressions compiled per part
+    kernel_arrays = None
 
     def __init__(self, name, coordinates, q, qd, M, Q, T, V, params, frames=(), geometry=(), initial=None,
                  shared=None):
         """``shared``: (q slots, q̇ slots, constants) when M, Q, T, V are a template's,
         written in those slots and in placeholders with the values ``constants`` ((symbol,
-        value) pairs): compiled once for all parts alike, put in only when asked."""
+        value) pairs): compiled once for all parts alike, put in only when asked. M None: a
+        part that evaluates (2.1) and its energies itself (``evaluate``, ``energy``,
+        ``power``, ``reads``, ``derivatives``), its sympy M, Q, T, V made by ``reference``
+        when first asked."""
         self.name = name
         self.coordinates = tuple(coordinates)
         self.q, self.qd = list(q), list(qd)
         self.frames = {f.name: f for f in frames}
         self.geometry = tuple(geometry)
         self.initial = dict(initial or {})
+        if M is None:
+            self._symbolic = self._shared = self._evaluate = self._energy = None
+            self._defined_by = ()
+            return
         template = (_matrix(M), _matrix(Q), sp.sympify(T), sp.sympify(V))
         q_slots, qd_slots, constants = shared or (self.q, self.qd, ())
         self._symbolic = None if shared else template
@@ -88,7 +98,9 @@ class Part(Keyed):
         return base + tuple(getattr(self, name) for name in self.content_fields)
 
     def _materialized(self):
-        if self._symbolic is None:
+        if self._symbolic is None and not self._shared:
+            self._symbolic = tuple(self.reference())
+        elif self._symbolic is None:
             template, slots, constants = self._shared
             put = placed_values(slots, range(len(self.q)), constants, self.q, self.qd)
             self._symbolic = tuple(x.xreplace(put) for x in template)
@@ -146,6 +158,16 @@ class Part(Keyed):
     def symbolic(self):
         """(M, Q) as sympy matrices of the model's symbols."""
         return self.M, self.Q
+
+    def reference(self):
+        """(M, Q, T, V) in sympy of a part that evaluates them itself (``__init__``'s M None)."""
+        raise NotImplementedError(f"a {self.kind} part has no sympy form")
+
+    def derivatives(self):
+        """The exact Jacobians of M q̈ − Q of a part that evaluates (2.1) itself, as an object
+        with analysis/linearization.py's ``BlockFunction.jacobians``; None: derived from its
+        sympy M and Q."""
+        return None
 
     def own_constraints(self, q, qd, params):
         """Constraints the part's coordinates always obey (a quaternion's unit norm)."""

@@ -3,18 +3,20 @@ frame's origin in the world), the unit quaternion qw, qx, qy, qz of its axes (as
 body, with the same unit-norm row) and the amplitudes eta1 … etar of a reduced FE model
 (model/flexible/reduction.py), u = Φ η the nodal DOFs in the frame's axes.
 
-M(q) and Q(q, q̇) are sympy expressions of the part's coordinates written with the reduced
-model's invariants as numbers (model/flexible/invariants.py): with ν = (V, ω, η̇) = B q̇,
-B = blockdiag(Aᵀ, 2E(u), I), the invariants' M(η) ν̇ = h + F gives
+M(q) and Q(q, q̇) follow from the reduced model's invariants (model/flexible/invariants.py):
+with ν = (V, ω, η̇) = B q̇, B = blockdiag(Aᵀ, 2E(u), I), the invariants' M(η) ν̇ = h + F gives
 
     M_q = Bᵀ M(η) B,   Q_q = Bᵀ (h + F + M(η) (ω × V, 0, 0)),
 
 (Ḃq̇ = (−ω × V, 0, 0) since E(u̇)u̇ = 0), F = gravity (exact: the first moment s(η)),
 −K_r η and −D η̇ on η. M_q keeps the rigid body's null direction u (closed by the unit-norm
-row). Being ordinary sympy M and Q, the part is evaluated, linearized (complex step) and
-compiled as any other part; its size grows as r², so it is meant for few modes (tens).
-With ``stiffening`` S (model/flexible/stiffening.py), M(η)'s ω–ω block loses Σ ω_a ω_b ηᵀ
-S_ab η: the centrifugal stiffening of a spinning part, as a term of its kinetic energy.
+row). With ``stiffening`` S (model/flexible/stiffening.py), M(η)'s ω–ω block loses Σ ω_a ω_b
+ηᵀ S_ab η: the centrifugal stiffening of a spinning part, as a term of its kinetic energy.
+One compiled kernel evaluates them for every flexible part from its invariants as arrays
+(compiled/flexible.py, O(r²)): on both paths (``evaluate``; the compiled path's generated
+outputs, compiled/layout.py) and, through complex numbers, the exact Jacobians of a
+linearization (``derivatives``); nothing is derived or generated per model. The same
+formulas in sympy (``reference``, ``symbolic()``) are the kernel's test reference.
 
 Frames sit at FE nodes: node j at x_j + u_j(η) in the part's axes, turned by the node's
 elastic rotation θ_j(η) (its rotation DOFs; none for 3-DOF nodes) through the Cayley map
@@ -24,19 +26,31 @@ I + [θ]× to first order — so joints and forces attach to them as to a rigid 
 frame's elastic turn rate (joint rates, actuation and springs along a joint, reaction frames).
 """
 
+from typing import NamedTuple
+
 import numpy as np
 import sympy as sp
 
 from ..constraints.base import Constraint
 from ...core.errors import ModelError
 from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
-from ...symbolic.derive import positions
+from ...symbolic.derive import PARAMETERS, T_SYMBOL, compile_function, positions
 from ..flexible.invariants import invariants
 from .base import Frame, Part
 from .part_type import EXTRA_NODE, FE_MESH, PartType, QUATERNION, check
 from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
-from ...core.tolerances import GRAM_ZERO_RTOL
+from ...core.tolerances import COMPLEX_STEP, GRAM_ZERO_RTOL
 
+
+class PartArrays(NamedTuple):
+    """What compiled/flexible.py's kernel reads of a flexible part (``kernel_arrays``)."""
+
+    W: np.ndarray        # the Gram matrix, (6 + 4r) square, rounding-level entries zeroed (``_gram``)
+    s0: np.ndarray       # the undeformed first moment (3,)
+    K: np.ndarray        # K_r (r × r)
+    D: np.ndarray        # the damping (r × r)
+    S: np.ndarray        # the stiffening (3 × 3 × r × r)
+    gravity: sp.Matrix   # the gravity vector, in the model's parameter symbols
 
 
 class FlexibleBody(Part):
@@ -71,9 +85,6 @@ class FlexibleBody(Part):
         self.damping = np.zeros((r, r)) if damping is None else np.asarray(damping, float)
         if self.damping.shape != (r, r):
             raise ModelError(f"flexible body '{name}': damping is {self.damping.shape}, the reduction has {r} coordinates")
-        eta_dot = sp.Matrix(qd[7:])
-        if self.damping.any():
-            self.power_expression = -(eta_dot.T * _numbers(self.damping) * eta_dot)[0]  # the damping's: −η̇ᵀDη̇
         self.stiffening = np.zeros((3, 3, r, r)) if stiffening is None else np.asarray(stiffening, float)
         if self.stiffening.shape != (3, 3, r, r):
             raise ModelError(f"flexible body '{name}': stiffening is {self.stiffening.shape}, expected {(3, 3, r, r)}")
@@ -82,23 +93,76 @@ class FlexibleBody(Part):
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
         self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
         made = [self._node_frame(name, label, spec, q[self.elastic], qd[self.elastic]) for label, spec in named.items()]
-        M, Q, T, V = _equations(self.invariants, reduction.stiffness, self.damping, self.stiffening, q, qd,
-                                self.gravity)
-        super().__init__(name, coordinates(r), q, qd, M, Q, T, V, params, made, geometry, initial)
+        self.kernel_arrays = PartArrays(_gram(self.invariants), np.array(self.invariants.first_moment, float),
+                                        np.ascontiguousarray(reduction.stiffness, float),
+                                        np.ascontiguousarray(self.damping), np.ascontiguousarray(self.stiffening),
+                                        self.gravity)
+        self._params = list(params)
+        self._gravity = compile_function((T_SYMBOL, list(q), list(qd), self._params), [self.gravity],
+                                         picked=PARAMETERS)
+        self._gravity_last = None  # (p, the gravity vector at p), ``gravity_at``
+        super().__init__(name, coordinates(r), q, qd, None, None, None, None, params, made, geometry, initial)
+
+    def reference(self):
+        """(M, Q, T, V) in sympy (the module's formulas): the kernel's test reference."""
+        return _equations(self.invariants, self.reduction.stiffness, self.damping, self.stiffening, self.q,
+                          self.qd, self.gravity)
+
+    def gravity_at(self, t, p):
+        """The gravity vector (world) at parameter values p (the last one kept while t does not enter)."""
+        last = self._gravity_last
+        if last is not None and np.array_equal(last[0], p):
+            return last[1]
+        rest = np.zeros(len(self.q))
+        g = np.ascontiguousarray(self._gravity(t, rest, rest, p)[0], float).ravel()
+        if T_SYMBOL not in self.gravity.free_symbols:
+            self._gravity_last = (np.array(p, float), g)
+        return g
+
+    def evaluate(self, t, q, qd, p):
+        """(M, Q) at the part's coordinates (2.1), by the compiled kernel."""
+        return equations(np.asarray(q, float), np.asarray(qd, float), self.gravity_at(t, p), self.kernel_arrays)[:2]
+
+    def energy(self, t, q, qd, p):
+        """(T, V): ½ νᵀ M(η) ν and ½ ηᵀ K_r η − gᵀ(m R + A s(η))."""
+        q, qd = np.asarray(q, float), np.asarray(qd, float)
+        g = self.gravity_at(t, p)
+        _, _, Mnu, nu = equations(q, qd, g, self.kernel_arrays)
+        W, s0, K = self.kernel_arrays[:3]
+        eta = q[7:]
+        first = s0 + W[:3, 6 + 3 * len(eta):] @ eta
+        return float(nu @ Mnu @ nu) / 2, float(eta @ K @ eta / 2 - g @ (W[0, 0] * q[:3] + _rotation(q[3:7]) @ first))
+
+    @property
+    def working(self):
+        return bool(self.damping.any())
+
+    def power(self, t, q, qd, p):
+        """The damping's power −η̇ᵀ D η̇."""
+        eta_dot = np.asarray(qd, float)[7:]
+        return float(-eta_dot @ self.damping @ eta_dot)
+
+    def reads(self, symbols):
+        return not self.gravity.free_symbols.isdisjoint(symbols)
+
+    def derivatives(self):
+        return _Derivatives(self)
 
     def _node_frame(self, part, label, spec, eta, eta_dot):
         node, turn, geometry = (*spec, ())[:3] if isinstance(spec, tuple) else (spec, np.eye(3), ())
         rows = self.reduction.node_rows(node)  # raises for a node the FE model lacks
-        Phi = _numbers(self.reduction.basis[rows])
-        position = sp.Matrix(self.reduction.fe.nodes[node]) + Phi[:3, :] * sp.Matrix(eta)
+        Phi = np.asarray(self.reduction.basis[rows], float)
+        position = sp.Matrix(self.reduction.fe.nodes[node]) + _combination(Phi[:3], eta)
         if len(rows) == 6:
-            half, half_rate = Phi[3:, :] * sp.Matrix(eta) / 2, Phi[3:, :] * sp.Matrix(eta_dot) / 2
-            elastic = rotation([1, *half]) / (1 + (half.T * half)[0])
+            half, half_rate = _combination(Phi[3:] / 2, eta), _combination(Phi[3:] / 2, eta_dot)
+            scale = 1 + sp.Add(*(x * x for x in half))
+            elastic = _cayley(half, scale)
             # the Cayley map's angular velocity (Rodrigues parameters g = θ/2): 2(ġ + g × ġ)/(1 + gᵀg)
-            self._turn_rates[label] = 2 * (half_rate + half.cross(half_rate)) / (1 + (half.T * half)[0])
+            self._turn_rates[label] = 2 * (half_rate + half.cross(half_rate)) / scale
         else:
             elastic = sp.eye(3)
-        return Frame(part, label, position, elastic * sp.Matrix(turn), tuple(geometry))
+        rotated = elastic if np.array_equal(turn, np.eye(3)) else _product(elastic, _numbers(turn))
+        return Frame(part, label, position, rotated, tuple(geometry))
 
     def own_constraints(self, q, qd, params):
         """The frame's quaternion has unit norm (the rigid body's row, rigid_body.py)."""
@@ -109,7 +173,7 @@ class FlexibleBody(Part):
 
     def pose(self, frame):
         A = rotation(self.q[3:7])
-        return sp.Matrix(self.q[:3]) + A * frame.position, A * frame.rotation
+        return sp.Matrix(self.q[:3]) + _product(A, frame.position), _product(A, frame.rotation)
 
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:7]) * sp.Matrix(self.qd[3:7])
@@ -150,6 +214,30 @@ def modal_damping(reduction, ratio):
     return (D + D.T) / 2
 
 
+def _gram(inv):
+    """The invariants' Gram matrix W with the entries below GRAM_ZERO_RTOL of the largest zeroed."""
+    return np.ascontiguousarray(np.where(np.abs(inv.gram) > GRAM_ZERO_RTOL * np.abs(inv.gram).max(), inv.gram, 0.0))
+
+
+def _cayley(g, scale):
+    """((1 − gᵀg) I + 2 g gᵀ + 2 [g]×) / ``scale`` (= 1 + gᵀg) in sympy, entry by entry:
+    core/kinematics.py's ``rotation`` of (1, g) over its norm, without sympy's matrix
+    products (slow on sums of many terms)."""
+    g = list(g)
+    diagonal = 2 - scale  # 1 − gᵀg
+
+    def entry(i, j):
+        k = 3 - i - j  # the third axis, for i ≠ j
+        turn = 0 if i == j else sp.Mul(2 if (j - i) % 3 == 1 else -2, g[k])  # 2[g]×: (0, 1) holds −2 g_z
+        return sp.Add(diagonal if i == j else 0, sp.Mul(2, g[i], g[j]), -turn) / scale
+    return sp.Matrix(3, 3, entry)
+
+
+def _combination(matrix, symbols):
+    """The sympy column Σ_k matrix[:, k] symbols[k] (float coefficients, zeros left out)."""
+    return sp.Matrix([sp.Add(*(sp.Mul(sp.Float(c), x) for c, x in zip(row, symbols) if c != 0)) for row in matrix])
+
+
 def _numbers(array):
     """A numpy array as a sympy matrix of floats."""
     return sp.Matrix(np.atleast_2d(array).tolist())
@@ -182,7 +270,7 @@ def _equations(inv, K, D, S, q, qd, gravity):
     u, eta = sp.Matrix(q[3:7]), sp.Matrix(q[7:])
     R_dot, u_dot, eta_dot = sp.Matrix(qd[:3]), sp.Matrix(qd[3:7]), sp.Matrix(qd[7:])
     A, E = rotation(u), body_rate_matrix(u)
-    W = np.where(np.abs(inv.gram) > GRAM_ZERO_RTOL * np.abs(inv.gram).max(), inv.gram, 0.0)
+    W = _gram(inv)
     # M(η) = Pᵀ W P with P = P0 + Σ η_k P_k (invariants.py): P_k puts I₃ at rows 6 + 3k, columns 3:6
     P0 = np.zeros((6 + 4 * r, 6 + r))
     P0[:6, :6], P0[6 + 3 * r:, 6:] = np.eye(6), np.eye(r)
@@ -218,3 +306,56 @@ def _equations(inv, K, D, S, q, qd, gravity):
     potential = (_product(eta.T, _numbers(K), eta)[0] / 2
                  - _product(gravity.T, mass * sp.Matrix(q[:3]) + _product(A, first))[0])
     return M, Q, T, potential
+
+
+def equations(q, qd, g, arrays):
+    """(M_q, Q_q, M(η), ν) of a part with ``arrays`` (PartArrays) at its coordinates q, q̇ and
+    gravity g: compiled/flexible.py's kernel, complex where q, q̇ or g is."""
+    from ...compiled import flexible  # numba: loaded with the first flexible part evaluated
+
+    dtype = np.result_type(q, qd, g, float)
+    n = len(q)
+    M, Q = np.zeros((n, n), dtype), np.zeros(n, dtype)
+    Mnu, nu = np.zeros((n - 1, n - 1), dtype), np.zeros(n - 1, dtype)
+    flexible.equations(*(np.ascontiguousarray(x, dtype) for x in (q, qd, g)), *arrays[:5], M, Q, Mnu, nu)
+    return M, Q, Mnu, nu
+
+
+def _rotation(u):
+    """A(u) of a scalar-first quaternion, numpy (core/kinematics.py ``rotation``)."""
+    w, v = u[0], np.asarray(u[1:])
+    skew = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * w * skew
+
+
+class _Derivatives:
+    """The exact Jacobians of G = M q̈ − Q of a flexible part by q, q̇ and parameters, for
+    analysis/linearization.py (its ``BlockFunction.jacobians``): the complex step (Im G(x + ih
+    e_j)/h, exact to rounding) through the kernel; Q is linear in the gravity vector g, so
+    ∂G/∂p = −(∂Q/∂g)(∂g/∂p), ∂g/∂p from the gravity's sympy expressions."""
+
+    def __init__(self, part):
+        self.part = part
+
+    def jacobians(self, t, q, qd, qdd, lam, p, parameters=()):
+        part, h = self.part, COMPLEX_STEP
+        q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
+        g = part.gravity_at(t, p)
+        n = len(q)
+
+        def moved(which, j):
+            x = [q.astype(complex), qd.astype(complex), g.astype(complex)]
+            x[which][j] += 1j * h
+            M, Q = equations(*x, part.kernel_arrays)[:2]
+            return (M @ qdd - Q).imag / h
+
+        G_q = np.column_stack([moved(0, j) for j in range(n)])
+        G_qd = np.column_stack([moved(1, j) for j in range(n)])
+        G_g = np.column_stack([moved(2, j) for j in range(3)])
+        G_p = np.zeros((n, len(parameters)))
+        values = dict(zip(part._params, p))
+        for c, j in enumerate(parameters):
+            symbol = part._params[j]
+            if symbol in part.gravity.free_symbols:
+                G_p[:, c] = G_g @ np.array(part.gravity.diff(symbol).subs(values), dtype=float).ravel()
+        return G_q, G_qd, G_p
