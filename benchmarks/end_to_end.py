@@ -1,6 +1,6 @@
 """Whole simulations against Pinocchio's ``aba`` or equations by hand, inside scipy's ``solve_ivp``.
 
-    MBSYNTH_FAST=wait .venv/bin/python benchmarks/end_to_end.py [--rounds R] [--simulations-only] [--out FILE]
+    MBSYNTH_COMPILED=wait .venv/bin/python benchmarks/end_to_end.py [--rounds R] [--simulations-only] [--out FILE]
 
 Each case runs ``mb.simulate(system, t_end, q0=, qd0=)`` with DOP853, rtol = atol = 1e-10
 and 501 output rows, against ``solve_ivp(f, (0, t_end), (q, v), method="DOP853",
@@ -24,7 +24,7 @@ model with a free-flyer root, the chain's joints) and start both codes from the 
 (``Twin.to_maximal`` of Pinocchio's); the table gives the largest difference of their final
 positions of the bodies. Each figure is the best of ``--rounds`` runs, the two codes alternating;
 the ratio is to Pinocchio's time in the same run. mbsynth runs twice a round: as a user
-gets it, the corrections of the output rows a step passed split among the cores
+gets it, the projections of the output rows a step passed split among the cores
 (mbsynth/compiled/threads.py), and on one thread, as Pinocchio runs. Also: the evaluations of the right-hand
 side, and for mbsynth the largest position residual of the outputs and the spread of the
 total energy (zero for the exact motion). Model building is not timed in that table; the
@@ -35,7 +35,7 @@ engine built from numba's cache), then with the derivation cache off
 (``MBSYNTH_DERIVATION_CACHE=off``: every derivation done again; numba's cache warm); and
 ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process); once,
 ``from_robot("talos")`` and its first motion with no caches at all, waiting while numba
-compiles the kernels (``MBSYNTH_FAST=wait``; by default the KKT path answers meanwhile);
+compiles the kernels (``MBSYNTH_COMPILED=wait``; by default the KKT path answers meanwhile);
 Pinocchio's ``buildModelFromUrdf`` for scale. Writes benchmarks/end_to_end_results.md (or
 ``--out``).
 
@@ -58,7 +58,7 @@ import tempfile
 import time
 from pathlib import Path
 
-os.environ.setdefault("MBSYNTH_FAST", "wait")  # the compiled kernels, not the KKT path while they build
+os.environ.setdefault("MBSYNTH_COMPILED", "wait")  # the compiled kernels, not the KKT path while they build
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
@@ -173,7 +173,7 @@ def andrews_by_hand(text):
     import sympy as sp
     import yaml
     spec = yaml.safe_load(text)
-    part = spec["subsystems"]["sq"]
+    part = spec["parts"]["sq"]
     names = part["coordinates"]
     q, qd = sp.symbols(names), sp.symbols([f"{c}_dot" for c in names])
     numbers = {sp.Symbol(k): v for k, v in spec["parameters"].items()}
@@ -239,7 +239,7 @@ def reference_run(case):
 
 def mbsynth_run(case, cores=None):
     """(seconds, evaluations, largest position residual, energy spread, final q) of
-    mb.simulate; ``cores``: the threads its corrections may take (default: one per core)."""
+    mb.simulate; ``cores``: the threads its projections may take (default: one per core)."""
     default, threads.THREADS = threads.THREADS, cores or threads.THREADS
     try:
         started = time.perf_counter()
@@ -278,7 +278,7 @@ BUILDS = {  # what is timed in a fresh process: (code, settings)
 COLD = ("from_robot(\"talos\") and its first compiled motion, no caches (numba compiles)",
         "import mbsynth as mb; t = time.perf_counter(); s = mb.from_robot('talos'); s.motion(0.0, *s.initial_state())")
 CHECK = ["-m", "mbsynth", "check", "models/robots/ur5_payload.yaml"]
-USER_ENV = {k: v for k, v in os.environ.items() if k != "MBSYNTH_FAST"}  # as a user runs them (set above)
+USER_ENV = {k: v for k, v in os.environ.items() if k != "MBSYNTH_COMPILED"}  # as a user runs them (set above)
 
 
 def fresh_seconds(code, settings):
@@ -290,11 +290,11 @@ def fresh_seconds(code, settings):
 
 def cold_seconds():
     """Seconds of COLD in a fresh process with empty caches (derivations and numba's machine
-    code in a new directory) that waits for the compiled engine (MBSYNTH_FAST=wait) instead
+    code in a new directory) that waits for the compiled engine (MBSYNTH_COMPILED=wait) instead
     of answering with the KKT path while it compiles."""
     with tempfile.TemporaryDirectory() as empty:
         return fresh_seconds(COLD[1], {"MBSYNTH_CACHE_DIR": empty, "NUMBA_CACHE_DIR": str(Path(empty) / "numba"),
-                                       "MBSYNTH_FAST": "wait"})
+                                       "MBSYNTH_COMPILED": "wait"})
 
 
 def check_seconds():

@@ -1,8 +1,8 @@
-"""What reusing the compiled fast path saves: ``with_parameters`` + first motion, and a small sweep.
+"""What reusing the compiled path saves: ``with_parameters`` + first motion, and a small sweep.
 
     .venv/bin/python benchmarks/engine_reuse.py [--models M.yaml ... chain:N] [--runs 6] [--repeats 5]
 
-In one process, the kernels compiled before anything is timed, MBSYNTH_FAST=wait (every
+In one process, the kernels compiled before anything is timed, MBSYNTH_COMPILED=wait (every
 motion on the tree path), for each model (``chain:N``: N links of ``chain_yaml`` of
 fast_dynamics.py), its first parameter m scaled by a random factor in [0.9, 1.1]:
 
@@ -28,7 +28,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-os.environ["MBSYNTH_FAST"] = "wait"
+os.environ["MBSYNTH_COMPILED"] = "wait"
 
 import numpy as np  # noqa: E402
 

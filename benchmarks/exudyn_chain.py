@@ -96,7 +96,7 @@ class State:
 
 def mbsynth_system(count):
     system = mb.loads(chain_yaml(count), name=f"chain_{count}")
-    engine_for(system)  # compile (or load) the fast path before anything is timed
+    engine_for(system)  # compile (or load) the compiled path before anything is timed
     return system
 
 

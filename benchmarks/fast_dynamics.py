@@ -1,4 +1,4 @@
-"""The fast path (mbsynth.compiled) against Pinocchio's ``aba`` on the same systems, in one process.
+"""The compiled path (mbsynth.compiled) against Pinocchio's ``aba`` on the same systems, in one process.
 
     .venv/bin/python benchmarks/fast_dynamics.py [--quick]
 
@@ -58,7 +58,7 @@ def axis(i):
 def chain_yaml(count):
     """N links of length LENGTH hanging from the world, revolute joints about x, y, x, ..."""
     lines = [f"name: chain_{count}", f"parameters: {{m: {MASS}, L: {LENGTH}}}", "gravity: [0, 0, -9.81]",
-             f"world: {{frames: {{pivot: {{position: [0, 0, 0], axis: {axis(0)}}}}}}}", "subsystems:"]
+             f"world: {{frames: {{pivot: {{position: [0, 0, 0], axis: {axis(0)}}}}}}}", "parts:"]
     for i in range(count):
         lines.append(f"  link{i}: {{type: rigid_body, mass: m, inertia: [m*L**2/12, m*L**2/12, m*L**2/40], "
                      f"frames: {{top: {{position: [0, 0, L/2], axis: {axis(i)}}}, "
@@ -343,7 +343,7 @@ def write(rows, batch, startups, compiled, memory):
         lines.append("")
     if memory:
         count, mib = memory
-        lines += [f"Peak traced memory of building the fast path (layout, buffers) and one motion() for the "
+        lines += [f"Peak traced memory of building the compiled path (layout, buffers) and one motion() for the "
                   f"chain of N = {count}: {mib:.1f} MiB (the dense KKT matrix alone would take "
                   f"{(7 * count + 6 * count) ** 2 * 8 / 2**20:,.0f} MiB).", ""]
     lines += [f"`mbsynth check models/paper/example1_wheel.yaml`: {startups[0]:.2f} s with an empty cache, "

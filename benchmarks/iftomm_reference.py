@@ -93,7 +93,7 @@ def n_four_bar_yaml(N, L=1.0, m=1.0, g=9.81, v0=1.0):
     ]
     for i in range(N + 1):
         lines.append(f"    p{i}: {{position: [{i}*L, 0, 0]}}")
-    lines.append("subsystems:")
+    lines.append("parts:")
     for i in range(N + 1):
         lines.append(f"  v{i}: {{type: planar_body, mass: m, inertia: m*L**2/12, "
                      f"frames: {{bottom: {{position: [0, -L/2, 0]}}, top: {{position: [0, L/2, 0]}}}}, "

@@ -67,7 +67,7 @@ import sys
 import time
 from pathlib import Path
 
-os.environ.setdefault("MBSYNTH_FAST", "wait")  # the compiled kernels, not the KKT path while they build
+os.environ.setdefault("MBSYNTH_COMPILED", "wait")  # the compiled kernels, not the KKT path while they build
 
 import numpy as np  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
@@ -409,7 +409,7 @@ CART_POLE = """\
 # A cart of almost no mass on a spring, carrying a pole: two coordinates, one energy-defined part.
 name: cart_pole_light
 parameters: {M: 0.001, m: 1.0, l: 0.5, I: 0.0833333333333333, k: 10.0, g: 9.81}
-subsystems:
+parts:
   cp:
     type: lagrangian
     coordinates: [x, theta]
@@ -687,7 +687,7 @@ def write(results, args, started):
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "mbsynth"], cwd=ROOT,
                            capture_output=True, text=True).stdout.strip()
-    command = "MBSYNTH_FAST=wait .venv/bin/python benchmarks/loops.py" + "".join(f" {a}" for a in sys.argv[1:])
+    command = "MBSYNTH_COMPILED=wait .venv/bin/python benchmarks/loops.py" + "".join(f" {a}" for a in sys.argv[1:])
     lines = ["# Loops, energy-defined parts and singular positions: mbsynth, Exudyn and exact equations (issue 44)", "",
              f"{datetime.date.today()}, {platform.platform()}, {platform.processor() or platform.machine()}, "
              f"{os.cpu_count()} cores (shared), Python {platform.python_version()}, Exudyn {exu.config.Version()}, "

@@ -1,6 +1,6 @@
 """``System.motion_batch`` against ``pinocchio.aba`` per state, as a distribution over rounds.
 
-    MBSYNTH_FAST=wait .venv/bin/python benchmarks/motion_batch.py [--rounds R] [--count B]
+    MBSYNTH_COMPILED=wait .venv/bin/python benchmarks/motion_batch.py [--rounds R] [--count B]
 
 For the UR5 (fixed base) and talos (floating) of example-robot-data: B states (default
 1024) drawn in Pinocchio's coordinates and mapped to mbsynth's by forward kinematics
@@ -18,7 +18,7 @@ import os
 import platform
 from pathlib import Path
 
-os.environ.setdefault("MBSYNTH_FAST", "wait")  # the compiled kernels, not the KKT path while they build
+os.environ.setdefault("MBSYNTH_COMPILED", "wait")  # the compiled kernels, not the KKT path while they build
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402

@@ -62,7 +62,7 @@ def renamed(text, names):
 
 def copy_names(cell, i):
     """{cell name: copy i's name}: its parts and its parameters."""
-    names = {p: f"cell_{i}_{p}" for p in cell["subsystems"]}
+    names = {p: f"cell_{i}_{p}" for p in cell["parts"]}
     names.update({p: f"{p}_{i}" for p in cell["parameters"]})
     return names
 
@@ -71,15 +71,15 @@ def flat_model(count, cell_path=CELL):
     """The flat model file (a dict) of ``count`` copies of the cell: copy i's parts and
     parameters renamed (``copy_names``), its initial angle theta0_i spread over the copies."""
     cell = yaml.safe_load(Path(cell_path).read_text())
-    model = {"name": f"{cell['name']}_x{count}", "parameters": {}, "subsystems": {}, "constraints": [],
+    model = {"name": f"{cell['name']}_x{count}", "parameters": {}, "parts": {}, "constraints": [],
              "initial": {}}
     for i in range(count):
         names = copy_names(cell, i)
         for key, value in cell["parameters"].items():
             model["parameters"][names[key]] = value
         model["parameters"][names["theta0"]] = round(0.1 + 0.4 * i / max(count - 1, 1), 6)
-        for part, spec in cell["subsystems"].items():
-            model["subsystems"][names[part]] = {k: ([renamed(x, names) for x in v] if k == "coordinates" else
+        for part, spec in cell["parts"].items():
+            model["parts"][names[part]] = {k: ([renamed(x, names) for x in v] if k == "coordinates" else
                                                     renamed(v, names) if k in ("T", "V") else v)
                                                 for k, v in spec.items()}
         for constraint in cell.get("constraints", []):
@@ -93,14 +93,14 @@ def composed_model(count, cell_path=CELL):
     """The model file (a dict) of ``count`` copies of the cell as one ``type: model`` entry."""
     spread = f"0.1 + 0.4*index/{max(count - 1, 1)}"
     return {"name": f"pendulum_cell_x{count}", "parameters": {"N": count},
-            "subsystems": {"cell": {"type": "model", "file": str(cell_path), "count": "N",
+            "parts": {"cell": {"type": "model", "file": str(cell_path), "count": "N",
                                     "parameters": {"theta0": spread}}}}
 
 
 def run(path, simulate=False):
     """One fresh interpreter loading (and simulating) the model at ``path``, cold derivation cache."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
-               MBSYNTH_DERIVATION_CACHE="off", **({"MBSYNTH_FAST": "wait"} if simulate else {}))
+               MBSYNTH_DERIVATION_CACHE="off", **({"MBSYNTH_COMPILED": "wait"} if simulate else {}))
     result = subprocess.run([sys.executable, "-c", PROBE, str(path), "simulate" if simulate else "load"],
                             cwd=ROOT, env=env, capture_output=True, text=True, check=False)
     if result.returncode:
@@ -144,7 +144,7 @@ def main(argv=None):
         f"that process); medians of {args.runs} runs; ratios to one composed copy (the bar: at most 5×).", "",
         *rows, "",
         f"The {args.copies}-copy model on the compiled path (asserted): its Template built and its generated",
-        f"function compiled (`system.data()`, MBSYNTH_FAST=wait) in {simulated['build']:.1f} s, then",
+        f"function compiled (`system.data()`, MBSYNTH_COMPILED=wait) in {simulated['build']:.1f} s, then",
         f"`mb.simulate` for {SIM_T_END} s of motion in {simulated['simulate']:.2f} s ({simulated['steps']} recorded steps).", "",
         f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()};",
         "shared with other work: compare figures within one table, CPU times are the steadier.", ""])

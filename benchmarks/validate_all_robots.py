@@ -5,8 +5,7 @@ floating base, and for the model files of robots and loops; writes a results tab
 
 Each robot is built once (floating; the fixed base adds a weld), so "build s" is the time
 to derive and compile every part, joint and torque symbolically (sympy), shared by both
-rows. "motion ms" is one evaluation of (2.14) by the dense fast path (issue 7 makes it
-fast). BLAS runs single-threaded (OPENBLAS_NUM_THREADS=1): on a busy 2-core machine its
+rows. "motion ms" is one evaluation of (2.14) by the dense KKT solve. BLAS runs single-threaded (OPENBLAS_NUM_THREADS=1): on a busy 2-core machine its
 threads otherwise fight over the cores. Writes benchmarks/validate_results.md after every
 robot, so an interrupted run keeps what it measured.
 """
@@ -14,7 +13,7 @@ robot, so an interrupted run keeps what it measured.
 import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("MBSYNTH_FAST", "wait")  # the production (compiled) path, not the KKT path while it builds
+os.environ.setdefault("MBSYNTH_COMPILED", "wait")  # the production (compiled) path, not the KKT path while it builds
 
 import argparse  # noqa: E402
 import platform  # noqa: E402

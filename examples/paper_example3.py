@@ -3,11 +3,11 @@
 Run it with `make run` (or `.venv/bin/python examples/paper_example3.py`).
 
 Udwadia & Phohomsiri (2006) decompose the system of their figure 2 into two
-sub-systems (figure 3), each described in its own coordinates as if it were free,
+parts (figure 3), each described in its own coordinates as if it were free,
 and join them with one connection constraint. The unconstrained mass matrix (5.33)
 is singular, yet the motion is unique: Result 3 says so exactly when [M; A] has
 full column rank. When a mass is zero the rank drops, and the missing equation is a
-force balance, which mbsynth derives and can append by itself (`closure: auto`).
+force balance, which mbsynth derives and can append by itself (`balances: auto`).
 
 Each model here has a handful of coordinates: the walk computes on the KKT path of (2.14)
 (``system.data(path="kkt")``), which answers at once, instead of compiling the kernels of
@@ -38,7 +38,7 @@ def section(title):
 
 
 def main():
-    section("1. Two sub-systems joined by q1 = x1 + d (case 5.1, m1, m2 > 0)")
+    section("1. Two parts joined by q1 = x1 + d (case 5.1, m1, m2 > 0)")
     path = MODELS / "example3_two_masses.yaml"
     system = mb.load(path)
     data = system.data(path="kkt")  # the model's workspace: its parameter values and path
@@ -64,7 +64,7 @@ def main():
     open_model = mb.loads(text, name="example3 with m1 = 0")
     print(format_check(diagnose(open_model.data(path="kkt"), q=[1.06, 1.26, 0.9]), "m1 = 0, as decomposed"))
 
-    section("3. The same with `closure: auto` (models/paper/example3_m1_zero_auto.yaml)")
+    section("3. The same with `balances: auto` (models/paper/example3_m1_zero_auto.yaml)")
     path = MODELS / "example3_m1_zero_auto.yaml"
     closed = mb.load(path)
     data = closed.data(path="kkt")

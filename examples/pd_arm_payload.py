@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import mbsynth as mb
-from mbsynth.model.connectors.base import Connector
+from mbsynth.model.constraints.base import Constraint
 from mbsynth.model.joint_values import along, constraint_symbols
 
 MODEL = Path(__file__).resolve().parent.parent / "models" / "robots" / "ur5_payload.yaml"
@@ -49,9 +49,9 @@ def gains():
 def static_torques(system, names, t, q):
     """The joint torques that hold ``system`` at rest at the positions q: the multipliers
     of one servo row per joint angle (inverse statics by constraints, reactions.py)."""
-    joints = {c.name: c for c in system.connectors}
+    joints = {c.name: c for c in system.constraints}
     angles = system.joint_values(t, q, np.zeros(system.n))
-    servos = [Connector.holonomic(f"{name}_servo", [constraint_symbols(joints[name])["angle"]
+    servos = [Constraint.holonomic(f"{name}_servo", [constraint_symbols(joints[name])["angle"]
                                                     - angles[name].position[0]],
                                   system.q_symbols, system.qd_symbols, system.parameter_symbols) for name in names]
     held = system.with_constraints(servos)

@@ -3,7 +3,7 @@
 Run it with `.venv/bin/python examples/ur5_circle.py [picture.png]` (about a minute).
 
 1. The tool path as a constraint. The UR5 of example-robot-data (every link a rigid body)
-   gets one more connector: its tool frame (``tool0``) held at a point that runs round a
+   gets one more constraint: its tool frame (``tool0``) held at a point that runs round a
    10 cm circle in 2 s, with the tool's orientation kept — six rows, as many as the arm
    has joints. The arm then has no freedom left: the motion (2.14) is the inverse
    kinematics, and the simulation gives the joint angles along the path
@@ -25,8 +25,8 @@ import pinocchio as pin
 import sympy as sp
 
 import mbsynth as mb
-from mbsynth.model.connectors.joints import joint_equations
-from mbsynth.model.connectors.base import Connector
+from mbsynth.model.constraints.joints import joint_equations
+from mbsynth.model.constraints.base import Constraint
 from mbsynth.analysis.projection import project_velocities
 from mbsynth.robots.build import LINK_FRAME
 from mbsynth.symbolic.derive import T_SYMBOL
@@ -42,14 +42,14 @@ def tool_path_constraint(system, tool, p0, R0):
     target = sp.Matrix(p0) + RADIUS * sp.Matrix([sp.cos(w * T_SYMBOL) - 1, sp.sin(w * T_SYMBOL), 0])
     p, R = tool.pose(tool.frames[LINK_FRAME])
     phis, labels = joint_equations("fixed", target, sp.Matrix(R0), p, R)
-    return Connector.holonomic("tool_path", phis, system.q_symbols, system.qd_symbols, system.parameter_symbols,
+    return Constraint.holonomic("tool_path", phis, system.q_symbols, system.qd_symbols, system.parameter_symbols,
                                row_labels=labels)
 
 
 def servo_rows(system, joints):
     """One row ``joint.angle`` per joint: its multiplier is the torque about the joint."""
-    by_name = {c.name: c for c in system.connectors}
-    return [Connector.holonomic(f"{name}_servo", [by_name[name].angle], system.q_symbols, system.qd_symbols,
+    by_name = {c.name: c for c in system.constraints}
+    return [Constraint.holonomic(f"{name}_servo", [by_name[name].angle], system.q_symbols, system.qd_symbols,
                                 system.parameter_symbols) for name in joints]
 
 

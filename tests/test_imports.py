@@ -46,7 +46,7 @@ def module_names():
 @pytest.mark.slow  # each of the package's modules imported first, its dependencies afresh each time
 def test_every_submodule_imports_first_in_a_fresh_interpreter():
     names = module_names()
-    assert "mbsynth.model.parts" in names and "mbsynth.model.connectors.joints" in names
+    assert "mbsynth.model.parts" in names and "mbsynth.model.constraints.joints" in names
     result = subprocess.run([sys.executable, "-c", FIRST_IMPORTS, str(PACKAGE), *names],
                             capture_output=True, text=True, timeout=600, check=False)
     assert result.returncode == 0, result.stderr

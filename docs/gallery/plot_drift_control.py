@@ -10,7 +10,7 @@ A q̈ = b (2.4): integrated, positions and velocities drift off φ = 0 and φ̇ 
   quaternions included. On a model with loops, as this one, it is projected — least
   change, Gauss–Newton on positions then velocities — at every output time, and in
   between as often as keeps the relative drift below 1e-9; on a tree of bodies and joints
-  the compiled kernel corrects every accepted step and every output row itself, in the
+  the compiled kernel projects every accepted step and every output row itself, in the
   mass metric, and the integrator runs through the output times;
 * ``"baumgarte"``: b is replaced by b − 2αφ̇ − β²φ (α = β = 10 by default), which pulls
   the drift back without restarts;

@@ -27,7 +27,7 @@ top = mb.loads(dedent("""
     name: heavy_top
     parameters: {m: 0.5, l: 0.1, A: 2.0e-3, C: 0.8e-3, g: 9.81, tilt: 0.3, spin: 60.0}
     gravity: [0, 0, -g]
-    subsystems:
+    parts:
       top:
         type: rigid_body
         mass: m

@@ -2,11 +2,11 @@
 The paper's example 3: a massless node between two springs
 ==========================================================
 
-Two masses and two springs, modelled as two sub-systems joined by the connection
+Two masses and two springs, modelled as two parts joined by the connection
 constraint q1 = x1 + d, (5.32). The unconstrained mass matrix (5.33) is singular whatever
 the masses. With the first mass removed (m1 = 0, case 5.2) the rank of [M; A] drops and
 the missing equation is the force balance of the massless node, (5.40):
-k1 (x1 − l10) = k2 (q2 − l20). ``closure: auto`` derives it from the null space of [M; A]
+k1 (x1 − l10) = k2 (q2 − l20). ``balances: auto`` derives it from the null space of [M; A]
 and appends it; the motion is then (5.47), unique by Result 3.
 
 The node follows the mass m2 through the springs in series: with
@@ -22,7 +22,7 @@ a harmonic oscillator we compare the simulation with.
 # The model and its verdict
 # -------------------------
 # ``models/paper/example3_m1_zero_auto.yaml`` is example 3 with ``m1: 0.0`` and
-# ``closure: auto``. ``mbsynth check`` prints the same report.
+# ``balances: auto``. ``mbsynth check`` prints the same report.
 from pathlib import Path
 
 import matplotlib.pyplot as plt

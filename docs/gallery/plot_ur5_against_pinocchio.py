@@ -26,7 +26,7 @@ import mbsynth as mb
 from mbsynth.model.joint_values import along
 
 robot = mb.from_robot("ur5", floating=False)
-print(f"{robot.name}: {len(robot.parts)} parts, n = {robot.n} coordinates, {len(robot.connectors)} connectors")
+print(f"{robot.name}: {len(robot.parts)} parts, n = {robot.n} coordinates, {len(robot.constraints)} constraints")
 traj = mb.simulate(robot, 0.6, dt=0.02)
 values = along(robot, traj.t, traj.q, traj.qd)
 

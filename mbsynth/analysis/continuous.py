@@ -4,18 +4,18 @@ and an explicit Runge–Kutta pair (RK23, RK45, DOP853).
 The steps are chosen by the error control alone, up to the next control sample or the end;
 each accepted step is put back on the constraints and the integrator goes on from there,
 given that state's derivative, its steps capped (``max_step``) to keep the drift between
-corrections below DRIFT_TARGET (drift.py). Each output row is read from the step's dense
+projections below DRIFT_TARGET (drift.py). Each output row is read from the step's dense
 output (the interpolant ``solve_ivp`` gives at ``t_eval``) and put back on the constraints
 too (a copy: the integrator goes on from its own state). Where the compiled kernel covers
-the model (compiled/correction.py: kernel joints and bodies, in a tree or closing loops; or
-compiled/extra_correction.py: a small model of extra coordinates alone) it corrects the rows
+the model (compiled/projection.py: kernel joints and bodies, in a tree or closing loops; or
+compiled/extra_projection.py: a small model of extra coordinates alone) it projects the rows
 a step passed in one block with its end (``block``, on all cores where it threads);
 elsewhere each state is projected (projection.py) and judged strictly there
-(Integration.arrived), and a model with no rows has nothing to correct. An output interval
+(Integration.arrived), and a model with no rows has nothing to project. An output interval
 in which the integrator crawls near a singular position, or fails, is integrated again,
 cut (cut.py), from the last output: a failure is then reported in the interval it happens
-in, the rows before it kept. Where the kernel corrects the states and the run's singular
-watch or the correction measures how near the rows are to losing rank, a singular position
+in, the rows before it kept. Where the kernel projects the states and the run's singular
+watch or the projection measures how near the rows are to losing rank, a singular position
 seen coming is crossed by one planned step whose stages keep away from it and are put on
 the constraints first (crossing.py): no crawl.
 """
@@ -40,13 +40,13 @@ from ..core.tolerances import MAX_STATE, RELAXED_MAX
 
 class Passed(NamedTuple):
     """The states a step passed: at ``times`` (the output times and control samples it
-    passed, then its end) the integrator's ``states`` (rows of y), their corrections
-    (CorrectedRows, or None where the kernel corrects nothing) and whether each is within
+    passed, then its end) the integrator's ``states`` (rows of y), their projections
+    (ProjectedRows, or None where the kernel projects nothing) and whether each is within
     MAX_STATE (``bounded``)."""
 
     times: list
     states: np.ndarray
-    corrected: object
+    projected: object
     bounded: np.ndarray
 
     def index(self, t):
@@ -55,13 +55,13 @@ class Passed(NamedTuple):
         return i if i < len(self.times) and self.times[i] == t else None
 
     def at(self, t):
-        """(y, Corrected or None, bounded) at the time t (one the step passed)."""
+        """(y, Projected or None, bounded) at the time t (one the step passed)."""
         i = self.index(t)
-        return self.states[i], None if self.corrected is None else self.corrected.row(i), self.bounded[i]
+        return self.states[i], None if self.projected is None else self.projected.row(i), self.bounded[i]
 
 
 class ContinuousIntegration(CutIntegration):
-    """Integration by the error control alone, each step corrected (integration.py); an
+    """Integration by the error control alone, each step projected (integration.py); an
     interval it cannot do is done cut (CutIntegration.advance)."""
 
     @staticmethod
@@ -79,7 +79,7 @@ class ContinuousIntegration(CutIntegration):
 
     def advance(self, t_next, q, qd, t_stop):
         try:
-            y, corrected, bounded = self._reach(t_next, q, qd, t_stop)
+            y, projected, bounded = self._reach(t_next, q, qd, t_stop)
         except (Crawl, SolveError) as stop:
             if isinstance(stop, EventError):  # found where it happens: no cut interval avoids it
                 raise
@@ -87,16 +87,16 @@ class ContinuousIntegration(CutIntegration):
             q, qd = super().advance(t_next, q, qd, loosen=isinstance(stop, Crawl))
             self.solver = None  # the continuous integrator starts afresh from t_next
             return q, qd
-        if bounded and corrected is not None:  # the kernel's correction holds the state on the constraints
-            return self.arrived(t_next, corrected.q, corrected.qd, None, corrected)
+        if bounded and projected is not None:  # the kernel's projection holds the state on the constraints
+            return self.arrived(t_next, projected.q, projected.qd, None, projected)
         q, qd = self.form.to_state(y)
         if not bounded:
             self.f.check(t_next, q, qd)
-        q, qd = self._on_constraints(t_next, q, qd, corrected)
-        return self.arrived(t_next, q, qd, None, corrected)
+        q, qd = self._on_constraints(t_next, q, qd, projected)
+        return self.arrived(t_next, q, qd, None, projected)
 
     def _reach(self, t_next, q, qd, t_stop):
-        """The state at t_next, its correction and whether it is finite and within MAX_STATE:
+        """The state at t_next, its projection and whether it is finite and within MAX_STATE:
         the integrator's steps taken until one reaches or passes t_next. At the start, after a
         control sample or a cut interval it goes on from (q, q̇) at ``t_now`` towards t_stop
         (Integration.resumed)."""
@@ -112,35 +112,35 @@ class ContinuousIntegration(CutIntegration):
         return self.passed.at(t_next)
 
     def ready(self):
-        """(times, CorrectedRows) of the output rows after ``t_now`` that the last step passed
-        and corrected, up to the first one that needs more (a state not corrected or beyond
+        """(times, ProjectedRows) of the output rows after ``t_now`` that the last step passed
+        and projected, up to the first one that needs more (a state not projected or beyond
         MAX_STATE, the step's end, a control sample), taken as arrived; None where there are
         none: ``simulate`` records them at once."""
         passed = self.passed
         start = None if passed is None else passed.index(self.t_now)
-        if start is None or passed.corrected is None:
+        if start is None or passed.projected is None:
             return None
         start += 1
-        ok = passed.corrected.done[start:-1] & passed.bounded[start:-1]  # the step's end is not a row here
+        ok = passed.projected.done[start:-1] & passed.bounded[start:-1]  # the step's end is not a row here
         stop = start + (int(np.argmin(ok)) if not ok.all() else ok.size)
         if stop == start:
             return None
-        rows = passed.corrected
+        rows = passed.projected
         self.f.note_singular()
-        self.t_now, self.arrays, self.corrected = passed.times[stop - 1], None, rows.row(stop - 1)
+        self.t_now, self.arrays, self.projected = passed.times[stop - 1], None, rows.row(stop - 1)
         return passed.times[start:stop], rows.part(start, stop)
 
     def _step(self, solver, t_next):
-        """One accepted step, its state then corrected, and with it, in one block
-        (correction.Correction.block), the states at the times from t_next to where it
-        reached, read from its interpolant: ``passed`` keeps (state, Corrected or None,
+        """One accepted step, its state then projected, and with it, in one block
+        (projection.Projection.block), the states at the times from t_next to where it
+        reached, read from its interpolant: ``passed`` keeps (state, Projected or None,
         whether the state is within MAX_STATE) per time. The step is capped (``max_step``) to
-        keep the drift between corrections below DRIFT_TARGET: halved after a larger drift,
+        keep the drift between projections below DRIFT_TARGET: halved after a larger drift,
         doubled after one below a hundredth of it; a step that drifted more than
         DRIFT_REDO × DRIFT_TARGET is taken again at a quarter of its length. Near a singular
         position the step is aimed where ``crossing`` plans it, and the step across it
         evaluates its stages on the constraints (crossing.py). A step that reaches the bound
-        (a control sample or the end) leaves f at the corrected state to be computed when
+        (a control sample or the end) leaves f at the projected state to be computed when
         the integrator goes on (Integration.resumed)."""
         start = stepper.saved(solver)
         target, across = (None, False) if self.crossing is None else \
@@ -161,16 +161,16 @@ class ContinuousIntegration(CutIntegration):
         with self._stages_on_manifold(True):  # the interpolant's extra stages, as the step's
             stepper.interpolate(solver, [t_star], y)
         q, qd = self.form.to_state(y[0])
-        on = self.correction(q, qd)
-        rows = self.correction.least_rows(*((q, qd) if on is None else on[:2]), NAMED_SHARE)
+        on = self.projection(q, qd)
+        rows = self.projection.least_rows(*((q, qd) if on is None else on[:2]), NAMED_SHARE)
         names = self.data.system.constraint_names
         self.f.add_singular(t_star, tuple(names[r] for r in rows), solver.t - t_start)
 
     @contextlib.contextmanager
     def _stages_on_manifold(self, across):
         """Within: where ``across`` (a step across a singular position), each stage is put on
-        the constraints by the kernel's correction before its motion is evaluated."""
-        self.f.on_manifold = self.correction if across else None
+        the constraints by the kernel's projection before its motion is evaluated."""
+        self.f.on_manifold = self.projection if across else None
         try:
             yield
         finally:
@@ -207,11 +207,11 @@ class ContinuousIntegration(CutIntegration):
                 stepper.interpolate(solver, times, states[:-1])
         states[-1] = solver.y
         times.append(solver.t)
-        corrected = None if self.correction is None else \
-            self.correction.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
+        projected = None if self.projection is None else \
+            self.projection.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
         bounded = _bounded(states)
-        self.passed = Passed(times, states, corrected, bounded)
-        q_on, qd_on = self._on_constraints(solver.t, q, qd, None if corrected is None else corrected.row(-1), arrays)
+        self.passed = Passed(times, states, projected, bounded)
+        q_on, qd_on = self._on_constraints(solver.t, q, qd, None if projected is None else projected.row(-1), arrays)
         # A before the projection: it moved q by the drift alone
         self._look(solver.t, q_on, qd_on, None if arrays is None else arrays.A)
         if not (np.array_equal(q_on, q) and np.array_equal(qd_on, qd)):
@@ -225,15 +225,15 @@ class ContinuousIntegration(CutIntegration):
 
     def _watch_from(self, t, q, qd):
         """Watch for the singular positions passed between stages from the state (t, q, q̇)
-        on (singular_watch.py): on runs projected or corrected by extra_correction.py
+        on (singular_watch.py): on runs projected by analysis/projection.py or by compiled/extra_projection.py
         (``watched``) of models whose A is small enough. Plan the steps across them
-        (crossing.py) where the kernel corrects the states and the watch or the correction
-        (extra_correction.py's ``measure``) measures them."""
-        if self.watch is None and (self.correction is None or self.correction.watched) and \
+        (crossing.py) where the kernel projects the states and the watch or the projection
+        (extra_projection.py's ``measure``) measures them."""
+        if self.watch is None and (self.projection is None or self.projection.watched) and \
                 SingularWatch.fits(self.data):
             self.watch = SingularWatch(self.data, t, q, qd)
-        if self.crossing is None and self.correction is not None and \
-                (self.watch is not None or self.correction.measure is not None):
+        if self.crossing is None and self.projection is not None and \
+                (self.watch is not None or self.projection.measure is not None):
             self.crossing = Crossing(self.method)
         for watching in (self.watch, self.crossing):
             if watching is not None:
@@ -252,25 +252,25 @@ class ContinuousIntegration(CutIntegration):
             if self.watch is not None:
                 m = self.watch.measure
             else:
-                m = self.correction.measure(q, qd)
+                m = self.projection.measure(q, qd)
             self.crossing.passed(t, m)
 
     def _drift(self, t, q, qd):
         """(the state's relative drift off the constraints, its ConstraintArrays or None):
-        the kernel's rows where it corrects the model, else projection.py's."""
-        if self.correction is not None:
-            return self.correction.drift(q, qd), None
+        the kernel's rows where it projects the model, else projection.py's."""
+        if self.projection is not None:
+            return self.projection.drift(q, qd), None
         if not self.has_rows:
             return 0.0, None
         arrays = self.data.constraint_arrays(t, q, qd, sparse=None)
         return relative_drift(self.data, t, q, qd, arrays), arrays
 
-    def _on_constraints(self, t, q, qd, corrected, arrays=None):
-        """The state (q, q̇) on the constraints: ``corrected``'s where the kernel's correction
-        put it there (correction.Corrected), else projected (projection.py; ``arrays``: the
-        ConstraintArrays at the state, if at hand), as it is in a model with no rows."""
-        if corrected is not None:
-            return corrected[:2]
+    def _on_constraints(self, t, q, qd, projected, arrays=None):
+        """The state (q, q̇) on the constraints: ``projected``'s where the kernel's projection
+        put it there (compiled/projection.py: Projected), else projected by analysis/projection.py
+        (``arrays``: the ConstraintArrays at the state, if at hand), as it is in a model with no rows."""
+        if projected is not None:
+            return projected[:2]
         return project(self.data, t, q, qd, arrays=arrays) if self.has_rows else (q, qd)
 
 

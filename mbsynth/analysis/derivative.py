@@ -115,8 +115,8 @@ class StateDerivative:
         """The stage y put on the constraints by ``on_manifold`` (as it is where that declines)."""
         if not np.abs(y).max(initial=0.0) <= MAX_STATE:
             return y
-        corrected = self.on_manifold(*self.form.to_state(y))
-        return y if corrected is None else self.form.to_integrator(corrected.q, corrected.qd)
+        projected = self.on_manifold(*self.form.to_state(y))
+        return y if projected is None else self.form.to_integrator(projected.q, projected.qd)
 
     def add_singular(self, t, rows, within):
         """A singular position passed at t (``rows``: its nearly dependent rows) found between

@@ -38,7 +38,7 @@ class Diagnosis:
     suggested_constraints: list
     balances: list
     state_dependent: bool
-    closures: list
+    appended_balances: list
     constraint_residuals: dict
     qdd: dict = field(default_factory=dict)
     error: str = None
@@ -65,7 +65,7 @@ class Diagnosis:
 
 
 def diagnose(data, t=0.0, q=None, qd=None):
-    """Result 3 and the closure balances of the model of ``data`` (a Data, or a model: its
+    """Result 3 and the balances of the model of ``data`` (a Data, or a model: its
     default-path Data) at (t, q, q̇), by default its initial state."""
     data = workspace(data)
     system = data.model
@@ -90,8 +90,8 @@ def diagnose(data, t=0.0, q=None, qd=None):
         suggested_constraints=[b.equation for b in found if not b.free],
         balances=[_balance(system, b, arrays.Q + arrays.C, q) for b in found],
         state_dependent=any(b.state_dependent for b in found),
-        closures=[{"constraint": c.constraint, "equation": c.equation, "direction": c.direction,
-                   "state_dependent": c.state_dependent} for c in system.closures],
+        appended_balances=[{"constraint": c.constraint, "equation": c.equation, "direction": c.direction,
+                   "state_dependent": c.state_dependent} for c in system.appended_balances],
         constraint_residuals=residuals, qdd=qdd, error=error, condition=_finite(report.condition),
         rank_tolerance=report.rtol, verdict_margin=_finite(report.verdict_margin), warnings=_warnings(report),
         joints=_joints(data, t, q, qd, motion), free_joints=_moved_joints(data, t, q, report.nullspace),
@@ -104,9 +104,9 @@ def _gaps(data, t, q, qd):
     system = data.model
     found = {}
     for u in system.unilaterals:
-        (g,), (rate,) = u.row.residuals(t, q, qd, data.p)
+        (g,), (rate,) = u.row.residuals(t, q, qd, data.parameter_values)
         found[u.name] = {"kind": u.kind, "gap": float(g), "rate": float(rate),
-                         "restitution": u.restitution_at(system, data.p)}
+                         "restitution": u.restitution_at(system, data.parameter_values)}
     return found
 
 

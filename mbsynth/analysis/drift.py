@@ -1,5 +1,5 @@
 """The run loop's drift control: how long a span of integration may be before the state is
-put back on the constraints (after each step of a continuous run, corrected by the kernel or
+put back on the constraints (after each step of a continuous run, projected by the kernel or
 projected; between the output times of a cut one, projected).
 
 The accelerations (2.14) satisfy the constraints at the acceleration level only, so positions

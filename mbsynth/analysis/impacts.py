@@ -69,7 +69,7 @@ class EventIntegration(ContinuousIntegration):
         super().__init__(*args)
         self.base = self.data  # the run's Data: the model without held gaps
         system = self.base.system
-        self.gaps = Gaps(system, self.base.p)
+        self.gaps = Gaps(system, self.base.parameter_values)
         self.phases = {frozenset(): self.base}  # active set -> its Data
         self.pending = None
         self.events = []  # trajectory.Event (simulate hands the recorder's list)
@@ -83,7 +83,7 @@ class EventIntegration(ContinuousIntegration):
         if data is None:
             names = {self.gaps.names[i] for i in active}
             data = self.phases[active] = with_active(self.base.system, names).data(self.base.path)
-        if not np.array_equal(data.p, self.base.p):
+        if not np.array_equal(data.parameter_values, self.base.parameter_values):
             defined = self.base.system.definitions or {}
             data.set_parameters({k: v for k, v in self.base.parameters.items() if k not in defined})
         return data
@@ -92,7 +92,7 @@ class EventIntegration(ContinuousIntegration):
         if self.active:  # new parameter values at a control sample: the phase's Data follows the run's
             self.data = self.f.data = self._phase(self.active)
         if self.started:  # and the restitutions
-            self.gaps = Gaps(self.base.system, self.base.p)
+            self.gaps = Gaps(self.base.system, self.base.parameter_values)
         super().restart()
 
     def _switch(self, active):
@@ -104,8 +104,8 @@ class EventIntegration(ContinuousIntegration):
         self.data = self.f.data = self._phase(active)
         engine = self.data.engine
         self.f.use(engine)
-        self.correction = None if engine is None else engine.correction()
-        self.compiled_energy = self.correction is not None and self.correction.energies and self.potential_free
+        self.projection = None if engine is None else engine.projection()
+        self.compiled_energy = self.projection is not None and self.projection.energies and self.potential_free
         self.has_rows = len(self.data.system.constraint_names) > 0
         self.watch = self.crossing = None
 
@@ -119,7 +119,7 @@ class EventIntegration(ContinuousIntegration):
         q, qd = super().advance(t_next, q, qd, t_stop)
         if self.solver is not None:  # integrated continuously, its events found
             return q, qd
-        g = self.gaps.values(t_next, q, qd, self.base.p)[0]
+        g = self.gaps.values(t_next, q, qd, self.base.parameter_values)[0]
         passed = [self.gaps.names[i] for i in self._open() if g[i] < -self.atol]
         if passed:  # an interval integrated cut (cut.py, near a singular position) sees no events
             self.f.t_failed = t_next
@@ -131,7 +131,7 @@ class EventIntegration(ContinuousIntegration):
         """ModelError where the state the run starts from penetrates a gap by more than
         ASSEMBLED_TOL (io/unilateral.py's check of a model file's initial state, for a state
         given otherwise: ``q0``, other parameter values)."""
-        g = self.gaps.values(t, q, qd, self.base.p)[0]
+        g = self.gaps.values(t, q, qd, self.base.parameter_values)[0]
         deep = [(name, -x) for name, x in zip(self.gaps.names, g) if x < -ASSEMBLED_TOL]
         if deep:
             raise ModelError(f"model '{self.base.system.name}': the state at t = {t:g} penetrates "
@@ -178,7 +178,7 @@ class EventIntegration(ContinuousIntegration):
         aiming = self.pending is not None and target == self.pending.t
         ignore = (self.pending.closing | self.pending.released) if aiming else frozenset()
         q1, qd1 = self.form.to_state(solver.y)
-        p = self.base.p
+        p = self.base.parameter_values
         g1 = self.gaps.values(t1, q1, qd1, p)[0]
         limit = -self.atol if aiming else 0.0
         closing = [i for i in self._open() if i not in ignore and g1[i] < limit]
@@ -212,11 +212,11 @@ class EventIntegration(ContinuousIntegration):
 
     def _gap_at(self, dense, i, t):
         q, qd = self.form.to_state(dense(t))
-        return self.gaps.values(t, q, qd, self.base.p)[0][i]
+        return self.gaps.values(t, q, qd, self.base.parameter_values)[0][i]
 
     def _rounding(self, t, q, qd):
         """Per gap, the rate within which it is rounding (SPEED_ROUNDING × ‖a‖₁ max |q̇|)."""
-        return SPEED_ROUNDING * np.abs(self.gaps.rows(t, q, qd, self.base.p)[0]).sum(axis=1) * \
+        return SPEED_ROUNDING * np.abs(self.gaps.rows(t, q, qd, self.base.parameter_values)[0]).sum(axis=1) * \
             np.abs(qd).max(initial=0.0)
 
     def _closing(self, dense, i, t0, t1, g0, gd0, g1, floor):
@@ -252,7 +252,7 @@ class EventIntegration(ContinuousIntegration):
         its row times the larger of q̈ and the forces over the largest mass (a state at rest has
         q̈ = 0 to rounding), a multiplier against the largest |Q + C| and |λ|."""
         arrays = self.base.evaluate(t, q, qd)
-        A_gaps, b_gaps = self.gaps.rows(t, q, qd, self.base.p)
+        A_gaps, b_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)
         rows = list(rows)
         A = np.vstack([arrays.A, A_gaps[rows]])
         b = np.concatenate([arrays.b, b_gaps[rows]])
@@ -278,7 +278,7 @@ class EventIntegration(ContinuousIntegration):
         """(q, q̇⁺, whether anything changed) at an event at t: the impacts, then the
         persistent contacts (module docstring); ``released``: held gaps whose force fell
         to zero here (they open). Records the events."""
-        p, changed = self.base.p, False
+        p, changed = self.base.parameter_values, False
         for _ in range(ROUNDS):
             g, gd = self.gaps.values(t, q, qd, p)
             gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
@@ -327,7 +327,7 @@ class EventIntegration(ContinuousIntegration):
         if len(rows) > ENUMERATED:
             raise self._fail(t, rows, f"{len(rows)} gaps strike at once (at most {ENUMERATED} are solved exactly)")
         A_b, v_b, names_b = self._bilateral(t, q, qd)
-        A_gaps = self.gaps.rows(t, q, qd, self.base.p)[0]
+        A_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)[0]
         M = self.base.evaluate(t, q, qd).M
         coordinates = self.base.system.coordinates
         failed = None
@@ -372,7 +372,7 @@ class EventIntegration(ContinuousIntegration):
         """q̇⁺ with the newly held gaps of ``active`` brought to rest (an e = 0 jump, every
         held row at zero rate), their events recorded."""
         A_b, v_b, names_b = self._bilateral(t, q, qd)
-        A_gaps = self.gaps.rows(t, q, qd, self.base.p)[0]
+        A_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)[0]
         rows = sorted(active)
         jump = self._jump(t, rows, self.base.evaluate(t, q, qd).M, qd, np.vstack([A_b, A_gaps[rows]]),
                           np.concatenate([v_b, np.zeros(len(rows))]), coordinates=self.base.system.coordinates,

@@ -3,14 +3,14 @@
 An Integration takes a run's state from the time it reached (``t_now``) to the next output
 time or control sample (``advance``), stepping one of scipy's OdeSolvers (stepper.py) on the
 right-hand side of derivative.py. With ``stabilization="projection"`` the state it hands
-back lies on the constraints (projected, projection.py, or corrected by the compiled kernel,
-compiled/correction.py) and has been judged strictly there: a real contradiction raises
+back lies on the constraints (projected by analysis/projection.py, or by the compiled kernel,
+compiled/projection.py) and has been judged strictly there: a real contradiction raises
 SolveError. ``restart`` follows a jump of the forces (new parameter values in the Data, at a
 control sample): the integrator's f is computed afresh there.
 
 - ContinuousIntegration (continuous.py): with an explicit pair and projection, the steps
   are chosen by the error control alone, up to the next control sample or the end, each
-  corrected (by the kernel where it covers the model, else projected).
+  projected (by the kernel where it covers the model, else by analysis/projection.py).
 - CutIntegration (cut.py): otherwise, and for an interval the continuous integrator cannot
   do, each interval integrated on its own, the last step cut short at its end, the state
   projected there and between as the drift asks.
@@ -46,7 +46,7 @@ class Integration:
         self.next_step = None  # the step it proposed after its last step not cut short at an interval's end
         self.t_now = None  # the time the state has reached (outputs and control samples alike)
         self.arrays = None  # the ConstraintArrays at the state ``advance`` reached, if at hand
-        self.corrected = None  # the kernel's correction.Corrected there, if at hand
+        self.projected = None  # the kernel's projection.Projected there, if at hand
         self.relaxed_spans = []  # {t_from, t_to, rtol, atol} of the spans integrated again, more loosely
         self.potential_free = all(f.V == 0 for f in data.model.forces)  # no force element with a potential
         self.restart()
@@ -59,12 +59,12 @@ class Integration:
     def restart(self):
         """Go on from the Data's parameter values (new at a control sample: the forces
         jump, so the integrator's f is computed afresh): its stages' motion and its compiled
-        correction, where the kernel covers the model."""
+        projection, where the kernel covers the model."""
         self.forces_jumped = True
         engine = self.data.engine
         self.f.use(engine)
-        self.correction = None if engine is None else engine.correction()
-        self.compiled_energy = self.correction is not None and self.correction.energies and self.potential_free
+        self.projection = None if engine is None else engine.projection()
+        self.compiled_energy = self.projection is not None and self.projection.energies and self.potential_free
 
     def advance(self, t_next, q, qd, t_stop):
         """The state (q, q̇) at t_next from (q, q̇) at ``t_now``; t_stop: the next control
@@ -90,19 +90,19 @@ class Integration:
         self.forces_jumped = False
         return solver
 
-    def arrived(self, t_next, q, qd, arrays=None, corrected=None):
+    def arrived(self, t_next, q, qd, arrays=None, projected=None):
         """The state reached at t_next (``arrays``: its ConstraintArrays, if at hand), judged
-        strictly there with projection, unless the kernel ``corrected`` it (its checks passed
-        there already; correction.Corrected, with the rows there)."""
+        strictly there with projection, unless the kernel ``projected`` it (its checks passed
+        there already; projection.Projected, with the rows there)."""
         self.f.note_singular()
-        if self.stabilization == "projection" and corrected is None:
+        if self.stabilization == "projection" and projected is None:
             self.f.t_failed = t_next
             self.data.motion(t_next, q, qd)  # on the manifold: a contradiction raises here
-        self.t_now, self.arrays, self.corrected = t_next, arrays, corrected
+        self.t_now, self.arrays, self.projected = t_next, arrays, projected
         return q, qd
 
     def ready(self):
-        """(times, CorrectedRows) of output rows after ``t_now`` reached already and corrected,
+        """(times, ProjectedRows) of output rows after ``t_now`` reached already and projected,
         taken as arrived, for ``simulate`` to record at once; None: none (continuous.py's
         integrator has them)."""
         return None

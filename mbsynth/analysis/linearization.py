@@ -5,7 +5,7 @@ The motion q̈ = f(q, q̇, t) of (2.14) lives on the manifold of the position-le
 independent coordinates of that manifold's tangent space, so redundant coordinates (a
 rigid body's four quaternion numbers: each body's ``<body>.unit_quaternion`` is a row),
 dependent loop coordinates and massless coordinates fixed by a holonomic balance
-(``closure: auto``, model/balances.py, or a model's own, as models/paper/example3_m1_zero.yaml's
+(``balances: auto``, model/balances.py, or a model's own, as models/paper/example3_m1_zero.yaml's
 ``node_balance``) all drop out by themselves:
 
 - positions: the k independent coordinates u are k of the model's coordinates, picked by
@@ -39,7 +39,7 @@ accuracy next to the zeros.
 
 Massless parts. The independent state is that of the masses: a massless coordinate is
 fixed, at every instant, by its balance wᵀ(Q + C) = 0 (model/balances.py). Written as a
-holonomic row (``closure: auto`` appends it so when it involves no velocities), the
+holonomic row (``balances: auto`` appends it so when it involves no velocities), the
 balance is one of the rows of Φ_q and removes the massless coordinate from the tangent
 space: in example 3 with m1 = 0 the node x1 follows from (5.40) and (5.32), and the state
 is (q2, q̇2), one mode. A balance with velocities (a damper at a massless node) is a
@@ -227,7 +227,7 @@ def linearize(model, t, q, qd, inputs=None, speeds=None):
         moving = _named(system.coordinates, np.abs(motion.nullspace).max(axis=1))
         raise SolveError(f"model '{system.name}': the motion is not unique at this state "
                          f"({motion.nullspace.shape[1]} indeterminate direction(s) in {moving}): "
-                         "no linearization (add the massless parts' balances: closure: auto)",
+                         "no linearization (add the massless parts' force balances with balances: auto)",
                          coordinates=moving)
     derivatives = derivatives_of(system)
     arrays = data.evaluate(t, q, qd)
@@ -315,13 +315,13 @@ def finite_state(system, q, qd):
 def time_rows(system):
     """The names of the rows whose constraint holds t explicitly (a servo's θ(t)): their
     manifold moves with time."""
-    return _time_rows(system.connectors)
+    return _time_rows(system.constraints)
 
 
 @MEMO.function(_CACHE_SIZE)
-def _time_rows(connectors):
+def _time_rows(constraints):
     found = []
-    for con in connectors:
+    for con in constraints:
         own = con.phi if con.phi is not None else con.psi if con.psi is not None else con.b
         found += [name for name, x in zip(con.row_names, own) if x.has(T_SYMBOL)]
     return tuple(found)
@@ -343,7 +343,7 @@ def prescribed_motion(model, t, q, qd):
 def _refuse_unsupported(data, t, q, qd):
     """SolveError for what the linearization does not cover (module docstring)."""
     system = data.model
-    friction = [c.name for c in system.connectors if getattr(c, "coulomb", None)]
+    friction = [c.name for c in system.constraints if getattr(c, "coulomb", None)]
     if friction:
         raise SolveError(f"model '{system.name}': Coulomb friction at {friction} is not differentiable; "
                          "no linearization", constraints=friction)
@@ -353,7 +353,7 @@ def _refuse_unsupported(data, t, q, qd):
         raise SolveError(f"model '{system.name}': rows {acceleration_only} restrict accelerations only (a balance "
                          "with velocities, a servo's acceleration row): they are first-order equations of their own, "
                          "outside the state (q, speeds) the linearization takes (write a massless part's balance as "
-                         "a holonomic row, or use closure: auto)", constraints=acceleration_only)
+                         "a holonomic row, or use balances: auto)", constraints=acceleration_only)
     moving = prescribed_motion(data, t, q, qd)
     if moving:
         why = "q̇ ≠ 0" if np.any(qd) else f"∂φ/∂t ≠ 0 at t = {t:g}"
@@ -493,9 +493,9 @@ class BlockFunction:
 class Derivatives:
     """The exact Jacobians the linearization needs, block by block as ``System.evaluate``
     assembles M, Q, A, b, C: each part's M q̈ − Q, each force element's −Q, each
-    connector's −C, Aᵀλ, A q̈ − b and ψ, over its own coordinates (``BlockFunction``).
-    Compiled once per model structure; the parameter values are arguments (a Data's ``p``
-    at each call), so the models and Data of one structure share them."""
+    constraint's −C, Aᵀλ, A q̈ − b and ψ, over its own coordinates (``BlockFunction``).
+    Compiled once per model structure; the parameter values are arguments (a Data's
+    ``parameter_values`` at each call), so the models and Data of one structure share them."""
 
     def __init__(self, system):
         p = list(system.parameter_symbols)
@@ -513,7 +513,7 @@ class Derivatives:
             indices = [int(i) for i in element.indices]
             self._add_force(indices, None, -element.symbolic().extract(indices, [0]), system, p)
         row = 0
-        for con in system.connectors:
+        for con in system.constraints:
             indices, k = [int(i) for i in con.indices], con.size
             q, qd = [system.q_symbols[i] for i in indices], [system.qd_symbols[i] for i in indices]
             qdd, lam = _dummies("qdd", len(indices)), _dummies("lam", k)
@@ -540,7 +540,7 @@ class Derivatives:
         position, velocity = ~np.isnan(phi), np.isnan(phi) & ~np.isnan(psi)
         A = data.evaluate(t, q, qd).A
         Psi_q = np.zeros((len(phi), data.model.n))
-        p = data.p
+        p = data.parameter_values
         for i, rows, f in self._rows:
             k = rows.stop - rows.start
             Psi_q[rows, i] = f.jacobians(t, q[i], qd[i], np.zeros(len(i)), np.zeros(k), p)[0][len(i) + k:]
@@ -551,7 +551,7 @@ class Derivatives:
         by q and q̇, and of Q + C by the ``inputs`` (which must not enter A or b), at the
         parameter values of ``data``."""
         system = data.model
-        n, m, p = system.n, len(system.constraint_names), data.p
+        n, m, p = system.n, len(system.constraint_names), data.parameter_values
         lam = np.zeros(m) if lam is None else np.asarray(lam, dtype=float)
         columns = [self.parameters.index(u) for u in inputs]
         R_q, R_qd, F_u = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, len(columns)))
@@ -579,7 +579,7 @@ class Derivatives:
         lam = np.zeros(len(position_rows))
         lam[position_rows] = w
         n = data.model.n
-        H, p = np.zeros((n, n)), data.p
+        H, p = np.zeros((n, n)), data.parameter_values
         for i, rows, f in self._rows:
             if np.any(lam[rows]):
                 H[np.ix_(i, i)] += f.jacobians(t, q[i], qd[i], np.zeros(len(i)), lam[rows], p)[0][:len(i)]

@@ -2,7 +2,7 @@
 
 (2.14) enforces the constraints only at the acceleration level (2.4): an integrated
 state drifts off φ(q, t) = 0 and φ̇ = 0. These functions move it back with the least
-change (each coordinate weighed by how strongly it moves the constraints, ``_correction``):
+change (each coordinate weighed by how strongly it moves the constraints, ``_least_change``):
 positions by Gauss–Newton on the position-level rows, q ← q − Φ_q⁺ φ
 (Φ_q = the rows of A of the holonomic constraints), then velocities on every
 velocity-level row (holonomic and non-holonomic, both linear in q̇),
@@ -39,7 +39,7 @@ def _free_columns(n, fixed):
 
 
 
-def _correction(J, r, groups, floor=0.0):
+def _least_change(J, r, groups, floor=0.0):
     """The smallest Δ with J Δ = r in the metric that weighs each coordinate by how strongly
     it moves the constraints, ‖diag(c) Δ‖ with c_j = ‖J_:j‖ (column equilibration): a
     quaternion's unit then costs as much as the lever arms it turns, so a body 1 km long is
@@ -57,9 +57,9 @@ def _correction(J, r, groups, floor=0.0):
     if J.shape[0] == 0 or J.shape[1] == 0:  # no rows, or every coordinate fixed
         return np.zeros(J.shape[1])
     if not scipy.sparse.issparse(J):
-        return _dense_correction(J, r, groups, floor)
+        return _dense_least_change(J, r, groups, floor)
     if J.shape[0] * J.shape[1] <= DENSE_ENTRIES:
-        return _dense_correction(J.toarray(), r, groups, floor)
+        return _dense_least_change(J.toarray(), r, groups, floor)
     columns = _grouped(np.asarray(J.multiply(J).sum(axis=0)).ravel(), groups)
     magnitude = abs(J).tocsr()
     widest = np.asarray(magnitude.max(axis=1).todense()).ravel()  # each row's largest entry
@@ -79,8 +79,8 @@ def _correction(J, r, groups, floor=0.0):
     return D @ np.linalg.lstsq(G.toarray(), r, rcond=PROJECTION_RCOND)[0]
 
 
-def _dense_correction(J, r, groups, floor=0.0):
-    """``_correction`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
+def _dense_least_change(J, r, groups, floor=0.0):
+    """``_least_change`` of a small or dense J, with numpy's dense solve of G Gᵀ (no sparse overhead)."""
     columns = _grouped(np.einsum("ij,ij->j", J, J), groups)
     least = 0.0
     if floor:
@@ -132,7 +132,7 @@ def project_positions(data, t, q, fixed=None, tolerance=PROJECTION_RTOL, arrays=
     """q on φ(q, t) = 0, changing only the coordinates not in ``fixed`` (indices);
     ``arrays``: the ConstraintArrays at q (any q̇), if at hand.
 
-    Gauss–Newton in the equilibrated metric of ``_correction``; where its residual grows,
+    Gauss–Newton in the equilibrated metric of ``_least_change``; where its residual grows,
     again from q with every column scale at least COLUMN_FLOOR × the largest entry of the
     rows it meets. A column nearly zero only at this point (a quaternion component near 0:
     ∂(|u|² − 1)/∂u_z = 2u_z) counts in that metric as nearly free to move: the step moves
@@ -169,7 +169,7 @@ def _newton(data, t, q, free, tolerance, floor, last=False, arrays=None):
         elif size > PROJECTION_DIVERGED * best[0]:  # the last pass gives up once it runs away from its best
             break
         previous = size
-        q[free] -= _correction(arrays.A[rows][:, free], phi[rows], data.model.coordinate_groups[free], floor)
+        q[free] -= _least_change(arrays.A[rows][:, free], phi[rows], data.model.coordinate_groups[free], floor)
         arrays = None
         if not np.all(np.isfinite(q)):
             break
@@ -191,7 +191,7 @@ def project_velocities(data, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, ar
     if not (np.abs(psi[rows]) > tolerance * term_scales(arrays.A, qd)[rows]).any():
         return qd
     A = arrays.A[rows]
-    qd[free] -= _correction(A[:, free], psi[rows], data.model.coordinate_groups[free])  # ψ is affine in q̇, slope A
+    qd[free] -= _least_change(A[:, free], psi[rows], data.model.coordinate_groups[free])  # ψ is affine in q̇, slope A
     _, psi = data.constraint_residuals(t, q, qd)
     unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
     if unmet.any():

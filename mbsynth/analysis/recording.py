@@ -45,28 +45,28 @@ class Recorder:
         """The times recorded so far."""
         return self.columns["t"][:self.count]
 
-    def record(self, t, q, qd, correction=None, compiled_energy=False, arrays=None, corrected=None):
+    def record(self, t, q, qd, projection=None, compiled_energy=False, arrays=None, projected=None):
         """A row at (t, q, q̇). Its residuals and energies are the compiled ones where the
-        kernel covers the model: ``corrected`` (correction.Corrected: the state's row came
-        from a correction, which measured them) or else ``correction``'s rows
+        kernel covers the model: ``projected`` (projection.Projected: the state's row came
+        from a projection, which measured them) or else ``projection``'s rows
         (compiled/rows.py), the energies only when ``compiled_energy``; otherwise they are
         evaluated here, from ``arrays`` (the ConstraintArrays at the state) where at hand."""
         data = self.data
-        if corrected is None:
-            if correction is not None:
-                phi, psi, kinetic, potential = correction.residuals_energy(q, qd)
+        if projected is None:
+            if projection is not None:
+                phi, psi, kinetic, potential = projection.residuals_energy(q, qd)
             else:
                 phi, psi = data.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
             residuals = _max_abs(phi), _max_abs(psi)
         else:
-            kinetic, potential, *residuals = corrected[2:]
+            kinetic, potential, *residuals = projected[2:]
         if not compiled_energy:
             kinetic, potential = data.energy(t, q, qd)
         self._store([t], q[None, :], qd[None, :], kinetic, potential, *residuals)
 
     def record_rows(self, times, rows, compiled_energy):
-        """A row at each of ``times`` from their corrected states ``rows``
-        (correction.CorrectedRows, with their residuals and, where ``compiled_energy``,
+        """A row at each of ``times`` from their projected states ``rows``
+        (projection.ProjectedRows, with their residuals and, where ``compiled_energy``,
         energies; else the energies are evaluated here), as ``record`` would one by one."""
         kinetic, potential, residual_position, residual_velocity = rows.found[:, :4].T
         if not compiled_energy:

@@ -3,7 +3,7 @@
 The accelerations satisfy the constraints only at the acceleration level (2.4), so
 positions and velocities drift. ``simulate`` is the run loop, in stages: integration
 (integration.py: one interface, the continuous strategy of continuous.py where the compiled
-kernel corrects states itself, else the cut one of cut.py; the right-hand side and its
+kernel projects states itself, else the cut one of cut.py; the right-hand side and its
 counts in derivative.py, scipy's integrators driven by stepper.py, the drift rule in
 drift.py), sampled control (control.py) and recording (recording.py). It steps from output
 time to output time and control sample; at a sample the controller writes new parameter
@@ -108,7 +108,7 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
         if control is not None:
             control.apply(data, t0, q, qd)
             run.restart()
-        recorder.record(t0, q, qd, run.correction, run.compiled_energy)
+        recorder.record(t0, q, qd, run.projection, run.compiled_energy)
         run.t_now = t0
         for t_next, is_output, is_sample in schedule:
             q, qd = run.advance(t_next, q, qd, schedule.next_stop(t_next))
@@ -117,12 +117,12 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
                     control.apply(data, t_next, q, qd)
                 except ControlError:
                     if is_output:  # the state reached is good: its row, with the values held until now
-                        recorder.record(t_next, q, qd, run.correction, run.compiled_energy, run.arrays, run.corrected)
+                        recorder.record(t_next, q, qd, run.projection, run.compiled_energy, run.arrays, run.projected)
                     raise
                 run.restart()
             if is_output:
-                at_hand = () if is_sample else (run.arrays, run.corrected)  # a sample's parameters are new
-                recorder.record(t_next, q, qd, run.correction, run.compiled_energy, *at_hand)
+                at_hand = () if is_sample else (run.arrays, run.projected)  # a sample's parameters are new
+                recorder.record(t_next, q, qd, run.projection, run.compiled_energy, *at_hand)
                 if progress is not None:
                     progress(t_next)
                 q, qd = _record_ready(run, recorder, schedule, progress, q, qd)
@@ -171,19 +171,19 @@ def _strategy(system, method, stabilization):
 
 
 def _record_ready(run, recorder, schedule, progress, q, qd):
-    """The rows the integrator has passed and corrected already (ContinuousIntegration.ready),
+    """The rows the integrator has passed and projected already (ContinuousIntegration.ready),
     recorded at once and skipped in the ``schedule``; returns the last state recorded
     (q, q̇ as they were where there are none)."""
     rows = run.ready()
     if rows is None:
         return q, qd
-    times, corrected = rows
-    recorder.record_rows(times, corrected, run.compiled_energy)
+    times, projected = rows
+    recorder.record_rows(times, projected, run.compiled_energy)
     schedule.skip_through(times[-1])
     if progress is not None:
         for t in times:
             progress(t)
-    return corrected.q[-1], corrected.qd[-1]
+    return projected.q[-1], projected.qd[-1]
 
 
 def _trajectory(recorder, run, status):

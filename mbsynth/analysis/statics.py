@@ -34,7 +34,7 @@ Two contracts:
   (Levenberg–Marquardt). From a start near an equilibrium, that one (the inverted pendulum
   near the top); from far away, whichever equilibrium the iteration reaches, or a verdict.
 
-Massless parts balance through their rows (a ``closure: auto`` balance is one of them), so
+Massless parts balance through their rows (a ``balances: auto`` balance is one of them), so
 their equilibrium comes with the rest.
 
 Verdicts (``NoEquilibrium``): no rest after ``max_iterations`` steps (a model that keeps

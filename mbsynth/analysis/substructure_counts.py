@@ -3,7 +3,7 @@ the constraints wholly inside it and its degrees of freedom at a state.
 
 A substructure's coordinates are those of its parts and of the substructures it includes.
 A constraint is wholly inside it when every coordinate the constraint involves
-(``Connector.indices``) is one of them; the ground is inside every substructure, so a joint
+(``Constraint.indices``) is one of them; the ground is inside every substructure, so a joint
 to ``world`` inside a file is that file's own. Its degrees of freedom are its coordinates
 minus the rank of those rows (``equations.rank_report`` on its own blocks of M and A:
 the rank rule and tolerance of the whole model's Result 3).
@@ -38,9 +38,9 @@ def substructure_counts(system, M, A):
 
     top = [walk(substructure, ()) for substructure in system.substructures]
     row = 0
-    for connector in system.connectors:
-        k = len(connector.row_names)
-        for index in _common(chain[i] for i in connector.indices):
+    for constraint in system.constraints:
+        k = len(constraint.row_names)
+        for index in _common(chain[i] for i in constraint.indices):
             nodes[index]["rows"] += range(row, row + k)
         row += k
     M, A = np.asarray(M, dtype=float), np.asarray(A, dtype=float)

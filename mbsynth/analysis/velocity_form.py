@@ -8,11 +8,11 @@ rate, directly, not the four u̇ whose second derivative ü carries the unit-nor
 tennis-racket flip). h is ω scaled to the size of u̇ (|u̇| = |ω|/2 for a unit u), so the
 tolerances weigh a body's rates as they weighed u̇, and an integrator takes about as many
 steps. Everything outside the integrator — the
-correction and projection onto the constraints, the recorded rows, the drift checks,
+projection onto the constraints, the recorded rows, the drift checks,
 Baumgarte, control — keeps (q, q̇); the stages convert here:
 
 - ``to_state`` (y → (q, q̇)): u̇ = E(u)ᵀ h (= ½ u ⊗ (0, ω)), which keeps uᵀu̇ = 0 exactly,
-  so the integrated |u| stays constant up to the integration error (the correction or
+  so the integrated |u| stays constant up to the integration error (the projection or
   projection restores |u| = 1);
 - ``to_integrator`` ((q, q̇) → y): h = E(u) u̇ / |u|², half the body angular velocity of the
   unit quaternion u/|u| (ω = 2 E(u) u̇ for a unit u); E(u) E(u)ᵀ = |u|² I makes the round

@@ -17,7 +17,7 @@ what it left of each (outputs.py).
                  one module per command: ``run(args)`` and its report (``OUTPUTS``: its
                  output flags)
     compile_ahead.py
-                 ``python -m mbsynth.cli.compile_ahead``: the fast path's kernels compiled
+                 ``python -m mbsynth.cli.compile_ahead``: the compiled path's kernels compiled
                  ahead, on warm-up models (``make install``)
 
 ``main`` imports only the module of the command it runs, so ``mbsynth check`` loads no

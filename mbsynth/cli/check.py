@@ -12,7 +12,7 @@ from ..core.tolerances import CHECK_RESIDUAL_TOL
 
 def run(args):
     # a handful of evaluations at one state: the KKT path, no kernels to compile (a path the
-    # user set with MBSYNTH_FAST is kept)
+    # user set with MBSYNTH_COMPILED is kept)
     with default_path_as("kkt"):
         system = model_of(args)
         report = diagnose(system)
@@ -33,8 +33,8 @@ def format_check(report, path, coordinates="joints"):
              f"  rank M = {report.rank_M}, rank A = {report.rank_A}, "
              f"rank [M; A] = {report.rank_Mhat} of {report.n}"]
     lines += _format_substructures(report, path)
-    for closure in report.closures:
-        lines.append(f"  closure: auto appended {closure['constraint']}: {closure['equation']}")
+    for balance in report.appended_balances:
+        lines.append(f"  balances: auto appended {balance['constraint']}: {balance['equation']}")
     if report.unique:
         lines.append("  motion: unique (Result 3)")
     else:
@@ -82,9 +82,9 @@ def format_check(report, path, coordinates="joints"):
 
 def _format_balance(balance):
     """The lines of a balance that is needed: what it is physically where that is known,
-    and the equation, its numbers rounded (closure.readable)."""
+    and the equation, its numbers rounded (balances.readable)."""
     effort = balance["effort"]
-    advice = "(add it as a constraint, or set 'closure: auto')"
+    advice = "(add it as a constraint, or set 'balances: auto')"
     if effort is None:
         return [f"      balance needed: {balance['readable']}  {advice}"]
     value = "0 at this state, not at every state" if effort["value"] == 0 else f"{effort['value']:.6g} ≠ 0"

@@ -1,10 +1,10 @@
-"""``python -m mbsynth.cli.compile_ahead`` (run by ``make install``): compile the fast path's
+"""``python -m mbsynth.cli.compile_ahead`` (run by ``make install``): compile the compiled path's
 kernels (mbsynth.compiled) into the cache ahead of use, on warm-up models read as model files
 (hence here, on the floor that may read them).
 
 On two cores: first the kernel's largest parts for both variants of ``kernel.motion`` in
 helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
-correction) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
+projection) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
 general ones; then each warm-up model here, loading what is missing from the cache (all of
 it, unless a helper failed); then the flexible parts' kernel (ahead.PARTS). Each stage says
 on stderr what it compiles and how far it is (``[k/N]``); when the cache holds the kernels
@@ -31,11 +31,11 @@ def warm(texts):
         engine = background.build(system)
         q, qd = system.initial_state()
         engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
-        correction = engine.correction()
-        if correction is not None:  # simulate's rows and corrections, one by one and fitted (row_fit.py)
-            correction(q, qd)
+        projection = engine.projection()
+        if projection is not None:  # simulate's rows and projections, one by one and fitted (row_fit.py)
+            projection(q, qd)
             count = row_fit.MIN_ROWS
-            correction.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
+            projection.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
 
 
 def main():
@@ -47,10 +47,10 @@ def main():
     cold = not background.compiled()
     where = os.environ.get("NUMBA_CACHE_DIR") or cache.cache_dir()
     if cold:
-        say(f"compiling the fast path's kernels once ({COLD_TIME}); every later run loads them "
+        say(f"compiling the compiled path's kernels once ({COLD_TIME}); every later run loads them "
             f"from the cache ({where}) in about a second instead of compiling for tens of seconds")
     else:
-        say(f"the fast path's kernels are compiled already ({where}): loading them to check (seconds)")
+        say(f"the compiled path's kernels are compiled already ({where}): loading them to check (seconds)")
     stages = ([("the kernel's largest parts, in helper processes", None)] if cold else []) + [
         (f"the general kernel on warm-up model {k} of {len(WARM_MODELS)}", text)
         for k, text in enumerate(WARM_MODELS, start=1)] + [("the rigid tree's kernel", WARM_RIGID),
@@ -69,7 +69,7 @@ def main():
         if text is WARM_RIGID:
             ahead.wait(rigid)
         warm([text])
-    print(f"mbsynth fast path compiled into {where} in {time.perf_counter() - started:.1f} s")
+    print(f"mbsynth: the compiled path's kernels compiled into {where} in {time.perf_counter() - started:.1f} s")
 
 
 PARTS = "parts"  # the stage that compiles ahead.PARTS
@@ -81,12 +81,12 @@ def say(line):
 
 
 # A body on a spherical joint with a particle on a rod, without and with a loop (a second,
-# redundant hinge) and a generated force: every kernel runs, and the correction's (the
+# redundant hinge) and a generated force: every kernel runs, and the projection's (the
 # kernel at rest, the compiled rows) on the tree.
 WARM_TREE = """
 name: warm_up
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   link: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5]}},
          initial: {angular_velocity: [0.1, 0.2, 0.3]}}
   bob: {type: particle, mass: 0.5, initial: {position: [0, 0, -0.5]}}
@@ -99,7 +99,7 @@ WARM_RIGID = """
 name: warm_up_rigid
 gravity: [0, 0, -9.81]
 world: {frames: {pivot: {position: [0, 0, 0], axis: [1, 0, 0]}}}
-subsystems:
+parts:
   upper: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.02], frames: {top: {position: [0, 0, 0.5],
           axis: [1, 0, 0]}, low: {position: [0, 0, -0.5]}}, initial: {angular_velocity: [0.3, 0, 0]}}
   lower: {type: rigid_body, mass: 0.5, inertia: [0.05, 0.05, 0.01], frames: {top: {position: [0, 0, 0.3]}}}

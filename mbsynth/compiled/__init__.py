@@ -14,11 +14,11 @@ parts' and joints' attributes (layout.py) and imports nothing of model/.
     kernel.py      the whole evaluation and its checks
     engine.py      a Template per model structure, an Engine per parameter values: motion, motion_batch
     rows.py        φ, φ̇ of the kernel's rows and its nodes' energies (simulate's rows)
-    correction.py  states put back on the constraints by the kernel, in the mass metric
-    threads.py     the threads compiled kernels share (motion_batch, corrections)
-    background.py  building Templates off the caller's thread; MBSYNTH_FAST
+    projection.py  states put back on the constraints by the kernel, in the mass metric
+    threads.py     the threads compiled kernels share (motion_batch, projections)
+    background.py  building Templates off the caller's thread; MBSYNTH_COMPILED
     worker.py      the daemon thread such builds run on, and what leaving Python does to them
-    structures.py  a numba kernel per shared structure of connector or part expressions
+    structures.py  a numba kernel per shared structure of constraint or part expressions
     grouped.py     the instances of one structure evaluated together (model/evaluation.py)
     ahead.py       a cold compile's largest parts in helper processes, on the other core
     cache.py       where compiled code is kept

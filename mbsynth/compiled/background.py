@@ -1,11 +1,11 @@
-"""Compiled Templates built on the worker thread; MBSYNTH_FAST; the default path.
+"""Compiled Templates built on the worker thread; MBSYNTH_COMPILED; the default path.
 
 numba compiles the kernels once per machine and keeps them on disk (cache.py); a cold
 compile takes minutes, loading a warm cache well under a second. ``python -m
 mbsynth.cli.compile_ahead`` compiles ahead (``make install`` runs it).
 
 A model's path is chosen when its Data is made (model/data.py): "compiled" or "kkt",
-by default ``default_path()`` — "compiled", or "kkt" where ``MBSYNTH_FAST=off`` (the
+by default ``default_path()`` — "compiled", or "kkt" where ``MBSYNTH_COMPILED=off`` (the
 environment's choice) or inside ``default_path_as("kkt")`` (a command that evaluates a
 handful of states). On the compiled path ``template`` builds the Template of the model's
 structure (layout, generated function, compilation: engine.py) on the worker thread and
@@ -28,7 +28,9 @@ from . import ahead, cache
 from .worker import Worker
 
 log = logging.getLogger(__name__)
-MODES = ("on", "off")  # MBSYNTH_FAST: the compiled path where it covers a model, or never
+VARIABLE = "MBSYNTH_COMPILED"  # the environment's choice of the default path
+OLD_VARIABLE = "MBSYNTH_FAST"  # its old name, read where VARIABLE is not set
+MODES = ("on", "off")  # VARIABLE: the compiled path where it covers a model, or never
 LEGACY_MODES = {"wait": "on", "background": "on"}  # earlier names of "on", still accepted
 
 
@@ -45,7 +47,7 @@ _default_path = contextvars.ContextVar("default_path", default=None)  # ``defaul
 
 @contextlib.contextmanager
 def default_path_as(path):
-    """``default_path()`` is ``path`` inside the block where MBSYNTH_FAST is not set (a
+    """``default_path()`` is ``path`` inside the block where MBSYNTH_COMPILED is not set (a
     command that evaluates a handful of states has no use for compiling kernels)."""
     token = _default_path.set(path)
     try:
@@ -54,28 +56,36 @@ def default_path_as(path):
         _default_path.reset(token)
 
 
+def given():
+    """(name, text) of the environment's choice: MBSYNTH_COMPILED, else OLD_VARIABLE (its
+    old name); (MBSYNTH_COMPILED, None) where neither is set."""
+    for name in (VARIABLE, OLD_VARIABLE):
+        if os.environ.get(name) is not None:
+            return name, os.environ[name]
+    return VARIABLE, None
+
+
 def mode(value=None):
-    """MBSYNTH_FAST (or ``value``, its text): "on" (unset: the default) or "off"."""
-    value = os.environ.get("MBSYNTH_FAST") if value is None else value
+    """MBSYNTH_COMPILED (or ``value``, its text): "on" (unset: the default) or "off"."""
+    name, value = given() if value is None else (VARIABLE, value)
     value = LEGACY_MODES.get(value, value or "on")
     if value not in MODES:
-        raise ValueError(f"MBSYNTH_FAST must be one of {MODES}, got {value!r}")
+        raise ValueError(f"{name} must be one of {MODES}, got {value!r}")
     return value
 
 
 def default_path():
-    """The path of a Data made without one: "kkt" where MBSYNTH_FAST=off, else the
-    ``default_path_as`` block's where MBSYNTH_FAST is unset, else "compiled"."""
-    given = os.environ.get("MBSYNTH_FAST")
-    if mode(given) == "off":
+    """The path of a Data made without one: "kkt" where MBSYNTH_COMPILED=off, else the
+    ``default_path_as`` block's where MBSYNTH_COMPILED is unset, else "compiled"."""
+    if mode() == "off":
         return "kkt"
     block = _default_path.get()
-    return block if given is None and block is not None else "compiled"
+    return block if given()[1] is None and block is not None else "compiled"
 
 
 def template(system, slot):
     """The compiled Template of ``system``'s structure, built now if it is not yet (in
-    ``slot``, its TemplateSlot); None where MBSYNTH_FAST=off, its build failed, or the
+    ``slot``, its TemplateSlot); None where MBSYNTH_COMPILED=off, its build failed, or the
     kernels cover no part of the model."""
     if mode() == "off":
         return None
@@ -94,7 +104,7 @@ def engine_for(system):
 def compile_ahead(variant):
     """Start compiling the kernel's largest parts for ``variant`` ("rigid_tree" or
     "general": ahead.VARIANTS) in helper processes now, when the kernels are not compiled and
-    the fast path is on: a caller about to build a System of that variant (a robot: a rigid
+    the compiled path is on: a caller about to build a System of that variant (a robot: a rigid
     tree) lets them run beside its derivation."""
     if mode() != "off" and not compiled():
         ahead.start(ahead.VARIANTS[variant])

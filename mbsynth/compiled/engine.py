@@ -25,8 +25,8 @@ from ..core.equations import Motion
 from ..symbolic.derive import T_SYMBOL
 from . import ahead, codegen, flexible, kernel, layout
 from .assembly import Work, make_work
-from .correction import Correction
-from .extra_correction import ExtraCorrection
+from .projection import Projection
+from .extra_projection import ExtraProjection
 from .rows import Rows
 from .packing import pack, views
 from .threads import THREADS, pool
@@ -50,7 +50,7 @@ class Template:
         # the flexible parts' M and Q written after the generated function (layout.Own, flexible.py)
         self.module = flexible.Filled(generated, own) if own else generated
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
-        # the generated masses, rows and φ (all but the Q additions and C) depend on t: no correction without t
+        # the generated masses, rows and φ (all but the Q additions and C) depend on t: no projection without t
         self.rows_depend_on_time = any(T_SYMBOL in sp.sympify(expr).free_symbols
                                        for expr in exprs[L.gen_q.size + L.gen_c.size:] if expr is not None)
         self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
@@ -81,7 +81,7 @@ class Template:
 
 
 class Engine:
-    """The fast path for one System at its parameter values ``p`` (Layout ``L``)."""
+    """The compiled path for one System at its parameter values ``p`` (Layout ``L``)."""
 
     def __init__(self, template, L, p):
         self.template, self.L, self.p = template, L, p
@@ -96,7 +96,7 @@ class Engine:
         self.lock = threading.Lock()
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
-        self.corrections = []  # the Correction, once made (a list: ``at``'s copies share it)
+        self.projections = []  # the Projection, once made (a list: ``at``'s copies share it)
         # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with extra rows
         self.rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
         self.generated_phi = slice(self.outputs - template.phi_outputs, self.outputs)  # φ of the extra rows in gen
@@ -110,15 +110,15 @@ class Engine:
         return other
 
     def at_rest(self):
-        """This Engine with no gravity, for calls at q̇ = 0 with no generated forces (correction.py)."""
+        """This Engine with no gravity, for calls at q̇ = 0 with no generated forces (compiled/projection.py)."""
         return Engine(self.template, self.L._replace(node_mg=np.zeros_like(self.L.node_mg)), self.p)
 
-    def correction(self):
-        """The kernel's projection on this Engine's Layout (correction.py; extra_correction.py
+    def projection(self):
+        """The kernel's projection on this Engine's Layout (compiled/projection.py; extra_projection.py
         for a model of extra coordinates alone), or None where neither covers the System."""
-        if not self.corrections:
-            self.corrections.append(Correction.build(self) or ExtraCorrection.build(self))
-        return self.corrections[0]
+        if not self.projections:
+            self.projections.append(Projection.build(self) or ExtraProjection.build(self))
+        return self.projections[0]
 
     def new_work(self):
         """(packed buffers, Work of views into them)."""

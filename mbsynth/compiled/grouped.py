@@ -1,6 +1,6 @@
 """Many compiled functions evaluated together: one call per shared structure.
 
-Connectors and parts built from one template (``Connector._place``, a robot's links)
+Constraints and parts built from one template (``Constraint._place``, a robot's links)
 share the raw numpy function of ``symbolic.compile_function`` and differ only in the
 coordinates they read and in their numbers. ``Batch`` stacks those arguments (one column
 per instance) and calls the shared function once, numpy broadcasting every operation,
@@ -21,7 +21,7 @@ STACK_MIN = 8  # fewer instances than this are called one by one (numpy's per-ca
 
 class Batch:
     """``functions[i](t, q[indices[i]], qd[indices[i]], p)`` for all i at once; each
-    returns a tuple of arrays (one per *slot*: a, b, C, φ, ψ of a connector; M, Q or T, V
+    returns a tuple of arrays (one per *slot*: a, b, C, φ, ψ of a constraint; M, Q or T, V
     of a part). A call returns, per slot, the raveled outputs of all functions
     concatenated in order (``slots`` of them). The layout is fixed at the first call.
     ``compiled``: each group of a shared structure is evaluated by its numba kernel, built

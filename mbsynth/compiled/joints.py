@@ -1,4 +1,4 @@
-"""The rows of A and b of the holonomic joints (connectors/joints.py) over q̈, differentiated
+"""The rows of A and b of the holonomic joints (constraints/joints.py) over q̈, differentiated
 by hand: used for joints with a particle end and for loop rows (rate_rows.py writes the
 rows of joints between rigid bodies directly in the bodies' (r̈, α)).
 
@@ -18,7 +18,7 @@ A row's A and b then follow from φ̈ = a q̈ − b:
     distance    φ = (d·d − L²)/2L  a = dᵀJ_d / L,           b = −(ḋ·ḋ + d·β_d)/L
 
 A joint's program is its kind's rows (core/joint_kinds.py: operation, vector, vector or
-component), the rows ``connectors.joints.joint_equations`` reads too; the tests compare the
+component), the rows ``constraints.joints.joint_equations`` reads too; the tests compare the
 two for every kind. ``EVALUATED``: the operations ``joint_rows`` has a branch for, all of
 core/joint_kinds.OPERATIONS (checked at import).
 """

@@ -1,4 +1,4 @@
-"""The fast path's whole evaluation, in numba: assemble, factor the tree, close the loops,
+"""The compiled path's whole evaluation, in numba: assemble, factor the tree, close the loops,
 recover q̈ and Qc, check.
 
 Extra rows (loop joints, other constraints) and extra coordinates (other parts) join the
@@ -535,10 +535,10 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     added to b per row of the System (empty for none); LI, LF, LX and WI, WF, WX: the
     Layout and the Work packed (packing.py). ``mode``: CHECKED factors the tree and checks
     the residual; UNCHECKED skips the check (residual 0: a caller that checks the result
-    itself, correction.py); REUSED also keeps the factorization the last call on this Work
+    itself, compiled/projection.py); REUSED also keeps the factorization the last call on this Work
     left, for a call with the same M and A (the same q) and another right side; when that
     call was at the same state, at rest (q̇ = 0) with the same forces, and this one's shifts
-    leave the unit-norm rows alone (``_shifts_only``: a correction's velocity step), only
+    leave the unit-norm rows alone (``_shifts_only``: a projection's velocity step), only
     the right side is rebuilt and solved, not the masses and rows (nor, with loop rows, their
     Schur matrix: ``_close_solve`` with the last call's eigenvectors; not for a model with
     extra coordinates or generated right sides). ``drift``: negative for

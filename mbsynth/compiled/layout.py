@@ -1,4 +1,4 @@
-"""What the fast path computes where: a System turned, once, into index and number arrays.
+"""What the compiled path computes where: a System turned, once, into index and number arrays.
 
 Kernel nodes are the rigid bodies (with their own ``<body>.unit_quaternion`` row) and the
 particles (their type's ``node``); kernel joints are the holonomic joints (of a kind whose
@@ -169,12 +169,12 @@ def build(system):
     flexible parts' ``Own``) of ``system``, or None when a joint has Coulomb friction (its C depends on q̈:
     system.motion iterates) or no part is a kernel node and the dense Schur system of its
     coordinates and rows would exceed DENSE_SCHUR_MAX."""
-    if any(getattr(con, "coulomb", None) for con in system.connectors):
+    if any(getattr(con, "coulomb", None) for con in system.constraints):
         return None
     number = _Numbers(system.parameters)
     starts = np.cumsum([0] + [len(p.coordinates) for p in system.parts])
-    row_starts = np.cumsum([0] + [c.size for c in system.connectors])
-    quat = {c.name: r for c, r in zip(system.connectors, row_starts) if c.name.endswith(".unit_quaternion")}
+    row_starts = np.cumsum([0] + [c.size for c in system.constraints])
+    quat = {c.name: r for c, r in zip(system.constraints, row_starts) if c.name.endswith(".unit_quaternion")}
     nodes = [(part, int(start)) for part, start in zip(system.parts, starts)
              if (_node(part) == RIGID_NODE and f"{part.name}.unit_quaternion" in quat) or _node(part) == PARTICLE_NODE]
     if not nodes and system.n > DENSE_SCHUR_MAX and not all(part.kernel_arrays is None and part.M.is_diagonal()
@@ -183,7 +183,7 @@ def build(system):
     node_of = {part.name: i for i, (part, _) in enumerate(nodes)}
     quat_rows = {quat[f"{part.name}.unit_quaternion"] for part, _ in nodes if _node(part) == RIGID_NODE}
     joints, others = [], []
-    for con, row in zip(system.connectors, row_starts):
+    for con, row in zip(system.constraints, row_starts):
         if int(row) in quat_rows and con.size == 1:
             continue
         (joints if _kernel_joint(con, node_of, number) else others).append((con, int(row)))
@@ -265,9 +265,9 @@ def number_parameters(L, sources, parameters):
 def sources(L, system):
     """(the parts of ``L``'s nodes, the constraints of its kernel joints) in ``system``."""
     starts = np.cumsum([0] + [len(p.coordinates) for p in system.parts])
-    rows = np.cumsum([0] + [c.size for c in system.connectors])
+    rows = np.cumsum([0] + [c.size for c in system.constraints])
     part_at = {int(s): part for part, s in zip(system.parts, starts)}
-    con_at = {int(r): con for con, r in zip(system.connectors, rows)}
+    con_at = {int(r): con for con, r in zip(system.constraints, rows)}
     return [part_at[int(c)] for c in L.node_q], [con_at[int(r)] for r in L.joint_row]
 
 
@@ -342,7 +342,7 @@ class _Builder:
             band = dict(band_pos=position, band_width=_ints([width]))
         kernel = [self._joint(con) for con, _ in joints]
         numbers = _numbers([part for part, _ in nodes], [con for con, _ in joints], self.number)
-        sizes = [self.system.n, sum(c.size for c in self.system.connectors), int(yoff[-1]),
+        sizes = [self.system.n, sum(c.size for c in self.system.constraints), int(yoff[-1]),
                  int(rows[-1])]
         layout = Layout(
             node_kind=_ints([RIGID if r else PARTICLE for r in rigid]), node_q=_ints([s for _, s in nodes]),
@@ -404,7 +404,7 @@ class _Builder:
             for i in element.indices:
                 if element.Q[i] != 0:
                     Q[int(i)] = Q.get(int(i), 0) + element.Q[i]
-        for con in system.connectors:
+        for con in system.constraints:
             for i in con.indices:
                 if con.C[i] != 0:
                     C[int(i)] = C.get(int(i), 0) + con.C[i]

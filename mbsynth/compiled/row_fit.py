@@ -1,16 +1,16 @@
-"""The corrections of a step's many output rows, from a few of them corrected exactly.
+"""The projections of a step's many output rows, from a few of them projected exactly.
 
 Within one integrator step the rows are read from its interpolant, a polynomial in the
-step's fraction θ, and each is put back on the constraints (correction.py). The correction
+step's fraction θ, and each is put back on the constraints (compiled/projection.py). The projection
 Δ(θ) (of q and of q̇) is a smooth function of θ, as small as the drift, and it vanishes to
 second order at the step's start: there the state lies on the constraints and the
 interpolant's slope is the motion f there, whose rates and accelerations meet the rows'
 derivatives (A q̇ = −φ_t, A q̈ = b), so the drift φ(θ), φ̇(θ) and with it Δ start as θ².
 So where a step passes many rows, NODES of them, nearest the Chebyshev–Lobatto points of
-(0, 1] (the step's end among them), are corrected exactly, Δ is interpolated in the
+(0, 1] (the step's end among them), are projected exactly, Δ is interpolated in the
 Chebyshev basis through them and through Δ = 0, Δ' = 0 at θ = 0, and every other row gets
-the interpolated Δ: then it is judged as strictly as an exact correction is
-(correction.py's ``judge``), and a row that fails is corrected exactly. Where more than
+the interpolated Δ: then it is judged as strictly as an exact projection is
+(compiled/projection.py's ``judge``), and a row that fails is projected exactly. Where more than
 NODES rows fail (a long step: the interpolation error grows as the span's length to the
 power NODES), the span is halved and each half fitted again, the second through NODES + 1
 rows of its own, its first and last among them.
@@ -24,14 +24,14 @@ from numba import njit
 
 from .bodies import OPTIONS
 
-NODES = 9  # rows corrected exactly per span fitted
-MIN_ROWS = 3 * NODES  # a span of fewer rows has each corrected exactly
+NODES = 9  # rows projected exactly per span fitted
+MIN_ROWS = 3 * NODES  # a span of fewer rows has each projected exactly
 LOBATTO = 0.5 - 0.5 * np.cos(np.pi * np.arange(NODES + 1) / NODES)  # Chebyshev–Lobatto points of [0, 1]
 
 
 @njit(**OPTIONS)
 def nodes(fractions, a):
-    """The indices (increasing; the last row's among them) of the rows to correct exactly,
+    """The indices (increasing; the last row's among them) of the rows to project exactly,
     of rows at ``fractions`` θ (increasing) in a span from θ = a: nearest the span's
     Chebyshev–Lobatto points but its start where a is below the first row (the step's
     start, where Δ = 0), else at them all (a: the first row's θ)."""
@@ -52,7 +52,7 @@ def nodes(fractions, a):
 @njit(**OPTIONS)
 def interpolate(fractions, a, at, Q, QD, Q_at, QD_at, Q_on, QD_on):
     """Q_on, Q̇_on ← the states Q, Q̇ (rows at ``fractions``) moved by Δ interpolated
-    (module docstring) through the exact corrections Q_at, Q̇_at of the rows ``at`` (which
+    (module docstring) through the exact projections Q_at, Q̇_at of the rows ``at`` (which
     get those exactly) and, where a is below the first row's θ (the step's start), through
     Δ = 0 and Δ' = 0 at θ = a."""
     k, n = Q.shape[0], Q.shape[1]

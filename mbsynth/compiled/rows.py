@@ -1,5 +1,5 @@
 """φ, φ̇ of the kernel's rows and the energies of its nodes, compiled (for ``simulate``'s
-rows and corrections: compiled/correction.py).
+rows and projections: compiled/projection.py).
 
 The rows are those of kernel.py: each rigid body's unit-norm row φ = (uᵀu − 1)/2,
 φ̇ = uᵀu̇, and each kernel joint's rows from the vectors of joints.py (value and velocity):

@@ -1,6 +1,6 @@
-"""One numba function per shared structure of connector or part expressions.
+"""One numba function per shared structure of constraint or part expressions.
 
-``symbolic.compile_function`` compiles the expressions of connectors (and parts) alike
+``symbolic.compile_function`` compiles the expressions of constraints (and parts) alike
 once, in placeholder form (``symbolic.canonical``); grouped.py evaluates the instances of
 one structure together. ``kernel(raw)`` turns that structure into
 
@@ -12,7 +12,7 @@ one structure together. ``kernel(raw)`` turns that structure into
 written into the cache under the hash of its text and compiled by numba (``cache=True``:
 a structure seen before, by any model, loads its machine code from disk). A Data on the
 compiled path (grouped.Batch with ``compiled``) builds it at its first call, waiting;
-``MBSYNTH_FAST=off`` never builds it (grouped.py then uses numpy).
+``MBSYNTH_COMPILED=off`` never builds it (grouped.py then uses numpy).
 """
 
 import logging
@@ -43,7 +43,7 @@ UNSET = "unset"  # a raw function's ``kernel`` before its build
 
 def kernel(raw):
     """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
-    symbolic.derive._lambdified), built now if it is not yet, or None: MBSYNTH_FAST=off,
+    symbolic.derive._lambdified), built now if it is not yet, or None: MBSYNTH_COMPILED=off,
     or not compilable. Kept on ``raw`` itself (its attribute ``kernel``)."""
     if mode() == "off" or not hasattr(raw, "structure"):
         return None
@@ -58,7 +58,7 @@ def _build(raw):
         evaluate = load(source(*raw.structure()), prefix="mbsynth_structure").evaluate
         evaluate.compile(SIGNATURE)  # here, not at the first call
     except Exception as err:  # noqa: BLE001 - numpy serves
-        log.warning("a connector structure stays on numpy (%s: %s)", type(err).__name__, err)
+        log.warning("a constraint structure stays on numpy (%s: %s)", type(err).__name__, err)
         return None
     return evaluate
 

@@ -1,7 +1,7 @@
 """The threads the compiled kernels run in side by side (they release the GIL): THREADS,
 one per core unless ``MBSYNTH_THREADS`` says how many (a sweep's worker processes take
 one each, sweep.py), made on first use and shared by motion_batch (engine.py) and block
-corrections (correction.py)."""
+projections (compiled/projection.py)."""
 
 import os
 from concurrent.futures import ThreadPoolExecutor

@@ -162,7 +162,7 @@ class Motion:
     @classmethod
     def made(cls, qdd, unique, nullspace, Qc, residual, method, singular=()):
         """The same Motion without the frozen dataclass's __init__ (one object.__setattr__
-        per field): for the fast path, which makes one per call."""
+        per field): for the compiled path, which makes one per call."""
         motion = object.__new__(cls)
         motion.__dict__.update(qdd=qdd, unique=unique, nullspace=nullspace, Qc=Qc, residual=residual, method=method,
                                singular=singular, C=None)

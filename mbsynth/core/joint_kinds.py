@@ -11,7 +11,7 @@ two vectors (x, w), the statement every interpreter of a row program computes:
     dot (v, w)         φ = v·w                    φ̇ = v̇·w + v·ẇ
     distance (D, D)    φ = (d·d − L²) / 2L        φ̇ = d·ḋ / L         (L the joint's length)
 
-The interpreters: the sympy rows (model/connectors/joints.py: ``joint_equations``, which
+The interpreters: the sympy rows (model/constraints/joints.py: ``joint_equations``, which
 evaluates ``OPERATIONS`` itself), the compiled rows over q̈ (compiled/joints.py), the compiled
 φ, φ̇ (compiled/rows.py) and the rows in the bodies' rates (compiled/rate_rows.py). Each
 names the operations it covers and is refused at import unless that is all of them

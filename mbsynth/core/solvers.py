@@ -1,4 +1,4 @@
-"""Fast paths equivalent to the reference equation (2.14) in ``equations.py``.
+"""Faster solves equivalent to the reference equation (2.14) in ``equations.py``.
 
 Each returns exactly what ``equations.constrained_acceleration`` returns, and is tested
 against it; where its own method does not apply it falls back to the reference.

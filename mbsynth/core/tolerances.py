@@ -40,18 +40,18 @@ DRIFT_MASS_SPREAD = 1e-4  # kernel.py, off the manifold: masses (diagonal, over 
 # send a model's stages to the exact drift rule (the Schur eigenvalues mix masses with the rows' geometry)
 SPLIT_MOVES = 1e4  # kernel.py, off the manifold: a dropped direction of Schur eigenvalue λ may move accelerations
 # up to this times √(λ / the largest) (the drift splits dependent rows by about that much)
-CORRECTION_RTOL = 1e-14  # correction.py: largest |φ| left, relative to the largest coordinate (at least 1): ~50 ε;
-# extra_correction.py: relative to each row's terms
-CORRECTION_RATE_RTOL = 1e-12  # correction.py: a velocity step must leave φ̇ below this, relative to the
-# largest coordinate (at least 1) times the largest rate (or cut it by CORRECTION_SHRINK)
-DRIFT_FLOOR = 0.1  # projection.relative_drift, extra_correction.py: a row's scale is at least this share of
+MASS_PROJECTION_RTOL = 1e-14  # compiled/projection.py: largest |φ| left, relative to the largest coordinate
+# (at least 1): ~50 ε; extra_projection.py: relative to each row's terms
+MASS_PROJECTION_RATE_RTOL = 1e-12  # compiled/projection.py: a velocity step must leave φ̇ below this, relative to the
+# largest coordinate (at least 1) times the largest rate (or cut it by MASS_PROJECTION_SHRINK)
+DRIFT_FLOOR = 0.1  # projection.relative_drift, extra_projection.py: a row's scale is at least this share of
 # ‖A_i‖₁ ‖x‖∞: at a singular position some rows' terms vanish (the N-four-bar's horizontal velocity rows when the
 # bars lie flat), and the same absolute drift must not read a thousand times larger there (TERM_FLOOR's floor),
 # or the spans between projections shrink without end
-CORRECTION_REUSE = 1e-8  # correction.py: the largest position step and φ̇ (relative) for which the velocity step
-# reuses a factorization
-CORRECTION_SHRINK = 1e-3  # correction.py, extra_correction.py: a velocity step must cut φ̇ by this much at least
-# (or leave it below CORRECTION_RATE_RTOL of its terms)
+MASS_PROJECTION_REUSE = 1e-8  # compiled/projection.py: the largest position step and φ̇ (relative) for which the
+# velocity step reuses a factorization
+MASS_PROJECTION_SHRINK = 1e-3  # compiled/projection.py, extra_projection.py: a velocity step must cut φ̇ by this
+# much at least (or leave it below MASS_PROJECTION_RATE_RTOL of its terms)
 KERNEL_RESIDUAL_MAX = 1e-9  # kernel.py: a solution whose relative residual exceeds this goes to the exact path
 JACOBI_OFF_RTOL = 1e-36  # eigen.py: Jacobi sweeps stop when the off-diagonal's squared norm is below this share of
 # the whole (off-diagonal entries ~1e-18 of the matrix: below rounding)
@@ -119,7 +119,7 @@ ANGLES_NEAR = 1e-2  # derivative.py: |det H| of a part's angles below this (0.57
 # angle rates above 100 times the angular velocity
 RELAXED_RTOL = 1e-8  # cut.py: a span that crawls near a singular position is integrated again at this rtol (and atol)
 RELAXED_MAX = 1e-7  # cut.py: ... then ten times looser each time, up to this
-DRIFT_TARGET = 1e-9  # drift.py: largest relative drift off the manifold between two corrections or projections
+DRIFT_TARGET = 1e-9  # drift.py: largest relative drift off the manifold between two projections
 DRIFT_REDO = 1e3  # drift.py: a span that drifted more than this × DRIFT_TARGET is integrated again, shorter
 REDO_MIN_SPAN = 1e-6  # drift.py: of the output interval: the shortest span that is integrated again
 PROJECTION_DIVERGED = 1e6  # projection.py: a last pass stops where its largest residual exceeds this times its

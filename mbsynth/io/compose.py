@@ -15,14 +15,16 @@ are relative to ``folder`` (default: the working folder). Its error messages nam
 text it wrote (``System.source`` holds it).
 """
 
+import warnings
 from pathlib import Path
 
 import yaml
 
 from ..core.errors import ModelError
 from .loader import loads
+from .old_keys import OLD_KEYS
 
-TOP_KEYS = ("parameters", "gravity", "world", "constraints", "joints", "closure", "initial", "initial_fixed",
+TOP_KEYS = ("parameters", "gravity", "world", "constraints", "joints", "balances", "initial", "initial_fixed",
             "forces", "outputs", "ports")
 
 
@@ -36,17 +38,26 @@ def substructure(file, parameters=None, placement=None, count=None):
     return entry
 
 
-def compose(subsystems, joints=None, *, name="composed", folder=None, load_parameters=None, **keys):
-    """The System of a model whose top level is ``subsystems`` ({name: part or
+def compose(parts=None, joints=None, *, name="composed", folder=None, load_parameters=None, **keys):
+    """The System of a model whose top level is ``parts`` ({name: part or
     ``substructure(...)``}), ``joints`` and the other top-level keys of a model file
-    (``parameters``, ``gravity``, ``world``, ``constraints``, ``closure``, ``initial``,
+    (``parameters``, ``gravity``, ``world``, ``constraints``, ``balances``, ``initial``,
     ``initial_fixed``, ``forces``, ``outputs``, ``ports``); ``load_parameters``: as
-    ``parameters=`` of ``mb.load``."""
+    ``parameters=`` of ``mb.load``. A key's old name (io/old_keys.py) is read as the key, with a
+    DeprecationWarning."""
+    keys["parts"] = parts
+    for old in sorted(set(keys) & set(OLD_KEYS)):
+        new = OLD_KEYS[old]
+        warnings.warn(f"compose({old}=) is the old name of compose({new}=)", DeprecationWarning, stacklevel=2)
+        if keys.get(new) is not None:
+            raise ModelError(f"compose(): {new}= and its old name {old}= given both; give {new}= only")
+        keys[new] = keys.pop(old)
+    parts = keys.pop("parts")
     unknown = sorted(set(keys) - set(TOP_KEYS))
     if unknown:
         raise ModelError(f"compose(): unknown model key(s) {unknown}; allowed: {', '.join(TOP_KEYS)}")
     model = {"name": name, **{key: keys[key] for key in TOP_KEYS if keys.get(key) is not None},
-             "subsystems": subsystems}
+             "parts": parts}
     if joints is not None:
         model["joints"] = joints
     try:

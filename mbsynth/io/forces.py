@@ -79,7 +79,7 @@ def _torque(builder, name, spec, path):
     part = builder.parts[part_name]
     if not part.part_type.rigid:  # a torque turns a part with an orientation of its own, as one piece
         named = either(file_types_of(lambda part_type: part_type.rigid))
-        builder.fail(path + ("part",), f"a torque acts on a {named} part; '{part_name}' is a {part.kind}")
+        builder.fail(path + ("part",), f"a torque acts on a {named} part; '{part_name}' is a {part.type_name}")
     axes = spec.get("axes", "world")
     if axes not in AXES:
         builder.fail(path + ("axes",), f"axes must be one of {', '.join(AXES)}, got {axes!r}")

@@ -9,8 +9,8 @@ from dataclasses import replace
 import sympy as sp
 
 from ..core.joint_kinds import JOINT_KINDS, KINDS
-from ..model.connectors.joints import Joint
-from ..model.connectors.rolling import KnifeEdge, RollingDisk
+from ..model.constraints.joints import Joint
+from ..model.constraints.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from ..model.parts.part_type import ANGLES, PLANE, QUATERNION
 from .joint_forces import read_friction, read_joint_forces
@@ -71,7 +71,7 @@ def frame_reference(builder, text, path):
         part = builder.parts[part_name]
         frames = part.frames
         if not part.part_type.origin and not frame_name:
-            builder.fail(path, f"a {part.kind} part has no frame of its own: name one of its frames "
+            builder.fail(path, f"a {part.type_name} part has no frame of its own: name one of its frames "
                                f"({', '.join(frames) or 'it declares none'})")
     else:
         builder.fail(path, unknown_frame(builder, text))
@@ -176,7 +176,7 @@ def read_contact(builder, spec, path, names, suffix=""):
     if part is None or not hosts(part.part_type):
         named = file_types_of(hosts)  # a model file's types
         builder.fail(path + ("child",), f"a {kind} is a frame on a {either(named)} part, not on "
-                                        f"{'the world' if part is None else 'a ' + part.kind}")
+                                        f"{'the world' if part is None else 'a ' + part.type_name}")
     args = (builder.q, builder.qd, builder.parameter_symbols)
     if kind == "knife_edge":
         return KnifeEdge(name, part, frame, *args)

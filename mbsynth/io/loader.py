@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from ..model.balances import close
-from ..model.connectors.joints import Joint
-from ..model.connectors.base import Connector
+from ..model.balances import append_balances
+from ..model.constraints.joints import Joint
+from ..model.constraints.base import Constraint
 from ..model.joint_values import constraint_symbols, value_expressions, value_names
 from ..core.expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse
 from ..core.errors import ModelError
@@ -274,7 +274,7 @@ class _Builder:
         for builder in self.builders:
             builder.gravity = self.gravity  # a substructure's gravity is the model's
             builder.world_frames = {f.name: f for f in read_world(builder)}
-        parts = self.read_subsystems()
+        parts = self.read_parts()
         model.q += [sym for part in parts for sym in part.q]
         model.qd += [sym for part in parts for sym in part.qd]
         model.global_symbols = Names({str(s): s for s in model.parameter_symbols}, t=T_SYMBOL)
@@ -312,8 +312,8 @@ class _Builder:
         self.check_parts(system)
         self.check_branches(system)
         check_initial(system, unilaterals)
-        closures = [builder for builder in self.builders if builder.read_closure() == "auto"]
-        return close(system) if closures else system
+        auto = [builder for builder in self.builders if builder.read_balances() == "auto"]
+        return append_balances(system) if auto else system
 
     def plan(self):
         """This file's parameters, robots and included files (theirs in turn), before any
@@ -323,7 +323,7 @@ class _Builder:
         for name, value in self.robots_parameters():
             self.add_parameter(name, sp.Float(value) if name not in self.assembly.overrides
                                else sp.Float(self.assembly.overrides[name]), None)
-        self.check_subsystems()
+        self.check_part_entries()
         self.children = read_includes(self)
 
     def robots_parameters(self):
@@ -375,22 +375,22 @@ class _Builder:
             self.parameters[key] = self.assembly.values[symbol]
             self.param_symbols[key] = symbol
 
-    def read_subsystems(self):
+    def read_parts(self):
         """The parts of this file and of the files it includes, in the file's order."""
-        node = self.root["subsystems"]
+        node = self.root["parts"]
         parts, included = [], dict(self.children)
         self.own_parts = []
         for name, spec in node.items():
-            path = ("subsystems", name)
+            path = ("parts", name)
             if name in included:
                 for child in included[name]:
-                    parts += child.read_subsystems()
+                    parts += child.read_parts()
                 continue
-            kind = spec.get("type")
-            if kind not in FILE_TYPES:
-                self.fail(path + ("type",), f"unknown subsystem type {kind!r}; known: "
+            type_name = spec.get("type")
+            if type_name not in FILE_TYPES:
+                self.fail(path + ("type",), f"unknown part type {type_name!r}; known: "
                                             f"{', '.join((*FILE_TYPES, 'model'))}")
-            made = FILE_TYPES[kind].read(self, self.full_name(name), spec, path)
+            made = FILE_TYPES[type_name].read(self, self.full_name(name), spec, path)
             made = made if isinstance(made, list) else [made]  # a robot gives one part per link
             for part in made:
                 self.assembly.parts[part.name] = part
@@ -399,20 +399,20 @@ class _Builder:
             parts += made
         return parts
 
-    def check_subsystems(self):
-        """The ``subsystems:`` mapping: a mapping of named entries, each a mapping."""
-        node = self.root["subsystems"]
+    def check_part_entries(self):
+        """The ``parts:`` mapping: a mapping of named entries, each a mapping."""
+        node = self.root["parts"]
         if node is not None and not isinstance(node, LineDict):
-            self.fail(("subsystems",), f"expected a mapping of named parts, e.g. 'wheel: {{type: lagrangian, ...}}', "
+            self.fail(("parts",), f"expected a mapping of named parts, e.g. 'wheel: {{type: lagrangian, ...}}', "
                                        f"got {_kind(node)}")
         if not node:
-            self.fail(("subsystems",), "the mapping is empty: a model needs at least one part, e.g. "
+            self.fail(("parts",), "the mapping is empty: a model needs at least one part, e.g. "
                                        "'wheel: {type: lagrangian, ...}'")
         for name, spec in node.items():
-            path = ("subsystems", name)
-            self.identifier(name, path, "subsystem name")
+            path = ("parts", name)
+            self.identifier(name, path, "part name")
             if name in self.parameters or name == "world":
-                self.fail(path, f"subsystem '{name}' has the name of a parameter or of the world")
+                self.fail(path, f"part '{name}' has the name of a parameter or of the world")
             if not isinstance(spec, LineDict):
                 self.fail(path, f"expected a mapping with 'type' and the part's data, got {_kind(spec)}")
         return node
@@ -449,11 +449,11 @@ class _Builder:
                 limits += read_limits(self, spec, path, joint, own)
         return limits + read_contacts(self)
 
-    def read_closure(self):
-        closure = self.root.get("closure", "none")
-        if closure not in ("auto", "none"):
-            self.fail(("closure",), f"expected 'auto' or 'none', got {closure!r}")
-        return closure
+    def read_balances(self):
+        balances = self.root.get("balances", "none")
+        if balances not in ("auto", "none"):
+            self.fail(("balances",), f"expected 'auto' or 'none', got {balances!r}")
+        return balances
 
     def substructures(self):
         """The tree of files this model is made of (model/system.py's Substructure)."""
@@ -487,7 +487,7 @@ class _Builder:
             kpath = path + (kind,)
             if kind == "acceleration":
                 a, b = self.read_acceleration_row(spec[kind], kpath)
-                constraints.append(Connector.acceleration(name, a, b, *args, C=C))
+                constraints.append(Constraint.acceleration(name, a, b, *args, C=C))
                 continue
             expr = self.expression(spec[kind], kpath, self.constraint_symbols)
             self.differentiable(expr, kpath, None if kind == "holonomic" else ())
@@ -501,7 +501,7 @@ class _Builder:
             if kind == "nonholonomic" and not has_qd:
                 self.fail(kpath, f"constraint '{name}' involves no velocity (name_dot); "
                                  "a constraint on positions is 'holonomic:'")
-            make = getattr(Connector, kind)
+            make = getattr(Constraint, kind)
             constraints.append(make(name, [expr], *args, C=C))
         return constraints
 
@@ -557,7 +557,7 @@ class _Builder:
                 continue
             own = self.own_name(joint.name)
             if joint.name in model.parts:
-                self.fail(self.entry_of(own) or ("subsystems", own),
+                self.fail(self.entry_of(own) or ("parts", own),
                           f"joint '{own}' has the name of part '{own}': joints and parts share one "
                           f"namespace ('{own}.angle', '{own}.x'), rename one of them")
             base = own.split("[")[0]  # a for: entry's joints are base[i]
@@ -569,7 +569,7 @@ class _Builder:
             if own in self.parameters or own == "world":
                 entry = self.entry_of(own)
                 clash = "the world (its frames are 'world.<frame>')" if own == "world" else "a parameter"
-                self.fail(entry + ("name",) if entry else ("subsystems",),
+                self.fail(entry + ("name",) if entry else ("parts",),
                           f"joint '{own}' has the name of {clash}: rename the joint")
             values = functools.cache(functools.partial(value_expressions, joint))
             symbols = functools.cache(functools.partial(constraint_symbols, joint))
@@ -667,9 +667,9 @@ class _Builder:
         """Each part's M must be finite and positive semi-definite at the initial state."""
         for part, problem in system.part_problems():
             builder, own = self.assembly.owners.get(part, (self, part))
-            spec = (builder.root.get("subsystems") or {}).get(own)
+            spec = (builder.root.get("parts") or {}).get(own)
             energy = "semi-definite" in problem and isinstance(spec, dict) and "T" in spec  # a lagrangian part's T
-            builder.fail(("subsystems", own) + (("T",) if energy else ()), problem)
+            builder.fail(("parts", own) + (("T",) if energy else ()), problem)
 
     def check_branches(self, system):
         """No joint may be assembled at the initial state (its rows hold) in a pose its rows

@@ -12,7 +12,7 @@ KINDS = tuple(key.name for key in SECTIONS["output"].keys)
 
 def read_outputs(builder, constraints):
     """The Outputs the file declares (under their full names, ``left_leg.height``);
-    ``constraints``: the model's connectors."""
+    ``constraints``: the model's constraints."""
     node = builder.root.get("outputs")
     if node is None:
         return ()
@@ -35,11 +35,11 @@ def read_outputs(builder, constraints):
         (kind, value), = spec.items()
         kpath = path + (kind,)
         if kind == "reaction":
-            connector, _, which = str(value).rpartition(".")
-            if connector not in by_name:
-                builder.fail(kpath, f"unknown joint or constraint '{connector}' in '{value}' (write "
+            constraint, _, which = str(value).rpartition(".")
+            if constraint not in by_name:
+                builder.fail(kpath, f"unknown joint or constraint '{constraint}' in '{value}' (write "
                                     f"'<joint>.force', '.torque' or '.multipliers'); known: {', '.join(by_name)}")
-            make = functools.partial(reaction_output, name, by_name[connector], which)
+            make = functools.partial(reaction_output, name, by_name[constraint], which)
         elif kind == "energy":
             make = functools.partial(energy_output, name, value)
         else:

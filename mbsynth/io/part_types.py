@@ -1,4 +1,4 @@
-"""The part types a model file names: one record per value of a subsystem's ``type:``.
+"""The part types a model file names: one record per value of a part's ``type:``.
 
 A ``FileType`` gives the entry's schema ``section`` (schema.py's ``Section``: its keys,
 checked by the loader and listed in the model-file reference), its reader ``read(builder,

@@ -73,24 +73,24 @@ class RobotEntry:
 
 
 def read_robots(builder):
-    """{entry name: RobotEntry} of the file's ``type: robot`` subsystems, read before any
+    """{entry name: RobotEntry} of the file's ``type: robot`` parts, read before any
     part (the loader adds their torque parameters to the model's; a value the file gives wins)."""
-    node = builder.root.get("subsystems")
+    node = builder.root.get("parts")
     entries = {}
     for name, spec in (node.items() if isinstance(node, dict) else ()):
         if isinstance(spec, dict) and spec.get("type") == "robot":
-            path = ("subsystems", name)
-            builder.identifier(name, path, "subsystem name")
+            path = ("parts", name)
+            builder.identifier(name, path, "part name")
             entries[name] = RobotEntry(builder, name, spec, path)
     return entries
 
 
 def read_robot(builder, name, spec, path):
     """The parts of a ``type: robot`` entry (a list: the loader adds each)."""
-    others = set(builder.root["subsystems"]) - {name}
+    others = set(builder.root["parts"]) - {name}
     for part in map(builder.own_name, builder.robots[name].robot.parts.values()):
         if part in others or part in builder.parameters:
-            builder.fail(path, f"robot '{name}' has a link part '{part}', the name of another subsystem or "
+            builder.fail(path, f"robot '{name}' has a link part '{part}', the name of another part or "
                                "of a parameter: rename one of them")
     return builder.robots[name].parts(builder)
 

@@ -90,7 +90,8 @@ SHARED_KEYS = {key.name: key for key in (_DESCRIPTION, _FRAMES, _GEOMETRY)}
 
 SECTIONS = {section.name: section for section in (
     Section("model", "the top level of a model file",
-            "A model file is one mapping. Only ``subsystems`` is required.",
+            "A model file is one mapping. Only ``parts`` is required. A key under its old name is read "
+            "as the key: ``subsystems`` (old name of ``parts``), ``closure`` (old name of ``balances``).",
             (Key("name", "string", "the model's name", "example1_wheel", default="the file name"),
              _DESCRIPTION,
              Key("parameters", "mapping name → expression", "named constants; each may use those before it",
@@ -98,7 +99,7 @@ SECTIONS = {section.name: section for section in (
              Key("gravity", "list of 3 " + _EXPRS, "gravitational acceleration acting on rigid bodies, "
                  "particles, planar bodies, spring masses and flexible bodies [m/s²]", "[0, 0, -g]", default="[0, 0, 0]"),
              Key("world", "mapping (section *world*)", "frames fixed in the world", "{frames: {pin: {}}}"),
-             _required("subsystems", "mapping name → part", "the parts, each with a ``type`` whose section "
+             _required("parts", "mapping name → part", "the parts, each with a ``type`` whose section "
                        "below lists its keys (e.g. *rigid_body*; *model_part* for another model file)",
                        "{wheel: {type: particle, mass: m}}"),
              Key("constraints", "list of constraints (section *constraint*)",
@@ -110,7 +111,7 @@ SECTIONS = {section.name: section for section in (
              Key("contacts", "list of contacts (sections *contact_plane*, *contact_spheres*)",
                  "unilateral contacts that strike, rest and lift off (docs/guide.md, impacts)",
                  "[{name: floor, type: plane, child: ball, radius: r, restitution: 0.8}]", default="[]"),
-             Key("closure", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
+             Key("balances", "``auto`` or ``none``", "``auto`` appends the force balance of each massless "
                  "part whose motion the model leaves open (model/balances.py)", "auto", default="none"),
              Key("initial", "mapping coordinate → " + _EXPR, "initial values by coordinate name "
                  "(``part.c``, velocities ``part.c_dot``)", "{wheel.theta: 0.0, wheel.theta_dot: 1.0}",
@@ -124,7 +125,7 @@ SECTIONS = {section.name: section for section in (
                  default="{}"),
              Key("ports", "mapping name → frame", "frames a file that includes this one joins to as "
                  "``<entry>.<port>`` (docs/substructures.md)", "{hip: pelvis.hip}", default="{}"))),
-    Section("model_part", "``subsystems: {NAME: {type: model, ...}}``",
+    Section("model_part", "``parts: {NAME: {type: model, ...}}``",
             "Another model file as a substructure: its parts, joints, constraints, forces, outputs, "
             "initial values and parameters join the model, every name prefixed by the entry's "
             "(``NAME.thigh``, ``NAME.thigh.x``, ``NAME.L``; copies ``NAME[0]`` …). Its ``gravity`` "
@@ -156,7 +157,7 @@ SECTIONS = {section.name: section for section in (
             "orientation key. On a lagrangian part the position may use its coordinates.",
             (_POSITION, Key("geometry", "shape or list of shapes", "what the viewer draws at the frame",
                             "{sphere: 0.05}"), *_ORIENTATION)),
-    Section("lagrangian", "``subsystems: {NAME: {type: lagrangian, ...}}``",
+    Section("lagrangian", "``parts: {NAME: {type: lagrangian, ...}}``",
             "A part in its own coordinates, with M and Q derived from Lagrange's equations. Expressions "
             "use the parameters, ``t``, the coordinates and their velocities (``c_dot``).",
             (_TYPE_KEY["lagrangian"],
@@ -167,7 +168,7 @@ SECTIONS = {section.name: section for section in (
              Key("forces", "mapping coordinate → expression", "generalized forces not derived from V",
                  "{theta: -c*theta_dot}", default="{}"),
              _FRAMES, _GEOMETRY, _DESCRIPTION)),
-    Section("rigid_body", "``subsystems: {NAME: {type: rigid_body, ...}}``",
+    Section("rigid_body", "``parts: {NAME: {type: rigid_body, ...}}``",
             "A rigid body in space: coordinates x, y, z and the unit quaternion qw, qx, qy, qz; with "
             "``rotation: zxy`` (or another intrinsic sequence) three angles instead, ``angle_z``, "
             "``angle_x``, ``angle_y``, of turns about the body's axes in that order (``angle_z2`` for a "
@@ -182,19 +183,19 @@ SECTIONS = {section.name: section for section in (
              _FRAMES, _GEOMETRY,
              Key("initial", "mapping (section *initial_rigid_body*)", "initial pose and velocities",
                  "{position: [0, 0, 1]}", default="at rest at the origin"), _DESCRIPTION)),
-    Section("particle", "``subsystems: {NAME: {type: particle, ...}}``",
+    Section("particle", "``parts: {NAME: {type: particle, ...}}``",
             "A point mass in space: coordinates x, y, z. Its frames cannot be offset.",
             (_TYPE_KEY["particle"], _MASS, _FRAMES, _GEOMETRY,
              Key("initial", "mapping (section *initial_particle*)", "initial position and velocity",
                  "{position: [1, 0, 0]}", default="at rest at the origin"), _DESCRIPTION)),
-    Section("planar_body", "``subsystems: {NAME: {type: planar_body, ...}}``",
+    Section("planar_body", "``parts: {NAME: {type: planar_body, ...}}``",
             "A rigid body moving in the xy plane: coordinates x, y, theta.",
             (_TYPE_KEY["planar_body"], _MASS,
              _required("inertia", _EXPR + ", ≥ 0", "moment of inertia I_zz about the centre of mass", "0.02"),
              _FRAMES, _GEOMETRY,
              Key("initial", "mapping (section *initial_planar_body*)", "initial pose and velocities",
                  "{position: [0, 1], theta: 0.3}", default="at rest at the origin"), _DESCRIPTION)),
-    Section("spring", "``subsystems: {NAME: {type: spring, ...}}``",
+    Section("spring", "``parts: {NAME: {type: spring, ...}}``",
             "A spring part with two free ends, frames ``end1`` and ``end2`` (coordinates x1, y1, z1, x2, y2, z2); "
             "with mass, the uniform bar's consistent mass matrix and half its weight on each end.",
             (_TYPE_KEY["spring"],
@@ -204,7 +205,7 @@ SECTIONS = {section.name: section for section in (
              Key("mass", _EXPR + ", ≥ 0", "mass [kg]", "0.2", default="0"),
              Key("initial", "mapping (section *initial_spring*)", "initial positions and velocities of the ends",
                  "{end1: [0, 0, 0], end2: [0.5, 0, 0]}", default="at rest at the origin"), _DESCRIPTION)),
-    Section("robot", "``subsystems: {NAME: {type: robot, ...}}``",
+    Section("robot", "``parts: {NAME: {type: robot, ...}}``",
             "A whole robot: one rigid body per link (``NAME_<link>``), one joint per URDF joint "
             "(``NAME_<joint>``) and a torque parameter ``tau_NAME_<joint>`` per movable joint.",
             (_TYPE_KEY["robot"],
@@ -217,7 +218,7 @@ SECTIONS = {section.name: section for section in (
              Key("initial", "mapping URDF joint name → " + _EXPR, "initial position of each movable joint "
                  "[rad or m]: the links start where the URDF's kinematics puts them", "{elbow_joint: 0.5}",
                  default="0 for every joint"), _DESCRIPTION)),
-    Section("flexible_body", "``subsystems: {NAME: {type: flexible_body, ...}}``",
+    Section("flexible_body", "``parts: {NAME: {type: flexible_body, ...}}``",
             "A flexible body: a finite-element model (``beam`` or ``fe``, exactly one) reduced to a few "
             "coordinates, on a floating frame. Coordinates x, y, z (the frame's origin, which is the FE "
             "model's origin), the unit quaternion qw, qx, qy, qz of its axes and the reduced coordinates "

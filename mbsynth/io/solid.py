@@ -26,7 +26,7 @@ from .parts import read_body_initial, read_frames, read_geometry, read_nonnegati
 from .schema import SHARED_KEYS, Key, Section
 
 SOLID = Section(
-    "solid", "``subsystems: {NAME: {type: solid, ...}}``",
+    "solid", "``parts: {NAME: {type: solid, ...}}``",
     "A rigid body (coordinates x, y, z of its centre of mass and the unit quaternion qw, qx, qy, qz) "
     "whose mass and inertia are its shape's volume and inertia (computed by coal) times its density. "
     "Frames and the shape are written in the entry's axes; for a shape whose centre of mass is not at "

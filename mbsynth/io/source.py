@@ -16,6 +16,7 @@ from pathlib import Path
 import yaml
 
 from ..core.errors import ModelError
+from .old_keys import renamed
 
 LINE_BREAK = re.compile("\r\n|[\r\n\x85\u2028\u2029]")  # YAML's line breaks
 MAX_DEPTH = 64  # levels of nested mappings and lists
@@ -159,8 +160,8 @@ class Document:
                 loader.dispose()
         if not isinstance(root, LineDict):
             raise ModelError(f"{self.name}:1: a model file must be a mapping of keys "
-                             f"(name, parameters, subsystems, ...), got {type(root).__name__}")
-        self.root = root
+                             f"(name, parameters, parts, ...), got {type(root).__name__}")
+        self.root = renamed(root, self.name)
 
     def line_of(self, path):
         """The line of the deepest key or item of ``path`` that exists."""

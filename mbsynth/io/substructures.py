@@ -1,6 +1,6 @@
 """Model files as parts of other model files: ``type: model`` entries and ``ports:``.
 
-    subsystems:
+    parts:
       left_leg:
         type: model
         file: leg.yaml                  # relative to this file
@@ -13,7 +13,7 @@ initial values, parameters) joins the model under its entry's name as a prefix: 
 ``thigh`` becomes ``left_leg.thigh``, its coordinate ``left_leg.thigh.x``, the parameter
 ``L`` ``left_leg.L``; ``count: N`` makes copies ``cell[0]`` … ``cell[N-1]`` (``index`` is
 their number in ``parameters`` and ``placement``). The file's ``ports: {hip: pelvis.hip}``
-names frames the including file joins to as ``left_leg.hip``. The paper's sub-systems
+names frames the including file joins to as ``left_leg.hip``. The paper's sub-systems (parts)
 (section 2): each file is a system with its own equation of motion, and the composite is
 one again, so it may be included in turn.
 
@@ -60,11 +60,11 @@ class Include:
 def read_includes(builder):
     """[(entry name, [child builders, one per copy])] of the file's ``type: model``
     entries, each child's parameters read (and its own included files, depth first)."""
-    node = builder.root.get("subsystems")
+    node = builder.root.get("parts")
     children = []
     for name, spec in (node.items() if isinstance(node, dict) else ()):
         if isinstance(spec, dict) and spec.get("type") == "model":
-            children.append((name, _read_entry(builder, name, spec, ("subsystems", name))))
+            children.append((name, _read_entry(builder, name, spec, ("parts", name))))
     return children
 
 

@@ -1,3 +1,3 @@
-"""The model: parts (parts/), connectors (connectors/), force elements, the System (a
+"""The model: parts (parts/), constraints (constraints/), force elements, the System (a
 value) and its Data (the workspace of a computation), the evaluation of their arrays, joint
 values, reactions, outputs, and the force balances of massless parts (balances.py)."""

@@ -6,7 +6,7 @@ must balance, or no motion exists. Such a balance is exactly what the paper adds
 by hand in example 3: (5.40) k1 x̄1 = k2 q̄2 when m1 = 0, (5.49) k2 q̄2 = 0 when
 m2 = 0. Where the balance vanishes identically (example 2's massless particle,
 (5.23)) the direction is simply free. ``balances`` derives them symbolically;
-``close`` appends the non-trivial ones as constraints (``closure: auto``).
+``append_balances`` appends the non-trivial ones as constraints (``balances: auto``).
 """
 
 from dataclasses import dataclass
@@ -16,12 +16,12 @@ import scipy.linalg
 import sympy as sp
 
 from .angle_singularity import AngleParts
-from .connectors.base import Connector
+from .constraints.base import Constraint
 from .data import workspace
 from ..core.equations import rank_report
 from ..core.errors import ModelError
 from ..symbolic.derive import T_SYMBOL, exceeds, tidy
-from .system import Closure
+from .system import AppendedBalance
 from ..core.tolerances import BALANCE_ENTRY_ZERO, BALANCE_ZERO_RTOL, RATIONAL_TOL, READABLE_DROP
 
 SAMPLES = 8
@@ -200,22 +200,22 @@ def _canonical(D, state, dynamic):
     return [D[:, j] for j in range(D.shape[1])]
 
 
-def close(system, max_rounds=None):
+def append_balances(system, max_rounds=None):
     """Append every non-trivial balance as a constraint until the motion is unique or
-    only free directions are left (``closure: auto``). Returns a new System."""
+    only free directions are left (``balances: auto``). Returns a new System."""
     for round_ in range(max_rounds or system.n):
         needed = [bal for bal in balances(system) if not bal.free]
         if not needed:
             return system
         extra, notes = [], []
         for bal in needed:
-            name = f"closure_{len(system.closures) + len(extra) + 1}"
+            name = f"balance_{len(system.appended_balances) + len(extra) + 1}"
             extra.append(_as_constraint(system, name, bal))
-            notes.append(Closure(name, bal.equation, bal.direction, bal.state_dependent))
+            notes.append(AppendedBalance(name, bal.equation, bal.direction, bal.state_dependent))
         before = rank_report(*_MA(system)).rank_Mhat
         system = system.with_constraints(extra, notes)
         if rank_report(*_MA(system)).rank_Mhat == before:
-            raise ModelError(f"model '{system.name}': closure balances {[b.equation for b in needed]} "
+            raise ModelError(f"model '{system.name}': balances {[b.equation for b in needed]} "
                              "do not determine the indeterminate accelerations")
     return system
 
@@ -234,5 +234,5 @@ def _as_constraint(system, name, bal):
                          "that direction: the model admits no motion")
     args = (system.q_symbols, system.qd_symbols, system.parameter_symbols)
     if expression.free_symbols & set(system.qd_symbols):
-        return Connector.nonholonomic(name, [expression], *args)
-    return Connector.holonomic(name, [expression], *args)
+        return Constraint.nonholonomic(name, [expression], *args)
+    return Constraint.holonomic(name, [expression], *args)

@@ -9,7 +9,7 @@ in a Data made from it (``data.model`` is that System):
 - its path, chosen when it is made: "compiled" (the kernels of mbsynth.compiled where they
   cover the model, built at the first use and waited for) or "kkt" ((2.14) in its KKT form
   throughout); by default ``mbsynth.compiled.background.default_path()`` ("compiled";
-  "kkt" where MBSYNTH_FAST=off). The path never depends on what a background build or a
+  "kkt" where MBSYNTH_COMPILED=off). The path never depends on what a background build or a
   file on disk happens to have finished, so equal models give equal results;
 - the Evaluator of the constraints and parts (evaluation.py) and the compiled Engine at
   its parameter values.
@@ -25,6 +25,7 @@ joint kinematics, linearize's derivatives) is kept in the one cache (core/memo.p
 changes how fast a Data is made, never what it computes.
 """
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,7 +41,9 @@ from .joint_values import JointValuesBatch
 UNSET = object()  # a Data's engine before its first use
 PATHS = ("compiled", "kkt")  # the compiled kernels (mbsynth.compiled) where they cover the model, or (2.14)'s KKT form
 STRUCTURES_KEPT = 16  # model structures whose compiled Template and evaluators MEMO keeps
-METHODS = {"fast": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
+# the KKT form of (2.14), solved on the Data's path, or the literal pseudo-inverse of (2.14)
+METHODS = {"kkt": solvers.kkt_acceleration, "reference": equations.constrained_acceleration}
+OLD_METHODS = {"fast": "kkt"}  # old name -> the method's name (a DeprecationWarning)
 
 
 @dataclass(frozen=True)
@@ -96,7 +99,8 @@ _STRUCTURES = MEMO.table("model structures", STRUCTURES_KEPT)
 
 
 class Data:
-    """The workspace of computations on ``system`` at parameter values ``p``, on the
+    """The workspace of computations on ``system`` at its ``parameter_values`` (an array in
+    the model's parameter order; ``parameters``: the same as {name: value}), on the
     ``path`` "compiled" or "kkt" (``PATHS``; None: ``background.default_path()``)."""
 
     def __init__(self, system, path=None):
@@ -105,7 +109,7 @@ class Data:
             raise ValueError(f"path must be one of {PATHS}, got {path!r}")
         self.system = self.model = system
         self.path = path
-        self.p = system.parameter_values.copy()
+        self.parameter_values = system.parameter_values.copy()
         self._shared = shared(system)
         self._evaluator = None  # made on first use: a compiled run may never need it
         self._joint_values = None  # joint_values.JointValuesBatch, made on first use
@@ -117,11 +121,7 @@ class Data:
     @property
     def parameters(self):
         """{name: value} at this Data's parameter values."""
-        return dict(zip(self.system.parameters, self.p.tolist()))
-
-    @property
-    def parameter_values(self):
-        return self.p
+        return dict(zip(self.system.parameters, self.parameter_values.tolist()))
 
     @property
     def evaluator(self):
@@ -136,7 +136,7 @@ class Data:
         cover."""
         if self._engine is UNSET:
             template = None if self.path == "kkt" else background.template(self.system, self._shared.compiled)
-            self._engine = None if template is None else template.engine(self.p)
+            self._engine = None if template is None else template.engine(self.parameter_values)
         return self._engine
 
     def set_parameters(self, values):
@@ -144,14 +144,14 @@ class Data:
         those defined by expressions of others follow. Raises ModelError for an unknown
         name, a non-finite value, or a part whose M or Q the values make unusable
         (``System.resolved_parameters``)."""
-        self.p = self.system.resolved_parameters(values, self.p)
+        self.parameter_values = self.system.resolved_parameters(values, self.parameter_values)
         if self._engine is not None and self._engine is not UNSET:
-            self._engine = self._engine.template.engine(self.p)
+            self._engine = self._engine.template.engine(self.parameter_values)
 
     def initial_state(self):
         """(q, q̇) from the model's ``initial:`` mapping at this Data's parameter values
         (``System.initial_state``)."""
-        return self.system.initial_state(self.p)
+        return self.system.initial_state(self.parameter_values)
 
     def _state(self, q, qd):
         return self.system._state(q, qd)
@@ -162,7 +162,8 @@ class Data:
         """Assemble M (block diagonal), Q, A, b and C at the state (t, q, q̇)."""
         q, qd = self._state(q, qd)
         evaluator = self.evaluator
-        return Assembly(*evaluator.parts(t, q, qd, self.p), *evaluator.dense_rows(t, q, qd, self.p))
+        p = self.parameter_values
+        return Assembly(*evaluator.parts(t, q, qd, p), *evaluator.dense_rows(t, q, qd, p))
 
     def constraint_rows(self, t, q, qd):
         """A (m × n, scipy.sparse CSR) and b at (t, q, q̇): the rows alone, without M."""
@@ -170,35 +171,35 @@ class Data:
         return arrays.A, arrays.b
 
     def constraint_arrays(self, t, q, qd, sparse=True):
-        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the connectors
+        """A, b, C, φ and φ̇ at (t, q, q̇) from one evaluation of the constraints
         (``evaluation.ConstraintArrays``): A scipy.sparse CSR, or dense (sparse=False), or
         dense where that is faster (sparse=None: few rows and coordinates)."""
         q, qd = self._state(q, qd)
-        return self.evaluator.constraints(t, q, qd, self.p, sparse)
+        return self.evaluator.constraints(t, q, qd, self.parameter_values, sparse)
 
     def constraint_residuals(self, t, q, qd):
         """(φ, φ̇) per row of A: position and velocity residuals (NaN where not defined)."""
         q, qd = self._state(q, qd)
-        return self.evaluator.residuals(t, q, qd, self.p)
+        return self.evaluator.residuals(t, q, qd, self.parameter_values)
 
     def energy(self, t, q, qd):
         """(kinetic, potential) energy: the parts' T and V plus the force elements' potentials."""
         q, qd = self._state(q, qd)
-        return self.evaluator.energies(t, q, qd, self.p)
+        return self.evaluator.energies(t, q, qd, self.parameter_values)
 
     def power(self, t, q, qd):
         """The power of the forces that derive from no potential (``Evaluator.power``): the
         rate at which they change T + V."""
         q, qd = self._state(q, qd)
-        return self.evaluator.power(t, q, qd, self.p)
+        return self.evaluator.power(t, q, qd, self.parameter_values)
 
     def branch_problems(self, q=None, t=0.0):
         """``System.branch_problems`` at this Data's parameter values."""
-        return self.system.branch_problems(q, t, self.p)
+        return self.system.branch_problems(q, t, self.parameter_values)
 
     def part_problems(self, parameters=None):
         """``System.part_problems`` at this Data's parameter values."""
-        return self.system.part_problems(parameters, self.p)
+        return self.system.part_problems(parameters, self.parameter_values)
 
     def check_branches(self, q, t=0.0):
         """Raise SolveError naming the first joint whose frames, at the state q, are in a
@@ -209,9 +210,13 @@ class Data:
 
     # ---- the motion (2.14)
 
-    def motion(self, t, q, qd, method="fast", baumgarte=None, drift=False):
+    def motion(self, t, q, qd, method="kkt", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (``System.motion`` says
         what each argument means); its ``lam`` is computed when first read."""
+        if method in OLD_METHODS:
+            warnings.warn(f"method={method!r} is the old name of method={OLD_METHODS[method]!r}", DeprecationWarning,
+                          stacklevel=2)
+            method = OLD_METHODS[method]
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
@@ -220,7 +225,7 @@ class Data:
 
     def _solved(self, t, q, qd, method, baumgarte, drift):
         """The Motion of ``motion``, without its multipliers."""
-        if method == "fast":
+        if method == "kkt":
             engine = self.engine
             if engine is not None:
                 shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
@@ -241,7 +246,7 @@ class Data:
             return METHODS[method](arrays.M, arrays.Q, arrays.A, b, C, coordinates=system.coordinates,
                                    constraints=system.constraint_names, drift=off_manifold)
         if system.coulomb:  # C depends on q̈ (friction.py)
-            return friction.coulomb_motion(system.connectors, arrays, solve, t, q, qd, self.p)
+            return friction.coulomb_motion(system.constraints, arrays, solve, t, q, qd, self.parameter_values)
         return solve(arrays.C)
 
     def stage_motion(self, baumgarte=None, drift=False, compiled=True):
@@ -251,13 +256,13 @@ class Data:
         False: the KKT path alone (for stages the engine has declined already)."""
         engine = self.engine
         if not compiled:
-            return lambda t, q, qd: self._kkt_motion(t, *self._state(q, qd), "fast", baumgarte, drift)
+            return lambda t, q, qd: self._kkt_motion(t, *self._state(q, qd), "kkt", baumgarte, drift)
         if engine is None or baumgarte is not None:
-            return lambda t, q, qd: self._solved(t, *self._state(q, qd), "fast", baumgarte, drift)
+            return lambda t, q, qd: self._solved(t, *self._state(q, qd), "kkt", baumgarte, drift)
 
         def stage(t, q, qd):
             found = engine.motion(t, q, qd, None, drift)
-            return found if found is not None else self._kkt_motion(t, q, qd, "fast", None, drift)
+            return found if found is not None else self._kkt_motion(t, q, qd, "kkt", None, drift)
         return stage
 
     def motion_batch(self, t, q_batch, qd_batch):
@@ -309,18 +314,18 @@ class Data:
         if self._joint_values is None:
             self._joint_values = JointValuesBatch((k for k in self.system.joint_kinematics().values()
                                                    if k.position_names), self.path == "compiled")
-        return self._joint_values(t, q, qd, qdd, self.p)
+        return self._joint_values(t, q, qd, qdd, self.parameter_values)
 
     def reactions(self, t, q, qd, motion=None):
-        """{connector name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default this
+        """{constraint name: reactions.Reaction} at (t, q, q̇) for ``motion`` (by default this
         Data's motion there): ``System.reactions`` says what they hold."""
         q, qd = self._state(q, qd)
         motion = self.motion(t, q, qd) if motion is None else motion
         arrays = self.evaluate(t, q, qd)
         lam, dependent = self._multipliers(t, q, qd, motion, arrays)
-        kinematics, p = self.system.joint_kinematics(), self.p
+        kinematics, p = self.system.joint_kinematics(), self.parameter_values
         out, row = {}, 0
-        for con in self.system.connectors:
+        for con in self.system.constraints:
             rows = slice(row, row + con.size)
             force = torque = None
             if con.name in kinematics:
@@ -335,7 +340,7 @@ class Data:
     def _joint_force(self, joint, lam, t, q, qd):
         """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the
         load λ gives, Coulomb friction: friction.py) and its force elements."""
-        p = self.p
+        p = self.parameter_values
         g = np.zeros(self.system.n)
         a, _, c = joint.evaluate(t, q, qd, p)
         g[joint.indices] += a.T @ lam + c

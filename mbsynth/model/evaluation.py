@@ -3,14 +3,14 @@
 An ``Evaluator(system, compiled)`` (a Data's, data.py; ``compiled``: the shared structures
 evaluated by their numba kernels, else by numpy) gives
 
-- ``constraints(t, q, qd)``: one evaluation of every connector's rows: A (sparse CSR), b,
+- ``constraints(t, q, qd)``: one evaluation of every constraint's rows: A (sparse CSR), b,
   C, and the residuals φ, φ̇ (NaN on rows without that level) — drift control and
   projection (projection.py) need them together;
 - ``parts(t, q, qd)``: the block-diagonal M and the stacked Q of (2.1), force elements included;
 - ``energies(t, q, qd)``: kinetic and potential energies of the parts and force elements;
 - ``power(t, q, qd)``: the power of the forces that derive from no potential.
 
-The results equal those of calling each connector and part (``Connector.evaluate``,
+The results equal those of calling each constraint and part (``Constraint.evaluate``,
 ``residuals``, ``Part.evaluate``, ``energy``), which remain the reference.
 """
 
@@ -37,10 +37,10 @@ class ConstraintArrays(NamedTuple):
 
 
 class Evaluator:
-    """The layout of a System's connectors and parts for evaluation in batches."""
+    """The layout of a System's constraints and parts for evaluation in batches."""
 
     def __init__(self, system, compiled):
-        constraints, n = system.connectors, system.n
+        constraints, n = system.constraints, system.n
         self.n = n
         self.m = sum(c.size for c in constraints)
         self.rows = Batch([c._rows for c in constraints], [c.indices for c in constraints], 5, compiled)
@@ -50,7 +50,7 @@ class Evaluator:
         a_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in pattern])
         a_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in pattern])
         self.c_cols = np.concatenate([np.zeros(0, int)] + [c.indices for c in constraints])
-        # CSR of A: the entries sorted by (row, column) — a connector's columns are distinct,
+        # CSR of A: the entries sorted by (row, column) — a constraint's columns are distinct,
         # its rows its own, so no two entries share a place
         self.a_order = np.lexsort((a_cols, a_rows))
         self.a_indices = a_cols[self.a_order]

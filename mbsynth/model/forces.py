@@ -51,7 +51,7 @@ class ForceElement(Keyed):
     @classmethod
     def along_rates(cls, name, efforts, gradients, placed, params, joint=None):
         """Efforts along rates whose ∂/∂q̇ are known in a template's velocity slots (a
-        joint's free motions: connectors.joints): ``efforts`` are expressions of t and the
+        joint's free motions: constraints.joints): ``efforts`` are expressions of t and the
         parameters, ``placed`` = (slots, coordinates, constants, q, q̇) as the joint keeps
         it. Compiled once for every element of the template; Q over the model's symbols is
         built only when asked."""

@@ -1,7 +1,7 @@
 """Force elements along a joint's free motion (forces.ForceElement, added to Q).
 
 A revolute joint turns by ``angle`` θ at ``angle_rate``, a prismatic joint slides by
-``displacement`` s at ``displacement_rate`` (connectors.joints.Joint); a cylindrical
+``displacement`` s at ``displacement_rate`` (constraints.joints.Joint); a cylindrical
 joint does both. Along these:
 
     actuation   effort τ(t) along the rate: a torque about the axis, a force along it

@@ -1,4 +1,4 @@
-"""Derivations shared by joints alike: a joint's rows (connectors/joints.py) and its values
+"""Derivations shared by joints alike: a joint's rows (constraints/joints.py) and its values
 and reaction frame (joint_values.py).
 
 What a joint derives depends on its kind, the types of its two parts (and their numbers of

@@ -21,7 +21,7 @@ Fixed and distance joints have no values. The names per kind are those of its re
 core/joint_kinds.py, the formulas its entry of ``VALUES``, a table that must name every kind
 (``NO_VALUES`` for one without values) and agree with its record, or this module is
 refused at import. A joint's free motions, along which its actuation, spring and friction
-act (connectors/joints.py), are its first values, from the same formulas (``free_motions``).
+act (constraints/joints.py), are its first values, from the same formulas (``free_motions``).
 
 The same compiled function gives the pose of the joint's reaction frame (the child frame
 B, or a robot's child link frame) and its Jacobian, which turn the generalized force a
@@ -64,7 +64,7 @@ class JointKinematics:
     frame on the child with B's origin: B itself, or a robot's link frame). Joints alike
     (kind, types of parts, frames fixed on them) share one derivation and one compiled
     function (``TEMPLATES``, joint_templates.py), their frames' values passed in, as
-    connectors.joints does."""
+    constraints.joints does."""
 
     def __init__(self, name, kind, parent, frame_a, child, frame_b, report_frame, system):
         self.name, self.kind = name, kind

@@ -4,7 +4,7 @@
       elbow: arm_elbow_joint.angle          # an expression of t, parameters, coordinates,
                                             #   velocities (part.c_dot) and joint values
       hinge_load: {reaction: hinge.force}   # a joint's force or torque (System.reactions),
-                                            #   or a connector's multipliers
+                                            #   or a constraint's multipliers
       tip: {position: rod.tip}              # a frame's origin in the world (x, y, z)
       tip_velocity: {velocity: rod.tip}     # its velocity in the world
       kinetic: {energy: kinetic}            # kinetic, potential or total
@@ -38,13 +38,13 @@ log = logging.getLogger(__name__)
 class Output:
     """One declared output: ``kind`` (expression, reaction, position, velocity, energy),
     the sympy ``expressions`` of its components (expression, position, velocity), and for
-    a reaction its ``connector`` and ``part`` (force, torque, multipliers), for an energy
+    a reaction its ``constraint`` and ``part`` (force, torque, multipliers), for an energy
     which one (``part``)."""
 
     name: str
     kind: str
     expressions: tuple = ()
-    connector: str = ""
+    constraint: str = ""
     part: str = ""
     size: int = 1
 
@@ -68,15 +68,15 @@ def frame_output(name, kind, part, frame, q, qd):
     return Output(name, kind, tuple(position), size=3)
 
 
-def reaction_output(name, connector, which):
-    """``which`` (force, torque or multipliers) of ``connector``'s reaction."""
+def reaction_output(name, constraint, which):
+    """``which`` (force, torque or multipliers) of ``constraint``'s reaction."""
     if which not in REACTION_PARTS:
-        raise ModelError(f"output '{name}': a reaction is '<connector>.force', '.torque' or '.multipliers', "
+        raise ModelError(f"output '{name}': a reaction is '<constraint>.force', '.torque' or '.multipliers', "
                          f"not '.{which}'")
-    if which != "multipliers" and not hasattr(connector, "joint_kind"):
-        raise ModelError(f"output '{name}': '{connector.name}' is no joint: it has multipliers, not a {which}")
-    return Output(name, "reaction", connector=connector.name, part=which,
-                  size=connector.size if which == "multipliers" else 3)
+    if which != "multipliers" and not hasattr(constraint, "joint_kind"):
+        raise ModelError(f"output '{name}': '{constraint.name}' is no joint: it has multipliers, not a {which}")
+    return Output(name, "reaction", constraint=constraint.name, part=which,
+                  size=constraint.size if which == "multipliers" else 3)
 
 
 def energy_output(name, which):
@@ -106,7 +106,7 @@ class OutputEvaluator:
     def evaluate(self, t, q, qd, motion=None):
         """One row: every output's columns at (t, q, q̇); ``motion`` (System.motion at that
         state) for reactions, computed when not given."""
-        data, p = self.data, self.data.p
+        data, p = self.data, self.data.parameter_values
         compiled = iter(self._compiled(t, q, qd, p)[0].ravel()) if self._compiled else iter(())
         reactions = None
         if self.needs_reactions:
@@ -115,7 +115,7 @@ class OutputEvaluator:
         row = []
         for output in self.outputs:
             if output.kind == "reaction":
-                row += list(getattr(reactions[output.connector], output.part))
+                row += list(getattr(reactions[output.constraint], output.part))
             elif output.kind == "energy":
                 energies = data.energy(t, q, qd) if energies is None else energies
                 kinetic, potential = energies

@@ -29,11 +29,11 @@ from ..core.tolerances import DEPENDENT_RTOL, RANK_RTOL
 
 @dataclass(frozen=True)
 class Reaction:
-    """The reaction of one connector: ``multipliers`` (λ of its rows), ``redundant`` (its rows
+    """The reaction of one constraint: ``multipliers`` (λ of its rows), ``redundant`` (its rows
     share a dependency with others, so the split of λ among them is the minimum-norm one,
     not the only one), and for a joint ``force`` and ``torque``: the wrench the parent
     exerts on the child through the joint, at the reaction frame's origin, in its axes
-    (None for other connectors)."""
+    (None for other constraints)."""
 
     multipliers: np.ndarray
     redundant: bool

@@ -3,12 +3,12 @@
 A ``Unilateral`` is one gap with Newton's restitution coefficient e (0 ≤ e ≤ 1): a joint's
 limit (``hinge.lower``: g = angle − lo; ``hinge.upper``: g = hi − angle) or a contact (a
 point or sphere on a part's frame against a ground plane, g = n·p − h − r; two spheres,
-g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Connector with φ = g, so that its
+g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Constraint with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
 
 While a gap is open the row is no constraint; while it holds (persistent contact) it is one
-of the System's rows: ``with_active`` makes the System of an active set (its ``connectors``
+of the System's rows: ``with_active`` makes the System of an active set (its ``constraints``
 followed by the active rows), which the run loop switches between (analysis/impacts.py).
 """
 
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .connectors.base import Connector
+from .constraints.base import Constraint
 from ..core.errors import ModelError
 
 
@@ -29,7 +29,7 @@ class Unilateral:
     name: str
     kind: str
     restitution: sp.Expr
-    row: Connector
+    row: Constraint
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
@@ -41,13 +41,13 @@ class Unilateral:
 
 
 def gap_row(name, gap, q, qd, params):
-    """The holonomic Connector of the gap expression ``gap`` (sympy; joint values allowed)."""
-    return Connector.holonomic(name, [gap], q, qd, params)
+    """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed)."""
+    return Constraint.holonomic(name, [gap], q, qd, params)
 
 
 def with_active(system, names):
     """``system`` with the rows of its unilaterals named in ``names`` appended to its
-    connectors, in the order of ``system.unilaterals``: the System of that active set."""
+    constraints, in the order of ``system.unilaterals``: the System of that active set."""
     if not names:
         return system
     return system.with_constraints(u.row for u in system.unilaterals if u.name in names)

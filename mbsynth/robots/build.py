@@ -1,5 +1,5 @@
 """Whole robots as parts: every URDF link a rigid body in its own seven coordinates,
-every URDF joint a connector between frames on two links.
+every URDF joint a constraint between frames on two links.
 
 A link's body has its centre of mass as position and the link frame's axes as body
 axes; its inertia is turned from the URDF inertial frame into link axes (urdf.py). A
@@ -28,7 +28,7 @@ import numpy as np
 import sympy as sp
 
 from .. import compiled
-from ..model.connectors.joints import Joint
+from ..model.constraints.joints import Joint
 from ..core.errors import ModelError
 from ..core.joint_kinds import URDF_KINDS
 from ..model.joint_forces import actuation, joint_motion
@@ -124,7 +124,7 @@ def identifier(text):
 @dataclass(frozen=True)
 class Robot:
     """A robot decomposed into parts: ``parts`` maps each URDF link to its part's name,
-    ``joints`` each URDF joint to its connector's name, ``torques`` each movable joint to
+    ``joints`` each URDF joint to its constraint's name, ``torques`` each movable joint to
     its torque parameter. ``base`` is the root link's world (position, rotation) when
     fixed, its initial pose when ``floating``; ``positions`` the initial joint positions
     ({URDF joint name: value}, 0 where not given)."""
@@ -141,7 +141,7 @@ class Robot:
 
     @classmethod
     def plan(cls, description, prefix="", floating=False, base=None, scope=""):
-        """Names for the parts, connectors and torque parameters of ``description``, each
+        """Names for the parts, constraints and torque parameters of ``description``, each
         after ``scope`` (a substructure's ``left_leg.``)."""
         base = (np.zeros(3), np.eye(3)) if base is None else tuple(np.asarray(x, dtype=float) for x in base)
         parts = _unique({link: scope + prefix + identifier(link) for link in description.links})
@@ -195,12 +195,12 @@ class Robot:
         for joint in self.description.joints:
             on_parent, on_child = self.joint_frames(joint)
             child = parts[on_child.part]
-            connector = Joint(self.joints[joint.name], URDF_KINDS[joint.kind], parts[on_parent.part], on_parent,
+            constraint = Joint(self.joints[joint.name], URDF_KINDS[joint.kind], parts[on_parent.part], on_parent,
                               child, on_child, q, qd, params, report_frame=child.frames[LINK_FRAME])
-            joints.append(connector)
+            joints.append(constraint)
             if joint.name in self.torques:
-                elements.append(actuation(f"{connector.name}.actuation", connector,
-                                          {joint_motion(connector): sp.Symbol(self.torques[joint.name])}, q, qd, params))
+                elements.append(actuation(f"{constraint.name}.actuation", constraint,
+                                          {joint_motion(constraint): sp.Symbol(self.torques[joint.name])}, q, qd, params))
         return joints, elements
 
     def weld(self, parts, q, qd, params):

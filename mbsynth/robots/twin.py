@@ -18,7 +18,7 @@ joined by constraints. The twin of a System is built as follows:
 State maps. Pinocchio → mbsynth is forward kinematics: a body at placement X in joint i
 has the world pose oMᵢ X and the spatial velocity X⁻¹ vᵢ in its own axes. mbsynth →
 Pinocchio reads each Pinocchio joint off the bodies as expressions of their coordinates:
-a revolute joint's ``angle`` and ``angle_rate`` (connectors.joints; a continuous joint's
+a revolute joint's ``angle`` and ``angle_rate`` (constraints.joints; a continuous joint's
 q is (cos θ, sin θ)), a prismatic joint's ``displacement`` and its rate, a free-flyer's
 frame origin p, quaternion (x, y, z, w — Pinocchio's order) and spatial velocity in its
 own axes (Rᵀṗ, Rᵀω). Joint accelerations are the time derivatives of these rates,
@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 import sympy as sp
 
-from ..model.connectors.joints import Joint
+from ..model.constraints.joints import Joint
 from ..core.errors import ModelError
 from ..core.joint_kinds import KINDS, WELD
 from ..core.kinematics import body_rate_matrix, rotation
@@ -121,7 +121,7 @@ class Twin:
         if odd:
             raise no_twin(system, f"parts {odd} are not rigid bodies")
         own = {f"{p.name}.unit_quaternion" for p in system.parts}
-        joints = [c for c in system.connectors if c.name not in own]
+        joints = [c for c in system.constraints if c.name not in own]
         odd = [c.name for c in joints if not isinstance(c, Joint) or any(x != 0 for x in c.C)]
         if odd:
             raise no_twin(system, f"constraints {odd} are not ideal joints")
@@ -160,7 +160,7 @@ class Twin:
         return placement.act(pin.Inertia(self._value(part.mass), np.zeros(3), J))
 
     def _add_robot(self, robot, parts):
-        """Graft Pinocchio's model of the robot's URDF; returns the connectors it replaces."""
+        """Graft Pinocchio's model of the robot's URDF; returns the constraints it replaces."""
         urdf = robot.description.path
         source = (pin.buildModelFromUrdf(urdf, pin.JointModelFreeFlyer()) if robot.floating
                   else pin.buildModelFromUrdf(urdf))
@@ -178,8 +178,8 @@ class Twin:
             if j.shortname() == "JointModelFreeFlyer":
                 self._free_flyer(joint_name, ids[i], root, root.frames[LINK_FRAME])
             else:
-                connector = next(c for c in self.system.connectors if c.name == robot.joints[name])
-                self.coordinates.append(_joint_coordinate(joint_name, ids[i], self.model, connector, 1, self.system,
+                constraint = next(c for c in self.system.constraints if c.name == robot.joints[name])
+                self.coordinates.append(_joint_coordinate(joint_name, ids[i], self.model, constraint, 1, self.system,
                                                           _kind(j), limits, robot.torques.get(name)))
         for link, part in robot.parts.items():
             frame = source.frames[source.getFrameId(link, pin.FrameType.BODY)]

@@ -87,7 +87,7 @@ class Metric:
             return getattr(traj, kind)
         args = [T_SYMBOL, *system.q_symbols, *system.qd_symbols, *system.parameter_symbols]
         f = sp.lambdify(args, expr, modules="numpy")
-        params = [np.full(traj.t.size, v) for v in data.p]
+        params = [np.full(traj.t.size, v) for v in data.parameter_values]
         values = np.broadcast_to(f(traj.t, *traj.q.T, *traj.qd.T, *params), traj.t.shape)
         return float({"final": lambda v: v[-1], "max": np.max, "min": np.min, "mean": np.mean}[kind](values))
 

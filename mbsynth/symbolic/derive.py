@@ -22,7 +22,7 @@ from ..core.memo import MEMO
 
 T_SYMBOL = sp.Symbol("t")
 LAMBDIFIED_KEPT = 65536  # structures whose numpy function the one cache keeps (far above a model's count)
-PARAMETERS = 3  # the position of the model's parameters among a part's or connector's arguments (t, q, q̇, p)
+PARAMETERS = 3  # the position of the model's parameters among a part's or constraint's arguments (t, q, q̇, p)
 _LARGEST = sp.Float(np.finfo(float).max)
 # pi and e as numpy floats, so that all arithmetic of a compiled expression is numpy's:
 # Python floats raise on overflow and division by zero ((2*pi + 1e308)**251, 1/(1 - t) at
@@ -341,7 +341,7 @@ def compile_function(args, exprs, constants=(), dtype=float, picked=None):
 
     ``constants``: (placeholder, value) pairs — ``exprs`` may hold the placeholders, whose
     values (numbers or expressions of ``args``) are put in at each evaluation, so that
-    expressions shared by many instances (connectors.joints) are compiled once.
+    expressions shared by many instances (constraints.joints) are compiled once.
 
     ``picked``: the position in ``args`` of a list of symbols (the model's parameters) that
     the function is given whole and of which ``exprs`` read a few: those few become

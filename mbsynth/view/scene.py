@@ -44,7 +44,7 @@ import sympy as sp
 from ..core.errors import ModelError
 from ..core.joint_kinds import KINDS
 from ..io.parts import COLORS
-from ..model.connectors.rolling import KnifeEdge, RollingDisk
+from ..model.constraints.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
 from ..model.parts.part_type import BODY, FE_MESH, FRAMES, LINE, SPHERE
 from ..symbolic.derive import T_SYMBOL, compile_function
@@ -277,7 +277,7 @@ def _joint_items(system, poses, markers):
     """Lines of the distance joints (massless rods) and, if ``markers``, a marker at both
     frames of every other joint."""
     lines, specs = [], []
-    for con in system.connectors:
+    for con in system.constraints:
         if getattr(con, "joint_kind", None) is None:
             continue
         ends = [poses.add(part, frame) for part, frame in zip(con.parts, con.frames)]
@@ -344,7 +344,7 @@ def _structure(system, poses, colors):
     frames away from it, its own and those its joints and contacts attach to."""
     values = dict(zip(system.parameter_symbols, system.parameter_values))
     attached, wheels = {}, []
-    for con in system.connectors:
+    for con in system.constraints:
         if getattr(con, "joint_kind", None) is not None:
             ends = zip(con.parts, con.frames)
         elif isinstance(con, (RollingDisk, KnifeEdge)):

@@ -189,9 +189,9 @@ def test_n_four_bar_40_follows_the_one_dof_reference(monkeypatch):
     how near its rows are to losing rank at every step's end: compiled/least_direction.py)
     and listed within 1e-3 s of its time with rows along x (the flat bars' dependency), no
     span relaxed, B0 within 1e-7 m of the exact motion. benchmarks/loops.py runs the
-    benchmark's 20 s. The compiled kernels waited for (MBSYNTH_FAST=wait): without them the
+    benchmark's 20 s. The compiled kernels waited for (MBSYNTH_COMPILED=wait): without them the
     run projects each step and lists the crossings its stages come near."""
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
     system = mb.loads(ref.n_four_bar_yaml(40), name="n_four_bar_40")
     traj = mb.simulate(system, 4.0, dt=0.1)
     assert_follows_the_one_dof_reference(traj, 40)

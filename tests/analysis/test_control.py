@@ -10,7 +10,7 @@ from mbsynth.analysis.trajectory import load_trajectory
 PUSHED = """
 name: pushed
 parameters: {m: 2.0, u: 0.0}
-subsystems:
+parts:
   p: {type: lagrangian, coordinates: [x], T: 0.5*m*x_dot**2, V: -u*x}
 initial: {p.x: 0.1, p.x_dot: -0.2}
 """

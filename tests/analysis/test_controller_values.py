@@ -14,7 +14,7 @@ name: pendulum
 parameters: {m: 1.0, L: 1.0, g: 9.81, tau0: 0.0}
 gravity: [0, 0, -g]
 world: {frames: {pivot: {axis: [0, 1, 0]}}}
-subsystems:
+parts:
   rod:
     type: rigid_body
     mass: m

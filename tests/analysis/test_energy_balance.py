@@ -12,7 +12,7 @@ M, K, C, X0 = 1.0, 40.0, 0.8, 0.1  # m ẍ + c ẋ + k x = 0, from x = X0 at res
 LAGRANGIAN = f"""
 name: damped_oscillator
 parameters: {{m: {M}, k: {K}, c: {C}}}
-subsystems:
+parts:
   mass:
     type: lagrangian
     coordinates: [x]
@@ -26,7 +26,7 @@ SLIDER = """
 name: damped_slider
 parameters: {{m: {m}, k: {k}, c: {c}}}
 world: {{frames: {{rail: {{axis: [1, 0, 0]}}}}}}
-subsystems:
+parts:
   block:
     type: rigid_body
     mass: m

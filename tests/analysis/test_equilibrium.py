@@ -171,7 +171,7 @@ def test_near_the_top_nearest_finds_the_inverted_rest_and_default_the_hanging_on
 DOUBLE_WELL = """
 name: double_well
 parameters: {m: 2.0}
-subsystems:
+parts:
   b:
     type: lagrangian
     coordinates: [x, y]

@@ -27,7 +27,7 @@ MIXED = """\
 parameters: {Mc: 1000.0, m: 0.001, L: 0.001, mb: 0.002, R: 1000.0, h: 2000.0, g: 9.81, th0: 0.3, ph0: 0.2}
 gravity: [0, 0, -g]
 world: {frames: {top: {position: [0, 0, h]}}}
-subsystems:
+parts:
   cart: {type: lagrangian, coordinates: [X], T: 0.5*Mc*X_dot**2}
   bob: {type: particle, mass: m, initial: {position: [L*sin(th0), 0, -L*cos(th0)]}}
   big: {type: particle, mass: mb, initial: {position: [R*sin(ph0), 0, h - R*cos(ph0)]}}
@@ -65,7 +65,7 @@ parameters: {a: 0.5, b: 1.2, m1: 0.7, I1: 0.02, m2: 1.5, I2: 0.3, g: 9.81, th: 0
 gravity: [0, -g, 0]
 world:
   frames: {O: {position: [0, 0, 0]}, E: {position: [b/2, 0, 0]}, D: {position: [b, 0, 0]}}
-subsystems:
+parts:
   crank: &link
     type: planar_body
     mass: m1
@@ -117,7 +117,7 @@ def parallelogram_four_bar(angle, a=0.4, b=1.0, m1=0.5, m2=1.2, m3=0.9, I2=0.15)
 parameters: {{a: {a}, b: {b}, m1: {m1}, m2: {m2}, m3: {m3}, I2: {I2}, g: 9.81, th: {angle}}}
 gravity: [0, -g, 0]
 world: {{frames: {{O: {{position: [0, 0, 0]}}, D: {{position: [b, 0, 0]}}}}}}
-subsystems:
+parts:
   crank:
     {{type: planar_body, mass: m1, inertia: m1*a**2/12,
      initial: {{position: ['a/2*cos(th)', 'a/2*sin(th)'], theta: th}},
@@ -161,7 +161,7 @@ SLIDER_CRANK = """\
 parameters: {a: 0.3, b: 0.8, m1: 0.6, m2: 0.9, m3: 1.5, I3: 0.02, g: 9.81}
 gravity: [0, -g, 0]
 world: {frames: {O: {position: [0, 0, 0]}, rail: {position: [0, 0, 0], axis: [1, 0, 0]}}}
-subsystems:
+parts:
   crank:
     {type: planar_body, mass: m1, inertia: m1*a**2/12, initial: {position: [a/2, 0]},
      frames: {O: {position: [-a/2, 0, 0]}, B: {position: [a/2, 0, 0]}}}
@@ -199,7 +199,7 @@ def two_strings(offset):
     values √2/√(1 + offset²) and √2·offset/√(1 + offset²), ratio exactly offset."""
     return mb.loads(f"""\
 parameters: {{e: {offset!r}}}
-subsystems:
+parts:
   p: {{type: lagrangian, coordinates: [x, y], T: 0}}
 constraints:
   - {{name: left, holonomic: (p.x + 1)**2 + p.y**2 - 1 - e**2}}
@@ -228,7 +228,7 @@ def test_strings_that_become_parallel_make_the_verdict_uncertain_then_not_unique
 def masses(ratio):
     return mb.loads(f"""\
 parameters: {{m: 2.0, r: {ratio!r}}}
-subsystems:
+parts:
   p: {{type: lagrangian, coordinates: [x, y], T: 0.5*m*x_dot**2 + 0.5*r*m*y_dot**2, forces: {{x: 3.0, y: 3.0*r}}}}
 """)
 
@@ -251,7 +251,7 @@ def test_a_mass_below_the_tolerance_is_reported_with_the_warning(capsys, tmp_pat
     assert report.verdict_margin == pytest.approx(10, rel=1e-6)
     assert len(report.warnings) == 1 and "may in fact be unique" in report.warnings[0]
     model = tmp_path / "tiny.yaml"
-    model.write_text("parameters: {m: 2.0, r: 1.0e-13}\nsubsystems:\n  p: {type: lagrangian, coordinates: "
+    model.write_text("parameters: {m: 2.0, r: 1.0e-13}\nparts:\n  p: {type: lagrangian, coordinates: "
                      "[x, y], T: 0.5*m*x_dot**2 + 0.5*r*m*y_dot**2, forces: {x: 3.0, y: 3.0*r}}\n")
     assert main(["check", str(model), "--json"]) == 1
     data = json.loads(capsys.readouterr().out)

@@ -22,7 +22,7 @@ from mbsynth.analysis.trajectory import Trajectory, TrajectoryWriter, load_traje
 
 
 def one_coordinate(force, x0=0.0):
-    return mb.loads(f"subsystems:\n  p: {{type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
+    return mb.loads(f"parts:\n  p: {{type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
                     f"forces: {{x: '{force}'}}}}\ninitial: {{p.x: {x0}}}\n")
 
 
@@ -129,7 +129,7 @@ RUNNER = """\
 import sys
 import mbsynth as mb
 from mbsynth.analysis.simulate import simulate
-system = mb.loads("subsystems:\\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0.5*x**2}\\n"
+system = mb.loads("parts:\\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0.5*x**2}\\n"
                   "initial: {p.x: 1}\\n")
 simulate(system, 1e3, dt=1e-3, out=sys.argv[1])
 """
@@ -172,7 +172,7 @@ def test_a_killed_run_never_leaves_half_a_file_under_the_final_name(tmp_path, su
 def test_output_that_cannot_fit_in_memory_is_refused_before_the_run(tmp_path):
     """10¹² + 1 rows of a 1-coordinate model, 8 bytes × (2·1 + 7) each (t, q, q̇, energies,
     power, residuals and the output time): 72 TB, refused before anything is written."""
-    system = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0.5*x**2}\n")
+    system = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0.5*x**2}\n")
     out = tmp_path / "big.npz"
     with pytest.raises(mb.ModelError, match=r"1,000,000,000,001 output rows would take 72 TB") as caught:
         simulate(system, 1e6, dt=1e-6, out=out)

@@ -97,7 +97,7 @@ def _cradle(count, gap, speed):
                       + (f", velocity: [{speed!r}, 0, 0]" if k == 0 else "") + "}}" for k in range(count))
     contacts = "\n".join(f"  - {{name: c{k}, type: spheres, between: [b{k}, b{k + 1}], radius: [r, r], restitution: 1}}"
                          for k in range(count - 1))
-    return mb.loads(f"name: cradle\nparameters: {{m: 0.3, r: {r}}}\nsubsystems:\n{balls}\ncontacts:\n{contacts}\n")
+    return mb.loads(f"name: cradle\nparameters: {{m: 0.3, r: {r}}}\nparts:\n{balls}\ncontacts:\n{contacts}\n")
 
 
 @pytest.mark.parametrize("count", [3, 5])
@@ -123,7 +123,7 @@ def test_a_jump_is_the_classical_impulse_solution_with_a_massless_link():
 name: link_strike
 parameters: {{m: {m}, L: {L}, s: {s!r}, c: {c!r}, w0: {w0}}}
 world: {{frames: {{pivot: {{axis: [0, 1, 0]}}}}}}
-subsystems:
+parts:
   link:
     type: rigid_body
     mass: 0
@@ -161,7 +161,7 @@ def test_a_jump_is_the_classical_impulse_solution_for_a_quaternion_body():
     corner = np.array([0.2, -0.1, -0.15])
     system = mb.loads(f"""
 name: corner_strike
-subsystems:
+parts:
   body:
     type: rigid_body
     mass: {m}
@@ -223,7 +223,7 @@ def test_a_resting_contact_holds_until_its_force_would_pull_and_then_releases():
 name: lift
 parameters: {{m: {m}, r: {r}, g: {g}, k: {k}}}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   ball: {{type: particle, mass: m, initial: {{position: [0, 0, r]}}}}
 forces:
   - {{name: lift, type: force, at: ball, value: [0, 0, k*t]}}
@@ -262,7 +262,7 @@ def test_a_slider_strikes_the_end_of_its_rail():
     system = mb.loads(f"""
 name: rail
 world: {{frames: {{rail: {{axis: [1, 0, 0]}}}}}}
-subsystems:
+parts:
   block:
     type: rigid_body
     mass: 2.0
@@ -305,7 +305,7 @@ def test_a_ball_bounces_to_rest_on_a_tilted_plane_and_slides_on_in_contact():
 name: slope
 parameters: {{m: 0.2, r: {r}, g: {g}}}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   ball: {{type: particle, mass: m, initial: {{position: {start.tolist()}}}}}
 contacts:
   - {{name: slope, type: plane, child: ball, radius: r, normal: {n.tolist()}, restitution: {e}}}
@@ -329,7 +329,7 @@ def test_a_body_landing_flat_on_two_points_strikes_on_both_at_once():
     m, a, b, v, e = 1.5, 0.3, 0.1, 2.0, 0.6
     system = mb.loads(f"""
 name: plank
-subsystems:
+parts:
   plank:
     type: rigid_body
     mass: {m}
@@ -357,7 +357,7 @@ def test_a_controller_that_lifts_a_resting_ball_releases_its_contact_at_the_samp
 name: lift
 parameters: {{m: {m}, r: {r}, g: {g}, F: 0.0}}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   ball: {{type: particle, mass: m, initial: {{position: [0, 0, r]}}}}
 forces:
   - {{name: lift, type: force, at: ball, value: [0, 0, F]}}

@@ -53,9 +53,9 @@ def test_example3_massless_spring_end():
 
 
 def test_massless_node_without_its_balance_is_refused():
-    """Without closure the massless node is indeterminate: a verdict, no spectrum."""
+    """Without the balance the massless node is indeterminate: a verdict, no spectrum."""
     with open("models/paper/example3_m1_zero_auto.yaml") as f:
-        text = f.read().replace("closure: auto", "")
+        text = f.read().replace("balances: auto", "")
     system = mb.loads(text)
     q = np.array([1.0, 1.2, 0.8])
     with pytest.raises(mb.SolveError, match="not unique|no motion|balance"):
@@ -93,7 +93,7 @@ name: damped_bob
 parameters: {m: 1.2, k: 80.0, l0: 0.5, c: 1.5, g: 9.81}
 gravity: [0, 0, -g]
 world: {frames: {anchor: {position: [0, 0, 0]}}}
-subsystems:
+parts:
   bob: {type: particle, mass: m, initial: {position: [0.05, 0.02, -0.6]}}
 forces:
   - {name: spring, type: spring, between: [world.anchor, bob], stiffness: k, rest_length: l0, damping: c}
@@ -125,7 +125,7 @@ name: parallelogram
 parameters: {{a: 0.4, d: 1.1, m1: 0.5, m2: 1.2, m3: 0.9, I2: 0.15, g: 9.81, th: {crank_angle!r}}}
 gravity: [0, -g, 0]
 world: {{frames: {{O: {{position: [0, 0, 0]}}, D: {{position: [d, 0, 0]}}}}}}
-subsystems:
+parts:
   crank:
     type: planar_body
     mass: m1
@@ -197,7 +197,7 @@ def test_four_bar_at_and_near_its_change_point(offset):
 CARTESIAN = """
 name: cartesian_pendulum
 parameters: {m: 0.8, l: 1.3, g: 9.81}
-subsystems:
+parts:
   bob:
     type: lagrangian
     coordinates: [x, z]
@@ -241,7 +241,7 @@ FREE = """
 name: drifting
 parameters: {m: 1.0, g: 0.0}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   p: {type: particle, mass: m}
 """
 
@@ -325,7 +325,7 @@ UR5_HELD = """
 name: ur5_hanging
 parameters: {g: 9.81}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]},
         initial: {shoulder_lift_joint: -0.5, elbow_joint: 0.7, wrist_2_joint: 0.4}}
 constraints:   # the joints about vertical axes at the rest, held (free there: no isolated rest)

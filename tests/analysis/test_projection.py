@@ -1,4 +1,4 @@
-"""projection._correction: the least-norm step of a sparse J, checked against dense least
+"""projection._least_change: the least-norm step of a sparse J, checked against dense least
 squares (numpy's SVD-based lstsq, an independent computation); a projection that fails
 names the rows at fault (a servo no configuration meets, a loop at a singular position)."""
 
@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse
 
 import mbsynth as mb
-from mbsynth.analysis.projection import _correction, consistent_initial_state
+from mbsynth.analysis.projection import _least_change, consistent_initial_state
 from mbsynth.cli import main
 
 RNG = np.random.default_rng(3)
@@ -29,7 +29,7 @@ def tree_rows(count, width=5):
 
 def weighted_least_norm(J, r):
     """numpy's minimum of ‖diag(c) Δ‖ subject to J Δ = r, c_j = ‖J_:j‖ (the metric of
-    projection._correction): Δ = D (J D)⁺ r with D = diag(1/c)."""
+    projection._least_change): Δ = D (J D)⁺ r with D = diag(1/c)."""
     J = J.toarray()
     D = 1.0 / np.linalg.norm(J, axis=0)
     return D * np.linalg.lstsq(J * D, r, rcond=1e-12)[0]
@@ -39,7 +39,7 @@ def test_independent_rows_give_the_least_norm_step():
     J = tree_rows(40)
     J = (J @ scipy.sparse.diags(RNG.uniform(1e-3, 1e3, size=J.shape[1]))).tocsr()  # coordinates in mixed units
     r = RNG.normal(size=J.shape[0])
-    step = _correction(J, r, np.arange(J.shape[1]))
+    step = _least_change(J, r, np.arange(J.shape[1]))
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-10 * np.linalg.norm(expected)
 
@@ -50,16 +50,16 @@ def test_the_step_does_not_depend_on_the_coordinates_units():
     J = tree_rows(10)
     r = RNG.normal(size=J.shape[0])
     units = RNG.uniform(1e-3, 1e3, size=J.shape[1])
-    scaled = _correction((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r,
+    scaled = _least_change((J @ scipy.sparse.diags(1.0 / units)).tocsr(), r,
                          np.arange(J.shape[1]))  # coordinate j counted in 1/units_j
-    np.testing.assert_allclose(scaled / units, _correction(J, r, np.arange(J.shape[1])), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(scaled / units, _least_change(J, r, np.arange(J.shape[1])), rtol=1e-9, atol=1e-12)
 
 
 def test_dependent_rows_still_give_the_least_norm_step():
     J = tree_rows(10)
     J = scipy.sparse.vstack([J, J[3] + 2 * J[17]]).tocsr()  # a redundant row, as a planar loop in 3D has
     r = J @ RNG.normal(size=J.shape[1])  # consistent right side
-    step = _correction(J, r, np.arange(J.shape[1]))
+    step = _least_change(J, r, np.arange(J.shape[1]))
     expected = weighted_least_norm(J, r)
     assert np.linalg.norm(step - expected) < 1e-9 * np.linalg.norm(expected)
     assert np.linalg.norm(J @ step - r) < 1e-9 * np.linalg.norm(r)
@@ -72,7 +72,7 @@ def test_a_small_system_takes_the_dense_route_to_the_same_step():
     assert J.shape[0] * J.shape[1] <= DENSE_ENTRIES
     r = RNG.normal(size=J.shape[0])
     expected = weighted_least_norm(J, r)
-    assert np.linalg.norm(_correction(J, r, np.arange(J.shape[1])) - expected) < 1e-10 * np.linalg.norm(expected)
+    assert np.linalg.norm(_least_change(J, r, np.arange(J.shape[1])) - expected) < 1e-10 * np.linalg.norm(expected)
 
 
 def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
@@ -83,7 +83,7 @@ def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
     import mbsynth as mb
     from mbsynth.analysis.projection import project_positions
 
-    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+    system = mb.loads("name: spinner\nparts:\n  body: {type: rigid_body, mass: 1.0, "
                       "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
     q = system.initial_state()[0]
     u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
@@ -93,15 +93,15 @@ def test_a_quaternion_component_near_zero_does_not_throw_the_projection_off():
     assert np.abs(projected - q).max() < 1e-11
 
 
-def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near_zero():
+def test_a_quaternion_rate_is_projected_by_a_small_move_when_a_component_is_near_zero():
     """The velocity row u·u̇ = 0 of a body with u = (0.6, 0.8, 0, 1e-8) and ψ = 1e-9: a scale
-    of u_z's column alone (2u_z) would take the correction almost entirely on u̇_z, about
+    of u_z's column alone (2u_z) would take the projection almost entirely on u̇_z, about
     ψ/(3 u_z) = 0.03 rad/s, a kick to the spin. The quaternion's four columns share one
     scale (System.coordinate_groups), so u̇ moves along u by ψ/|u|² and no more."""
     import mbsynth as mb
     from mbsynth.analysis.projection import project_velocities
 
-    system = mb.loads("name: spinner\nsubsystems:\n  body: {type: rigid_body, mass: 1.0, "
+    system = mb.loads("name: spinner\nparts:\n  body: {type: rigid_body, mass: 1.0, "
                       "inertia: [1.0, 2.0, 3.0]}\n", name="spinner")
     q, qd = system.initial_state()
     u = [system.coordinates.index(f"body.q{c}") for c in "wxyz"]
@@ -116,7 +116,7 @@ def test_a_quaternion_rate_is_corrected_by_a_small_move_when_a_component_is_near
 def test_a_pendulum_bob_near_the_vertical_is_moved_along_its_rod():
     """A01's bob (an energy-defined part, T = ½ m (ẋ² + ẏ²)) near the bottom, x = −0.0127,
     its rod 1e-9 too long: x and y have equal M_ii, hence the same units, and share one
-    scale (subsystems.lagrangian.same_units), so the least change moves the bob along the
+    scale (parts/lagrangian.py, same_units), so the least change moves the bob along the
     rod, Δ ∥ (x, y). With a scale per coordinate the step went on x almost alone, by
     φ/(2 ∂φ/∂x) ≈ 20 φ, and its velocity projection changed the energy by 4e-7 of mg L."""
     import mbsynth as mb
@@ -135,9 +135,9 @@ def test_coordinates_of_equal_mass_entries_share_a_scale_and_others_do_not():
     """same_units: x, y under ½ m (ẋ² + ẏ²) together; r, θ under ½ m (ṙ² + r² θ̇²) apart."""
     import mbsynth as mb
 
-    cartesian = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x, y], "
+    cartesian = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [x, y], "
                          "T: 0.5*(x_dot**2 + y_dot**2)}\n")
-    polar = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [r, th], "
+    polar = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [r, th], "
                      "T: 0.5*(r_dot**2 + r**2*th_dot**2)}\n")
     assert len(set(cartesian.coordinate_groups)) == 1
     assert len(set(polar.coordinate_groups)) == 2
@@ -166,7 +166,7 @@ TWO_ARMS_AT_ZERO = """
 name: two_arms_at_zero
 parameters: {m: 1.5, L: 0.6, r: 0.02, g: 9.81}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   left: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}
   right: {type: robot, robot: ur5, base: {position: [1.6345, 0.3829 + L, 1], rpy: [0, 0, pi]}}
   bar:
@@ -210,7 +210,7 @@ def test_a_servo_beyond_the_joints_range_is_named(tmp_path, capsys):
     exit 2 naming the servo, unmet from the start, not the joint rows Newton's steps break."""
     path = tmp_path / "servo.yaml"
     path.write_text("name: ur5_servo\nparameters: {g: 9.81}\ngravity: [0, 0, -g]\n"
-                    "subsystems:\n  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}\n"
+                    "parts:\n  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}\n"
                     "constraints:\n  - {name: elbow_servo, holonomic: arm_elbow_joint.angle - 4}\n")
     assert main(["simulate", str(path), "--t-end", "0.1"]) == 2
     err = capsys.readouterr().err
@@ -230,7 +230,7 @@ def test_a_row_out_of_reach_says_it_is_at_its_least():
 PENDULUM = """\
 name: pendulum
 parameters: {m: 1.0, L: 2.0, g: 9.81}
-subsystems:
+parts:
   bob: {type: lagrangian, coordinates: [x, y], T: 0.5*m*(x_dot**2 + y_dot**2), V: m*g*y}
 constraints:
   - {name: rod, holonomic: bob.x**2 + bob.y**2 - L**2}

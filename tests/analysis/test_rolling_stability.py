@@ -90,7 +90,7 @@ UPRIGHT_DISK = """
 name: upright_disk
 parameters: {m: 1.0, R: 0.1, g: 9.81, A: m*R**2/4, C: m*R**2/2, w: 12.0}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   disk:
     type: rigid_body
     rotation: zxz
@@ -172,7 +172,7 @@ def test_turning_disk_against_kanes_method(omega):
 SLEIGH = """
 name: sleigh_on_a_massless_blade
 parameters: {m: 1.0, I: 0.02, a: 0.2, u0: 1.0}
-subsystems:
+parts:
   carrier: {type: planar_body, mass: 0, inertia: 0, frames: {weld: {position: [-a, 0, 0]}}}
   sleigh: {type: planar_body, mass: m, inertia: I, frames: {weld: {position: [0, 0, 0]}}}
 initial: {carrier.x: a, carrier.x_dot: u0, sleigh.x_dot: u0}

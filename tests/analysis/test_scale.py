@@ -49,7 +49,7 @@ def test_n_four_bar_through_its_singular_position_at_any_scale(length, mass):
     by = (traj.column("v0.y") + 0.5 * length * np.cos(theta)) / length
     xr, yr = ref.n_four_bar_reference(traj.t / unit, 1)
     # of L; the benchmark asks 1e-3. Measured at the 1 m scale 3.2e-7, in millimetres 4.6e-8; in
-    # kilometres 2.5e-6 with the connectors evaluated in Python and 1.0e-5 with their compiled
+    # kilometres 2.5e-6 with the constraints evaluated in Python and 1.0e-5 with their compiled
     # kernels (once `make install` has compiled them): the crossings amplify rounding there
     assert np.hypot(bx - xr, by - yr).max() < 3e-5
 

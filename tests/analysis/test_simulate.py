@@ -45,7 +45,7 @@ def test_example3_matches_the_exact_modal_solution_over_10_s():
 
 
 def test_massless_node_closed_by_auto_balance_equals_series_spring():
-    """Case 5.2 (m1 = 0, closure: auto): m2 oscillates on k1 k2/(k1 + k2) (springs in series)."""
+    """Case 5.2 (m1 = 0, balances: auto): m2 oscillates on k1 k2/(k1 + k2) (springs in series)."""
     system = mb.load(PAPER / "example3_m1_zero_auto.yaml")
     p = system.parameters
     traj = simulate(system, 5.0)
@@ -109,7 +109,7 @@ def test_baumgarte_keeps_drift_small_without_projection():
 
 PENDULUM = """\
 parameters: {m: 1.0, L: 2.0, g: 9.81}
-subsystems:
+parts:
   bob: {type: lagrangian, coordinates: [x, y], T: 0.5*m*(x_dot**2 + y_dot**2), V: m*g*y}
 constraints:
   - {name: rod, holonomic: bob.x**2 + bob.y**2 - L**2}
@@ -166,7 +166,7 @@ def test_a_failed_csv_run_leaves_no_file_under_the_final_name(tmp_path):
     and the earlier run's file is gone (it is not this run's output)."""
     out = tmp_path / "run.csv"
     out.write_text("t,p.x,p.x_dot,energy\n0.0,0.0,0.0,0.0\n")
-    system = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
+    system = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
                       "forces: {x: sqrt(1 - t)}}\n")
     with pytest.raises(mb.SimulationError):
         simulate(system, 2.0, out=out, dt=0.01)
@@ -179,7 +179,7 @@ def test_a_failed_csv_run_leaves_no_file_under_the_final_name(tmp_path):
 
 def test_a_state_that_becomes_nan_stops_with_the_last_good_state_saved(tmp_path):
     """A force sqrt(1 − t) is NaN after t = 1: the run stops there, saying when and where."""
-    system = mb.loads("subsystems:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
+    system = mb.loads("parts:\n  p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, "
                       "forces: {x: sqrt(1 - t)}}\n")
     out = tmp_path / "run.npz"
     with pytest.raises(mb.SimulationError) as err:

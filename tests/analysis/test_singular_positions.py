@@ -91,10 +91,10 @@ def test_a_span_that_crawls_near_a_singular_position_is_integrated_again_at_a_lo
     horizontal position at 0.3 rad/s (a slow crossing, long in the zone where σ is small),
     the first 5 ms crawl: that span is integrated again at RELAXED_RTOL and listed in
     stats["relaxed_spans"], and the bars still follow the exact motion (to 1e-9: the
-    relaxed tolerance). The compiled kernels waited for (MBSYNTH_FAST=wait): the crawl is
-    the kernel-corrected run's (its first step, which has no measure behind it to plan
+    relaxed tolerance). The compiled kernels waited for (MBSYNTH_COMPILED=wait): the crawl is
+    the kernel-projected run's (its first step, which has no measure behind it to plan
     from); the KKT path's least-squares stages pass this crossing without one."""
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
     traj, error = crossing(1e-3, 0.3)
     assert traj.status == "completed"
     relaxed = traj.stats["relaxed_spans"]
@@ -109,7 +109,7 @@ def test_a_span_that_crawls_still_at_the_loosest_tolerance_stops_naming_the_rows
     count it may crawl there (STUCK_CALLS) to 50: no further loosening exists, so the run
     stops within the bound with a SimulationError naming the nearly dependent rows, the
     rows before it kept (no loop without progress)."""
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
     monkeypatch.setattr(cut, "RELAXED_MAX", RELAXED_RTOL)
     monkeypatch.setattr(derivative, "STUCK_CALLS", 50)
     with pytest.raises(mb.SimulationError) as err:
@@ -125,8 +125,8 @@ def test_crossings_at_a_tight_tolerance_are_stepped_across_on_the_exact_motion(m
     the integrator crawled. The run plans one step across each (crossing.py: its stages at
     least 0.13 of the step from it, put on the constraints first): no span relaxed, and B0
     within 1e-11 m of the exact one-degree-of-freedom motion, its energy kept to 1e-10 J. The
-    kernel's correction puts the stages on the constraints: its kernels waited for."""
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    kernel's projection puts the stages on the constraints: its kernels waited for."""
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
     system = mb.loads(ref.n_four_bar_yaml(2), name="n_four_bar_2")
     traj = mb.simulate(system, 4.0, dt=0.1, rtol=1e-12, atol=1e-12)
     assert traj.status == "completed" and not traj.stats["relaxed_spans"]

@@ -94,7 +94,7 @@ def test_every_method_runs_a_pendulum_to_its_exact_motion(method):
     rad of θ̈ = −(g/L) sin θ solved by solve_ivp at rtol 1e-12."""
     model = mb.loads("""
 parameters: {g: 9.81, L: 0.5}
-subsystems:
+parts:
   bob:
     type: lagrangian
     coordinates: [theta]

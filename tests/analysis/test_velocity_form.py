@@ -26,7 +26,7 @@ def hamilton(a, b):
 def rod():
     """Particles before and after a rigid body: the body's block inside the state."""
     system = mb.load(ROOT / "models" / "mechanisms" / "massless_rod.yaml")
-    assert [p.kind for p in system.parts if p.coordinates][1:4] == ["particle", "rigid_body", "particle"]
+    assert [p.type_name for p in system.parts if p.coordinates][1:4] == ["particle", "rigid_body", "particle"]
     return system
 
 

@@ -21,7 +21,7 @@ BODY = """
 name: lock
 parameters: {{m: 1.0, g: 9.81}}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   body:
     type: rigid_body
     rotation: {rotation}
@@ -55,7 +55,7 @@ def test_check_names_the_angles_singular_position_not_a_balance(tmp_path):
     assert ("part body (angle_x = 1.5708): its zxy angles are at their singular position (singular at "
             "angle_x = ±π/2, where angle_z and angle_y turn about one axis") in done.stdout
     assert "use a quaternion body (rotation: quaternion) or another sequence" in done.stdout
-    assert "balance needed" not in done.stdout and "closure" not in done.stdout
+    assert "balance needed" not in done.stdout and "balances: auto" not in done.stdout
 
 
 def test_check_json_lists_the_part_and_a_proper_euler_sequence_at_zero(tmp_path):
@@ -95,10 +95,10 @@ def test_a_falling_bicycle_stops_at_its_angles_singular_position():
     angles' angle_x) towards π/2, where the steps crawled without end. It stops within the
     bound with exit 1 (the run had to stop) and one line naming the parts (a wheel file's part
     by its full name, rear.wheel), their angles by the names within a part and their singular
-    value. Without the compiled kernels (MBSYNTH_FAST=off): the same path in every process."""
+    value. Without the compiled kernels (MBSYNTH_COMPILED=off): the same path in every process."""
     started = time.monotonic()
     done = mbsynth("simulate", ROOT / "models/rolling/bicycle.yaml", "--set", "v=0.5", "--set", "kick=0.3",
-                   "--t-end", "4", env=dict(os.environ, MBSYNTH_FAST="off"))
+                   "--t-end", "4", env=dict(os.environ, MBSYNTH_COMPILED="off"))
     assert time.monotonic() - started < HANG
     assert done.returncode == 1, done.stderr
     [line] = done.stderr.splitlines()

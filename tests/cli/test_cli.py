@@ -39,18 +39,18 @@ def test_unique_models(capsys, name, n, m, rank_M, rank_A):
 
 
 def test_check_compiles_nothing_and_leaves_the_default_path_as_it_was(capsys, monkeypatch):
-    """``check`` computes on the KKT path where the user left MBSYNTH_FAST unset, and only
+    """``check`` computes on the KKT path where the user left MBSYNTH_COMPILED unset, and only
     while it runs: the models simulated after it in the same process (as in this test
     session) still get the compiled path; a value the user set is kept."""
     from mbsynth.compiled import background
-    monkeypatch.delenv("MBSYNTH_FAST", raising=False)
+    monkeypatch.delenv("MBSYNTH_COMPILED", raising=False)
     seen = []  # Templates put to build
     monkeypatch.setattr(background, "_submit", lambda *args: seen.append("engine"))
     assert main(["check", str(MODELS.parent / "robots" / "ur5_payload.yaml")]) == 0
-    assert "MBSYNTH_FAST" not in os.environ and background.default_path() == "compiled" and seen == []
+    assert "MBSYNTH_COMPILED" not in os.environ and background.default_path() == "compiled" and seen == []
     with background.default_path_as("kkt"):
         assert background.default_path() == "kkt"
-        monkeypatch.setenv("MBSYNTH_FAST", "on")
+        monkeypatch.setenv("MBSYNTH_COMPILED", "on")
         assert background.default_path() == "compiled"
 
 
@@ -95,7 +95,7 @@ def test_text_report_and_console_script(tmp_path):
 
 def test_model_error_is_one_line_and_exit_2(capsys, tmp_path):
     bad = tmp_path / "bad.yaml"
-    bad.write_text("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
+    bad.write_text("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
     assert main(["check", str(bad)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: {bad}:2:") and "\n" not in err
@@ -128,7 +128,7 @@ LEAF = """
 name: massless_leaf
 gravity: [0, 0, -9.81]
 world: {frames: {pivot: {axis: [0, 1, 0]}}}
-subsystems:
+parts:
   rod: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.01], initial: {position: [0, 0, -0.5]},
         frames: {top: {position: [0, 0, 0.5], axis: [0, 1, 0]}, bottom: {position: [0, 0, -0.5], axis: [0, 1, 0]}}}
   leaf: {type: rigid_body, mass: 0, inertia: [0, 0, 0], initial: {position: [0, 0, -1.2]},

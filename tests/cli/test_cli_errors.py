@@ -27,7 +27,7 @@ def files(tmp_path):
     (tmp_path / "folder.yaml").mkdir()
     (tmp_path / "picture.png").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(range(256)))
     (tmp_path / "table.csv").write_text("a,b\n1,2\n")
-    (tmp_path / "bad.yaml").write_text("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
+    (tmp_path / "bad.yaml").write_text("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**}\n")
     (tmp_path / "a_file").write_text("")
     return tmp_path
 

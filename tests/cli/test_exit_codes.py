@@ -20,10 +20,10 @@ ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
 EXAMPLE3 = MODELS / "paper" / "example3_two_masses.yaml"
 # x'' = 4 x³ from x = 1: the state runs away before t = 1 (the run has to stop), a dot to draw
-RUNAWAY = ("subsystems:\n  a:\n    type: lagrangian\n    coordinates: [x]\n    T: 0.5*x_dot**2\n    V: -x**4\n"
+RUNAWAY = ("parts:\n  a:\n    type: lagrangian\n    coordinates: [x]\n    T: 0.5*x_dot**2\n    V: -x**4\n"
            "    frames: {dot: {position: [x, 0, 0], geometry: {sphere: 0.1}}}\ninitial: {a.x: 1.0}\n")
 # a constant force and nothing to balance it: no rest anywhere
-NO_REST = "subsystems:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: x}\n"
+NO_REST = "parts:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: x}\n"
 
 
 def run(capsys, *words):

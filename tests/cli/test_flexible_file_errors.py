@@ -22,7 +22,7 @@ def check(folder, source, reduction=CB):
     """``mbsynth check`` of a rod whose FE model is ``source`` (line 5) reduced by
     ``reduction`` (line 6): (exit status, stderr)."""
     path = folder / "rod.yaml"
-    path.write_text(f"name: rod\nsubsystems:\n  rod:\n    type: flexible_body\n    {source}\n"
+    path.write_text(f"name: rod\nparts:\n  rod:\n    type: flexible_body\n    {source}\n"
                     f"    reduction: {reduction}\n")
     result = subprocess.run([sys.executable, "-m", "mbsynth.cli", "check", str(path)], capture_output=True,
                             text=True, check=False, timeout=120)
@@ -32,7 +32,7 @@ def check(folder, source, reduction=CB):
 def refused(folder, source, reduction, line, key, words):
     status, stderr = check(folder, source, reduction)
     assert status == 2 and stderr.count("\n") == 1, stderr
-    assert stderr.startswith(f"error: {folder / 'rod.yaml'}:{line}: at subsystems.rod.{key}: "), stderr
+    assert stderr.startswith(f"error: {folder / 'rod.yaml'}:{line}: at parts.rod.{key}: "), stderr
     assert all(word in stderr for word in words), stderr
     return stderr
 

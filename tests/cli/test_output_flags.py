@@ -32,7 +32,7 @@ AUTO = ROOT / "models" / "paper" / "example3_m1_zero_auto.yaml"  # modes --equil
 PENDULUM = """\
 name: rod
 parameters: {L: 1.0, g: 9.81}
-subsystems:
+parts:
   bob:
     type: lagrangian
     coordinates: [x, y]
@@ -44,7 +44,7 @@ constraints:
 initial: {bob.x: L, bob.y: 0}
 """
 # two rows no position meets: no consistent initial state (SolveError)
-CONTRADICTION = ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0}\n"
+CONTRADICTION = ("parts:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 0}\n"
                  "constraints:\n  - {name: here, holonomic: a.x}\n  - {name: there, holonomic: a.x - 1}\n")
 HOOKED = """\
 import importlib, os, runpy, signal, sys

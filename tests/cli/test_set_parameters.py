@@ -58,7 +58,7 @@ def test_set_rebuilds_what_the_file_builds_from_a_parameter(capsys):
     omega = 1.8751041**2 * np.sqrt(2.1e11 * 4e-9 / (7850 * 1e-4 * 2.0**4))
     assert abs(first - omega / (2 * np.pi)) < 1e-5 * first
     with pytest.raises(ModelError, match=r"parameter 'Iz' was built into the model .*cantilever.yaml:\d+"
-                                         r", key subsystems\.strip\.beam\.I[yz]"):
+                                         r", key parts\.strip\.beam\.I[yz]"):
         mb.load(CANTILEVER).with_parameters(Iz=4e-9)
     assert mb.load(CANTILEVER).with_parameters(L=2.0).parameters["L"] == 2.0  # an unchanged value is no change
 

@@ -24,12 +24,12 @@ def test_compiling_ahead_says_what_and_how_far():
     assert done.returncode == 0, done.stderr[-3000:]
     lines = done.stderr.splitlines()
     if cold:
-        assert lines[0].startswith("mbsynth: compiling the fast path's kernels once (about 2-3 minutes")
+        assert lines[0].startswith("mbsynth: compiling the compiled path's kernels once (about 2-3 minutes")
         assert "every later run loads them from the cache" in lines[0]
     else:
-        assert lines[0].startswith("mbsynth: the fast path's kernels are compiled already (")
+        assert lines[0].startswith("mbsynth: the compiled path's kernels are compiled already (")
     stages = [tuple(map(int, m.groups())) for m in map(STAGE.match, lines[1:]) if m]
     count = 5 if cold else 4
     assert stages == [(k, count) for k in range(1, count + 1)] and len(lines) == count + 1
     assert lines[-1].startswith(f"mbsynth: [{count}/{count}] the flexible parts' kernel")
-    assert done.stdout.startswith("mbsynth fast path compiled into ")
+    assert done.stdout.startswith("mbsynth: the compiled path's kernels compiled into ")

@@ -1,6 +1,6 @@
-"""Continuous integration with the kernel's own correction: the compiled rows
-(fast/rows.py) against the System's residuals and energies, the correction
-(fast/correction.py) against the least-mass-norm step's defining identity, and a whole
+"""Continuous integration with the kernel's own projection: the compiled rows
+(fast/rows.py) against the System's residuals and energies, the projection
+(fast/compiled/projection.py) against the least-mass-norm step's defining identity, and a whole
 run against Pinocchio's aba in the same scipy integrator."""
 
 import multiprocessing
@@ -14,28 +14,28 @@ import scipy.integrate
 import scipy.linalg
 
 import mbsynth as mb
-import mbsynth.compiled.correction as correction_module
+import mbsynth.compiled.projection as projection_module
 from mbsynth.robots.twin import Twin
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ["rigid/double_pendulum_3d.yaml", "rigid/tennis_racket.yaml", "robots/ur5_payload.yaml"]
 # joint ends on particles too: the rows read a particle's frame origin at its position
 WITH_PARTICLES = ["mechanisms/massless_link.yaml", "mechanisms/double_pendulum_rods.yaml"]
-# extra coordinates alone (compiled/extra_correction.py): an energy-defined part (a full M), planar bodies
+# extra coordinates alone (compiled/extra_projection.py): an energy-defined part (a full M), planar bodies
 EXTRA = ["mechanisms/andrews.yaml", "mechanisms/four_bar.yaml", "mechanisms/slider_crank.yaml"]
 
 
 @pytest.fixture(autouse=True)
 def compiled_path(monkeypatch):
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
 
 
-def correction_of(system):
+def projection_of(system):
     engine = system.data().engine
     assert engine is not None
-    correction = engine.correction()
-    assert correction is not None
-    return correction
+    projection = engine.projection()
+    assert projection is not None
+    return projection
 
 
 def drifted_state(system, rng, size=1e-6, rate_size=1.0):
@@ -51,27 +51,27 @@ def test_compiled_rows_equal_the_systems_residuals_and_energies(model):
     system = mb.load(ROOT / "models" / model)
     rng = np.random.default_rng(3)
     q, qd = drifted_state(system, rng)
-    phi, psi, kinetic, potential = correction_of(system).residuals_energy(q, qd)
+    phi, psi, kinetic, potential = projection_of(system).residuals_energy(q, qd)
     phi_ref, psi_ref = system.constraint_residuals(0.0, q, qd)
     np.testing.assert_allclose(phi, phi_ref, rtol=1e-10, atol=1e-15)
     np.testing.assert_allclose(psi, psi_ref, rtol=1e-10, atol=1e-13)
-    if correction_of(system).energies and all(f.V == 0 for f in system.forces):
+    if projection_of(system).energies and all(f.V == 0 for f in system.forces):
         np.testing.assert_allclose((kinetic, potential), system.energy(0.0, q, qd), rtol=1e-12, atol=1e-12)
 
 
 @pytest.mark.parametrize("drift", [(1e-6, 1.0), (1e-10, 1e-10)], ids=["large", "integrator's"])
 @pytest.mark.parametrize("model", MODELS + EXTRA)
-def test_a_correction_is_the_least_mass_norm_step_onto_the_constraints(model, drift):
+def test_a_projection_is_the_least_mass_norm_step_onto_the_constraints(model, drift):
     """The step Δ onto A Δ = −r that is least in the mass metric satisfies M Δ ∈ range(Aᵀ)
     (its Lagrange condition, with A where the step was taken): Nᵀ M Δ = 0 for a basis N of
-    null(A) (a free body's M Δ is zero: its unit-norm row is corrected along the
+    null(A) (a free body's M Δ is zero: its unit-norm row is projected along the
     quaternion, which M does not weigh). The position step is taken at the drifted q
-    (Gauss–Newton), the velocity step at the corrected one — or, after an integrator's
+    (Gauss–Newton), the velocity step at the projected one — or, after an integrator's
     drift, with the position step's factorization (A at the drifted q, equal to the
     identity's tolerance). After them, φ and φ̇ vanish to rounding."""
     system = mb.load(ROOT / "models" / model)
     q, qd = drifted_state(system, np.random.default_rng(4), *drift)
-    q_on, qd_on = correction_of(system)(q, qd)[:2]
+    q_on, qd_on = projection_of(system)(q, qd)[:2]
     phi, psi = system.constraint_residuals(0.0, q_on, qd_on)
     assert np.abs(phi).max() < 1e-14 * max(np.abs(q).max(), 1) and np.abs(psi).max() < 1e-12 * np.abs(qd).max()
     for at, start, end in ((q, q, q_on), (q_on, qd, qd_on)):
@@ -86,7 +86,7 @@ def test_a_correction_is_the_least_mass_norm_step_onto_the_constraints(model, dr
 @pytest.mark.parametrize("model", MODELS + ["mechanisms/double_pendulum_rods.yaml"])
 def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     """kernel.motion's REUSED at rest (q̇ = 0, no gravity) with shifts on the joint rows
-    alone — a correction's velocity step — rebuilds only the right side (the shifts,
+    alone — a projection's velocity step — rebuilds only the right side (the shifts,
     equilibrated) and solves with the factorization of the call before it: its q̈ equals
     that of a full call at the same state and shifts, and meets the rows as the System's
     sympy derivation gives them (A q̈ = shift: b vanishes at rest); with a unit-norm row
@@ -119,21 +119,21 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
         np.testing.assert_allclose(A @ reused, shift, rtol=0, atol=1e-10 * max(np.abs(shift).max(), 1))
 
 
-def test_a_block_of_states_is_corrected_as_each_state_alone():
-    """Correction.block splits many states among threads, each with its own Work and rows:
-    every state comes out bit for bit as a correction of that state alone, and one the
+def test_a_block_of_states_is_projected_as_each_state_alone():
+    """Projection.block splits many states among threads, each with its own Work and rows:
+    every state comes out bit for bit as a projection of that state alone, and one the
     kernel declines (not finite) comes out None without disturbing the others."""
     system = mb.load(ROOT / "models" / "robots/ur5_payload.yaml")
     rng = np.random.default_rng(6)
     q, qd = drifted_state(system, rng, 0.0, 0.0)
-    count = 2 * correction_module.PER_THREAD // q.size + 2  # enough for two threads
+    count = 2 * projection_module.PER_THREAD // q.size + 2  # enough for two threads
     Q, QD = q + 1e-9 * rng.standard_normal((count, q.size)), qd + 1e-9 * rng.standard_normal((count, q.size))
     Q[7] = np.nan
-    correction = correction_of(system)
-    block = correction.block(Q, QD)
+    projection = projection_of(system)
+    block = projection.block(Q, QD)
     assert len(block.q) == count and block.row(7) is None
     for i, (q, qd) in enumerate(zip(Q, QD)):
-        together, alone = block.row(i), correction(q, qd)
+        together, alone = block.row(i), projection(q, qd)
         if alone is None:
             assert together is None
             continue
@@ -145,13 +145,13 @@ def _simulate_into(queue, system):
     queue.put(mb.simulate(system, 0.02, dt=1e-4).q)
 
 
-def test_a_forked_process_corrects_in_threads_of_its_own():
-    """Each step of a UR5 passes tens of output rows (every 0.1 ms), corrected in blocks
+def test_a_forked_process_projects_in_threads_of_its_own():
+    """Each step of a UR5 passes tens of output rows (every 0.1 ms), projected in blocks
     on the shared threads (fast/threads.py); a process forked after that has none of the
     parent's threads, makes its own and gives the parent's trajectory to the bit."""
     system = mb.load(ROOT / "models" / "robots/ur5_payload.yaml")
     expected = mb.simulate(system, 0.02, dt=1e-4)
-    assert len(expected.t) * system.n > expected.stats["steps"] * 2 * correction_module.PER_THREAD
+    assert len(expected.t) * system.n > expected.stats["steps"] * 2 * projection_module.PER_THREAD
     context = multiprocessing.get_context("fork")
     queue = context.Queue()
     child = context.Process(target=_simulate_into, args=(queue, system))

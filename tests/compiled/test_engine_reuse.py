@@ -36,7 +36,7 @@ gravity: [0.3, -0.2, -g]
 world:
   frames:
     pivot: {position: [0.1, -0.2, 1.5], rpy: [0.3, -0.2, 0.5]}
-subsystems:
+parts:
   b0: {type: rigid_body, mass: m, inertia: [0.05, 0.04, 0.03], initial: {position: [0.1, -0.2, 1.1]},
        frames: {top: {position: [0, 0, L]}, low: {position: [0.1, 0, -L], rpy: [0.2, 0, 0]}}}
   b1: {type: rigid_body, mass: mb, inertia: [Ib, Ib, 2*Ib], initial: {position: [0.15, -0.25828, 0.48412], rpy: [0.2, 0, 0]},
@@ -131,7 +131,7 @@ def test_parameters_written_into_a_data_give_a_loaded_systems_arrays(model):
     parts = {p.name: p for p in model.parts}
     m, k = sp.Symbol("m"), sp.Symbol("k")
     assert parts["b0"].reads({m}) and not parts["b1"].reads({m}) and not parts["b0"].reads({k})
-    with pytest.raises(mb.ModelError, match="subsystem 'b0': the mass matrix is not positive semi-definite"):
+    with pytest.raises(mb.ModelError, match="part 'b0': the mass matrix is not positive semi-definite"):
         data.set_parameters({"m": -1.0})
     with pytest.raises(mb.ModelError, match=r"no parameter\(s\) \['mass'\]"):
         data.set_parameters({"mass": 1.0})
@@ -171,7 +171,7 @@ def test_a_structural_replace_gets_a_cache_of_its_own(model):
     values keep them."""
     assert shared(replace(model, parameters={**model.parameters, "m": 2.0})) is shared(model)
     assert shared(model.with_constraints([])) is shared(model)  # nothing appended: the same structure
-    assert shared(replace(model, connectors=model.connectors[:-1])) is not shared(model)
+    assert shared(replace(model, constraints=model.constraints[:-1])) is not shared(model)
     renamed = {("mass" if k == "m" else k): v for k, v in model.parameters.items()}
     assert shared(replace(model, parameters=renamed)) is not shared(model)
 
@@ -283,7 +283,7 @@ def test_runs_are_bit_identical(tmp_path):
     """Two runs of one model in fresh processes, each compiling in the background: 4 s are
     long enough that a run switching paths when its compilation finished (as they did) would
     switch at a different step each time, and differ by about 1e-12."""
-    env = {**os.environ, "MBSYNTH_FAST": "background"}
+    env = {**os.environ, "MBSYNTH_COMPILED": "background"}
     results = []
     for k in range(2):
         out = tmp_path / f"run{k}.npy"

@@ -50,7 +50,7 @@ def test_exit_during_a_compilation_waits_for_it(tmp_path):
 @pytest.mark.parametrize("attempt", [1, 2])
 def test_a_script_that_ends_while_its_model_compiles_exits_cleanly(attempt):
     """The user's case: a System's first motion starts its compiled build in the background
-    (MBSYNTH_FAST=background) and the script ends at once: exit status 0, nothing on stderr."""
+    (MBSYNTH_COMPILED=background) and the script ends at once: exit status 0, nothing on stderr."""
     done = run("""
         import mbsynth as mb
         system = mb.load("models/rigid/double_pendulum_spatial.yaml")

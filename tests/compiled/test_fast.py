@@ -1,4 +1,4 @@
-"""The fast path (mbsynth.compiled): its hand-differentiated rows and body blocks against the
+"""The compiled path (mbsynth.compiled): its hand-differentiated rows and body blocks against the
 sympy-compiled ones, its accelerations against the reference (2.14) on every model file and
 on random chains, trees and loops, its fallback to the exact treatment, and the batch.
 
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.model.connectors.joints import Joint
+from mbsynth.model.constraints.joints import Joint
 from mbsynth.core.equations import constrained_acceleration, equilibrate_rows
 from mbsynth.core.joint_kinds import JOINT_KINDS, KINDS
 from mbsynth.core.tolerances import RANK_RTOL
@@ -54,7 +54,7 @@ world:
   frames:
     pivot: {position: [0.1, -0.2, 1.5], rpy: [0.3, -0.2, 0.5]}
     hook: {position: [0.7, 0.4, 0.2], axis: [1, 1, 0]}
-subsystems:
+parts:
   b0: {type: rigid_body, mass: m, inertia: [[0.05, 0.01, 0], [0.01, 0.04, 0.002], [0, 0.002, 0.03]],
        frames: {top: {position: [0, 0, L], rpy: [0.1, 0.2, 0.3]}, low: {position: [0.1, 0, -L], axis: [0, 1, 1]}}}
   b1: {type: rigid_body, mass: 0.7, inertia: [0.02, 0.03, 0.04],
@@ -93,7 +93,7 @@ def test_joint_rows_equal_the_sympy_rows(all_joints):
     of the table, at random states with quaternions of any length (the forms are homogeneous)."""
     system = all_joints
     L = build_layout(system)[0]
-    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
     assert len(L.joint_k) == len(kernel_joints) == 8
     assert sorted({c.joint_kind for c in kernel_joints}) == sorted(JOINT_KINDS)  # a new kind joins ALL_JOINTS
     V, R, Jt = vector_work()
@@ -123,7 +123,7 @@ def test_rate_rows_equal_the_sympy_rows_in_body_rates(all_joints):
     without a particle, quaternions of any length."""
     system = all_joints
     L = build_layout(system)[0]
-    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
     A, b = np.zeros((6, 14)), np.zeros(6)
     Rs = make_work(L).Rs  # with the world's slot
     rng = np.random.default_rng(4)
@@ -167,7 +167,7 @@ def test_every_kind_agrees_in_every_interpreter(all_joints):
     along) and its joint values, one entry per position and rate its record names."""
     system = all_joints
     L = build_layout(system)[0]
-    kernel_joints = [c for c in system.connectors if isinstance(c, Joint)]
+    kernel_joints = [c for c in system.constraints if isinstance(c, Joint)]
     assert sorted({c.joint_kind for c in kernel_joints}) == sorted(JOINT_KINDS)  # a new kind joins ALL_JOINTS
     rows = Rows(L, pack(L), int(L.sizes[1]))
     rng = np.random.default_rng(61)
@@ -241,7 +241,7 @@ def test_body_blocks_equal_the_sympy_blocks(all_joints):
 
 
 def assert_same_motion(system, t, q, qd, *, rtol=1e-10):
-    """The fast path answers, and as (2.15) does."""
+    """The compiled path answers, and as (2.15) does."""
     engine = engine_for(system)
     assert engine is not None
     fast = engine.motion(t, q, qd)
@@ -382,7 +382,7 @@ def numbers(values):
 def chain(count, kinds, masses, rng, loop=None):
     """A random open chain of rigid bodies hanging from the world; ``loop``: a distance rod
     (or a second spherical joint, 'redundant') from the last body back to the world."""
-    lines = ["name: chain", "gravity: [0, 0, -9.81]", "subsystems:"]
+    lines = ["name: chain", "gravity: [0, 0, -9.81]", "parts:"]
     for i in range(count):
         moments = np.sort(rng.uniform(0.01, 0.05, 3))
         moments[2] = min(moments[2], 0.9 * (moments[0] + moments[1]))
@@ -433,7 +433,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
     the range of two equal unit rows by 1/√2; the force 1 on the massless dot."""
     free = loads("""
         name: free_spin
-        subsystems:
+        parts:
           heavy: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1], frames: {tip: {position: [0, 0, -0.5]}}}
           ghost: {type: rigid_body, mass: 0.0, inertia: [0, 0, 0]}
         gravity: [0, 0, -9.81]
@@ -457,7 +457,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
 
     contradiction = loads("""
         name: contradiction
-        subsystems:
+        parts:
           block: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1]}
         joints:
           - {name: weld, type: fixed, parent: world, child: block}
@@ -466,7 +466,7 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
         """)
     pushed = loads("""
         name: pushed
-        subsystems:
+        parts:
           dot: {type: particle, mass: 0.0}
         forces:
           - {name: shove, type: force, at: dot, value: [1, 0, 0]}
@@ -545,7 +545,7 @@ def test_baumgarte_and_parameters(all_joints):
 def test_compiled_code_is_kept_per_version_of_the_sources(tmp_path):
     """numba checks only the file of the function it loads from its cache, so a kernel built
     against an older module it calls would come back stale: the cache directory is named by
-    a digest of all the fast path's sources, which any edit changes."""
+    a digest of all the compiled path's sources, which any edit changes."""
     import shutil
 
     from mbsynth.compiled import cache
@@ -708,7 +708,7 @@ def test_kernel_views_are_the_packed_fields():
 
 @pytest.mark.implementation
 def test_motion_made_is_the_frozen_dataclass():
-    """Motion.made (the fast path's constructor) gives the same fields as Motion(...) and
+    """Motion.made (the compiled path's constructor) gives the same fields as Motion(...) and
     the same frozen object."""
     import dataclasses
 

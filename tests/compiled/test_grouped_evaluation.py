@@ -1,5 +1,5 @@
-"""evaluation.py (connectors and parts evaluated a structure at a time) against the
-reference: each connector's and part's own compiled function called one by one."""
+"""evaluation.py (constraints and parts evaluated a structure at a time) against the
+reference: each constraint's and part's own compiled function called one by one."""
 
 from pathlib import Path
 
@@ -14,9 +14,9 @@ RNG = np.random.default_rng(7)
 
 
 def one_by_one(system, t, q, qd):
-    """M, Q, A, b, C, φ, φ̇, T, V from a Python loop over parts and connectors."""
+    """M, Q, A, b, C, φ, φ̇, T, V from a Python loop over parts and constraints."""
     p = system.parameter_values
-    n, m = system.n, sum(c.size for c in system.connectors)
+    n, m = system.n, sum(c.size for c in system.constraints)
     M, Q, A, b, C = np.zeros((n, n)), np.zeros(n), np.zeros((m, n)), np.zeros(m), np.zeros(n)
     phi, psi, T, V = [], [], 0.0, 0.0
     start = row = 0
@@ -28,7 +28,7 @@ def one_by_one(system, t, q, qd):
     for element in system.forces:
         Q[element.indices] += element.evaluate(t, q, qd, p)
         V += element.potential(t, q, qd, p)
-    for con in system.connectors:
+    for con in system.constraints:
         a, b[row:row + con.size], c = con.evaluate(t, q, qd, p)
         A[row:row + con.size, con.indices] = a
         C[con.indices] += c
@@ -48,7 +48,7 @@ def close(x, y, terms=1.0):
 
 
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: Path(p).stem)
-def test_batched_arrays_equal_the_loop_over_connectors(path):
+def test_batched_arrays_equal_the_loop_over_constraints(path):
     system = mb.load(path)
     q0, qd0 = system.initial_state()
     for k in range(3):  # the first state fixes the layout; the others use it
@@ -67,7 +67,7 @@ def test_batched_arrays_equal_the_loop_over_connectors(path):
 @pytest.mark.implementation
 def test_a_robots_joints_share_one_call():
     """The UR5's links and joints are built from templates: far fewer raw calls than parts
-    and connectors, and the same arrays."""
+    and constraints, and the same arrays."""
     system = mb.from_robot("ur5")
     data = system.data()
     q, qd = system.initial_state()
@@ -77,7 +77,7 @@ def test_a_robots_joints_share_one_call():
     assert close(rows.A.toarray(), A) and close(rows.phi, phi) and close(rows.psi, psi)
     batch = data.evaluator.rows
     groups, singles = batch.layout[1], batch.layout[2]
-    assert len(groups) + len(singles) < len(system.connectors) / 2
+    assert len(groups) + len(singles) < len(system.constraints) / 2
 
 
 def test_a_robots_joint_torques_share_one_call_and_equal_their_sympy_force():

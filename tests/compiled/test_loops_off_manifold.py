@@ -31,7 +31,7 @@ def rigid_n_four_bar(N, L=1.0, m=1.0):
     lines = [f"name: rigid_n_four_bar_{N}", f"parameters: {{L: {L!r}, m: {m!r}, g: 9.81, speed: 1.0}}",
              "gravity: [0, -g, 0]", "world:", "  frames:"]
     lines += [f"    p{i}: {{position: [{i}*L, 0, 0]}}" for i in range(N + 1)]
-    lines.append("subsystems:")
+    lines.append("parts:")
     for i in range(N + 1):
         lines.append(f"  v{i}: {{type: rigid_body, mass: m, inertia: [{rod}, {small}, {rod}], "
                      "frames: {bottom: {position: [0, -L/2, 0]}, top: {position: [0, L/2, 0]}}, "
@@ -72,7 +72,7 @@ def test_off_the_manifold_the_kernel_gives_the_drift_rules_motion(name):
         q, qd = drifted(system, rng, 1e-9)
         compiled = engine.motion(0.0, q, qd, None, True)
         assert compiled is not None  # served by the kernel, not handed to the KKT path
-        exact = data._kkt_motion(0.0, q, qd, "fast", None, True)
+        exact = data._kkt_motion(0.0, q, qd, "kkt", None, True)
         scale = np.abs(exact.qdd).max()
         assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-6 * scale
 
@@ -191,7 +191,7 @@ def test_a_model_of_extra_coordinates_keeps_its_stages_where_no_direction_is_nea
         qd = qd0 + 1e-9 * rng.standard_normal(q0.size)
         compiled = engine.motion(0.0, q, qd, None, True)
         assert compiled is not None
-        exact = data._kkt_motion(0.0, q, qd, "fast", None, True)
+        exact = data._kkt_motion(0.0, q, qd, "kkt", None, True)
         assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-9 * np.abs(exact.qdd).max()
 
 
@@ -225,7 +225,7 @@ def test_a_large_planar_loop_is_served_by_the_banded_schur_step(tmp_path):
     Schur system beyond layout.DENSE_SCHUR_MAX) gets a banded Schur matrix (banded.py). On the
     manifold the kernel's acceleration is the exact one-degree-of-freedom motion's, 1 rad and
     1e-3 rad from the horizontal position alike (the KKT path's SVD loses digits near it: its
-    q̈ there is held to 1e-6 only); the kernel's correction puts a state 1e-9 off the
+    q̈ there is held to 1e-6 only); the kernel's projection puts a state 1e-9 off the
     manifold back on it to rounding; 1e-9 off the manifold 1 rad from it the kernel serves the
     stage with the KKT drift rule's motion; 1e-7 rad from it, where a direction of the rows is
     nearly dependent, the certificate fails and the stage goes to the exact drift rule."""
@@ -237,10 +237,10 @@ def test_a_large_planar_loop_is_served_by_the_banded_schur_step(tmp_path):
     engine = data.engine
     assert engine is not None and engine.L.band_width.size == 1
     assert engine.L.x_coord.size + engine.L.xrow_row.size > layout.DENSE_SCHUR_MAX
-    correction = engine.correction()  # extra_correction.py, through the banded step
+    projection = engine.projection()  # extra_projection.py, through the banded step
     q, qd = ref.n_four_bar_state(system.coordinates, N, 0.5, 2.0)
     rng = np.random.default_rng(4)
-    on = correction(q + 1e-9 * rng.standard_normal(q.size), qd + 1e-9 * rng.standard_normal(q.size))
+    on = projection(q + 1e-9 * rng.standard_normal(q.size), qd + 1e-9 * rng.standard_normal(q.size))
     phi, psi = system.constraint_residuals(0.0, on.q, on.qd)
     assert np.abs(phi).max() < 1e-14 and np.abs(psi).max() < 1e-13
     J, K = ref.n_four_bar_constants(N)

@@ -1,5 +1,5 @@
-"""The rows a step passes, corrected through a few exact corrections (compiled/row_fit.py),
-against the exact correction of each row and the System's own (sympy) residuals; the
+"""The rows a step passes, projected through a few exact projections (compiled/row_fit.py),
+against the exact projection of each row and the System's own (sympy) residuals; the
 kernel's reusing call at rest on loop rows against a full call; the rows of a dense output
 grid against those of a sparse one."""
 
@@ -18,7 +18,7 @@ LOOPS = ["bricard.yaml", "bennett.yaml", "sarrus.yaml", "four_bar_3d.yaml"]
 
 @pytest.fixture(autouse=True)
 def compiled_path(monkeypatch):
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +29,7 @@ def bricard():
 def drifted_rows(system, span, count, seed):
     """``count`` states of a run over ``span`` s (on the constraints) at their fractions θ of
     the span, pushed off the constraints by a smooth drift of 1e-9 that vanishes with its
-    slope at θ = 0, as an integrator's interpolant drifts from a corrected step start (its
+    slope at θ = 0, as an integrator's interpolant drifts from a projected step start (its
     slope there is the motion, which meets the rows' derivatives: row_fit.py)."""
     traj = mb.simulate(system, 0.2 + span, dt=span / count)
     Q, QD = traj.q[-count:], traj.qd[-count:]
@@ -40,28 +40,28 @@ def drifted_rows(system, span, count, seed):
     return Q + drift(shape[:2]), QD + drift(shape[2:]), fractions
 
 
-def counting(correction):
-    """The correction with its exact corrections counted (``count[0]``: states)."""
-    count, exact = [0], correction._exact
+def counting(projection):
+    """The projection with its exact projections counted (``count[0]``: states)."""
+    count, exact = [0], projection._exact
 
     def counted(Q, QD):
         count[0] += Q.shape[0]
         return exact(Q, QD)
-    correction._exact = counted
+    projection._exact = counted
     return count
 
 
 @pytest.mark.parametrize("span", [0.1, 2.0], ids=["a step", "a long span, halved"])
-def test_fitted_rows_are_the_exact_corrections_and_meet_the_systems_constraints(bricard, span):
-    """Each row corrected through the fit is where the exact correction of that row puts
+def test_fitted_rows_are_the_exact_projections_and_meet_the_systems_constraints(bricard, span):
+    """Each row projected through the fit is where the exact projection of that row puts
     it (to 1e-12 of the coordinates), its residuals by the System's sympy rows within the
-    exact correction's bounds; far fewer rows are corrected exactly. Over a long span the
+    exact projection's bounds; far fewer rows are projected exactly. Over a long span the
     fit through NODES rows fails and the span is halved until it holds."""
     Q, QD, fractions = drifted_rows(bricard, span, 120, seed=1)
-    correction = bricard.data().engine.correction()
-    exact = correction.block(Q, QD)
-    count = counting(correction)
-    fitted = correction.block(Q, QD, fractions)
+    projection = bricard.data().engine.projection()
+    exact = projection.block(Q, QD)
+    count = counting(projection)
+    fitted = projection.block(Q, QD, fractions)
     assert fitted.done.all() and exact.done.all()
     assert count[0] < (len(Q) if span > 1 else 2 * row_fit.NODES)
     np.testing.assert_allclose(fitted.q, exact.q, rtol=0, atol=1e-12)
@@ -73,13 +73,13 @@ def test_fitted_rows_are_the_exact_corrections_and_meet_the_systems_constraints(
         np.testing.assert_allclose(found[:2], bricard.energy(0.0, q, qd), rtol=1e-12, atol=1e-12)
 
 
-def test_a_row_the_fit_misses_is_corrected_exactly(bricard):
+def test_a_row_the_fit_misses_is_projected_exactly(bricard):
     """A row pushed off the smooth drift (1e-7, a kink the interpolant cannot follow) fails
-    its judgement and is corrected on its own: it ends where its exact correction puts it."""
+    its judgement and is projected on its own: it ends where its exact projection puts it."""
     Q, QD, fractions = drifted_rows(bricard, 0.1, 120, seed=2)
     Q[50] += 1e-7
-    correction = bricard.data().engine.correction()
-    fitted, exact = correction.block(Q, QD, fractions), correction.block(Q, QD)
+    projection = bricard.data().engine.projection()
+    fitted, exact = projection.block(Q, QD, fractions), projection.block(Q, QD)
     np.testing.assert_array_equal(fitted.q[50], exact.q[50])
     np.testing.assert_allclose(fitted.q, exact.q, rtol=0, atol=1e-12)
 
@@ -102,19 +102,19 @@ def test_a_dense_output_grid_leaves_the_motion_as_a_sparse_one(bricard):
 
 
 @pytest.mark.implementation
-def test_each_step_of_a_run_corrects_nodes_rows_exactly(bricard, monkeypatch):
+def test_each_step_of_a_run_projects_nodes_rows_exactly(bricard, monkeypatch):
     """The integrator's own drift starts as θ² at each step's start, slope included
-    (row_fit.py): on a real run no row fails the fit through NODES exact corrections, so
-    each step corrects NODES rows exactly, no more (without the slope condition some fail)."""
-    from mbsynth.compiled import correction
-    exact, count = correction.Correction._exact, [0]
+    (row_fit.py): on a real run no row fails the fit through NODES exact projections, so
+    each step projects NODES rows exactly, no more (without the slope condition some fail)."""
+    from mbsynth.compiled import projection
+    exact, count = projection.Projection._exact, [0]
 
     def counted(self, Q, QD):
         count[0] += Q.shape[0]
         return exact(self, Q, QD)
-    monkeypatch.setattr(correction.Correction, "_exact", counted)
+    monkeypatch.setattr(projection.Projection, "_exact", counted)
     dense = mb.simulate(bricard, 2.0, dt=1e-3)
-    assert count[0] <= row_fit.NODES * dense.stats["steps"] + 2  # the start's and the end's own corrections
+    assert count[0] <= row_fit.NODES * dense.stats["steps"] + 2  # the start's and the end's own projections
 
 
 def test_a_dense_grid_reports_every_row_to_progress_and_the_file(bricard, tmp_path):
@@ -133,7 +133,7 @@ def test_a_dense_grid_reports_every_row_to_progress_and_the_file(bricard, tmp_pa
 @pytest.mark.parametrize("model", LOOPS)
 def test_a_reusing_call_at_rest_solves_loop_rows_as_a_full_call(model):
     """kernel.motion's REUSED at rest with shifts on the joint rows of a model with loop
-    rows (a correction's velocity step) solves the Schur system with the last call's
+    rows (a projection's velocity step) solves the Schur system with the last call's
     eigendecomposition: its q̈ equals a full call's at the same state and shifts, and meets
     the System's sympy rows (A q̈ = shift, a shift in range(A): the loops' rows are
     dependent in Bricard's and Bennett's mechanisms)."""

@@ -209,7 +209,7 @@ def test_example_3_case_5_3_massless_m2(seed):
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_example_3_without_closure_needs_the_force_balance(seed):
+def test_example_3_without_the_balance_needs_the_force_balance(seed):
     """m1 = 0 with only (5.35): null([M; A]) = (1, 1, −1)/√3, so wᵀQ = −k1 x̄1 + k2 q̄2
     must vanish, which is the paper's closing constraint (5.40)."""
     p = dict(spring_parameters(seed), m1=0.0)

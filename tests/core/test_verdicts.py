@@ -1,6 +1,6 @@
 """One verdict on uniqueness: every path — the KKT solve, the tree kernel, the
 Udwadia–Kalaba form — says "unique" exactly where the reference (2.14) does, and gives its
-q̈, on random singular, redundant and near-singular problems. The fast paths defer to the
+q̈, on random singular, redundant and near-singular problems. The faster solves defer to the
 reference near their own thresholds, so the reference's rank rule decides every close case.
 
 Agreement: 1e-9 relative, or what two backward-stable solves of one problem may differ by
@@ -78,7 +78,7 @@ def test_every_path_gives_the_verdict_and_acceleration_of_2_14(problem):
     tolerance = agreement(M, A, Q + C, ref.qdd)
     assert rel(kkt.qdd, ref.qdd) < tolerance
     if ref.unique and np.linalg.eigvalsh(M).min() > 1e-6 * np.abs(M).max():
-        # (4.24) adds the constraint correction to a = M⁻¹Q: it cancels ‖a‖/‖q̈‖ digits
+        # (4.24) adds the constraint projection to a = M⁻¹Q: it cancels ‖a‖/‖q̈‖ digits
         cancelled = 1 + np.linalg.norm(np.linalg.solve(M, Q)) / max(np.linalg.norm(ref.qdd), 1e-300)
         assert rel(udwadia_kalaba(M, Q, A, b, C).qdd, ref.qdd) < tolerance * cancelled
 

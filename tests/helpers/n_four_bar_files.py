@@ -8,7 +8,7 @@ parameters: {L: 1.0, m: 1.0, speed: 1.0}
 world:
   frames:
     pivot: {}
-subsystems:
+parts:
   v: {type: planar_body, mass: m, inertia: m*L**2/12, frames: {bottom: {position: [0, -L/2, 0]}, top: {position: [0, L/2, 0]}}, initial: {position: [0, L/2], theta: 0, velocity: [speed/2, 0], angular_velocity: -speed/L}}
   h: {type: planar_body, mass: m, inertia: m*L**2/12, frames: {left: {position: [-L/2, 0, 0]}, right: {position: [L/2, 0, 0]}}, initial: {position: [L/2, L], theta: 0, velocity: [speed, 0]}}
 joints:
@@ -24,7 +24,7 @@ gravity: [0, -g, 0]
 world:
   frames:
     last: {position: [N*L, 0, 0]}
-subsystems:
+parts:
   cell: {type: model, file: four_bar_cell.yaml, count: N, parameters: {L: L, m: m, speed: speed}, placement: {position: [index*L, 0, 0]}}
   v: {type: planar_body, mass: m, inertia: m*L**2/12, frames: {bottom: {position: [0, -L/2, 0]}, top: {position: [0, L/2, 0]}}, initial: {position: [N*L, L/2], theta: 0, velocity: [speed/2, 0], angular_velocity: -speed/L}}
 joints:
@@ -41,7 +41,7 @@ joints:
 PAIR = """\
 name: pair
 parameters: {L: 1.0}
-subsystems:
+parts:
   cell: {type: model, file: four_bar_cell.yaml, count: 2, parameters: {L: L}, placement: {position: [index*L, 0, 0]}}
 joints:
   - {name: link, type: revolute, parent: "cell[1].top", child: "cell[0].right"}
@@ -50,7 +50,7 @@ joints:
 PAIRS = """\
 name: pairs
 parameters: {L: 1.0}
-subsystems:
+parts:
   pair: {type: model, file: pair.yaml, count: 3, parameters: {L: L}, placement: {position: [0, 3*index, 0]}}
   extra: {type: model, file: four_bar_cell.yaml}
 """

@@ -9,7 +9,7 @@ import mbsynth as mb
 PENDULUM = """\
 parameters: {L: 1.0, m: 1.0, angle: 0.3}
 world: {frames: {pin: {}}}
-subsystems:
+parts:
   bob: {type: particle, mass: m, initial: {position: [L*sin(angle), 0, -L*cos(angle)]}}
 joints:
   - {name: rod, type: distance, parent: world.pin, child: bob, length: L}
@@ -19,7 +19,7 @@ ports: {tip: bob}
 TOP = """\
 parameters: {g: 9.81, L0: 0.5}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   first: {type: model, file: pendulum.yaml, parameters: {L: L0, angle: 0.2}}
   second: {type: model, file: pendulum.yaml, parameters: {L: 2*L0}, placement: {position: [1, 0, 0], rpy: [0, 0, 0.5]}}
 forces:

@@ -39,7 +39,7 @@ def test_the_composed_n_four_bar_starts_as_the_flat_one(N):
     assert np.array_equal(q, qf[order]) and np.array_equal(qd, qdf[order])
     qdd, qddf = composed.motion(0.0, q, qd).qdd, flat.motion(0.0, qf, qdf).qdd
     assert np.abs(qdd - qddf[order]).max() < 1e-12
-    assert len(composed.connectors) == len(flat.connectors) == 3 * N + 1  # N + 1 ground pivots, 2 N pins
+    assert len(composed.constraints) == len(flat.constraints) == 3 * N + 1  # N + 1 ground pivots, 2 N pins
 
 
 @pytest.mark.parametrize("N", [2, 10])

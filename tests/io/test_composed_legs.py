@@ -132,7 +132,7 @@ def test_without_the_balance_each_knee_link_is_indeterminate(unbalanced):
     q, qd = system.initial_state()
     fast, reference = system.motion(0.0, q, qd), system.motion(0.0, q, qd, method="reference")
     assert not fast.unique and not reference.unique
-    massless = [part.name for part in system.parts if part.kind == "rigid_body" and part.name.endswith(".link")]
+    massless = [part.name for part in system.parts if part.type_name == "rigid_body" and part.name.endswith(".link")]
     assert massless == [f"{leg}.link" for leg in LEGS]
     N = reference.nullspace
     assert N.shape[1] == len(massless) == 4
@@ -191,11 +191,11 @@ def flat_twin():
     top = yaml.safe_load((MODELS / "quadruped.yaml").read_text())
     parameters = dict(top["parameters"])
     parts, joints, constraints = {}, [], []
-    for name, entry in top["subsystems"].items():
+    for name, entry in top["parts"].items():
         if entry.get("type") != "model":
             parts[name] = entry
             continue
-        own = list(leg["parameters"]) + [part for part in leg["subsystems"]] + [j["name"] for j in leg["joints"]]
+        own = list(leg["parameters"]) + [part for part in leg["parts"]] + [j["name"] for j in leg["joints"]]
         pattern = re.compile(r"\b(" + "|".join(own) + r")\b")
 
         def rename(text, prefix=f"{name}_", pattern=pattern):
@@ -206,7 +206,7 @@ def flat_twin():
         position = [str(x) for x in entry["placement"]["position"]]
         yaw = str(entry["placement"].get("rpy", [0, 0, 0])[2])
         assert entry["placement"].get("rpy", [0, 0, 0])[:2] == [0, 0]
-        for part_name, part in leg["subsystems"].items():
+        for part_name, part in leg["parts"].items():
             part = renamed(part, rename)
             initial = part["initial"]
             x, y, z = initial["position"]
@@ -228,7 +228,7 @@ def flat_twin():
         joints.append(dict(joint, parent=ports.get(joint["parent"], joint["parent"]),
                            child=ports.get(joint["child"], joint["child"])))
     flat = dict(name="quadruped_flat", parameters=parameters, gravity=top["gravity"], world=top["world"],
-                subsystems=parts, joints=joints, constraints=constraints)
+                parts=parts, joints=joints, constraints=constraints)
     return yaml.dump(flat, Dumper=_Plain, sort_keys=False)
 
 
@@ -261,7 +261,7 @@ def test_composed_quadruped_equals_its_flat_twin(quadruped, flat):
 BODY = """\
 name: body
 parameters: {pitch: 0.3}
-subsystems:
+parts:
   block:
     type: rigid_body
     mass: 1.0
@@ -278,7 +278,7 @@ def test_a_half_turn_gives_one_quaternion_written_or_placed(tmp_path, turn):
     computed here, written as a quaternion and as a matrix's rpy)."""
     (tmp_path / "body.yaml").write_text(BODY)
     (tmp_path / "top.yaml").write_text(
-        "name: top\nsubsystems:\n  it: {type: model, file: body.yaml, "
+        "name: top\nparts:\n  it: {type: model, file: body.yaml, "
         f"placement: {{rpy: [{', '.join(map(str, turn))}]}}}}\n")
     placed = mb.load(tmp_path / "top.yaml")
     angles = [float(eval(str(x), {"pi": np.pi})) for x in turn]

@@ -13,7 +13,7 @@ BEAM = "{length: 1.0, elements: 4, area: 1e-4, Iy: 2e-9, Iz: 1e-9, J: 2e-9, E: 2
 
 
 def model(body, rest=""):
-    return f"subsystems:\n  rod:\n    type: flexible_body\n{body}{rest}"
+    return f"parts:\n  rod:\n    type: flexible_body\n{body}{rest}"
 
 
 def error(text, tmp_path):
@@ -41,26 +41,26 @@ def test_an_fe_bundle_beside_the_model_file_is_the_beams_part(tmp_path):
 
 
 @pytest.mark.parametrize("body, line, where, words", [
-    ("    reduction: {method: craig_bampton, interface: [0], modes: 1}\n", 2, "subsystems.rod",
+    ("    reduction: {method: craig_bampton, interface: [0], modes: 1}\n", 2, "parts.rod",
      "exactly one of beam (the beam generator) and fe"),
     (f"    beam: {BEAM}\n    reduction: {{method: craig_bampton, interface: [0, 9], modes: 1}}\n", 5,
-     "subsystems.rod.reduction", "node 9 is not one of its 5 nodes"),
+     "parts.rod.reduction", "node 9 is not one of its 5 nodes"),
     (f"    beam: {BEAM}\n    reduction: {{method: craig_bampton, interface: [0], modes: 1, reference: 3}}\n", 5,
-     "subsystems.rod.reduction.reference", "must be one of the interface nodes [0]"),
+     "parts.rod.reduction.reference", "must be one of the interface nodes [0]"),
     (f"    beam: {BEAM}\n    reduction: {{method: guyan, interface: [0], modes: 1}}\n", 5,
-     "subsystems.rod.reduction.method", "craig_bampton or free_interface"),
-    (f"    beam: {BEAM}\n    reduction: {{method: free_interface}}\n", 5, "subsystems.rod.reduction",
+     "parts.rod.reduction.method", "craig_bampton or free_interface"),
+    (f"    beam: {BEAM}\n    reduction: {{method: free_interface}}\n", 5, "parts.rod.reduction",
      "exactly one of modes (a count) and max_frequency"),
     ("    fe: {mass: m.mtx, stiffness: k.mtx, nodes: nodes.csv}\n    reduction: {method: free_interface, modes: 1}\n",
-     4, "subsystems.rod.fe.mass", "file 'm.mtx' not found"),
+     4, "parts.rod.fe.mass", "file 'm.mtx' not found"),
     (f"    beam: {BEAM}\n    reduction: {{method: craig_bampton, interface: [0], modes: 2}}\n"
-     "    initial: {amplitudes: [0.1]}\n", 6, "subsystems.rod.initial.amplitudes", "a list of 2 numbers"),
+     "    initial: {amplitudes: [0.1]}\n", 6, "parts.rod.initial.amplitudes", "a list of 2 numbers"),
     (f"    beam: {BEAM}\n    reduction: {{method: craig_bampton, interface: [0], modes: 1}}\n"
-     "    frames: {tip: {node: 7}}\n", 6, "subsystems.rod.frames.tip.node", "0 to 4; got 7"),
+     "    frames: {tip: {node: 7}}\n", 6, "parts.rod.frames.tip.node", "0 to 4; got 7"),
     (f"    beam: {BEAM}\n    reduction: {{method: craig_bampton, interface: [0], modes: 1}}\n"
-     "    damping: {rayleigh: [0.1, -1]}\n", 6, "subsystems.rod.damping.rayleigh", "must be ≥ 0"),
+     "    damping: {rayleigh: [0.1, -1]}\n", 6, "parts.rod.damping.rayleigh", "must be ≥ 0"),
     ("    beam: {length: 1.0, elements: 4, area: 1e-4, Iy: 2e-9, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000, "
-     "theory: timoshenko}\n    reduction: {method: free_interface, modes: 1}\n", 4, "subsystems.rod.beam",
+     "theory: timoshenko}\n    reduction: {method: free_interface, modes: 1}\n", 4, "parts.rod.beam",
      "needs shear_factor"),
 ])
 def test_faults_are_named_with_file_line_and_key(body, line, where, words, tmp_path):

@@ -1,6 +1,6 @@
 """The FE loader under hostile input: every malformed ``fe:`` file (its bytes, its arrays, its
 Matrix Market text) and every hostile value of a ``beam:``, ``fe:`` or ``reduction:`` key
-loads, or is refused with a ModelError ``rod.yaml:LINE: at subsystems.rod.<key>: ...`` at
+loads, or is refused with a ModelError ``rod.yaml:LINE: at parts.rod.<key>: ...`` at
 that key, naming the data file where the fault is in one; never another exception.
 
 Property-based (hypothesis), derandomized and of a fixed number of cases: the same cases in
@@ -39,19 +39,19 @@ def flow(mapping):
 
 def model(source, reduction=REDUCTION):
     """The model text of a rod from ``source`` ("fe: {...}" or "beam: {...}", one line)."""
-    return (f"name: rod\nsubsystems:\n  rod:\n    type: flexible_body\n    {source}\n"
+    return (f"name: rod\nparts:\n  rod:\n    type: flexible_body\n    {source}\n"
             f"    reduction: {flow(reduction)}\n")
 
 
 def refused_or_loaded(text, folder, keys, names=()):
     """Load ``text`` as rod.yaml in ``folder``. A refusal must read ``rod.yaml:LINE: at
-    subsystems.rod.KEY...`` with KEY one of ``keys`` and LINE that key's line, and name one of
+    parts.rod.KEY...`` with KEY one of ``keys`` and LINE that key's line, and name one of
     the data files ``names`` (if any). Returns the error's message, or None when it loaded."""
     try:
         loads(text, name=MODEL, folder=folder)
     except ModelError as err:
         message = str(err)
-        match = re.match(r"rod\.yaml:(\d+): at subsystems\.rod\.(\w+)[.:]", message)
+        match = re.match(r"rod\.yaml:(\d+): at parts\.rod\.(\w+)[.:]", message)
         assert match and match.group(2) in keys, message
         assert int(match.group(1)) == (REDUCTION_LINE if match.group(2) == "reduction" else SOURCE_LINE), message
         assert not names or any(name in message for name in names), message
@@ -92,7 +92,7 @@ def test_every_key_refuses_every_value_that_is_no_number(folder):
                                      ("reduction",)) is not None, (key, value)
     for value in NOT_NUMBERS + ["4", "0", "6.0", "[6]", "six"]:
         message = refused_or_loaded(model(f"fe: {{bundle: rod.npz, dofs_per_node: {value}}}"), folder, ("fe",))
-        assert value == "~" or "at subsystems.rod.fe.dofs_per_node: dofs_per_node must be 3 or 6" in message, value
+        assert value == "~" or "at parts.rod.fe.dofs_per_node: dofs_per_node must be 3 or 6" in message, value
 
 
 BEAM_KEYS = st.sampled_from(sorted(BEAM) + ["theory", "mass", "axis", "up", "G", "shear_factor"])
@@ -106,7 +106,7 @@ def test_hostile_beam_keys(folder, changes):
     beam it makes has no modes to keep, at ``reduction``."""
     message = refused_or_loaded(model("beam: " + flow(BEAM | changes)), folder, ("beam", "reduction"))
     if set(changes.values()) & set(NOT_NUMBERS) - {"~"}:
-        assert message is not None and message.startswith(f"rod.yaml:{SOURCE_LINE}: at subsystems.rod.beam"), changes
+        assert message is not None and message.startswith(f"rod.yaml:{SOURCE_LINE}: at parts.rod.beam"), changes
 
 
 REDUCTION_KEYS = st.sampled_from(["method", "interface", "modes", "max_frequency", "reference"])

@@ -124,7 +124,7 @@ gravity: [0, 0, -9.81]
 world:
   frames:
     pivot: {position: [0, 0, 1]}
-subsystems:
+parts:
   bob:
     type: particle
     mass: m
@@ -162,7 +162,7 @@ def test_the_model_to_break_loads():
 
 def test_an_empty_constraint_entry_is_refused_by_line():
     """A list item with nothing after its dash (YAML null), found by the mutation fuzzer."""
-    text = ("name: empty_entry\nsubsystems:\n  body: {type: lagrangian, coordinates: [x], T: x_dot**2/2}\n"
+    text = ("name: empty_entry\nparts:\n  body: {type: lagrangian, coordinates: [x], T: x_dot**2/2}\n"
             "constraints:\n  - holonomic: body.x - 1\n  -\n")
     with pytest.raises(ModelError, match=r":6: at constraints\[1\]: .*needs exactly one of holonomic"):
         loads(text)
@@ -198,8 +198,8 @@ def test_random_yaml_documents(document):
     refused_or_loaded(dump(document))
 
 
-TOP = ["name", "description", "parameters", "gravity", "world", "subsystems", "constraints", "joints",
-       "closure", "initial", "initial_fixed", "forces"]
+TOP = ["name", "description", "parameters", "gravity", "world", "parts", "constraints", "joints",
+       "balances", "initial", "initial_fixed", "forces"]
 PART_KEYS = ["mass", "inertia", "coordinates", "T", "V", "forces", "frames", "geometry", "initial",
              "stiffness", "rest_length", "description", "color"]
 TYPES = st.sampled_from(["lagrangian", "rigid_body", "particle", "planar_body", "spring", "robot"]) | SCALARS
@@ -208,7 +208,7 @@ ENTRY_KEYS = ["name", "type", "parent", "child", "holonomic", "nonholonomic", "a
               "part", "value", "length", "stiffness", "rest_length", "damping", "radius", "C", "axes",
               "actuation", "friction", "spring"]
 ENTRIES = st.fixed_dictionaries({}, optional={k: SMALL | st.sampled_from(NAMES) for k in ENTRY_KEYS})
-SECTIONS = {"subsystems": st.dictionaries(st.sampled_from(NAMES) | st.text(max_size=6), PARTS, max_size=3) | SMALL,
+SECTIONS = {"parts": st.dictionaries(st.sampled_from(NAMES) | st.text(max_size=6), PARTS, max_size=3) | SMALL,
             "constraints": st.lists(ENTRIES, max_size=3) | SMALL,
             "joints": st.lists(ENTRIES.map(lambda e: {"type": "revolute", **e}), max_size=3) | SMALL,
             "forces": st.lists(ENTRIES.map(lambda e: {"type": "spring", **e}), max_size=3) | SMALL}
@@ -227,10 +227,10 @@ def test_model_shaped_documents(document):
 BAD_NUMBERS = [".nan", ".inf", "-.inf", "1e999", "1/0", "0/0", "log(0)", "10**400", "exp(1000)", "sqrt(-1)",
                "(-8)**(1/3)", "acos(2)", "2**2**2**2**2**2", "9" * 5000, "'" + "9" * 5000 + "'", "1e308*10",
                "[1, 2]", "{a: 1}", "nosuch", "''", "'1 +'", "exp(exp(exp(100)))", "~", "true", "2001-02-30"]
-NUMBER_PLACES = [("parameters", "m"), ("gravity", 2), ("subsystems", "bob", "mass"),
-                 ("subsystems", "plate", "inertia"), ("joints", 0, "length"), ("forces", 0, "stiffness"),
-                 ("initial", "cart.x"), ("subsystems", "bob", "initial", "position", 0),
-                 ("world", "frames", "pivot", "position", 1), ("subsystems", "cart", "frames", "tip", "position", 2)]
+NUMBER_PLACES = [("parameters", "m"), ("gravity", 2), ("parts", "bob", "mass"),
+                 ("parts", "plate", "inertia"), ("joints", 0, "length"), ("forces", 0, "stiffness"),
+                 ("initial", "cart.x"), ("parts", "bob", "initial", "position", 0),
+                 ("world", "frames", "pivot", "position", 1), ("parts", "cart", "frames", "tip", "position", 2)]
 
 
 @budget(240, space=len(NUMBER_PLACES) * len(BAD_NUMBERS))
@@ -241,7 +241,7 @@ def test_bad_numbers_are_refused(place, text):
     refused_or_loaded(with_text(base(), place, text), must_fail=True)
 
 
-NONNEGATIVE = [("subsystems", "bob", "mass"), ("subsystems", "plate", "inertia"), ("joints", 0, "length"),
+NONNEGATIVE = [("parts", "bob", "mass"), ("parts", "plate", "inertia"), ("joints", 0, "length"),
                ("forces", 0, "stiffness"), ("forces", 0, "rest_length")]
 
 
@@ -269,7 +269,7 @@ def impossible_inertia(J):
 @given(J=st.lists(st.lists(st.floats(-10, 10, allow_subnormal=False), min_size=3, max_size=3), min_size=3,
                   max_size=3).filter(impossible_inertia))
 def test_impossible_inertia_is_refused(J):
-    refused_or_loaded(f"subsystems:\n  body:\n    type: rigid_body\n    mass: 1\n    inertia: {J}\n", must_fail=True)
+    refused_or_loaded(f"parts:\n  body:\n    type: rigid_body\n    mass: 1\n    inertia: {J}\n", must_fail=True)
 
 
 @budget(300)
@@ -279,7 +279,7 @@ def test_a_kinetic_energy_that_is_not_positive_semi_definite_is_refused(a, b, c)
     T = f"0.5*({a!r})*x_dot**2 + ({b!r})*x_dot*y_dot + 0.5*({c!r})*y_dot**2"
     lowest, highest = np.linalg.eigvalsh([[a, b], [b, c]])[[0, -1]]
     scale = max(abs(lowest), abs(highest), 1e-300)
-    result = refused_or_loaded(f"subsystems:\n  p: {{type: lagrangian, coordinates: [x, y], T: '{T}'}}\n",
+    result = refused_or_loaded(f"parts:\n  p: {{type: lagrangian, coordinates: [x, y], T: '{T}'}}\n",
                                must_fail=lowest < -1e-9 * scale)
     assert isinstance(result, ModelError) == (lowest < -1e-12 * scale) or abs(lowest) <= 1e-9 * scale
 
@@ -291,15 +291,15 @@ DEFECTS = [
     (("forces", 0, "between"), ["world.pivot"]), (("forces", 0, "between"), ["world", "world.pivot"]),
     (("constraints", 0, "holonomic"), "cart.y - plate.x"), (("constraints", 0, "holonomic"), "m - 1"),
     (("constraints", 0, "name"), "rod"), (("initial",), {"cart.q": 1.0}), (("initial_fixed",), ["cart.x_dot"]),
-    (("initial_fixed",), [["cart.x"]]), (("subsystems", "cart", "coordinates"), ["x", "x"]),
-    (("subsystems", "cart", "coordinates"), ["x_dot"]), (("subsystems", "cart", "T"), "0.5*m*y_dot**2"),
-    (("subsystems", "cart", "V"), "x_dot**2"), (("subsystems", "plate", "type"), "planar"),
-    (("subsystems", "plate", "type"), ["planar_body"]), (("subsystems", "bob", "frames", "c"), {"position": [1, 0, 0]}),
-    (("closure",), "sometimes"), (("closure",), ["auto"]), (("subsystems", "m"), {"type": "particle", "mass": 1}),
+    (("initial_fixed",), [["cart.x"]]), (("parts", "cart", "coordinates"), ["x", "x"]),
+    (("parts", "cart", "coordinates"), ["x_dot"]), (("parts", "cart", "T"), "0.5*m*y_dot**2"),
+    (("parts", "cart", "V"), "x_dot**2"), (("parts", "plate", "type"), "planar"),
+    (("parts", "plate", "type"), ["planar_body"]), (("parts", "bob", "frames", "c"), {"position": [1, 0, 0]}),
+    (("balances",), "sometimes"), (("balances",), ["auto"]), (("parts", "m"), {"type": "particle", "mass": 1}),
     (("parameters", "t"), 1.0), (("parameters", "sin"), 1.0), (("parameters", "k"), "k + 1"),
-    (("subsystems", "world"), {"type": "particle", "mass": 1}), (("name",), ["a"]), (("gravity",), [0, 0]),
+    (("parts", "world"), {"type": "particle", "mass": 1}), (("name",), ["a"]), (("gravity",), [0, 0]),
 ]
-DUPLICATE_LINES = ["parameters:", "gravity:", "  bob:", "    mass: m", "    T: 0.5", "initial:", "subsystems:"]
+DUPLICATE_LINES = ["parameters:", "gravity:", "  bob:", "    mass: m", "    T: 0.5", "initial:", "parts:"]
 
 
 @budget(200, space=len(DEFECTS) * 2 * 4)
@@ -335,7 +335,7 @@ def test_cycles_of_joints_load_or_are_refused(count, kind, offset):
                        "frames": {"f": {"position": [offset, 0, 0]}}} for i in range(count)}
     joints = [{"name": f"j{i}", "type": kind, "parent": f"b{i}.f", "child": f"b{(i + 1) % count}"}
               for i in range(count)]
-    result = refused_or_loaded(dump({"subsystems": parts, "joints": joints}))
+    result = refused_or_loaded(dump({"parts": parts, "joints": joints}))
     if not isinstance(result, ModelError):
         assert diagnose(result).n == 3 * count
 
@@ -370,13 +370,13 @@ LONG = st.one_of(
     st.tuples(st.sampled_from(["sin(", "(", "-(", "exp(", "sqrt(", "x**(", "cart.x*("]), st.integers(20, 400)).map(
         lambda r: r[0] * r[1] + "1" + ")" * r[1]),
     st.integers(100, 30000).map(lambda n: "-" * n + "1"))
-SLOTS = {"parameter": ("parameters", "k"), "gravity": ("gravity", 0), "energy": ("subsystems", "cart", "V"),
+SLOTS = {"parameter": ("parameters", "k"), "gravity": ("gravity", 0), "energy": ("parts", "cart", "V"),
          "constraint": ("constraints", 0, "holonomic"), "initial": ("initial", "cart.x"),
-         "frame": ("subsystems", "cart", "frames", "tip", "position", 0)}
+         "frame": ("parts", "cart", "frames", "tip", "position", 0)}
 SMALL_MODEL = """\
 parameters: {m: 1.0, k: 10.0}
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   cart:
     type: lagrangian
     coordinates: [x]
@@ -417,20 +417,20 @@ def test_deep_nesting_is_refused(depth, kind):
     else:
         depth = min(depth, 300)  # block styles: the indentation alone grows as depth²
         body = "\n" + "".join(" " * i + kind + "\n" for i in range(depth)) + " " * depth + "1"
-    refused_or_loaded("subsystems: " + body + "\n", must_fail=True)
+    refused_or_loaded("parts: " + body + "\n", must_fail=True)
 
 
 @budget(150)
 @given(width=st.integers(2, 12), levels=st.integers(2, 12),
-       place=st.sampled_from(["closure", "initial_fixed", "name", "gravity", "subsystems", "parameters", None]))
+       place=st.sampled_from(["balances", "initial_fixed", "name", "gravity", "parts", "parameters", None]))
 def test_alias_bombs_are_refused_quickly(width, levels, place):
     """A "billion laughs": anchors &l0 ... &lN in ``description``, each level repeating the
     one before ``width`` times, the last one used at ``place``."""
     lines = ["description:", f"  - &l0 [{', '.join(['lol'] * width)}]"]
     lines += [f"  - &l{i} [{', '.join([f'*l{i - 1}'] * width)}]" for i in range(1, levels)]
-    lines.append("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}" if place != "subsystems"
-                 else f"subsystems: *l{levels - 1}")
-    if place not in (None, "subsystems"):
+    lines.append("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}" if place != "parts"
+                 else f"parts: *l{levels - 1}")
+    if place not in (None, "parts"):
         lines.append(f"{place}: *l{levels - 1}")
     start = time.perf_counter()
     refused_or_loaded("\n".join(lines) + "\n", must_fail=width**levels > 200_000)

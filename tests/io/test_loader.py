@@ -11,7 +11,7 @@ import mbsynth as mb
 PENDULUM_XY = """\
 name: pendulum_xy
 parameters: {m: 1.5, L: 2.0, g: 9.81}
-subsystems:
+parts:
   bob:
     type: lagrangian
     coordinates: [x, y]
@@ -51,7 +51,7 @@ def test_velocity_dependent_kinetic_energy_terms_and_forces():
     R θ̈ = R w² sinθ cosθ − g sinθ + F/(mR) for a generalized force F."""
     system = loads("""\
         parameters: {m: 0.7, R: 0.5, w: 3.0, g: 9.81, F: 0.2}
-        subsystems:
+        parts:
           bead:
             type: lagrangian
             coordinates: [theta]
@@ -72,7 +72,7 @@ def test_nonholonomic_and_time_dependent_constraints():
     (non-holonomic form of a line): ẍ = 0, ÿ = 0, with both constraints reported."""
     system = loads("""\
         parameters: {m: 1.0, v: 2.0, a: 0.5, g: 9.81}
-        subsystems:
+        parts:
           p:
             type: lagrangian
             coordinates: [x, y]
@@ -93,7 +93,7 @@ def test_acceleration_rows_and_nonideal_C_enter_2_14():
     C = −c ẋ along x give ẍ = (F − c ẋ)/m."""
     system = loads("""\
         parameters: {m: 2.0, c: 0.3, F: 1.0}
-        subsystems:
+        parts:
           block:
             type: lagrangian
             coordinates: [x, y]
@@ -111,7 +111,7 @@ def test_acceleration_rows_and_nonideal_C_enter_2_14():
 def test_parameters_may_be_expressions_of_earlier_ones():
     system = loads("""\
         parameters: {m: 2.0, R: 0.5, Ic: 0.5*m*R**2}
-        subsystems:
+        parts:
           disk: {type: lagrangian, coordinates: [th], T: 0.5*Ic*th_dot**2}
         """)
     assert system.parameters["Ic"] == pytest.approx(0.25)
@@ -120,43 +120,43 @@ def test_parameters_may_be_expressions_of_earlier_ones():
 HINGED = """\
 parameters: {k: 2.0}
 world: {frames: {pivot: {axis: [0, 1, 0]}}}
-subsystems:
+parts:
   rod: {type: rigid_body, mass: 1, inertia: [1, 1, 1], frames: {top: {position: [0, 0, 1], axis: [0, 1, 0]}}}
 joints:
   - {name: hinge, type: revolute, parent: world.pivot, child: rod.top}
 """
 
 ERRORS = [
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*m*x_dot**2}\n",
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: 0.5*m*x_dot**2}\n",
      2, "unknown name 'm'"),
-    ("parameters: {m: 1}\nsubsystems:\n  a:\n    type: lagrangian\n    coordinates: [x]\n    T: 0.5*m*x_dot**2\n"
-     "    V: x +* 2\n", 7, "at subsystems.a.V: malformed expression"),
-    ("subsystems:\n  a:\n    type: rigid\n", 3, "unknown subsystem type 'rigid'"),
-    ("subsystems:\n  a:\n    type: lagrangian\n    coordinates: [x]\n", 2, "missing required key 'T'"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraint: []\n", 3,
+    ("parameters: {m: 1}\nparts:\n  a:\n    type: lagrangian\n    coordinates: [x]\n    T: 0.5*m*x_dot**2\n"
+     "    V: x +* 2\n", 7, "at parts.a.V: malformed expression"),
+    ("parts:\n  a:\n    type: rigid\n", 3, "unknown part type 'rigid'"),
+    ("parts:\n  a:\n    type: lagrangian\n    coordinates: [x]\n", 2, "missing required key 'T'"),
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraint: []\n", 3,
      "unknown key 'constraint' (did you mean 'constraints'?)"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n  - name: c\n"
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n  - name: c\n"
      "    holonomic: a.x_dot\n", 5, "write it as 'nonholonomic:'"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n  - name: c\n"
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n  - name: c\n"
      "    holonomic: b.x\n", 5, "unknown name 'b.x' (did you mean a.x?)"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\ninitial: {a.y: 1}\n", 3,
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\ninitial: {a.y: 1}\n", 3,
      "unknown key 'a.y'"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: -x_dot**2}\n", 2, "not positive semi-definite"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x, x], T: x_dot**2}\n", 2, "listed twice"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\n  a: {}\n", 3, "duplicate key 'a'"),
-    ("subsystems: [1, 2]\n", 1, "expected a mapping of named parts"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2, V: x_dot}\n", 2,
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: -x_dot**2}\n", 2, "not positive semi-definite"),
+    ("parts:\n  a: {type: lagrangian, coordinates: [x, x], T: x_dot**2}\n", 2, "listed twice"),
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\n  a: {}\n", 3, "duplicate key 'a'"),
+    ("parts: [1, 2]\n", 1, "expected a mapping of named parts"),
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2, V: x_dot}\n", 2,
      "V must not depend on velocities"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n  - {name: c, nonholonomic: a.x}\n",
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n  - {name: c, nonholonomic: a.x}\n",
      4, "involves no velocity"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n"
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nconstraints:\n"
      "  - {name: c, acceleration: {A: [1, 2], b: 0}}\n", 4, "needs 1 entries"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2\n", 3, "not valid YAML"),
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2\n", 3, "not valid YAML"),
     ("- just\n- a list\n", 1, "must be a mapping"),
-    ("parameters: {t: 1}\nsubsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\n", 1, "reserved"),
-    ("subsystems:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nclosure: yes\n", 3,
+    ("parameters: {t: 1}\nparts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\n", 1, "reserved"),
+    ("parts:\n  a: {type: lagrangian, coordinates: [x], T: x_dot**2}\nbalances: yes\n", 3,
      "expected 'auto' or 'none'"),
-    ("subsystems: {}\n", 1, "the mapping is empty: a model needs at least one part"),
+    ("parts: {}\n", 1, "the mapping is empty: a model needs at least one part"),
     (f"{HINGED}outputs: {{d: hinge.displacement}}\n", 7,
      "unknown name 'hinge.displacement' ('hinge' has angle, rate)"),  # a revolute joint's values
     (HINGED.replace("name: hinge", "name: world"), 6, "at joints[0].name: joint 'world' has the name of the world"),

@@ -18,13 +18,13 @@ from mbsynth.view.scene import build_scene
 # per file type, model files made of one entry of it (``{entry}``) and what holds it
 EXAMPLES = {
     "lagrangian": ["""
-        subsystems:
+        parts:
           p: {type: lagrangian, coordinates: [x], T: 0.5*x_dot**2, V: 2*x**2, frames: {bob: {position: [x, 0, 0]}}}
         initial: {p.x: 0.1}
         """],
     "rigid_body": [f"""
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           b: {{type: rigid_body, mass: 1.2, inertia: [0.1, 0.2, 0.3], {rotation}frames: {{top: {{position: [0, 0, 0.5]}}}},
               initial: {{position: [0, 0, -0.5]}}}}
         joints:
@@ -32,28 +32,28 @@ EXAMPLES = {
         """ for rotation in ("", "rotation: zxy, ")],
     "particle": ["""
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           p: {type: particle, mass: 1.0, initial: {position: [0.6, 0, -0.8]}}
         joints:
           - {name: rod, type: distance, parent: world, child: p, length: 1.0}
         """],
     "planar_body": ["""
         gravity: [0, -9.81, 0]
-        subsystems:
+        parts:
           p: {type: planar_body, mass: 1.0, inertia: 0.1, frames: {tip: {position: [0.5, 0, 0]}}}
         """],
     "spring": ["""
-        subsystems:
+        parts:
           s: {type: spring, stiffness: 10, rest_length: 0.5, mass: 0.3, initial: {end2: [0.6, 0, 0]}}
         """],
     "robot": ["""
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           arm: {type: robot, robot: double_pendulum, initial: {}}
         """],
     "solid": ["""
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           s: {type: solid, shape: {capsule: [0.05, 0.4]}, density: 1000, frames: {top: {position: [0, 0, 0.25]}},
               initial: {position: [0, 0, -0.25]}}
         joints:
@@ -61,7 +61,7 @@ EXAMPLES = {
         """],
     "flexible_body": ["""
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           strip:
             type: flexible_body
             beam: {length: 1.0, elements: 4, area: 1e-4, Iy: 4e-9, Iz: 1e-9, J: 5e-9, E: 2.1e11, nu: 0.3, density: 7850}
@@ -95,7 +95,7 @@ CASES = [(name, i, text) for name, texts in EXAMPLES.items() for i, text in enum
 @pytest.mark.parametrize("name, i, text", CASES, ids=[f"{name}-{i}" for name, i, _ in CASES])
 def test_each_type_is_read_drawn_linearized_and_compiled(name, i, text):
     system = mb.loads(textwrap.dedent(text), name=f"{name}.yaml")
-    assert {p.kind for p in system.parts} <= {t.name for t in FILE_TYPES[name].builds}
+    assert {p.type_name for p in system.parts} <= {t.name for t in FILE_TYPES[name].builds}
     q, qd = system.initial_state()
     # drawn: every part has a node at its own pose or its frames (a spring: its line)
     rows = np.array([q, q + 0.01])

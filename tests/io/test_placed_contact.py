@@ -16,7 +16,7 @@ TURN = 0.7  # the placement's turn about z
 DISK = """name: disk
 parameters: {R: 0.1, m: 1.0}
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   disk:
     type: rigid_body
     mass: m
@@ -28,14 +28,14 @@ joints:
 """
 PLACED = f"""name: placed
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   d: {{type: model, file: disk.yaml, placement: {{position: [1, 0, 0.5], rpy: [0, 0, {TURN}]}}}}
 """
 # the same disk written out: its pose and velocities turned by TURN about z and raised 0.5 m
 FLAT = f"""name: flat
 parameters: {{R: 0.1, m: 1.0}}
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   disk:
     type: rigid_body
     mass: m

@@ -20,7 +20,7 @@ URDF = """<robot name="arm">
 """
 
 BASE = {"parameters": {"m": 1.0, "k": 10.0, "L": 0.5, "R": 0.2, "g": 9.81, "F": 1.0, "tau": 0.1, "f": 0.1},
-        "subsystems": {
+        "parts": {
             "body": {"type": "rigid_body", "mass": "m", "inertia": [0.1, 0.1, 0.2],
                      "frames": {"tip": {"position": [0, 0, -0.5]}, "top": {}}},
             "link": {"type": "planar_body", "mass": 1, "inertia": 0.1, "frames": {"top": {"position": [0, 0.5, 0]}}},
@@ -33,24 +33,24 @@ ROD = {"type": "flexible_body", "beam": {"length": 1.0, "elements": 20, "area": 
 
 # Where each section's mapping sits: (path of the mapping in the model, its minimal valid
 # content, the model's other entries it needs). Keys are then added to that mapping.
-LEG = "parameters: {L: 0.4, m: 1}\nsubsystems: {foot: {type: particle, mass: m}}\n"  # a file to include
+LEG = "parameters: {L: 0.4, m: 1}\nparts: {foot: {type: particle, mass: m}}\n"  # a file to include
 HOSTS = {
     "model": ((), None, {}),
     "world": (("world",), {}, {}),
     "frame": (("world", "frames", "anchor"), {}, {}),
-    "lagrangian": (("subsystems", "cart"), {"type": "lagrangian", "coordinates": ["x"], "T": "0.5*m*x_dot**2"}, {}),
-    "rigid_body": (("subsystems", "body"), None, {}),
-    "particle": (("subsystems", "point"), None, {}),
-    "planar_body": (("subsystems", "link"), None, {}),
-    "spring": (("subsystems", "coil"), {"type": "spring", "stiffness": 1, "rest_length": 1}, {}),
-    "robot": (("subsystems", "arm"), {"type": "robot", "robot": "arm.urdf"}, {}),
-    "initial_rigid_body": (("subsystems", "body", "initial"), {}, {}),
-    "initial_particle": (("subsystems", "point", "initial"), {}, {}),
-    "initial_planar_body": (("subsystems", "link", "initial"), {}, {}),
-    "initial_spring": (("subsystems", "coil", "initial"), {},
-                       {("subsystems", "coil"): {"type": "spring", "stiffness": 1, "rest_length": 1}}),
-    "pose": (("subsystems", "arm", "base"), {}, {("subsystems", "arm"): {"type": "robot", "robot": "arm.urdf"}}),
-    "geometry": (("subsystems", "body", "frames", "tip", "geometry"), {}, {}),
+    "lagrangian": (("parts", "cart"), {"type": "lagrangian", "coordinates": ["x"], "T": "0.5*m*x_dot**2"}, {}),
+    "rigid_body": (("parts", "body"), None, {}),
+    "particle": (("parts", "point"), None, {}),
+    "planar_body": (("parts", "link"), None, {}),
+    "spring": (("parts", "coil"), {"type": "spring", "stiffness": 1, "rest_length": 1}, {}),
+    "robot": (("parts", "arm"), {"type": "robot", "robot": "arm.urdf"}, {}),
+    "initial_rigid_body": (("parts", "body", "initial"), {}, {}),
+    "initial_particle": (("parts", "point", "initial"), {}, {}),
+    "initial_planar_body": (("parts", "link", "initial"), {}, {}),
+    "initial_spring": (("parts", "coil", "initial"), {},
+                       {("parts", "coil"): {"type": "spring", "stiffness": 1, "rest_length": 1}}),
+    "pose": (("parts", "arm", "base"), {}, {("parts", "arm"): {"type": "robot", "robot": "arm.urdf"}}),
+    "geometry": (("parts", "body", "frames", "tip", "geometry"), {}, {}),
     "constraint": (("constraints", 0), {}, {}),
     "acceleration_row": (("constraints", 0, "acceleration"), {"A": {"point.x": 1}}, {("constraints", 0): {}}),
     "joint": (("joints", 0), {"name": "pin", "type": "revolute", "parent": "world", "child": "body.top"}, {}),
@@ -71,16 +71,16 @@ HOSTS = {
     "force_force": (("forces", 0), {"type": "force", "at": "body.tip", "value": [0, 0, 1]}, {}),
     "force_torque": (("forces", 0), {"type": "torque", "part": "body", "value": [0, 0, 1]}, {}),
     "output": (("outputs", "watch"), {}, {}),
-    "model_part": (("subsystems", "leg"), {"type": "model", "file": "leg.yaml"}, {}),
-    "placement": (("subsystems", "leg", "placement"), {}, {("subsystems", "leg"): {"type": "model", "file": "leg.yaml"}}),
-    "flexible_body": (("subsystems", "rod"), dict(ROD), {}),
-    "solid": (("subsystems", "block"), {"type": "solid", "shape": {"box": [0.2, 0.1, 0.1]}, "density": 1000}, {}),
-    "flexible_beam": (("subsystems", "rod", "beam"), dict(ROD["beam"]), {("subsystems", "rod"): dict(ROD)}),
-    "flexible_fe": (("subsystems", "rod", "fe"), {}, {("subsystems", "rod"): {k: v for k, v in ROD.items() if k != "beam"}}),
-    "flexible_reduction": (("subsystems", "rod", "reduction"), dict(ROD["reduction"]), {("subsystems", "rod"): dict(ROD)}),
-    "flexible_damping": (("subsystems", "rod", "damping"), {}, {("subsystems", "rod"): dict(ROD)}),
-    "flexible_frame": (("subsystems", "rod", "frames", "tip"), {"node": 20}, {("subsystems", "rod"): dict(ROD)}),
-    "initial_flexible_body": (("subsystems", "rod", "initial"), {}, {("subsystems", "rod"): dict(ROD)}),
+    "model_part": (("parts", "leg"), {"type": "model", "file": "leg.yaml"}, {}),
+    "placement": (("parts", "leg", "placement"), {}, {("parts", "leg"): {"type": "model", "file": "leg.yaml"}}),
+    "flexible_body": (("parts", "rod"), dict(ROD), {}),
+    "solid": (("parts", "block"), {"type": "solid", "shape": {"box": [0.2, 0.1, 0.1]}, "density": 1000}, {}),
+    "flexible_beam": (("parts", "rod", "beam"), dict(ROD["beam"]), {("parts", "rod"): dict(ROD)}),
+    "flexible_fe": (("parts", "rod", "fe"), {}, {("parts", "rod"): {k: v for k, v in ROD.items() if k != "beam"}}),
+    "flexible_reduction": (("parts", "rod", "reduction"), dict(ROD["reduction"]), {("parts", "rod"): dict(ROD)}),
+    "flexible_damping": (("parts", "rod", "damping"), {}, {("parts", "rod"): dict(ROD)}),
+    "flexible_frame": (("parts", "rod", "frames", "tip"), {"node": 20}, {("parts", "rod"): dict(ROD)}),
+    "initial_flexible_body": (("parts", "rod", "initial"), {}, {("parts", "rod"): dict(ROD)}),
 }
 # Keys of which a mapping takes at most one: each is tried in a model of its own.
 EXCLUSIVE = [{"rpy", "axis", "quaternion"}, {"box", "sphere", "cylinder", "capsule", "mesh", "line"},

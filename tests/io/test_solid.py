@@ -20,7 +20,7 @@ MODEL = Path(__file__).resolve().parents[2] / "models" / "rigid" / "solid_pendul
 def solid(shape, extra="", folder=None, parameters=""):
     text = textwrap.dedent(f"""\
         parameters: {{rho: {RHO}{parameters}}}
-        subsystems:
+        parts:
           s: {{type: solid, shape: {shape}, density: rho{extra}}}
         """)
     return mb.loads(text, name="solid.yaml", folder=folder)
@@ -125,7 +125,7 @@ def test_density_is_a_parameter_and_the_shape_is_built_in():
 ])
 def test_mistakes_name_the_line(entry, message):
     with pytest.raises(mb.ModelError) as caught:
-        mb.loads(f"subsystems:\n  s: {{type: solid, {entry}}}\n", name="bad.yaml")
+        mb.loads(f"parts:\n  s: {{type: solid, {entry}}}\n", name="bad.yaml")
     assert "bad.yaml:2" in str(caught.value) and message in str(caught.value)
 
 
@@ -134,7 +134,7 @@ def test_an_open_mesh_is_refused_from_the_command_line(tmp_path):
     box_stl(tmp_path / "box.stl", [0.4, 0.2, 0.1], [0, 0, 0])
     lines = (tmp_path / "box.stl").read_text().splitlines()
     (tmp_path / "open.stl").write_text("\n".join(lines[:1] + lines[15:]))  # two triangles (7 lines each) fewer
-    (tmp_path / "open.yaml").write_text("subsystems:\n  s: {type: solid, shape: {mesh: open.stl}, density: 1000}\n")
+    (tmp_path / "open.yaml").write_text("parts:\n  s: {type: solid, shape: {mesh: open.stl}, density: 1000}\n")
     done = subprocess.run([sys.executable, "-m", "mbsynth.cli", "check", str(tmp_path / "open.yaml")],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 2

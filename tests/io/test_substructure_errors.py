@@ -17,7 +17,7 @@ BAD_INPUT = 2  # the CLI's exit status for a bad model file
 CELL = """\
 name: cell
 parameters: {L: 1.0, m: 1.0}
-subsystems:
+parts:
   p: {type: particle, mass: m, initial: {position: [L, 0, 0]}}
 joints:
   - {name: pin, type: spherical, parent: world, child: p}
@@ -26,14 +26,14 @@ ports: {tip: p}
 NEGATIVE_MASS = """\
 name: negative
 parameters: {m: 1}
-subsystems:
+parts:
   p: {type: particle, mass: -m}
 """
 
 
 def entry(spec, rest=""):
     """A top file whose line 2 is the entry ``c: {type: model, SPEC}``, then ``rest``."""
-    return f"subsystems:\n  c: {{type: model, {spec}}}\n{rest}"
+    return f"parts:\n  c: {{type: model, {spec}}}\n{rest}"
 
 
 JOIN_TO = "  q: {{type: particle, mass: 1}}\njoints:\n  - {{name: j, type: spherical, parent: \"{frame}\", child: q}}\n"
@@ -49,17 +49,17 @@ joints:
 
 # case: ({file: text} besides cell.yaml, the top file, [texts the message must hold])
 CASES = {
-    "includes itself": ({"top.yaml": "parameters: {a: 1}\nsubsystems:\n  me: {type: model, file: top.yaml}\n"},
-                        "top.yaml", ["top.yaml:3: at subsystems.me.file:", "includes itself: top.yaml:3 →"]),
+    "includes itself": ({"top.yaml": "parameters: {a: 1}\nparts:\n  me: {type: model, file: top.yaml}\n"},
+                        "top.yaml", ["top.yaml:3: at parts.me.file:", "includes itself: top.yaml:3 →"]),
     "includes itself through another": (
-        {"a.yaml": "subsystems:\n  x: {type: model, file: b.yaml}\n",
-         "b.yaml": "parameters: {z: 1}\nsubsystems:\n  y: {type: model, file: a.yaml}\n"},
-        "a.yaml", ["b.yaml:3: at subsystems.y.file:", "includes itself: a.yaml:2 →", "b.yaml:3 →"]),
+        {"a.yaml": "parts:\n  x: {type: model, file: b.yaml}\n",
+         "b.yaml": "parameters: {z: 1}\nparts:\n  y: {type: model, file: a.yaml}\n"},
+        "a.yaml", ["b.yaml:3: at parts.y.file:", "includes itself: a.yaml:2 →", "b.yaml:3 →"]),
     "missing file": ({"top.yaml": entry("file: nothere.yaml")}, "top.yaml",
-                     ["top.yaml:2: at subsystems.c.file:", "no such model file 'nothere.yaml'"]),
+                     ["top.yaml:2: at parts.c.file:", "no such model file 'nothere.yaml'"]),
     "folder as file": ({"top.yaml": entry("file: folder.yaml")}, "top.yaml",
-                       ["top.yaml:2: at subsystems.c.file:", "'folder.yaml' is a folder"]),
-    "no file key": ({"top.yaml": entry("count: 2")}, "top.yaml", ["top.yaml:2: at subsystems.c:", "'file'"]),
+                       ["top.yaml:2: at parts.c.file:", "'folder.yaml' is a folder"]),
+    "no file key": ({"top.yaml": entry("count: 2")}, "top.yaml", ["top.yaml:2: at parts.c:", "'file'"]),
     "unknown port": ({"top.yaml": entry("file: cell.yaml", JOIN_TO.format(frame="c.nosuch"))}, "top.yaml",
                      ["top.yaml:5: at joints[0].parent:", "no port or part frame 'nosuch'", "its ports: tip"]),
     "part not in the child": ({"top.yaml": entry("file: cell.yaml", JOIN_TO.format(frame="c.arm.top"))},
@@ -82,53 +82,53 @@ CASES = {
     "negative index": ({"top.yaml": entry("file: cell.yaml, count: 2", JOIN_TO.format(frame="c[0 - 1].tip"))},
                        "top.yaml", ["top.yaml:5: at joints[0].parent:", "whole number ≥ 0"]),
     "count 0": ({"top.yaml": entry("file: cell.yaml, count: 0")}, "top.yaml",
-                ["top.yaml:2: at subsystems.c.count:", "whole number ≥ 1, got 0"]),
+                ["top.yaml:2: at parts.c.count:", "whole number ≥ 1, got 0"]),
     "negative count": ({"top.yaml": entry("file: cell.yaml, count: -3")}, "top.yaml",
-                       ["top.yaml:2: at subsystems.c.count:", "whole number ≥ 1, got -3"]),
+                       ["top.yaml:2: at parts.c.count:", "whole number ≥ 1, got -3"]),
     "fractional count": ({"top.yaml": entry("file: cell.yaml, count: 1.5")}, "top.yaml",
-                         ["top.yaml:2: at subsystems.c.count:", "whole number ≥ 1, got 1.5"]),
+                         ["top.yaml:2: at parts.c.count:", "whole number ≥ 1, got 1.5"]),
     "count not a number": ({"top.yaml": entry("file: cell.yaml, count: yes")}, "top.yaml",
-                           ["top.yaml:2: at subsystems.c.count:", "expected a number"]),
+                           ["top.yaml:2: at parts.c.count:", "expected a number"]),
     "huge count": ({"top.yaml": entry("file: cell.yaml, count: 1e9")}, "top.yaml",
-                   ["top.yaml:2: at subsystems.c.count:", "more than 100000 copies"]),
+                   ["top.yaml:2: at parts.c.count:", "more than 100000 copies"]),
     "zero axis": ({"top.yaml": entry("file: cell.yaml, placement: {axis: [0, 0, 0]}")}, "top.yaml",
-                  ["top.yaml:2: at subsystems.c.placement.axis:", "must not be zero"]),
+                  ["top.yaml:2: at parts.c.placement.axis:", "must not be zero"]),
     "zero quaternion": ({"top.yaml": entry("file: cell.yaml, placement: {quaternion: [0, 0, 0, 0]}")}, "top.yaml",
-                        ["top.yaml:2: at subsystems.c.placement.quaternion:", "must not be zero"]),
+                        ["top.yaml:2: at parts.c.placement.quaternion:", "must not be zero"]),
     "quaternion not of unit norm": (
         {"top.yaml": entry("file: cell.yaml, placement: {quaternion: [1, 1, 0, 0]}")}, "top.yaml",
-        ["top.yaml:2: at subsystems.c.placement.quaternion:", "not of unit norm"]),
+        ["top.yaml:2: at parts.c.placement.quaternion:", "not of unit norm"]),
     "two orientations": ({"top.yaml": entry("file: cell.yaml, placement: {rpy: [0, 0, 1], axis: [0, 0, 1]}")},
-                         "top.yaml", ["top.yaml:2: at subsystems.c.placement:", "at most one of"]),
+                         "top.yaml", ["top.yaml:2: at parts.c.placement:", "at most one of"]),
     "position not of 3": ({"top.yaml": entry("file: cell.yaml, placement: {position: [1, 0]}")}, "top.yaml",
-                          ["top.yaml:2: at subsystems.c.placement.position:", "list of 3"]),
+                          ["top.yaml:2: at parts.c.placement.position:", "list of 3"]),
     "index without count": ({"top.yaml": entry("file: cell.yaml, placement: {position: [index, 0, 0]}")},
-                            "top.yaml", ["top.yaml:2: at subsystems.c.placement.position[0]:", "'index'"]),
+                            "top.yaml", ["top.yaml:2: at parts.c.placement.position[0]:", "'index'"]),
     "parameter given twice": (
-        {"top.yaml": "subsystems:\n  c:\n    type: model\n    file: cell.yaml\n    parameters:\n"
+        {"top.yaml": "parts:\n  c:\n    type: model\n    file: cell.yaml\n    parameters:\n"
                      "      L: 2\n      L: 3\n"}, "top.yaml", ["top.yaml:7:", "duplicate key 'L'", "line 6"]),
     "parameter the child lacks": ({"top.yaml": entry("file: cell.yaml, parameters: {Ls: 2}")}, "top.yaml",
-                                  ["top.yaml:2: at subsystems.c.parameters.Ls:", "not a parameter of",
+                                  ["top.yaml:2: at parts.c.parameters.Ls:", "not a parameter of",
                                    "cell.yaml", "did you mean 'L'"]),
     "a parameter named index": ({"top.yaml": "parameters: {index: 1}\n" + entry("file: cell.yaml, count: 2")},
-                                "top.yaml", ["top.yaml:3: at subsystems.c.count:", "parameter 'index'"]),
+                                "top.yaml", ["top.yaml:3: at parts.c.count:", "parameter 'index'"]),
     "a copy's parameter not real": (
         {"top.yaml": entry("file: cell.yaml, count: 3, parameters: {L: sqrt(1 - index)}")}, "top.yaml",
-        ["top.yaml:2: at subsystems.c.parameters.L:", "not a finite real number", "(with index = 2)"]),
+        ["top.yaml:2: at parts.c.parameters.L:", "not a finite real number", "(with index = 2)"]),
     "unknown key of the entry": ({"top.yaml": entry("file: cell.yaml, mass: 3")}, "top.yaml",
-                                 ["top.yaml:2: at subsystems.c.mass:", "unknown key 'mass'"]),
+                                 ["top.yaml:2: at parts.c.mass:", "unknown key 'mass'"]),
     "error inside the child": ({"child.yaml": NEGATIVE_MASS, "top.yaml": entry("file: child.yaml")}, "top.yaml",
-                               ["child.yaml:4: at subsystems.p.mass:", "mass must be ≥ 0",
+                               ["child.yaml:4: at parts.p.mass:", "mass must be ≥ 0",
                                 "(in 'c', included from top.yaml:2)"]),
     "error in the child's child": (
-        {"leaf.yaml": NEGATIVE_MASS, "mid.yaml": "subsystems:\n  inner: {type: model, file: leaf.yaml}\n",
-         "top.yaml": "name: top\nsubsystems:\n  outer: {type: model, file: mid.yaml}\n"}, "top.yaml",
-        ["leaf.yaml:4: at subsystems.p.mass:", "(in 'outer.inner', included from ", "mid.yaml:2, top.yaml:3)"]),
+        {"leaf.yaml": NEGATIVE_MASS, "mid.yaml": "parts:\n  inner: {type: model, file: leaf.yaml}\n",
+         "top.yaml": "name: top\nparts:\n  outer: {type: model, file: mid.yaml}\n"}, "top.yaml",
+        ["leaf.yaml:4: at parts.p.mass:", "(in 'outer.inner', included from ", "mid.yaml:2, top.yaml:3)"]),
     "error in one copy's child": (
-        {"leaf.yaml": NEGATIVE_MASS, "mid.yaml": "subsystems:\n  inner: {type: model, file: leaf.yaml}\n",
+        {"leaf.yaml": NEGATIVE_MASS, "mid.yaml": "parts:\n  inner: {type: model, file: leaf.yaml}\n",
          "top.yaml": entry("file: mid.yaml, count: 2")}, "top.yaml",
-        ["leaf.yaml:4: at subsystems.p.mass:", "(in 'c[0].inner', included from ", "mid.yaml:2, top.yaml:2)"]),
-    "child not valid YAML": ({"child.yaml": "subsystems:\n  p: {type: particle, mass: [1,\n",
+        ["leaf.yaml:4: at parts.p.mass:", "(in 'c[0].inner', included from ", "mid.yaml:2, top.yaml:2)"]),
+    "child not valid YAML": ({"child.yaml": "parts:\n  p: {type: particle, mass: [1,\n",
                               "top.yaml": entry("file: child.yaml")}, "top.yaml",
                              ["child.yaml:3: not valid YAML", "(in 'c', included from top.yaml:2)"]),
     "for: range not whole": ({"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last=1.5))},
@@ -149,10 +149,10 @@ CASES = {
     "for: joints named like the copies": (
         {"top.yaml": entry("file: cell.yaml, count: 3", DISTANCES.format(last=1).replace("name: link", "name: c"))},
         "top.yaml", ["top.yaml:4: at joints[0].name:", "name of the substructure 'c'"]),
-    "port named like a part": ({"child.yaml": "subsystems:\n  p: {type: particle, mass: 1}\nports: {p: p}\n",
+    "port named like a part": ({"child.yaml": "parts:\n  p: {type: particle, mass: 1}\nports: {p: p}\n",
                                 "top.yaml": entry("file: child.yaml")}, "top.yaml",
                                ["child.yaml:3: at ports.p:", "name of a part", "(in 'c', included from top.yaml:2)"]),
-    "port to an unknown frame": ({"child.yaml": "subsystems:\n  p: {type: particle, mass: 1}\nports: {tip: p.end}\n",
+    "port to an unknown frame": ({"child.yaml": "parts:\n  p: {type: particle, mass: 1}\nports: {tip: p.end}\n",
                                   "top.yaml": entry("file: child.yaml")}, "top.yaml",
                                  ["child.yaml:3: at ports.tip:", "'p' has no frame 'end'",
                                   "(in 'c', included from top.yaml:2)"]),

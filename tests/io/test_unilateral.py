@@ -17,7 +17,7 @@ PENDULUM = """name: stop
 parameters: {{m: 1.0, L: 0.8}}
 gravity: [0, 0, -9.81]
 world: {{frames: {{pivot: {{axis: [0, 1, 0]}}}}}}
-subsystems:
+parts:
   rod:
     type: rigid_body
     mass: m
@@ -30,7 +30,7 @@ joints:
 
 BALL = """name: ball
 parameters: {{m: 1.0, r: 0.1}}
-subsystems:
+parts:
   ball: {{type: particle, mass: m, initial: {{position: [0, 0, {z}]}}}}
   other: {{type: particle, mass: m, initial: {{position: [0, 0, 1]}}}}
 contacts:

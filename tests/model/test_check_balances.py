@@ -31,7 +31,7 @@ ROD = f"""\
 name: massless_rod_spun
 parameters: {{m1: 0.7, m2: 1.9, L: {L}, g: 9.81, tau: {{tau}}}}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   p1: {{type: particle, mass: m1, initial: {{position: {END.tolist()}}}}}
   p2: {{type: particle, mass: m2, initial: {{position: {(-END).tolist()}}}}}
   rod:
@@ -53,7 +53,7 @@ forces:
 PUSHED = """\
 name: pushed
 parameters: {k: 10.0, F: 2.5}
-subsystems:
+parts:
   bead:
     type: particle
     mass: 0

@@ -17,7 +17,7 @@ MODELS = Path(__file__).resolve().parents[2] / "models"
 FREE_BODY = """
 name: spinning
 parameters: {m: 2.0}
-subsystems:
+parts:
   body:
     type: rigid_body
     rotation: {sequence}
@@ -65,7 +65,7 @@ def test_rolling_disk_with_angles_moves_as_with_a_quaternion():
 
 
 def test_model_file_errors_name_the_key():
-    with pytest.raises(mb.ModelError, match=r"subsystems\.body\.rotation.*quaternion or one of"):
+    with pytest.raises(mb.ModelError, match=r"parts\.body\.rotation.*quaternion or one of"):
         mb.loads(FREE_BODY.replace("{sequence}", "xxz"))
     singular = FREE_BODY.replace("{sequence}", "zxz") + "    initial: {angular_velocity: [1, 0, 0]}\n"
     with pytest.raises(mb.ModelError, match="singular position"):

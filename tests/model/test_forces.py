@@ -52,7 +52,7 @@ gravity: [0, 0, -g]
 world:
   frames:
     anchor: {{position: [0.1, -0.2, 1.5]}}
-subsystems:
+parts:
   p: {{type: particle, mass: m}}
 forces:
   - {{name: s, type: spring, between: [world.anchor, p], stiffness: k, rest_length: l0, damping: c}}
@@ -85,7 +85,7 @@ def test_coincident_spring_ends_give_no_force():
     part = loads("""\
         parameters: {m: 0.8}
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           s: {type: spring, mass: m, stiffness: 40, rest_length: 0.5, damping: 0.6}
         """)
     with warnings.catch_warnings():
@@ -102,7 +102,7 @@ gravity: [0, 0, -9.81]
 world:
   frames:
     anchor: {position: [0.2, 0.3, 1.0]}
-subsystems:
+parts:
   body:
     type: rigid_body
     mass: m
@@ -188,7 +188,7 @@ def test_massive_spring_part_uses_the_consistent_bar_mass():
     system = loads("""\
         parameters: {m: 0.9, k: 25.0, l0: 0.6, c: 0.3}
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           s: {type: spring, mass: m, stiffness: k, rest_length: l0, damping: c}
         joints:
           - {name: fix, type: spherical, parent: world, child: s.end1}
@@ -204,7 +204,7 @@ def test_check_reports_the_free_end_of_a_massless_spring():
     no constraint (rank [M; A] = 3 of 6), and each needs the spring force along it to vanish."""
     system = loads("""\
         parameters: {k: 50.0, l0: 1.0}
-        subsystems:
+        parts:
           s: {type: spring, stiffness: k, rest_length: l0, initial: {end2: [1.2, 0.3, 0.0]}}
         joints:
           - {name: fix, type: spherical, parent: world, child: s.end1}
@@ -254,7 +254,7 @@ def test_body_and_world_torques_agree_and_obey_euler():
                                rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(world_qdd[:3], [0, 0, -9.81], rtol=1e-12)
     planar = loads("""\
-        subsystems:
+        parts:
           disk: {type: planar_body, mass: 1.0, inertia: 0.25}
         forces:
           - {type: torque, part: disk, value: [0.3, 0.2, 0.5*t], axes: body}
@@ -313,7 +313,7 @@ def test_energy_of_a_massive_spring_part():
     system = loads("""\
         parameters: {m: 0.9, k: 25.0, l0: 0.6}
         gravity: [0, 0, -9.81]
-        subsystems:
+        parts:
           s: {type: spring, mass: m, stiffness: k, rest_length: l0}
         """)
     q, qd = RNG.normal(size=6), RNG.normal(size=6)
@@ -330,7 +330,7 @@ parameters: {k: 10.0}
 world:
   frames:
     a: {position: [0, 0, 1]}
-subsystems:
+parts:
   p: {type: particle, mass: 1.0}
   b: {type: rigid_body, mass: 1.0, inertia: [1, 1, 1], frames: {tip: {position: [1, 0, 0]}}}
 forces:
@@ -377,13 +377,13 @@ def test_force_mistakes_name_file_line_and_key(entry, where, fragment):
 
 
 @pytest.mark.parametrize("text, line, fragment", [
-    ("subsystems:\n  s:\n    type: spring\n    stiffness: 1\n    rest_length: -0.5\n", 5, "rest_length must be ≥ 0"),
-    ("subsystems:\n  s:\n    type: spring\n    stiffness: 1\n", 2, "missing required key 'rest_length'"),
-    ("subsystems:\n  s:\n    type: spring\n    stiffness: 1\n    rest_length: 1\n    initial: {end3: [0, 0, 0]}\n",
+    ("parts:\n  s:\n    type: spring\n    stiffness: 1\n    rest_length: -0.5\n", 5, "rest_length must be ≥ 0"),
+    ("parts:\n  s:\n    type: spring\n    stiffness: 1\n", 2, "missing required key 'rest_length'"),
+    ("parts:\n  s:\n    type: spring\n    stiffness: 1\n    rest_length: 1\n    initial: {end3: [0, 0, 0]}\n",
      6, "unknown key 'end3'"),
-    ("subsystems:\n  s: {type: spring, stiffness: 1, rest_length: 1, initial: {end1: [0, 0]}}\n", 2,
+    ("parts:\n  s: {type: spring, stiffness: 1, rest_length: 1, initial: {end1: [0, 0]}}\n", 2,
      "list of 3 numbers"),
-    ("subsystems:\n  s: {type: spring, stiffness: 1, rest_length: 1}\njoints:\n"
+    ("parts:\n  s: {type: spring, stiffness: 1, rest_length: 1}\njoints:\n"
      "  - {name: j, type: spherical, parent: world, child: s}\n", 4, "a spring part has no frame of its own"),
 ])
 def test_spring_part_mistakes(text, line, fragment):
@@ -395,7 +395,7 @@ def test_spring_part_mistakes(text, line, fragment):
 
 def test_spring_part_initial_state():
     system = loads("""\
-        subsystems:
+        parts:
           s:
             type: spring
             stiffness: 1

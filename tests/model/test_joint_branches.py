@@ -1,4 +1,4 @@
-"""Joints whose rows also hold in poses they do not mean (connectors/joints.py): a fixed
+"""Joints whose rows also hold in poses they do not mean (constraints/joints.py): a fixed
 joint's orientation lock x_A·y_B = y_A·z_B = z_A·x_B = 0 holds with the frames turned
 180° about an axis or 120° about a diagonal, a revolute joint's axis rows with
 z_B = −z_A. A model starting there is refused, naming the joint; the meant pose loads."""
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
-from mbsynth.model.connectors.joints import _numeric, _rotation_at
+from mbsynth.model.constraints.joints import _numeric, _rotation_at
 from mbsynth.model.joint_templates import pose
 from mbsynth.core.kinematics import matrix_quaternion, rpy_matrix
 from mbsynth.analysis.projection import consistent_initial_state, project_positions
@@ -23,7 +23,7 @@ gravity: [0, 0, -9.81]
 world:
   frames:
     mount: {{position: [0, 0, 1]}}
-subsystems:
+parts:
   block:
     type: rigid_body
     mass: 1.0
@@ -64,7 +64,7 @@ def test_the_refused_poses_meet_every_row_of_the_joint(kind, rotation):
     joint = textwrap.dedent(f"""\
         name: rows_only
         world: {{frames: {{mount: {{position: [0, 0, 1]}}}}}}
-        subsystems:
+        parts:
           block: {{type: rigid_body, mass: 1.0, inertia: [0.1, 0.2, 0.3], frames: {{top: {{position: [0, 0, 0.5]}}}}}}
         joints:
           - {{name: hinge, type: {kind}, parent: world.mount, child: block.top}}
@@ -117,7 +117,7 @@ def test_frame_rotations_of_the_branch_check_equal_the_poses_sympy_gives(model):
     values = {**dict(zip(system.q_symbols, q)), **dict(zip(system.parameter_symbols, system.parameter_values)),
               T_SYMBOL: 0.0}
     compared = 0
-    for joint in system.connectors:
+    for joint in system.constraints:
         for part, frame in zip(getattr(joint, "parts", ()), getattr(joint, "frames", ())):
             expected = _numeric(pose(part, frame)[1], values)
             np.testing.assert_allclose(_rotation_at(part, frame, values), expected, atol=1e-14)
@@ -132,7 +132,7 @@ def test_the_turn_is_judged_alike_for_scaled_rotations(scale):
     scale — 60° passes, 100° and 180° are refused."""
     from types import SimpleNamespace
 
-    from mbsynth.model.connectors.joints import _turned
+    from mbsynth.model.constraints.joints import _turned
     joint = SimpleNamespace(joint_kind="fixed", name="weld", parts=(None, SimpleNamespace(name="block")))
     axis = np.array([1.0, 2.0, 2.0]) / 3
     for degrees, refused in ((60, False), (89, False), (100, True), (180, True)):

@@ -45,12 +45,12 @@ def test_efforts_act_along_the_joint_values():
         for kind in MOVING:
             motions = KINDS[kind].motions
             position, rate = (getattr(values[f"j_{kind}"], x)[:len(motions)] for x in ("position", "rate"))
-            actuation = elements[f"j_{kind}.actuation"].power(0.0, q, qd, data.p)
+            actuation = elements[f"j_{kind}.actuation"].power(0.0, q, qd, data.parameter_values)
             expected = sum(EFFORT[EFFORTS[m]] * w for m, w in zip(motions, rate))
             assert actuation == pytest.approx(expected, rel=1e-12, abs=1e-12)
             if len(motions) == 1:
                 spring = elements[f"j_{kind}.spring"]
-                assert spring.potential(0.0, q, qd, data.p) == pytest.approx(
+                assert spring.potential(0.0, q, qd, data.parameter_values) == pytest.approx(
                     SPRING["stiffness"] * (position[0] - SPRING["rest"]) ** 2 / 2, rel=1e-12, abs=1e-12)
-                assert spring.power(0.0, q, qd, data.p) == pytest.approx(-SPRING["damping"] * rate[0] ** 2,
+                assert spring.power(0.0, q, qd, data.parameter_values) == pytest.approx(-SPRING["damping"] * rate[0] ** 2,
                                                                          rel=1e-12, abs=1e-12)

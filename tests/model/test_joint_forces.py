@@ -36,7 +36,7 @@ def block(joint_keys, gravity="[0, 0, -g]", parameters=""):
         world:
           frames:
             rail: {{position: [0.5, 0, 0], axis: [1, 0, 0]}}
-        subsystems:
+        parts:
           block:
             type: rigid_body
             mass: m
@@ -124,7 +124,7 @@ def rod(joint_keys, gravity="[0, 0, -g]", parameters=""):
         world:
           frames:
             pivot: {{axis: [0, 1, 0]}}
-        subsystems:
+        parts:
           rod:
             type: rigid_body
             mass: m
@@ -221,7 +221,7 @@ def test_cylindrical_joint_takes_a_torque_and_a_force():
         world:
           frames:
             axle: {position: [0, 0, 1]}
-        subsystems:
+        parts:
           sleeve: {type: rigid_body, mass: m, inertia: [0.3, 0.3, J]}
         joints:
           - name: shaft
@@ -245,7 +245,7 @@ parameters: {m: 1.0}
 world:
   frames:
     a: {axis: [1, 0, 0]}
-subsystems:
+parts:
   b: {type: rigid_body, mass: m, inertia: [1, 1, 1]}
 joints:
   - name: j

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 
 import mbsynth as mb
 from mbsynth.core.joint_kinds import JOINT_KINDS, KINDS
-from mbsynth.model.connectors.base import Connector
+from mbsynth.model.constraints.base import Constraint
 from mbsynth.analysis.projection import project_velocities
 from mbsynth.model.joint_values import constraint_symbols
 from mbsynth.robots.build import fix_base
@@ -102,10 +102,10 @@ def test_servo_constraints_give_the_inverse_dynamics(floating_ur5):
     twin = Twin(system)
     start = np.random.default_rng(3).uniform(-2, 2, twin.model.nq)
     qm, _ = twin.to_maximal(start, np.zeros(twin.model.nv))
-    joints = {c.name: c for c in system.connectors}
+    joints = {c.name: c for c in system.constraints}
     t = T_SYMBOL
     targets = {c.name: start[c.idx_q] + 0.3 * (sp.sin(2 * t + i) - np.sin(i)) for i, c in enumerate(twin.coordinates)}
-    servos = [Connector.holonomic(f"{name}_servo", [constraint_symbols(joints[name])["angle"] - target],
+    servos = [Constraint.holonomic(f"{name}_servo", [constraint_symbols(joints[name])["angle"] - target],
                                   system.q_symbols, system.qd_symbols, system.parameter_symbols)
               for name, target in targets.items()]
     servoed = system.with_constraints(servos)
@@ -175,7 +175,7 @@ def test_redundant_loop_multipliers():
 SPATIAL_CHAIN = """
 name: spatial_chain
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   a: {type: rigid_body, mass: 1.0, inertia: [0.02, 0.03, 0.04], frames: {top: {position: [0, 0, 0.3]}, bottom: {position: [0, 0, -0.3]}},
       initial: {position: [0, 0, -0.3], velocity: [0.2, -0.1, 0], angular_velocity: [0.3, -0.5, 0]}}
   b: {type: rigid_body, mass: 0.7, inertia: [0.01, 0.02, 0.015], frames: {top: {position: [0, 0, 0.25]}, bottom: {position: [0, 0, -0.25]}},
@@ -202,7 +202,7 @@ def value_chain():
                        for i in range(len(kinds)))
     joints = "\n".join(f"  - {{name: j_{kind}, type: {kind}, parent: {'world' if i == 0 else f'b{i - 1}.bottom'}, "
                        f"child: b{i}.{'cross' if kind == 'universal' else 'top'}}}" for i, kind in enumerate(kinds))
-    return mb.loads(f"name: value_chain\ngravity: [1.5, -0.8, -9.81]\nsubsystems:\n{bodies}\njoints:\n{joints}\n")
+    return mb.loads(f"name: value_chain\ngravity: [1.5, -0.8, -9.81]\nparts:\n{bodies}\njoints:\n{joints}\n")
 
 
 @pytest.mark.parametrize("model, sizes", [
@@ -220,7 +220,7 @@ def test_joint_rates_are_derivatives_of_positions(model, sizes):
     qdd = system.motion(t, q, qd).qdd
     values = system.joint_values(t, q, qd, qdd)
     assert {k: v.position.size for k, v in values.items()} == sizes
-    kinds = {c.name: c.joint_kind for c in system.connectors if hasattr(c, "joint_kind")}
+    kinds = {c.name: c.joint_kind for c in system.constraints if hasattr(c, "joint_kind")}
     assert all(np.abs(v.rate).max() > 1e-3 for v in values.values())  # every joint moves
 
     def at(h):

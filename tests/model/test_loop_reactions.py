@@ -30,7 +30,7 @@ def pinned_body(tmp_path):
         name: pinned_top
         gravity: {G.tolist()}
         world: {{frames: {{pivot: {{position: {PIVOT.tolist()}, rpy: {list(PIVOT_RPY)}}}}}}}
-        subsystems:
+        parts:
           body:
             type: rigid_body
             mass: {M}
@@ -100,7 +100,7 @@ world:
   frames:
     px: {{axis: [1, 0, 0]}}
     pivot: {{position: {PIVOT.tolist()}, rpy: {list(PIVOT_RPY)}}}
-subsystems:
+parts:
   s1: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{px: {{axis: [1, 0, 0]}}, py: {{axis: [0, 1, 0]}}}}}}
   s2: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{py: {{axis: [0, 1, 0]}}, pz: {{axis: [0, 0, 1]}}}}}}
   s3: {{type: rigid_body, mass: 0, inertia: [0, 0, 0], frames: {{pz: {{axis: [0, 0, 1]}}, rx: {{axis: [1, 0, 0]}}}}}}

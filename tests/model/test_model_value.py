@@ -61,7 +61,7 @@ def test_a_data_does_not_pass_for_its_model_and_computes_at_its_own_parameters()
     q, qd = model.initial_state()
     heavier = model.with_parameters(**{name: 3 * model.parameters[name] + 1})
     np.testing.assert_array_equal(data.motion(0.0, q, qd).qdd, heavier.data().motion(0.0, q, qd).qdd)
-    assert data.p[model.parameter_index[name]] != model.parameter_values[model.parameter_index[name]]
+    assert data.parameter_values[model.parameter_index[name]] != model.parameter_values[model.parameter_index[name]]
 
 
 def test_the_path_is_chosen_explicitly_and_both_give_the_motion():

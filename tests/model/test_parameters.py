@@ -38,11 +38,11 @@ def test_a_value_written_into_a_runs_data_stays_through_a_later_write_of_another
     data = system.data()
     data.set_parameters({"m1": 0.5})
     data.set_parameters({"k1": 50.0})
-    values = dict(zip(system.parameters, data.p))
+    values = dict(zip(system.parameters, data.parameter_values))
     assert values["m1"] == 0.5 and values["k1"] == 50.0
 
 
 def test_a_defined_parameter_follows_the_ones_it_is_defined_by():
     system = mb.loads("parameters: {m: 2.0, R: 0.5, Ic: 0.5*m*R**2}\n"
-                      "subsystems:\n  disk: {type: lagrangian, coordinates: [th], T: 0.5*Ic*th_dot**2}\n")
+                      "parts:\n  disk: {type: lagrangian, coordinates: [th], T: 0.5*Ic*th_dot**2}\n")
     assert system.with_parameters(m=4.0).with_parameters(R=1.0).parameters["Ic"] == pytest.approx(2.0)

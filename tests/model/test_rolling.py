@@ -123,7 +123,7 @@ def test_upright_disk_rolls_straight(slope):
     system = mb.loads(textwrap.dedent(f"""\
         parameters: {{m: {m}, R: {R}, g: {g}, alpha: {slope}}}
         gravity: [g*sin(alpha), 0, -g*cos(alpha)]
-        subsystems:
+        parts:
           disk: {{type: rigid_body, mass: m, inertia: [m*R**2/4, m*R**2/4, m*R**2/2]}}
         joints:
           - {{name: contact, type: rolling_disk, child: disk, radius: R, ground: 0.5}}
@@ -138,7 +138,7 @@ def test_upright_disk_rolls_straight(slope):
 def sleigh(offset, I=0.02, m=1.0):
     return mb.loads(textwrap.dedent(f"""\
         parameters: {{m: {m}, I: {I}, a: {offset}}}
-        subsystems:
+        parts:
           sleigh:
             type: planar_body
             mass: m
@@ -213,7 +213,7 @@ def test_check_reports_unique_motion(capsys, name, n, m):
 ])
 def test_contact_mistakes_name_the_line(joint, message):
     text = textwrap.dedent("""\
-        subsystems:
+        parts:
           disk: {type: rigid_body, mass: 1, inertia: [1, 1, 2]}
           cart: {type: planar_body, mass: 1, inertia: 1}
         joints:

@@ -78,7 +78,7 @@ def test_parts_are_the_links_with_their_masses(ur5):
     masses add up to Pinocchio's total mass of the floating robot."""
     description = ur5.robots[0].description
     assert [p.name for p in ur5.parts] == list(description.links)
-    assert all(p.kind == "rigid_body" for p in ur5.parts)
+    assert all(p.type_name == "rigid_body" for p in ur5.parts)
     model = pin.buildModelFromUrdf(description.path, pin.JointModelFreeFlyer())
     assert sum(float(p.mass) for p in ur5.parts) == pytest.approx(pin.computeTotalMass(model), rel=1e-12)
     q, qd = ur5.initial_state()
@@ -171,7 +171,7 @@ def arm_with_loop(tmp_path):
         parameters: {{k: 60.0, m: 0.3, g: 9.81, tau_arm_elbow_flex: 0.4}}
         gravity: [0, 0, -g]
         world: {{frames: {{anchor: {{position: {tip.tolist()}}}}}}}
-        subsystems:
+        parts:
           arm: {{type: robot, robot: so100}}
           bar:
             type: rigid_body
@@ -252,19 +252,19 @@ def test_yaml_robot_entry_errors_name_file_line_and_key(tmp_path):
         path.write_text(textwrap.dedent(text))
         return mb.load(path)
 
-    with pytest.raises(mb.ModelError, match=r"model\.yaml:3: at subsystems\.arm\.robot: no robot or URDF file"):
+    with pytest.raises(mb.ModelError, match=r"model\.yaml:3: at parts\.arm\.robot: no robot or URDF file"):
         load("""\
-            subsystems:
+            parts:
               arm:
                 robot: no_such_robot
                 type: robot
             """)
-    with pytest.raises(mb.ModelError, match=r"at subsystems\.arm\.floating: expected true or false"):
-        load("subsystems:\n  arm: {type: robot, robot: double_pendulum, floating: 'yes'}\n")
-    with pytest.raises(mb.ModelError, match=r"at subsystems\.arm\.base\.rpy: expected a list of 3"):
-        load("subsystems:\n  arm: {type: robot, robot: double_pendulum, base: {rpy: [0, 1]}}\n")
-    with pytest.raises(mb.ModelError, match=r"at subsystems\.arm: robot 'arm' has a link part 'arm_link1'"):
-        load("subsystems:\n  arm: {type: robot, robot: double_pendulum}\n"
+    with pytest.raises(mb.ModelError, match=r"at parts\.arm\.floating: expected true or false"):
+        load("parts:\n  arm: {type: robot, robot: double_pendulum, floating: 'yes'}\n")
+    with pytest.raises(mb.ModelError, match=r"at parts\.arm\.base\.rpy: expected a list of 3"):
+        load("parts:\n  arm: {type: robot, robot: double_pendulum, base: {rpy: [0, 1]}}\n")
+    with pytest.raises(mb.ModelError, match=r"at parts\.arm: robot 'arm' has a link part 'arm_link1'"):
+        load("parts:\n  arm: {type: robot, robot: double_pendulum}\n"
              "  arm_link1: {type: particle, mass: 1}\n")
 
 
@@ -309,7 +309,7 @@ def test_robot_entry_initial_joint_positions_place_the_links_as_pinocchio(tmp_pa
     ``base`` says; a joint the URDF has not (or a fixed one) is refused, the movable ones listed."""
     angles = {"shoulder_pan_joint": 0.3, "shoulder_lift_joint": -0.4, "elbow_joint": 0.8, "wrist_2_joint": 0.5}
     path = tmp_path / "arm.yaml"
-    path.write_text("subsystems:\n  arm: {type: robot, robot: ur5, base: {position: [0.1, 0, 1], rpy: [0, 0, 0.2]}, "
+    path.write_text("parts:\n  arm: {type: robot, robot: ur5, base: {position: [0.1, 0, 1], rpy: [0, 0, 0.2]}, "
                     f"initial: {json.dumps(angles)}}}\n")
     system = mb.load(path)
     model = pin.buildModelFromUrdf(describe("ur5").path)
@@ -325,8 +325,8 @@ def test_robot_entry_initial_joint_positions_place_the_links_as_pinocchio(tmp_pa
         np.testing.assert_allclose(system.initial_q[at[:3]], frame.translation + frame.rotation @ com, atol=1e-12)
         u = system.initial_q[at[3:]]
         np.testing.assert_allclose(np.abs(matrix_quaternion(frame.rotation) @ u), 1.0, atol=1e-12)
-    path.write_text("subsystems:\n  arm: {type: robot, robot: ur5, initial: {elbo_joint: 0.5}}\n")
-    with pytest.raises(mb.ModelError, match=r"arm\.yaml:2: at subsystems\.arm\.initial\.elbo_joint: unknown key "
+    path.write_text("parts:\n  arm: {type: robot, robot: ur5, initial: {elbo_joint: 0.5}}\n")
+    with pytest.raises(mb.ModelError, match=r"arm\.yaml:2: at parts\.arm\.initial\.elbo_joint: unknown key "
                                             r"'elbo_joint' \(did you mean 'elbow_joint'\?\); allowed: elbow_joint, "
                                             r"shoulder_lift_joint, shoulder_pan_joint, wrist_1_joint"):
         mb.load(path)

@@ -133,8 +133,8 @@ def test_the_command_says_model_error_not_internal_error(tmp_path, capsys):
 
 def test_a_model_file_names_its_line_and_the_urdf(tmp_path):
     urdf = write(tmp_path, edited('<sphere radius="0.05"/>', "<sphere/>"))
-    model = write(tmp_path, f"name: holder\nsubsystems:\n  arm: {{type: robot, robot: {urdf.name}}}\n", "m.yaml")
-    with pytest.raises(mb.ModelError, match=rf"m\.yaml:3: at subsystems\.arm\.robot: {urdf}: link 'slider'"):
+    model = write(tmp_path, f"name: holder\nparts:\n  arm: {{type: robot, robot: {urdf.name}}}\n", "m.yaml")
+    with pytest.raises(mb.ModelError, match=rf"m\.yaml:3: at parts\.arm\.robot: {urdf}: link 'slider'"):
         mb.load(model)
 
 

@@ -154,7 +154,7 @@ def test_bad_metric_and_unknown_parameter_are_model_errors():
 
 def test_derived_parameters_and_initial_values_follow_with_parameters():
     system = mb.loads("parameters: {m: 2.0, R: 0.5, Ic: 0.5*m*R**2}\n"
-                      "subsystems:\n  disk: {type: lagrangian, coordinates: [th], T: 0.5*Ic*th_dot**2}\n"
+                      "parts:\n  disk: {type: lagrangian, coordinates: [th], T: 0.5*Ic*th_dot**2}\n"
                       "initial: {disk.th_dot: 1/Ic}\n")
     changed = system.with_parameters(m=4.0)
     assert changed.parameters["Ic"] == pytest.approx(0.5) and changed.initial_state()[1][0] == pytest.approx(2.0)
@@ -166,7 +166,7 @@ def test_file_names_in_the_model_are_relative_to_its_folder_on_the_workers(clust
     (tmp_path / "meshes").mkdir()
     (tmp_path / "meshes" / "body.stl").write_text("solid body\nendsolid body\n")
     model = tmp_path / "body.yaml"
-    model.write_text("parameters: {m: 1.0}\nsubsystems:\n  body:\n    type: rigid_body\n    mass: m\n"
+    model.write_text("parameters: {m: 1.0}\nparts:\n  body:\n    type: rigid_body\n    mass: m\n"
                      "    inertia: [1, 1, 1]\n    geometry: {mesh: meshes/body.stl}\n"
                      "initial: {body.x_dot: 1.0}\n")
     monkeypatch.chdir(Path(__file__).parent)
@@ -383,7 +383,7 @@ FLEXIBLE_ROD = """\
 name: rod
 parameters: {L: 1.0, I0: 1.0e-9, Iy: 2*I0, g: 9.81}
 gravity: [0, 0, -g]
-subsystems:
+parts:
   rod:
     type: flexible_body
     beam: {length: L, elements: 4, area: 1e-4, Iy: Iy, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000}
@@ -392,8 +392,8 @@ subsystems:
 
 
 @pytest.mark.parametrize("param, words", [
-    ("L=1:2:3", ":7, key subsystems.rod.beam.length: parameter 'L' is built into the model"),
-    ("I0=1e-9:2e-9:3", ":7, key subsystems.rod.beam.Iy: parameter 'Iy' (defined by an expression of the swept 'I0')"),
+    ("L=1:2:3", ":7, key parts.rod.beam.length: parameter 'L' is built into the model"),
+    ("I0=1e-9:2e-9:3", ":7, key parts.rod.beam.Iy: parameter 'Iy' (defined by an expression of the swept 'I0')"),
 ])
 def test_sweeping_a_parameter_the_fe_model_is_built_from_is_refused_before_any_run(tmp_path, param, words):
     """``mbsynth sweep`` of the beam's length (or of a parameter another one the beam reads is

@@ -31,7 +31,7 @@ def model(count, first=0):
                           for i in range(first, first + count))
     initial = ", ".join(f"cell_{i}.r: {0.6 + 0.01 * i}, cell_{i}.th: {(0.6 + 0.01 * i) * (0.5 + 0.01 * i)}, "
                         f"cell_{i}.r_dot: 0.1" for i in range(first, first + count))
-    return (f"name: cells\nparameters: {{{parameters}}}\nsubsystems:\n{cells}constraints:\n{constraints}"
+    return (f"name: cells\nparameters: {{{parameters}}}\nparts:\n{cells}constraints:\n{constraints}"
             f"initial: {{{initial}}}\n")
 
 
@@ -76,7 +76,7 @@ def test_copies_are_derived_once_and_each_gets_its_own_equations(monkeypatch):
 
 
 def test_copies_simulate_on_the_compiled_path_in_one_loop_per_form(monkeypatch):
-    monkeypatch.setenv("MBSYNTH_FAST", "wait")  # the compiled path, built now
+    monkeypatch.setenv("MBSYNTH_COMPILED", "wait")  # the compiled path, built now
     system = mb.loads(model(COPIES))
     exprs = layout.build(system)[1]
     text = codegen.source(exprs, system.q_symbols, system.qd_symbols, system.parameter_symbols)
@@ -84,7 +84,7 @@ def test_copies_simulate_on_the_compiled_path_in_one_loop_per_form(monkeypatch):
     assert system.data().engine is not None  # the compiled path
     result = mb.simulate(system, 0.05)
     for i in (0, 4, COPIES - 1):  # each copy moves as the cell alone, on the KKT path (the copies are not coupled)
-        monkeypatch.setenv("MBSYNTH_FAST", "off")
+        monkeypatch.setenv("MBSYNTH_COMPILED", "off")
         alone = mb.simulate(mb.loads(model(1, first=i)), 0.05)
         at = system.coordinates.index(f"cell_{i}.r")
         assert np.allclose(result.q[-1][at:at + 2], alone.q[-1], rtol=0, atol=1e-8)

@@ -43,7 +43,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 
 def build(cache, **settings):
-    env = {**os.environ, "MBSYNTH_CACHE_DIR": str(cache), "MBSYNTH_FAST": "off", **settings}
+    env = {**os.environ, "MBSYNTH_CACHE_DIR": str(cache), "MBSYNTH_COMPILED": "off", **settings}
     out = subprocess.run([sys.executable, "-c", BUILD], env=env, cwd=ROOT, capture_output=True, text=True,
                          check=True, timeout=600)
     return json.loads(out.stdout.splitlines()[-1])

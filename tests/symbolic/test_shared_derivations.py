@@ -1,11 +1,11 @@
-"""Joints alike share one derivation (connectors.joints' templates): the rows a joint gets
+"""Joints alike share one derivation (constraints.joints' templates): the rows a joint gets
 that way equal those of differentiating its own φ directly, and the derivation is done once."""
 
 import numpy as np
 import sympy as sp
 
-from mbsynth.model.connectors.joints import Joint
-from mbsynth.model.connectors import joints
+from mbsynth.model.constraints.joints import Joint
+from mbsynth.model.constraints import joints
 from mbsynth.core.kinematics import rpy_matrix
 from mbsynth.model.parts import Frame, RigidBody
 from mbsynth.symbolic.derive import differentiate

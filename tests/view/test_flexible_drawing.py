@@ -18,7 +18,7 @@ from tests.helpers.scenes import animation_clips, node, segment_ends, trajectory
 ELEMENTS = 10
 STRIP = f"""
 name: strip_alone
-subsystems:
+parts:
   strip:
     type: flexible_body
     beam: {{length: 2.0, elements: {ELEMENTS}, area: 1e-4, Iy: 4e-9, Iz: 1e-9, J: 5e-9, E: 2.1e11, nu: 0.3,

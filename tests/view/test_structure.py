@@ -30,7 +30,7 @@ TWO_WHEELER = """
 name: two_wheeler
 parameters: {rR: 0.3, rF: 0.35}
 gravity: [0, 0, -9.81]
-subsystems:
+parts:
   rear_wheel:
     type: rigid_body
     mass: 2
@@ -167,7 +167,7 @@ def test_grid_moves_by_whole_cells_under_a_followed_model():
 def test_particles_grow_with_the_cube_root_of_their_mass():
     system = mb.loads("""
 name: beads
-subsystems:
+parts:
   light: {type: particle, mass: 1, initial: {position: [0, 0, 0]}}
   heavy: {type: particle, mass: 8, initial: {position: [1, 0, 0]}}
   ghost: {type: particle, mass: 0, initial: {position: [0, 1, 0]}}

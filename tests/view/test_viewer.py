@@ -35,7 +35,7 @@ CHANGED = 40  # a pixel differs when one of its channels moves by more than this
 BODIES = """
 name: bodies
 parameters: {a: 0.5}
-subsystems:
+parts:
   body:
     type: rigid_body
     mass: 1
@@ -137,7 +137,7 @@ def test_line_to_a_frame_the_part_lacks_is_a_model_error(tmp_path):
     text = EXAMPLE3.read_text().replace("{line: face}]", "{line: nowhere}]")
     path = tmp_path / "bad.yaml"
     path.write_text(text)
-    with pytest.raises(mb.ModelError, match=r"bad\.yaml:\d+: at subsystems\.body1\.frames\.wall\.geometry\[1\]\.line"):
+    with pytest.raises(mb.ModelError, match=r"bad\.yaml:\d+: at parts\.body1\.frames\.wall\.geometry\[1\]\.line"):
         mb.load(path)
 
 
@@ -158,7 +158,7 @@ def mesh_model(tmp_path):
     model = tmp_path / "tetra.yaml"
     model.write_text("""
 name: tetra
-subsystems:
+parts:
   body:
     type: rigid_body
     mass: 1
@@ -175,7 +175,7 @@ def test_mesh_paths_are_relative_to_the_model_file(tmp_path, monkeypatch):
     system = mb.load(model)
     assert system.parts[0].geometry[0]["file"] == str((tmp_path / "meshes" / "tetra.stl").resolve())
     model.write_text(model.read_text().replace("meshes/tetra.stl", "meshes/missing.stl"))
-    with pytest.raises(mb.ModelError, match=r"tetra\.yaml:\d+: at subsystems\.body\.geometry\.mesh: mesh file"):
+    with pytest.raises(mb.ModelError, match=r"tetra\.yaml:\d+: at parts\.body\.geometry\.mesh: mesh file"):
         mb.load(model)
 
 

@@ -1,10 +1,10 @@
 """Parts of a mechanical system, each in its own coordinates with its own M and Q (2.1).
 
-A subsystem knows only its own coordinates. It offers
+A part knows only its own coordinates. It offers
 ``evaluate(t, q, qd, p) -> (M, Q)`` on its own slice of the state (``p``: the
 model's parameter values in the model's order), ``symbolic()`` returning the same
-M and Q as sympy matrices (used to derive closure balances), its energies, and the
-world pose of its named frames for connectors and force elements. Each part class declares
+M and Q as sympy matrices (used to derive balances), its energies, and the
+world pose of its named frames for constraints and force elements. Each part class declares
 its type's record (part_type.py); ``PART_TYPES`` gathers them: a new type of part is a module
 here and its line below.
 """

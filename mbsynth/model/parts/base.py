@@ -39,7 +39,7 @@ class Frame:
 
 
 class Part(Keyed):
-    """A subsystem given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
+    """A part given by sympy M, Q, T, V in its own coordinate symbols ``q``, ``qd``
     and the model's parameter symbols ``params``.
 
     Subclasses describe a type of part: each declares its type's record ``part_type``
@@ -112,8 +112,8 @@ class Part(Keyed):
     V = property(lambda self: self._materialized()[3], doc="potential energy, sympy")
 
     @property
-    def kind(self):
-        """The name of the part's type (its ``part_type``'s)."""
+    def type_name(self):
+        """The name of the part's type (its ``part_type``'s: the ``type:`` a model file gives)."""
         return self.part_type.name
 
     def reads(self, symbols):
@@ -175,7 +175,7 @@ class Part(Keyed):
 
     def pose(self, frame):
         """(position, rotation) of ``frame`` in the world, as sympy expressions."""
-        raise NotImplementedError(f"a {self.kind} part has no frames")
+        raise NotImplementedError(f"a {self.type_name} part has no frames")
 
     def angular_velocity(self):
         """The part's angular velocity in world axes (zero for point-like parts)."""

@@ -31,7 +31,7 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from ..connectors.base import Connector
+from ..constraints.base import Constraint
 from ...core.errors import ModelError
 from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import PARAMETERS, T_SYMBOL, compile_function, positions
@@ -168,7 +168,7 @@ class FlexibleBody(Part):
         """The frame's quaternion has unit norm (the rigid body's row, rigid_body.py)."""
         where = positions(q, qd)
         rows, slots = _unit_norm_rows()
-        return [Connector.placed(f"{self.name}.unit_quaternion", "holonomic", rows, slots,
+        return [Constraint.placed(f"{self.name}.unit_quaternion", "holonomic", rows, slots,
                                  [where[s] for s in self.q[3:7]], q, qd, params)]
 
     def pose(self, frame):

@@ -1,9 +1,9 @@
 """The record of a type of part: what every floor asks of a part's type, in one place.
 
 Each part class (model/parts/<type>.py) declares its ``PartType`` beside it as the class
-attribute ``part_type``; ``Part.kind`` is the record's ``name``, and ``PART_TYPES``
+attribute ``part_type``; ``Part.type_name`` is the record's ``name``, and ``PART_TYPES``
 (model/parts/__init__.py) gathers them. Code outside a part's class asks its type questions
-by reading ``part.part_type``, never by comparing ``part.kind`` with a name or testing its
+by reading ``part.part_type``, never by comparing ``part.type_name`` with a name or testing its
 class. Every field is required (no defaults): a record that leaves a question open fails at
 import. The class itself answers what needs its symbols: ``pose(frame)`` (a frame's world
 pose from the coordinates), ``angular_velocity``, ``own_constraints``, M and Q (2.1).

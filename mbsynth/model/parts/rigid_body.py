@@ -4,7 +4,7 @@ quaternion u (scalar-first) for its orientation."""
 import numpy as np
 import sympy as sp
 
-from ..connectors.base import Connector
+from ..constraints.base import Constraint
 from ...symbolic.cache import placeholder, remembered
 from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import differentiate, positions
@@ -46,7 +46,7 @@ class RigidBody(Part):
         every body shares (``_unit_norm_rows``), derived once per process."""
         where = positions(q, qd)
         rows, slots = _unit_norm_rows()
-        return [Connector.placed(f"{self.name}.unit_quaternion", "holonomic", rows, slots,
+        return [Constraint.placed(f"{self.name}.unit_quaternion", "holonomic", rows, slots,
                                  [where[s] for s in self.q[3:]], q, qd, params)]
 
     def pose(self, frame):

@@ -1,5 +1,5 @@
 """A spring (and damper) as a part of its own: the substructuring way of the paper's
-example 3, where a spring is a sub-system joined to its neighbours by constraints.
+example 3, where a spring is a part joined to its neighbours by constraints.
 ``spring_damper`` is the spring law, shared with the force element ``forces.point_spring``."""
 
 import numpy as np

@@ -88,7 +88,7 @@ def test_timoshenko_converges_to_the_closed_form_of_a_stubby_beam():
 def test_a_slender_timoshenko_beam_approaches_euler_bernoulli():
     """The strip and its sections scaled by ½ and ¼ (radius of gyration r/L = 1.6e-3 down
     to 4e-4): the Timoshenko frequencies lie below Euler–Bernoulli's by a shear and rotary
-    correction of order (r/L)², a quarter per halving of r, while Euler–Bernoulli's stay
+    projection of order (r/L)², a quarter per halving of r, while Euler–Bernoulli's stay
     the analytic ones to 1e-6."""
     gaps = []
     for s in (1.0, 0.5, 0.25):

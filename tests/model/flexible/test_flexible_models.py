@@ -17,7 +17,7 @@ def test_a_clamped_free_beams_modes_are_the_analytic_ones():
     ω = (βL)² √(EI/ρAL⁴), βL = 1.8751041, 4.6940911, 7.8547574 with I = Iz and the first two
     with I = Iy, to 1e-6 (the 100-element FE model's own error is ~4e-8)."""
     model = mb.loads(f"""
-subsystems:
+parts:
   beam:
     type: flexible_body
     beam: {{length: {LENGTH}, elements: 100, {STRIP_FILE}}}
@@ -40,7 +40,7 @@ def test_a_round_beams_repeated_modes_are_real_and_independent():
     repeated mode's basis may be chosen (nodal tip translations orthogonal to 1e-6)."""
     round_strip = ", ".join(f"{k}: {v}" for k, v in {**STRIP, "Iy": STRIP["Iz"]}.items())
     model = mb.loads(f"""
-subsystems:
+parts:
   beam:
     type: flexible_body
     beam: {{length: {LENGTH}, elements: 40, {round_strip}}}
@@ -65,7 +65,7 @@ def test_a_free_beams_modes_are_the_analytic_free_free_ones():
     (rigid-body) modes of the frame and vibrations whose five lowest are the free–free
     βL = 4.7300407, 7.8532046, 10.9956078 with Iz and the first two with Iy, to 1e-6."""
     model = mb.loads(f"""
-subsystems:
+parts:
   beam:
     type: flexible_body
     beam: {{length: {LENGTH}, elements: 100, {STRIP_FILE}}}
@@ -86,7 +86,7 @@ def test_a_spinning_free_flexible_body_keeps_its_energy():
     stays within 1e-9 of the kinetic energy over 0.2 s, while the modes exchange energy with
     the spin (the elastic energy changes by more than 1e-4 of it)."""
     model = mb.loads("""
-subsystems:
+parts:
   rod:
     type: flexible_body
     beam: {length: 1.0, elements: 10, area: 1e-4, Iy: 2e-9, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000}

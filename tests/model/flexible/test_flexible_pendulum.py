@@ -70,7 +70,7 @@ def pendulum_yaml(modes):
     numbers = ", ".join(f"{k}: {v!r}" for k, v in SECTION.items())
     return f"""
 gravity: [0, -{G}, 0]
-subsystems:
+parts:
   rod:
     type: flexible_body
     beam: {{length: 1.0, elements: {ELEMENTS}, {numbers}}}

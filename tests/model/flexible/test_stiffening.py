@@ -51,14 +51,14 @@ def test_stiffening_needs_a_held_node_and_member_forces(tmp_path):
         centrifugal_stiffening(free_interface(fe, count=2, rigid=False), stress_stiffness(L, 4, **SECTION))
     from mbsynth.model.flexible.files import write_fe
     write_fe(fe, tmp_path / "rod.npz")
-    (tmp_path / "m.yaml").write_text("""subsystems:
+    (tmp_path / "m.yaml").write_text("""parts:
   rod:
     type: flexible_body
     fe: {bundle: rod.npz}
     reduction: {method: craig_bampton, interface: [0], modes: 2}
     stiffening: true
 """)
-    with pytest.raises(ModelError, match=r"m\.yaml:6: at subsystems\.rod\.stiffening: .*beam: parts"):
+    with pytest.raises(ModelError, match=r"m\.yaml:6: at parts\.rod\.stiffening: .*beam: parts"):
         mb.load(tmp_path / "m.yaml")
 
 
@@ -68,7 +68,7 @@ def test_a_spinning_stiffened_body_keeps_its_energy():
     with the spin (the elastic energy varies by more than 1e-4 of T) and the stiffening's
     share of T is no rounding (its ωᵀ[ηᵀSη]ω is above 1e-6 of T somewhere)."""
     model = mb.loads("""
-subsystems:
+parts:
   rod:
     type: flexible_body
     beam: {length: 1.0, elements: 10, area: 1e-4, Iy: 2e-9, Iz: 1e-9, J: 2e-9, E: 2e8, nu: 0.3, density: 1000}

@@ -22,7 +22,7 @@ frame's y axis:  ψ = y_f · v_p = 0 (one non-holonomic row).
 
 import sympy as sp
 
-from .base import Connector, mixed
+from .base import Constraint, mixed
 from ...symbolic.derive import time_derivative
 
 
@@ -30,7 +30,7 @@ def _velocity(position, q, qd):
     return sp.Matrix([time_derivative(x, q, qd) for x in position])
 
 
-class RollingDisk(Connector):
+class RollingDisk(Constraint):
     """A disk (``frame`` on the rigid ``part``) rolling on the ground z = ``height``:
     rows ``height``, ``slip_x``, ``slip_y``. Keeps ``part``, ``frame`` and ``radius``
     (the viewer draws the wheel)."""
@@ -49,7 +49,7 @@ class RollingDisk(Connector):
                          ["height", "slip_x", "slip_y"])
 
 
-class KnifeEdge(Connector):
+class KnifeEdge(Constraint):
     """A blade along the x axis of ``frame`` on ``part``: y_f · v_p = 0. Keeps ``part``
     and ``frame``."""
 

@@ -9,7 +9,7 @@ from ...symbolic.derive import (PARAMETERS, T_SYMBOL, compile_function, differen
 
 from ...core.memo import MEMO
 
-class Connector(Keyed):
+class Constraint(Keyed):
     """k rows ``a q̈ = b`` of (2.4), an optional non-ideal force C (2.6), and the
     position- and velocity-level residuals φ, φ̇ used for drift control.
 
@@ -47,11 +47,11 @@ class Connector(Keyed):
         self.row_names = [name] if k == 1 and row_labels is None else [f"{name}[{x}]" for x in labels]
 
     def _place(self, name, kind, rows, slots, coordinates, constants, q, qd, params, row_labels):
-        """Rows given in placeholder symbols, shared with connectors alike (joints.py):
+        """Rows given in placeholder symbols, shared with constraints alike (joints.py):
         ``rows`` = (a over the slots, b, φ, ψ) with the coordinate slots ``slots`` = (q
         slots, q̇ slots) standing for the model's coordinates ``coordinates`` (indices),
         and ``constants`` (placeholder, value) pairs. They are compiled once for all such
-        connectors; their sympy form over the model's symbols is built only when asked."""
+        constraints; their sympy form over the model's symbols is built only when asked."""
         self._name_rows(name, kind, len(rows[1]), row_labels)
         q_slots, qd_slots = slots
         free = _slots_in(rows, slots)
@@ -70,16 +70,16 @@ class Connector(Keyed):
 
     @classmethod
     def placed(cls, name, kind, rows, slots, coordinates, q, qd, params, constants=(), row_labels=None):
-        """A connector of rows given in placeholder symbols (``_place``)."""
-        connector = cls.__new__(cls)
-        connector._place(name, kind, rows, slots, coordinates, constants, q, qd, params, row_labels)
-        return connector
+        """A constraint of rows given in placeholder symbols (``_place``)."""
+        constraint = cls.__new__(cls)
+        constraint._place(name, kind, rows, slots, coordinates, constants, q, qd, params, row_labels)
+        return constraint
 
-    # attributes beyond the base's that define a connector of a subclass (``content``)
+    # attributes beyond the base's that define a constraint of a subclass (``content``)
     content_fields = ()
 
     def content(self):
-        """What defines the connector (its equality, ``core.values``): its name, kind, row
+        """What defines the constraint (its equality, ``core.values``): its name, kind, row
         names and the rows it was given (sympy, or a template with its values), and the
         subclass's ``content_fields``."""
         base = (self.name, self.kind, tuple(self.row_names), self._levels, self._defined_by)
@@ -135,7 +135,7 @@ class Connector(Keyed):
         return a, b.ravel(), C.ravel()
 
     def wrong_branch(self, values):
-        """A message when the rows hold at ``values`` in a pose the connector does not
+        """A message when the rows hold at ``values`` in a pose the constraint does not
         mean (joints.py); None for rows without such poses."""
         return None
 
@@ -149,7 +149,7 @@ class Connector(Keyed):
 @MEMO.function(256)
 def _slots_in(rows, slots):
     """The positions j whose coordinate slot or velocity slot the rows (a, b, φ, ψ) hold:
-    once per template (connectors alike share their rows)."""
+    once per template (constraints alike share their rows)."""
     a, b, phi, psi = rows
     free = symbols_in((*b, *phi, *psi, *(e for row in a for e in row)))
     return [j for j, (s, sd) in enumerate(zip(*slots)) if s in free or sd in free]
@@ -157,8 +157,8 @@ def _slots_in(rows, slots):
 
 @MEMO.function(256)
 def _placed_rows(rows, local):
-    """[a, b, C, φ, ψ] of ``Connector._rows`` for rows (a, b, φ, ψ) over the slots at
-    ``local``: once per template and selection (connectors alike share it)."""
+    """[a, b, C, φ, ψ] of ``Constraint._rows`` for rows (a, b, φ, ψ) over the slots at
+    ``local``: once per template and selection (constraints alike share it)."""
     a, b, phi, psi = rows
     k = len(b)
     return [sp.Matrix(k, len(local), [a[r][j] for r in range(k) for j in local]), sp.Matrix(b),
@@ -167,7 +167,7 @@ def _placed_rows(rows, local):
 
 def mixed(holonomic, nonholonomic, q, qd):
     """(a, b, φ, ψ) of position-level rows φ(q, t) = 0 followed by velocity-level rows
-    ψ(q, q̇, t) = 0 in one connector (2.4): φ is NaN on the velocity-level rows, which
+    ψ(q, q̇, t) = 0 in one constraint (2.4): φ is NaN on the velocity-level rows, which
     have no position form."""
     a, b, psi = differentiated(list(holonomic) + list(nonholonomic), q, qd)
     return a, b, [expand_joint_values(phi) for phi in holonomic] + [sp.nan] * len(nonholonomic), psi

@@ -19,7 +19,7 @@ meant one (frames turned less than 90° apart). Rows of A and b follow by differ
 twice (symbolic.differentiate), exactly — once per kind of joint and types of parts
 (``TEMPLATES``, joint_templates.py): φ is derived with the frames' offsets and rotations as
 placeholder symbols and the parts' coordinates as slots, compiled once, and each joint
-passes its frames' values and coordinates (Connector._place); its sympy rows are built only
+passes its frames' values and coordinates (Constraint._place); its sympy rows are built only
 when asked. Joints on parts whose frames move with their coordinates, or with friction, are
 derived directly. The rows of each kind are those of its record in core/joint_kinds.py.
 """
@@ -29,7 +29,7 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from .base import Connector
+from .base import Constraint
 from ...core.joint_kinds import ALIGNED_AXIS, JOINT_KINDS, KINDS, OPERATIONS, ORIENTATION_LOCK
 from ...core.kinematics import quaternion_rotation
 from ..joint_templates import Templates, joint_coordinates, pose, shared
@@ -54,7 +54,7 @@ def joint_equations(kind, pA, RA, pB, RB, length=None):
     return phis, list(KINDS[kind].labels)
 
 
-class Joint(Connector):
+class Joint(Constraint):
     """A holonomic joint between frame A (on ``parent``, or the world when None) and
     frame B (on ``child``). Rows that vanish identically (a revolute joint between planar
     bodies has no z or axis rows) are left out. Besides its rows it knows, where it has them, its free
@@ -179,7 +179,7 @@ def _rotation_at(part, frame, values):
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ own
     if part.part_type.orientation == QUATERNION:
         return quaternion_rotation([float(values[x]) for x in part.q[part.part_type.quaternion]]) @ own
-    raise ValueError(f"a {part.kind} part shares its poses but turns by {part.part_type.orientation}: no rotation "
+    raise ValueError(f"a {part.type_name} part shares its poses but turns by {part.part_type.orientation}: no rotation "
                      "from its coordinates here")
 
 

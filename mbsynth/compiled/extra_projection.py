@@ -2,23 +2,23 @@
 expression constraints: no kernel node) back on its constraints with the kernel, in the mass
 metric.
 
-As correction.py does for the kernel's own rows: with the generated forces, C and b set to
+As compiled/projection.py does for the kernel's own rows: with the generated forces, C and b set to
 zero and q̇ = 0, the kernel's q̈ for a right side shifted by −r is the least-M-norm Δ with
 A Δ = −r ((2.14) with Q = 0). Positions: Gauss–Newton steps with r = φ, the generated φ of
-the extra rows, while a row's |φ| exceeds CORRECTION_RTOL of its terms (Σ_j |A_ij q_j|, as
+the extra rows, while a row's |φ| exceeds MASS_PROJECTION_RTOL of its terms (Σ_j |A_ij q_j|, as
 core/equations.term_scales: alike at every scale), at most MAX_STEPS of them; then
 velocities, one step with r = φ̇ = A q̇ (linear). A velocity step must cut each row's φ̇ by
-CORRECTION_SHRINK at least, or leave it below CORRECTION_RATE_RTOL of its terms. A state the kernel declines
-(its dense Schur step finds the rows contradict) or whose steps do not meet these goals goes
-to projection.py (None), as with correction.py.
+MASS_PROJECTION_SHRINK at least, or leave it below MASS_PROJECTION_RATE_RTOL of its terms. A state the
+kernel declines (its dense Schur step finds the rows contradict) or whose steps do not meet these goals goes
+to analysis/projection.py (None), as with compiled/projection.py.
 
 Only for Systems whose every coordinate is an extra coordinate, every extra row has a φ
-(holonomic rows: a velocity-level row has no position to correct), whose masses and rows
-do not depend on time (a correction is called without t). The banded Schur step of a larger
+(holonomic rows: a velocity-level row has no position to project), whose masses and rows
+do not depend on time (a projection is called without t). The banded Schur step of a larger
 model (kernel.py; layout.DENSE_SCHUR_MAX) declines states near a singular position, and
-there the mass metric moves the velocity far more than projection.py's (a velocity 1e-10 off
+there the mass metric moves the velocity far more than analysis/projection.py's (a velocity 1e-10 off
 the N = 40 four-bar's manifold 1e-4 rad from a horizontal position is put 1e-6 from the
-exact one; projection.py: 2e-8): a run steps across such positions with its stages kept
+exact one; analysis/projection.py: 2e-8): a run steps across such positions with its stages kept
 away from them (analysis/crossing.py), from the rows' ``measure``, which its singular watch
 gives where the model is small. Its energies are left to the Data (``energies`` False); the
 run's singular watch goes on through its states (``watched``).
@@ -29,17 +29,17 @@ import threading
 import numpy as np
 
 from . import kernel
-from .correction import MAX_STEPS, TINY, Corrected, CorrectedRows
+from .projection import MAX_STEPS, TINY, Projected, ProjectedRows
 from ..core.equations import entry_term_scales
-from ..core.tolerances import CORRECTION_RATE_RTOL, CORRECTION_RTOL, CORRECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
+from ..core.tolerances import MASS_PROJECTION_RATE_RTOL, MASS_PROJECTION_RTOL, MASS_PROJECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
 from .least_direction import LeastDirection
 
 
-class ExtraCorrection:
+class ExtraProjection:
     """The kernel's projection of an Engine whose model has extra coordinates alone."""
 
-    energies = False  # Corrected's kinetic and potential energy are not computed here
-    watched = True  # the run's singular watch measures the states it corrects (analysis/singular_watch.py)
+    energies = False  # Projected's kinetic and potential energy are not computed here
+    watched = True  # the run's singular watch measures the states it projects (analysis/singular_watch.py)
 
     def __init__(self, engine):
         L = engine.L
@@ -62,7 +62,7 @@ class ExtraCorrection:
 
     @classmethod
     def build(cls, engine):
-        """The ExtraCorrection of ``engine``, or None where its model is not of extra
+        """The ExtraProjection of ``engine``, or None where its model is not of extra
         coordinates alone, has no row or a row without φ, or rows or masses that depend on t
         (Template.rows_depend_on_time)."""
         L, template = engine.L, engine.template
@@ -98,14 +98,14 @@ class ExtraCorrection:
         return self.W.qdd.copy() if status == kernel.OK else None
 
     def __call__(self, q, qd):
-        """``Corrected`` (q, q̇) on the constraints (new arrays; kinetic and potential energy
+        """``Projected`` (q, q̇) on the constraints (new arrays; kinetic and potential energy
         NaN), or None (module docstring)."""
         with self.lock:
             q, qd = np.array(q, dtype=float), np.array(qd, dtype=float)
             self._evaluate(q, qd)
             phi = self.gen[self.phi].copy()
             for step in range(MAX_STEPS + 1):
-                if np.all(np.abs(phi) <= CORRECTION_RTOL * self._terms(q, TERM_FLOOR)):
+                if np.all(np.abs(phi) <= MASS_PROJECTION_RTOL * self._terms(q, TERM_FLOOR)):
                     break
                 delta = None if step == MAX_STEPS else self._step(q, phi)
                 if delta is None:
@@ -121,16 +121,16 @@ class ExtraCorrection:
             qd += delta
             self._evaluate(q, qd)
             psi = self._rates(qd)
-            if not np.all(np.abs(psi) <= np.maximum(CORRECTION_SHRINK * before,
-                                                    CORRECTION_RATE_RTOL * self._terms(qd, TERM_FLOOR))):
+            if not np.all(np.abs(psi) <= np.maximum(MASS_PROJECTION_SHRINK * before,
+                                                    MASS_PROJECTION_RATE_RTOL * self._terms(qd, TERM_FLOOR))):
                 return None
-            return Corrected(q, qd, np.nan, np.nan, float(np.abs(self.gen[self.phi]).max(initial=0.0)),
+            return Projected(q, qd, np.nan, np.nan, float(np.abs(self.gen[self.phi]).max(initial=0.0)),
                              float(np.abs(psi).max(initial=0.0)))
 
     def block(self, Q, QD, fractions=None):
-        """``__call__`` of each state (row of Q, Q̇), as CorrectedRows (``fractions``, the
-        states' fractions of a step, are not used: each state is corrected on its own)."""
-        return CorrectedRows.of([self(q, qd) for q, qd in zip(Q, QD)], self.n)
+        """``__call__`` of each state (row of Q, Q̇), as ProjectedRows (``fractions``, the
+        states' fractions of a step, are not used: each state is projected on its own)."""
+        return ProjectedRows.of([self(q, qd) for q, qd in zip(Q, QD)], self.n)
 
     def measure(self, q, qd):
         """σ_min/σ₁ of the rows' A at (q, q̇), each row scaled to unit norm
