@@ -69,8 +69,11 @@ class Evaluator:
         self.forces = Batch([f._evaluate for f in forces], [f.indices for f in forces], 2, compiled)
         self.f_cols = np.concatenate([np.zeros(0, int)] + [f.indices for f in forces])
         self.working = ([(part, r) for part, r in zip(system.parts, ranges) if part.working],
-                        [f for f in forces if not f.conservative],
+                        [f for f in forces if not f.conservative and not f.efforts_only],
                         any(x != 0 for c in constraints for x in c.C.values()))  # parts, elements, a non-ideal C
+        # the entries of the stacked Q_e whose elements' power is q̇ᵀQ_e (one batched evaluation)
+        self.effort_entries = np.concatenate([np.zeros(0, bool)] + [np.full(len(f.indices), f.efforts_only)
+                                                                     for f in forces])
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
@@ -128,6 +131,9 @@ class Evaluator:
         Coulomb friction acts (``System.unaccounted_work``)."""
         parts, elements, nonideal = self.working
         total = sum(part.power(t, q[r], qd[r], p) for part, r in parts) + sum(e.power(t, q, qd, p) for e in elements)
+        if self.effort_entries.any():
+            efforts = self.forces(t, q, qd, p)[0][self.effort_entries]
+            total += float(qd[self.f_cols[self.effort_entries]] @ efforts)
         if nonideal:
             total += float(qd @ np.bincount(self.c_cols, weights=self.rows(t, q, qd, p)[2], minlength=self.n))
         return float(total)

@@ -91,6 +91,12 @@ class ForceElement(Keyed):
         with quiet_at_zero_length():
             return self._evaluate(t, q[self.indices], qd[self.indices], p)[0].ravel()
 
+    @property
+    def efforts_only(self):
+        """Whether all of Q_e is the efforts' (no potential, not conservative): its power is
+        q̇ᵀQ_e, from the values ``evaluate`` gives (evaluation.py sums it over all elements)."""
+        return not self.conservative and self._power_terms is None
+
     def power(self, t, q, qd, p):
         """The power q̇ᵀ(Q_e + ∂V/∂q) = Σ effort·rate of the element's efforts at the full
         state: what they add to d(T + V)/dt (0 for a conservative element)."""
