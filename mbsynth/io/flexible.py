@@ -55,7 +55,7 @@ def _read_fe(builder, spec, path):
         elements = node["elements"]
         if not isinstance(elements, int) or isinstance(elements, bool):
             builder.fail(where + ("elements",), f"elements must be a positive integer, got {elements!r}")
-        vectors = {k: builder.numbers(node[k], where + (k,), 3, fixed=True) for k in ("axis", "up") if k in node}
+        vectors = {k: builder.numbers(node[k], where + (k,), 3) for k in ("axis", "up") if k in node}
         length = numbers.pop("length")
         fe = _fe_layer(builder, where, beam, length, elements, **numbers, **vectors,
                        theory=node.get("theory", "euler_bernoulli"), mass=node.get("mass", "consistent"))
@@ -189,7 +189,7 @@ def _read_damping(builder, reduction, node, path):
     if len(node) != 1:
         builder.fail(path, f"give exactly one of rayleigh and modal; got {', '.join(node) or 'neither'}")
     if "rayleigh" in node:
-        alpha, beta = builder.numbers(node["rayleigh"], path + ("rayleigh",), 2, fixed=True)
+        alpha, beta = builder.numbers(node["rayleigh"], path + ("rayleigh",), 2)
         if alpha < 0 or beta < 0:
             builder.fail(path + ("rayleigh",), f"α and β must be ≥ 0, got {alpha}, {beta}")
         return rayleigh_damping(reduction, alpha, beta)

@@ -208,10 +208,17 @@ class _Builder:
         node = self.sized_list(node, path, size)
         return sp.Matrix([self.expression(x, path + (i,), symbols) for i, x in enumerate(node)])
 
-    def numbers(self, node, path, size, fixed=False):
-        """A list of ``size`` floats (expressions of parameters allowed; ``fixed``: built
-        from at load, as ``fixed_value``)."""
+    def numbers(self, node, path, size, fixed=True):
+        """A list of ``size`` floats (expressions of parameters allowed). They are built into
+        the model at load, so their parameters are recorded as fixed there (``fixed_value``:
+        ``with_parameters`` refuses to change them, naming this line); ``fixed`` False only
+        for numbers the model does not compute with (a drawing's sizes and colours)."""
         return [self.fixed_value(x, path) if fixed else self.value(x) for x in self.constants(node, path, size)]
+
+    def initial_values(self, node, path, size):
+        """A list of ``size`` initial coordinate values: expressions of parameters, which
+        follow ``with_parameters`` (``read_initial``'s definitions)."""
+        return list(self.constants(node, path, size))
 
     def constants(self, node, path, size):
         """A sympy column of ``size`` expressions of parameters, each finite and real."""
@@ -584,7 +591,8 @@ class _Builder:
         place per coordinate). ``definitions``: the values given by expressions (which
         follow ``with_parameters``); ``given``: the names the files set."""
         values = {f"{part.name}.{k}": v for part in self.own_parts for k, v in part.initial.items()}
-        definitions, given = {}, set(values)
+        definitions = {k: v for k, v in values.items() if isinstance(v, sp.Basic) and v.free_symbols}
+        given = set(values)
         for _, copies in self.children:
             for child in copies:
                 more, more_definitions, more_given = child.read_initial()

@@ -85,7 +85,7 @@ def read_particle(builder, name, spec, path):
     node = builder.section(spec.get("initial"), path + ("initial",), "initial_particle")
     for key, suffix in (("position", ""), ("velocity", "_dot")):
         if key in node:
-            values = builder.numbers(node[key], path + ("initial", key), 3)
+            values = builder.initial_values(node[key], path + ("initial", key), 3)
             initial.update({f"{c}{suffix}": v for c, v in zip("xyz", values)})
     return Particle(name, q, qd, read_mass(builder, spec, path), builder.gravity, builder.parameter_symbols,
                     frames, read_geometry(builder, spec.get("geometry"), path + ("geometry",)), initial)
@@ -117,7 +117,7 @@ def read_spring(builder, name, spec, path):
         end, _, velocity = key.partition("_")
         names = Spring.COORDINATES[:3] if end == "end1" else Spring.COORDINATES[3:]
         suffix = "_dot" if velocity else ""
-        initial.update({c + suffix: v for c, v in zip(names, builder.numbers(values, path + ("initial", key), 3))})
+        initial.update({c + suffix: v for c, v in zip(names, builder.initial_values(values, path + ("initial", key), 3))})
     return Spring(name, q, qd, stiffness, rest_length, damping, mass, builder.gravity,
                   builder.parameter_symbols, initial)
 
@@ -159,10 +159,10 @@ def read_inertia(builder, node, path):
     return J
 
 
-def read_rotation(builder, node, path, fixed=False):
+def read_rotation(builder, node, path, fixed=True):
     """A numeric 3 × 3 rotation from ``rpy`` (URDF: Rz(yaw) Ry(pitch) Rx(roll)), ``axis``
     (z along the vector) or ``quaternion`` (w, x, y, z); identity when none is given.
-    ``fixed``: its parameters are built in at load (``builder.fixed_value``)."""
+    Its parameters are built in at load (``builder.numbers``; ``fixed`` False: a drawing's)."""
     given = [k for k in ORIENTATION_KEYS if k in node]
     if len(given) > 1:
         builder.fail(path, f"give at most one of {', '.join(ORIENTATION_KEYS)}, got {', '.join(given)}")
@@ -211,14 +211,15 @@ def read_body_initial(builder, node, path, planar, sequence=None):
     names = ("x", "y", "z")[:size]
     values = {}
     if "position" in node:
-        values.update(zip(names, builder.numbers(node["position"], path + ("position",), size)))
+        values.update(zip(names, builder.initial_values(node["position"], path + ("position",), size)))
     if "velocity" in node:
-        values.update(zip((c + "_dot" for c in names), builder.numbers(node["velocity"], path + ("velocity",), size)))
+        values.update(zip((c + "_dot" for c in names),
+                          builder.initial_values(node["velocity"], path + ("velocity",), size)))
     if planar:
         if "theta" in node:
-            values["theta"] = builder.numbers([node["theta"]], path + ("theta",), 1)[0]
+            values["theta"] = builder.initial_values([node["theta"]], path + ("theta",), 1)[0]
         if "angular_velocity" in node:
-            values["theta_dot"] = builder.numbers([node["angular_velocity"]], path + ("angular_velocity",), 1)[0]
+            values["theta_dot"] = builder.initial_values([node["angular_velocity"]], path + ("angular_velocity",), 1)[0]
         return values
     if sequence is not None:
         names = coordinates(sequence)[3:]
@@ -273,17 +274,18 @@ def read_geometry(builder, node, path, frames=()):
             continue
         if kind == "mesh":
             shape["file"] = read_mesh_file(builder, item["mesh"], ipath + ("mesh",))
-            shape["scale"] = builder.numbers(item.get("scale", [1, 1, 1]), ipath + ("scale",), 3)
+            shape["scale"] = builder.numbers(item.get("scale", [1, 1, 1]), ipath + ("scale",), 3, fixed=False)
         else:
             size = builder.numbers(item[kind] if isinstance(item[kind], list) else [item[kind]],
-                                   ipath + (kind,), SHAPES[kind])
+                                   ipath + (kind,), SHAPES[kind], fixed=False)
             if min(size) <= 0:
                 builder.fail(ipath + (kind,), f"{kind} dimensions must be positive, got {size}")
             shape["size"] = size
         shape["color"] = read_color(builder, item.get("color", "grey"), ipath + ("color",))
         origin = builder.section(item.get("origin"), ipath + ("origin",), "pose")
-        shape["position"] = builder.numbers(origin.get("position", [0, 0, 0]), ipath + ("origin", "position"), 3)
-        shape["rotation"] = read_rotation(builder, origin, ipath + ("origin",)).tolist()
+        shape["position"] = builder.numbers(origin.get("position", [0, 0, 0]), ipath + ("origin", "position"), 3,
+                                            fixed=False)
+        shape["rotation"] = read_rotation(builder, origin, ipath + ("origin",), fixed=False).tolist()
         shapes.append(shape)
     return tuple(shapes)
 
@@ -320,7 +322,7 @@ def read_color(builder, node, path):
         return [*COLORS[node], 1.0]
     if not isinstance(node, list) or len(node) not in (3, 4):
         builder.fail(path, "colour must be a name or [r, g, b] / [r, g, b, a] in 0..1")
-    values = builder.numbers(node, path, len(node))
+    values = builder.numbers(node, path, len(node), fixed=False)
     if min(values) < 0 or max(values) > 1:
         builder.fail(path, f"colour components must lie in 0..1, got {values}")
     return values + [1.0] * (4 - len(values))

@@ -162,7 +162,7 @@ def _placement(builder, node, path):
         return Placement()
     node = builder.section(node, path, "placement")
     position = builder.constants(node.get("position", [0, 0, 0]), path + ("position",), 3)
-    return Placement(read_rotation(builder, node, path, fixed=True), position)
+    return Placement(read_rotation(builder, node, path), position)
 
 
 class Scoped(Mapping):

@@ -364,13 +364,13 @@ def _orthonormal(R):
     return U @ Vt
 
 
-def along(system, t, q, qd, qdd=None):
+def along(model_or_data, t, q, qd, qdd=None):
     """{joint name: JointValues of arrays (one row per time)} along a trajectory (arrays t,
     q, q̇ and optionally q̈, one row per time), with the angles made continuous (unwrapped):
-    a joint turning past π keeps counting."""
-    rows = [system.joint_values(ti, qi, qdi, None if qdd is None else qdd[i])
+    a joint turning past π keeps counting. Given a Data, at its parameter values."""
+    rows = [model_or_data.joint_values(ti, qi, qdi, None if qdd is None else qdd[i])
             for i, (ti, qi, qdi) in enumerate(zip(t, q, qd))]
-    kinematics = system.joint_kinematics()
+    kinematics = getattr(model_or_data, "model", model_or_data).joint_kinematics()
     out = {}
     for name in (rows[0] if rows else {}):
         position, rate, acceleration = (np.array([r[name][k] for r in rows]) if qdd is not None or k < 2 else None

@@ -100,3 +100,69 @@ def test_simulate_at_a_datas_parameters():
     other = "kkt" if data.path == "compiled" else "compiled"
     with pytest.raises(ValueError, match=f"path='{other}': the Data given runs on its own path, '{data.path}'"):
         mb.simulate(data, 0.5, path=other)
+
+
+SLIDER = """
+name: slider
+parameters: {m: 1.0, d: 0.5}
+world:
+  frames:
+    rail: {position: [d, 0, 0], axis: [1, 0, 0]}
+parts:
+  block:
+    type: rigid_body
+    mass: m
+    inertia: [0.1, 0.1, 0.1]
+    frames:
+      guide: {axis: [1, 0, 0]}
+joints:
+  - {name: slide, type: prismatic, parent: world.rail, child: block.guide}
+initial: {block.x: 0.75}
+"""
+
+
+def test_joint_values_along_a_run_at_a_datas_parameters():
+    """``along`` handed a Data reads the joints at its values: a block on a rail that starts
+    at x = d slides the displacement x − d, so the same states give x − 0.6 for a Data set
+    to d = 0.6, as the rebuilt model gives, and x − 0.5 for the model's own d."""
+    from mbsynth.model.joint_values import along
+    system = mb.loads(SLIDER)
+    data = system.data()
+    data.set_parameters({"d": 0.6})
+    changed = system.with_parameters(d=0.6)
+    q0, qd0 = system.initial_state()
+    x = system.coordinates.index("block.x")
+    q, qd = np.tile(q0, (3, 1)), np.tile(qd0, (3, 1))
+    q[:, x] = [0.7, 0.8, 0.9]
+    t = np.zeros(3)
+    found, expected, default = (along(m, t, q, qd)["slide"].position[:, 0] for m in (data, changed, system))
+    assert np.allclose(found, [0.1, 0.2, 0.3], rtol=0, atol=1e-12)
+    assert rel(found, expected) < SAME
+    assert np.allclose(default, [0.2, 0.3, 0.4], rtol=0, atol=1e-12)
+
+
+def test_with_parameters_refuses_a_value_built_into_a_frame_at_load():
+    """A frame's axis written with a parameter is a rotation computed at load: changing that
+    parameter with ``with_parameters`` is refused naming the file's line (it would keep the
+    old axis), while ``load(parameters=)`` builds the new one: the block slides down the
+    steeper slope at g (sin α − μ cos α) (slider_friction.yaml)."""
+    path = MODELS / "joints/slider_friction.yaml"
+    with pytest.raises(mb.ModelError, match=r"'alpha' was built into the model .*slider_friction.yaml:\d+, key world.frames.slope.axis"):
+        mb.load(path).with_parameters(alpha=0.7)
+    steeper = mb.load(path, parameters={"alpha": 0.7})
+    q, qd = steeper.initial_state()
+    qdd = steeper.motion(0.0, q, qd).qdd
+    x, z = (steeper.coordinates.index(f"block.{c}") for c in "xz")
+    g, mu = 9.81, 0.3
+    assert abs(np.hypot(qdd[x], qdd[z]) - g * (np.sin(0.7) - mu * np.cos(0.7))) < 1e-9
+
+
+def test_a_parts_initial_position_written_with_parameters_follows_them():
+    """A part's own ``initial: {position: ...}`` written with parameters is taken at the new
+    values by ``with_parameters`` as by ``load(parameters=)`` (four_bar.yaml's crank centre
+    at a/2)."""
+    path = MODELS / "mechanisms/four_bar.yaml"
+    a = mb.load(path).parameters["a"] * 1.1
+    for found, expected in zip(mb.load(path).with_parameters(a=a).initial_state(),
+                               mb.load(path, parameters={"a": a}).initial_state()):
+        assert np.array_equal(found, expected)
