@@ -24,6 +24,12 @@ the state there is ``settle``d:
    one brought to rest first (an e = 0 jump). A held row is released where its force
    falls to zero.
 
+A striking contact with Coulomb friction μ sticks or slips through its impact
+(impulse.Rough): Newton's law on its normal, and either its slip rows held at zero
+(stick: |Λ_t| ≤ μ Λ_n) or the tangential impulse μ Λ_n along the impulse stick would need
+(slip: Brach's algebraic impact law). A contact with friction that comes to rest is
+refused (EventError): stick and slip while it holds are not modelled.
+
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
 A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
 EventError (a SolveError) naming the time and the gaps: the run stops there.
@@ -37,7 +43,7 @@ from scipy.optimize import brentq
 
 from . import stepper
 from .continuous import ContinuousIntegration
-from .impulse import velocity_jump
+from .impulse import Rough, velocity_jump
 from .trajectory import Event
 from ..core.errors import EventError, ModelError, SolveError
 from ..core.solvers import kkt_acceleration
@@ -299,6 +305,10 @@ class EventIntegration(ContinuousIntegration):
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
         active = self._contact_set(t, q, qd, sorted((self.active - released) | set(resting)))
+        rough = [i for i in active if self.gaps.friction[i] > 0]
+        if rough:
+            raise self._fail(t, rough, "a resting contact with friction (μ > 0): its stick and slip while it "
+                                       "holds are not modelled (friction acts at impacts)")
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
@@ -333,22 +343,22 @@ class EventIntegration(ContinuousIntegration):
         failed = None
         for chosen in _subsets(rows):
             target = np.array([-e[i] * gd[i] if i in striking else 0.0 for i in chosen])
-            A = np.vstack([A_b, A_gaps[list(chosen)]])
+            rough = Rough(self.gaps, t, q, qd, self.base.p, chosen)
             try:
-                jump = velocity_jump(M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
-                                     constraints=names_b + [self.gaps.names[i] for i in chosen])
+                qd_after, impulses, modes = rough.jump(M, qd, A_b, v_b, names_b, A_gaps, target, coordinates)
             except SolveError as err:
                 failed = err
                 continue
-            impulses = jump.impulses[len(v_b):]
-            after = A_gaps @ jump.qd
+            after = A_gaps @ qd_after
             others = [i for i in rows if i not in chosen]
             if (impulses >= -COMPLEMENTARITY_RTOL * np.abs(impulses).max(initial=0.0)).all() and \
                     all(after[i] + e[i] * gd[i] >= -COMPLEMENTARITY_RTOL * abs(gd[i]) - floor[i] for i in others):
                 for i, impulse in zip(chosen, impulses):
                     if i in striking:
                         self.events.append(Event(float(t), self.gaps.names[i], "impact", float(impulse)))
-                return jump.qd
+                    if i in modes:
+                        self.events.append(Event(float(t), self.gaps.names[i], *modes[i]))
+                return qd_after
         if failed is not None:
             raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")

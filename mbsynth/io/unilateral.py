@@ -4,11 +4,14 @@
 Each reader returns (Unilateral, path of its entry); the loader keeps the paths to name
 the entry of a gap that the initial state penetrates (``check_initial``)."""
 
+import numpy as np
 import sympy as sp
 
 from ..core.joint_kinds import KINDS
 from ..core.tolerances import ASSEMBLED_TOL
-from ..model.unilateral import Unilateral, gap_row
+from ..model.connectors.base import Connector
+from ..model.parts.base import frame_velocity
+from ..model.unilateral import Unilateral, gap_row, tangent_basis
 from .joints import frame_reference
 
 CONTACT_KINDS = {"plane": "contact_plane", "spheres": "contact_spheres"}  # contact type -> schema section
@@ -57,8 +60,31 @@ def read_contacts(builder):
         gap = _plane_gap(builder, spec, path) if kind == "plane" else _spheres_gap(builder, spec, path)
         full = builder.full_name(name)
         row = gap_row(full, gap, builder.q, builder.qd, builder.parameter_symbols)
-        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row), path))
+        mu, slip = _friction(builder, spec, path, full) if kind == "plane" else (sp.S.Zero, None)
+        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip), path))
     return found
+
+
+def _friction(builder, spec, path, name):
+    """(μ, the slip rows) of a plane contact's ``friction: μ`` (μ ≥ 0, 0 by default): the
+    rows ψ = t_k·ṗ, the velocity of the contact point along two unit tangents t1, t2 of the
+    plane (None without friction). Friction needs a point (radius 0): a sphere's contact
+    point moves with its spin, which the point's velocity leaves out."""
+    if "friction" not in spec:
+        return sp.S.Zero, None
+    mu = builder.constant(spec["friction"], path + ("friction",))
+    if builder.value(mu) < 0:
+        builder.fail(path + ("friction",), f"friction must be ≥ 0, got {builder.value(mu):g}")
+    if builder.value(builder.constant(spec.get("radius", 0), path + ("radius",))) != 0:
+        builder.fail(path + ("friction",), "friction is modelled at a point contact (radius 0), not at a sphere")
+    p = _centre(builder, spec["child"], path + ("child",))
+    normal = builder.constants(spec.get("normal", [0, 0, 1]), path + ("normal",), 3)
+    n = np.array([builder.value(x) for x in normal], dtype=float)
+    tangents = tangent_basis(n / np.linalg.norm(n))
+    velocity = frame_velocity(p, builder.q, builder.qd)
+    rows = [sum(float(t[k]) * velocity[k] for k in range(3)) for t in tangents]
+    return mu, Connector.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
+                                      row_labels=["t1", "t2"])
 
 
 def _plane_gap(builder, spec, path):

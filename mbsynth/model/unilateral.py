@@ -6,6 +6,9 @@ point or sphere on a part's frame against a ground plane, g = n·p − h − r; 
 g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Connector with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
+A point contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·ṗ, the
+contact point's velocity along two unit tangents of the plane (``tangent_basis``): an
+impulse Λ_k on them is the tangential impulse Λ_k t_k at the point.
 
 While a gap is open the row is no constraint; while it holds (persistent contact) it is one
 of the System's rows: ``with_active`` makes the System of an active set (its ``connectors``
@@ -24,12 +27,15 @@ from ..core.errors import ModelError
 @dataclass(frozen=True)
 class Unilateral:
     """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), its restitution e (a
-    sympy expression of the parameters), its holonomic ``row`` (φ = g)."""
+    sympy expression of the parameters), its holonomic ``row`` (φ = g), Coulomb's
+    ``friction`` μ and the nonholonomic ``slip`` rows (None without friction)."""
 
     name: str
     kind: str
     restitution: sp.Expr
     row: Connector
+    friction: sp.Expr = sp.S.Zero
+    slip: Connector = None
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
@@ -38,6 +44,23 @@ class Unilateral:
             raise ModelError(f"model '{system.name}': the restitution of '{self.name}' is {e:g} at these parameter "
                              f"values; it must be between 0 and 1")
         return e
+
+    def friction_at(self, system, p):
+        """μ at the parameter values ``p`` of ``system``; ModelError unless μ ≥ 0."""
+        mu = float(sp.sympify(self.friction).xreplace(dict(zip(system.parameter_symbols, p))))
+        if not mu >= 0:
+            raise ModelError(f"model '{system.name}': the friction of '{self.name}' is {mu:g} at these parameter "
+                             f"values; it must be ≥ 0")
+        return mu
+
+
+def tangent_basis(n):
+    """Two unit tangents t1, t2 of the unit normal ``n`` (t1 = the first of e_x, e_y
+    least along n, made orthogonal to it; t2 = n × t1): a right-handed (t1, t2, n)."""
+    axis = np.eye(3)[int(np.argmin(np.abs(n[:2])))]
+    t1 = axis - (axis @ n) * n
+    t1 /= np.linalg.norm(t1)
+    return t1, np.cross(n, t1)
 
 
 def gap_row(name, gap, q, qd, params):
@@ -61,6 +84,8 @@ class Gaps:
         self.unilaterals, self.n = tuple(system.unilaterals), system.n
         self.names = tuple(u.name for u in self.unilaterals)
         self.restitution = np.array([u.restitution_at(system, p) for u in self.unilaterals], dtype=float)
+        self.friction = np.array([u.friction_at(system, p) if u.slip is not None else 0.0
+                                  for u in self.unilaterals], dtype=float)
 
     def __len__(self):
         return len(self.unilaterals)
@@ -78,3 +103,10 @@ class Gaps:
             a, b_row, _ = u.row.evaluate(t, q, qd, p)
             A[i, u.row.indices], b[i] = a[0], b_row[0]
         return A, b
+
+    def slip_rows(self, t, q, qd, p, i):
+        """The (2, n) rows of gap i's slip velocity (its tangential velocity T q̇)."""
+        u = self.unilaterals[i]
+        T = np.zeros((u.slip.size, self.n))
+        T[:, u.slip.indices] = u.slip.evaluate(t, q, qd, p)[0]
+        return T
