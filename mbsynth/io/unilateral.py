@@ -4,7 +4,6 @@
 Each reader returns (Unilateral, path of its entry); the loader keeps the paths to name
 the entry of a gap that the initial state penetrates (``check_initial``)."""
 
-import numpy as np
 import sympy as sp
 
 from ..core.joint_kinds import KINDS
@@ -78,11 +77,8 @@ def _friction(builder, spec, path, name):
     if builder.value(builder.constant(spec.get("radius", 0), path + ("radius",))) != 0:
         builder.fail(path + ("friction",), "friction is modelled at a point contact (radius 0), not at a sphere")
     p = _centre(builder, spec["child"], path + ("child",))
-    normal = builder.constants(spec.get("normal", [0, 0, 1]), path + ("normal",), 3)
-    n = np.array([builder.value(x) for x in normal], dtype=float)
-    tangents = tangent_basis(n / np.linalg.norm(n))
     velocity = frame_velocity(p, builder.q, builder.qd)
-    rows = [sum(float(t[k]) * velocity[k] for k in range(3)) for t in tangents]
+    rows = [t.dot(velocity) for t in tangent_basis(_normal(builder, spec, path), builder.value)]
     return mu, Connector.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
                                       row_labels=["t1", "t2"])
 
@@ -92,14 +88,19 @@ def _plane_gap(builder, spec, path):
     if not builder.placement.identity:
         builder.fail(path, "a ground contact in an included file with a placement: give it in the including file")
     p = _centre(builder, spec["child"], path + ("child",))
+    unit = _normal(builder, spec, path)
+    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
+    ground = builder.constant(spec.get("ground", 0), path + ("ground",))
+    return unit.dot(p) - ground - radius
+
+
+def _normal(builder, spec, path):
+    """The plane's unit normal n (sympy, an expression of parameters)."""
     normal = builder.constants(spec.get("normal", [0, 0, 1]), path + ("normal",), 3)
     length = sum(builder.value(x) ** 2 for x in normal) ** 0.5
     if not length > 0:
         builder.fail(path + ("normal",), "the plane's normal is zero")
-    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
-    ground = builder.constant(spec.get("ground", 0), path + ("ground",))
-    unit = (normal / sp.sqrt(sum(x**2 for x in normal))).evalf()  # a number's root as a float, not an integer's
-    return unit.dot(p) - ground - radius
+    return (normal / sp.sqrt(sum(x**2 for x in normal))).evalf()  # a number's root as a float, not an integer's
 
 
 def _spheres_gap(builder, spec, path):

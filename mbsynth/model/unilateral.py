@@ -54,13 +54,14 @@ class Unilateral:
         return mu
 
 
-def tangent_basis(n):
-    """Two unit tangents t1, t2 of the unit normal ``n`` (t1 = the first of e_x, e_y
-    least along n, made orthogonal to it; t2 = n × t1): a right-handed (t1, t2, n)."""
-    axis = np.eye(3)[int(np.argmin(np.abs(n[:2])))]
-    t1 = axis - (axis @ n) * n
-    t1 /= np.linalg.norm(t1)
-    return t1, np.cross(n, t1)
+def tangent_basis(n, value=float):
+    """Two unit tangents t1, t2 of the unit normal ``n`` (a sympy column, an expression of
+    parameters; ``value`` its number): t1 = the first of e_x, e_y least along n at its value,
+    made orthogonal to n; t2 = n × t1: a right-handed (t1, t2, n)."""
+    axis = sp.Matrix(np.eye(3)[int(np.argmin([abs(value(n[0])), abs(value(n[1]))]))])
+    t1 = axis - axis.dot(n) * n
+    t1 = t1 / sp.sqrt(t1.dot(t1))
+    return t1, n.cross(t1)
 
 
 def gap_row(name, gap, q, qd, params):
