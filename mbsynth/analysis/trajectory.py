@@ -47,7 +47,8 @@ class Event(NamedTuple):
     """What happened at a unilateral constraint (analysis/impacts.py) at time ``t``: ``kind``
     "impact" (a velocity jump, ``impulse`` its Λ), "contact" (the gap closed and holds: a
     persistent contact, ``impulse`` what brought it to rest), "release" (it opened), or at an
-    impact of a contact with friction "stick" or "slip" (``impulse`` the tangential |Λ_t|)."""
+    impact of a contact with friction "stick" or "slip" (``impulse`` the tangential |Λ_t|),
+    "slip" too where a held one starts to slide (``impulse`` 0)."""
 
     t: float
     name: str

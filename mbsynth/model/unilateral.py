@@ -15,6 +15,7 @@ of the System's rows: ``with_active`` makes the System of an active set (its ``c
 followed by the active rows), which the run loop switches between (analysis/impacts.py).
 """
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +23,7 @@ import sympy as sp
 
 from .connectors.base import Connector
 from ..core.errors import ModelError
+from ..core.tolerances import SPEED_ROUNDING
 
 
 @dataclass(frozen=True)
@@ -69,12 +71,48 @@ def gap_row(name, gap, q, qd, params):
     return Connector.holonomic(name, [gap], q, qd, params)
 
 
-def with_active(system, names):
+def with_active(system, names, sliding=None):
     """``system`` with the rows of its unilaterals named in ``names`` appended to its
-    connectors, in the order of ``system.unilaterals``: the System of that active set."""
+    connectors, in the order of ``system.unilaterals``: the System of that active set. A
+    contact named in ``sliding`` ({name: (μ, the slip's direction where it has no speed)})
+    carries its Coulomb friction."""
+    sliding = sliding or {}
     if not names:
         return system
-    return system.with_constraints(u.row for u in system.unilaterals if u.name in names)
+    rows = []
+    for u in system.unilaterals:
+        if u.name in names:
+            row = u.row
+            if u.name in sliding:
+                row = copy.copy(row)
+                row.coulomb = Sliding(u, *sliding[u.name])
+            rows.append(row)
+    return system.with_constraints(rows)
+
+
+class Sliding:
+    """Coulomb's friction of a held contact that slides, as friction.py's ``coulomb`` of its
+    gap row: C = −μ N Tᵀû (N the gap row's force, T its slip rows, û the unit slip T q̇/|T q̇|,
+    or ``direction`` where the slip's speed is rounding: at its onset from rest)."""
+
+    def __init__(self, unilateral, mu, direction):
+        self.joint, self.slip, self.mu = unilateral.name, unilateral.slip, mu
+        self.indices = unilateral.slip.indices
+        self.direction = np.asarray(direction, dtype=float)
+        self.load_rows = np.array([0])
+
+    def evaluate(self, t, q, qd, p):
+        """(1, μ Tᵀû on ``indices``): friction.py's (w, direction) with w > 0."""
+        T = self.slip.evaluate(t, q, qd, p)[0]
+        return 1.0, self.mu * T.T @ slip_direction(T, qd[self.indices], self.direction, np.abs(qd).max(initial=0.0))
+
+
+def slip_direction(T, qd, direction, speed):
+    """The unit slip T q̇/|T q̇|, or ``direction`` where |T q̇| is rounding (SPEED_ROUNDING ×
+    ‖T‖₁ × ``speed``, the largest |q̇|)."""
+    u = T @ qd
+    size = np.linalg.norm(u)
+    return u / size if size > SPEED_ROUNDING * np.abs(T).sum(axis=1).max() * speed else direction
 
 
 class Gaps:
@@ -106,8 +144,13 @@ class Gaps:
         return A, b
 
     def slip_rows(self, t, q, qd, p, i):
-        """The (2, n) rows of gap i's slip velocity (its tangential velocity T q̇)."""
+        """The (2, n) rows T of gap i's slip velocity T q̇ (its tangential velocity)."""
+        return self.slip_arrays(t, q, qd, p, i)[0]
+
+    def slip_arrays(self, t, q, qd, p, i):
+        """(T, b) of gap i's slip rows: T q̈ = b holds them at rest."""
         u = self.unilaterals[i]
         T = np.zeros((u.slip.size, self.n))
-        T[:, u.slip.indices] = u.slip.evaluate(t, q, qd, p)[0]
-        return T
+        a, b, _ = u.slip.evaluate(t, q, qd, p)
+        T[:, u.slip.indices] = a
+        return T, b

@@ -98,7 +98,7 @@ contacts:
 """)
     with pytest.raises(mb.SimulationError) as err:
         mb.simulate(system, 1.0)
-    assert f"at t = {np.sqrt(0.2 / 9.81):.9g}, floor: a resting contact with friction" in str(err.value)
+    assert f"at t = {np.sqrt(0.2 / 9.81):.9g}, floor: a held contact with friction sticks here" in str(err.value)
     assert err.value.trajectory.events[0].kind == "impact"
 
 
