@@ -1,4 +1,5 @@
-"""A robot's foot striking the ground against Pinocchio's impulse dynamics.
+"""A robot's foot striking the ground against Pinocchio's impulse dynamics, and a robot
+standing on its feet against its constraint dynamics.
 
 solo12 (example-robot-data, floating) is built by mbsynth as one rigid body per link with a
 contact point at the origin of its FL_FOOT link against the plane z = h. Pinocchio,
@@ -14,6 +15,8 @@ import pytest
 
 import mbsynth as mb
 from mbsynth.analysis.impulse import velocity_jump
+from mbsynth.core.solvers import kkt_acceleration
+from mbsynth.model.reactions import multipliers
 from mbsynth.model.unilateral import Gaps
 from mbsynth.robots.twin import Twin
 from mbsynth.robots.validate import sample_pinocchio_state
@@ -95,3 +98,52 @@ def test_a_run_from_the_striking_state_records_pinocchios_impulse(solo):
     first = traj.events[0]
     assert (first.t, first.name, first.kind) == (0.0, "foot", "impact")
     assert abs(first.impulse - impulse[0]) < 1e-10 * abs(impulse[0])
+
+
+FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+
+
+def test_standing_on_four_feet_equals_pinocchio_constraint_dynamics(solo):
+    """solo12 with its four feet held on the ground (each foot's gap row and its slip rows,
+    the contact of a sticking foot) at a random state whose feet are at rest: q̈ and the
+    contact forces equal ``pinocchio.constraintDynamics`` with a CONTACT_3D per foot
+    (LOCAL_WORLD_ALIGNED: its force in world axes, the gap row's λ its z, the slip rows' λ
+    its x and y, the tangents of the plane z = h being e_x, e_y)."""
+    system, twin, model = solo
+    feet = "\n".join(f"  - {{name: {f}, type: plane, child: solo_{f}.link, ground: h_{f}, friction: 1}}"
+                     for f in FEET)
+    standing = mb.loads(MODEL.split("contacts:")[0].replace("parameters: {h: -1.0, e: 0.0}", "parameters: {"
+                        + ", ".join(f"h_{f}: -1.0" for f in FEET) + "}") + "contacts:\n" + feet + "\n")
+    q, v = sample_pinocchio_state(twin, np.random.default_rng(4))
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    ids = [model.getFrameId(f) for f in FEET]
+    J = np.vstack([pin.getFrameJacobian(model, data, i, pin.LOCAL_WORLD_ALIGNED)[:3] for i in ids])
+    _, s, Vt = np.linalg.svd(J)
+    v = Vt[len(s):].T @ Vt[len(s):] @ v  # the feet at rest
+    contacts = [pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, model, model.frames[i].parentJoint,
+                                         model.frames[i].placement, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+                for i in ids]
+    contact_data = [c.createData() for c in contacts]
+    pin.initConstraintDynamics(model, data, contacts, contact_data)
+    a = pin.constraintDynamics(model, data, q, v, np.zeros(model.nv), contacts, contact_data,
+                               pin.ProximalSettings(1e-14, 1e-12, 100))
+    forces = np.array(data.lambda_c).reshape(4, 3)
+    heights = {f"h_{f}": float(data.oMf[i].translation[2]) for f, i in zip(FEET, ids)}
+    held = standing.with_parameters(**heights)
+    qm, qdm = twin.to_maximal(q, v)
+    kept = held.data()
+    gaps = Gaps(held, kept.p)
+    arrays = kept.evaluate(0.0, qm, qdm)
+    A_gaps, b_gaps = gaps.rows(0.0, qm, qdm, kept.p)
+    slips = [gaps.slip_arrays(0.0, qm, qdm, kept.p, i) for i in range(4)]
+    A = np.vstack([arrays.A, A_gaps, *(T for T, _ in slips)])
+    b = np.concatenate([arrays.b, b_gaps, *(b_slip for _, b_slip in slips)])
+    motion = kkt_acceleration(arrays.M, arrays.Q, A, b, arrays.C)
+    lam = multipliers(A, arrays.M @ motion.qdd - arrays.Q - arrays.C)[0]
+    scale = np.abs(a).max()
+    assert np.abs(twin.to_pinocchio(qm, qdm, motion.qdd)[2] - a).max() < 1e-10 * scale
+    k = len(arrays.b)
+    ours = np.column_stack([lam[k + 4:].reshape(4, 2), lam[k:k + 4]])  # (x, y, z) per foot
+    assert np.abs(ours - forces).max() < 1e-10 * np.abs(forces).max()
