@@ -24,6 +24,15 @@ the state there is ``settle``d:
    one brought to rest first (an e = 0 jump). A held row is released where its force
    falls to zero.
 
+A striking contact with Coulomb friction μ sticks or slips through its impact
+(impulse.Rough): Newton's law on its normal, and either its slip rows held at zero
+(stick: |Λ_t| ≤ μ Λ_n) or the tangential impulse μ Λ_n along the impulse stick would need
+(slip: Brach's algebraic impact law). A held contact with friction slides: C = −μ λ_n Tᵀû
+(T its slip rows, û the unit slip; λ_n found exactly, ``_held_motion``), from rest against
+the tangential force λ_t sticking would need where |λ_t| > μ λ_n; its slip stopping is an
+event found on the dense output. Where it would stick (|λ_t| ≤ μ λ_n at rest) the run stops
+with EventError: sticking while a contact holds is not modelled.
+
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
 A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
 EventError (a SolveError) naming the time and the gaps: the run stops there.
@@ -37,14 +46,14 @@ from scipy.optimize import brentq
 
 from . import stepper
 from .continuous import ContinuousIntegration
-from .impulse import velocity_jump
+from .impulse import Rough, velocity_jump
 from .trajectory import Event
 from ..core.errors import EventError, ModelError, SolveError
 from ..core.solvers import kkt_acceleration
 from ..core.tolerances import (ASSEMBLED_TOL, COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP,
                                SPEED_ROUNDING)
 from ..model.reactions import multipliers
-from ..model.unilateral import Gaps, with_active
+from ..model.unilateral import Gaps, slip_direction, with_active
 
 ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once is chattering (no hang)
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
@@ -53,11 +62,26 @@ ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12
 
 class Pending(NamedTuple):
     """The next event: at ``t`` the open gaps ``closing`` touch, the held ``released`` ones
-    lose their force (indices into Gaps)."""
+    lose their force, the sliding contacts ``switching`` stop sliding (indices into
+    Gaps)."""
 
     t: float
     closing: frozenset
     released: frozenset
+    switching: frozenset = frozenset()
+
+
+class Held(NamedTuple):
+    """The motion with some gaps held (``EventIntegration._held_motion``): q̈, the held gaps'
+    forces λ, every gap's g̈ and the size of its terms, the size of the forces, and per
+    sticking contact its tangential force λ_t (on its slip rows)."""
+
+    qdd: np.ndarray
+    lam: np.ndarray
+    gdd: np.ndarray
+    scale: np.ndarray
+    force: float
+    tangential: dict
 
 
 class EventIntegration(ContinuousIntegration):
@@ -65,24 +89,28 @@ class EventIntegration(ContinuousIntegration):
 
     def __init__(self, *args):
         self.active = frozenset()  # the held gaps (indices)
+        self.sliding = {}  # the held contacts with friction that slide: {index: the slip's direction at onset}
         self.started = False  # whether the state at the start is settled (``advance``)
         super().__init__(*args)
         self.base = self.data  # the run's Data: the model without held gaps
         system = self.base.system
         self.gaps = Gaps(system, self.base.parameter_values)
-        self.phases = {frozenset(): self.base}  # active set -> its Data
+        self.phases = {(frozenset(), ()): self.base}  # (active set, sliding) -> its Data
         self.pending = None
         self.events = []  # trajectory.Event (simulate hands the recorder's list)
         self.idle = 0  # events in a row that changed nothing
 
     # ---- the phases: the System with the held rows appended
 
-    def _phase(self, active):
-        """The Data of the active set, at the run's parameter values."""
-        data = self.phases.get(active)
+    def _phase(self, active, sliding):
+        """The Data of the active set (``sliding``: its contacts with friction, which slide),
+        at the run's parameter values."""
+        key = (active, tuple(sorted((i, tuple(d)) for i, d in sliding.items())))
+        data = self.phases.get(key)
         if data is None:
             names = {self.gaps.names[i] for i in active}
-            data = self.phases[active] = with_active(self.base.system, names).data(self.base.path)
+            slid = {self.gaps.names[i]: (self.gaps.friction[i], d) for i, d in sliding.items()}
+            data = self.phases[key] = with_active(self.base.system, names, slid).data(self.base.path)
         if not np.array_equal(data.parameter_values, self.base.parameter_values):
             defined = self.base.system.definitions or {}
             data.set_parameters({k: v for k, v in self.base.parameters.items() if k not in defined})
@@ -90,18 +118,18 @@ class EventIntegration(ContinuousIntegration):
 
     def restart(self):
         if self.active:  # new parameter values at a control sample: the phase's Data follows the run's
-            self.data = self.f.data = self._phase(self.active)
+            self.data = self.f.data = self._phase(self.active, self.sliding)
         if self.started:  # and the restitutions
             self.gaps = Gaps(self.base.system, self.base.parameter_values)
         super().restart()
 
-    def _switch(self, active):
-        """Integrate with the rows of ``active`` held from here (the solver's f is given anew
-        by the caller)."""
-        if active == self.active:
+    def _switch(self, active, sliding):
+        """Integrate with the rows of ``active`` held from here, its contacts ``sliding``
+        sliding (the solver's f is given anew by the caller)."""
+        if active == self.active and sliding.keys() == self.sliding.keys():
             return
-        self.active = active
-        self.data = self.f.data = self._phase(active)
+        self.active, self.sliding = active, sliding
+        self.data = self.f.data = self._phase(active, sliding)
         engine = self.data.engine
         self.f.use(engine)
         self.projection = None if engine is None else engine.projection()
@@ -151,11 +179,11 @@ class EventIntegration(ContinuousIntegration):
         pending, self.pending = self.pending, None
         t = solver.t
         q, qd = self.form.to_state(solver.y)
-        q, qd_new, changed = self.settle(t, q, qd, pending.released)
+        q, qd_new, changed = self.settle(t, q, qd, pending.released, pending.switching)
         self.idle = 0 if changed else self.idle + 1
         if self.idle > IDLE_EVENTS:
             self.f.t_failed = t
-            names = [self.gaps.names[i] for i in sorted(pending.closing | pending.released)]
+            names = [self.gaps.names[i] for i in sorted(pending.closing | pending.released | pending.switching)]
             raise EventError(f"the gaps {', '.join(names)} chatter at t = {t:.9g}: {IDLE_EVENTS} events in a row "
                              f"changed nothing", constraints=names)
         if changed:
@@ -176,32 +204,36 @@ class EventIntegration(ContinuousIntegration):
         rows and gaps that touch (within atol) at its end: ``settle`` takes them there."""
         t0, t1 = start[0], solver.t
         aiming = self.pending is not None and target == self.pending.t
-        ignore = (self.pending.closing | self.pending.released) if aiming else frozenset()
+        ignore = (self.pending.closing | self.pending.released | self.pending.switching) if aiming else frozenset()
         q1, qd1 = self.form.to_state(solver.y)
         p = self.base.parameter_values
         g1 = self.gaps.values(t1, q1, qd1, p)[0]
         limit = -self.atol if aiming else 0.0
         closing = [i for i in self._open() if i not in ignore and g1[i] < limit]
-        held = sorted(self.active - ignore)
-        force1 = self._forces(t1, q1, qd1) if held else {}
-        released = [i for i in held if force1[i] < 0]
-        if not closing and not released:
+        q0, qd0 = self.form.to_state(start[1])
+        held = self.active - ignore
+        reference = self._slip_references(t0, q0, qd0)
+        watched1 = {k: x for k, x in self._watched(t1, q1, qd1, reference).items() if k[1] in held} if held else {}
+        crossing = [k for k, x in watched1.items() if x < 0]
+        if not closing and not crossing:
             return False
         dense = solver.dense_output()
-        q0, qd0 = self.form.to_state(start[1])
         g0, gd0 = self.gaps.values(t0, q0, qd0, p)
         floor = self._rounding(t0, q0, qd0)
-        roots = {i: self._closing(dense, i, t0, t1, g0[i], gd0[i], g1[i], floor[i]) for i in closing}
-        roots = {i: t for i, t in roots.items() if t is not None}
-        if released:
-            force0 = self._forces(t0, q0, qd0)
-            roots.update({i: self._releasing(dense, i, t0, t1, force0[i], force1[i]) for i in released})
+        roots = {("close", i): self._closing(dense, i, t0, t1, g0[i], gd0[i], g1[i], floor[i]) for i in closing}
+        roots = {k: t for k, t in roots.items() if t is not None}
+        if crossing:
+            watched0 = self._watched(t0, q0, qd0, reference)
+            roots.update({k: self._crossing(dense, k, reference, t0, t1, watched0[k], watched1[k]) for k in crossing})
         if not roots:
             return False
         t_event = min(roots.values())
-        at = frozenset(i for i, t in roots.items() if t == t_event)
-        self.pending = Pending(t_event, frozenset(i for i in at if i not in self.active) | (ignore & self._open_set()),
-                               frozenset(i for i in at if i in self.active) | (ignore & self.active))
+        at = [k for k, t in roots.items() if t == t_event]
+        before = self.pending if aiming else Pending(t_event, frozenset(), frozenset())
+        self.pending = Pending(t_event, frozenset(i for kind, i in at if kind == "close") | (ignore & self._open_set()),
+                               frozenset(i for kind, i in at if kind == "release") | before.released |
+                               (before.closing & self.active),
+                               frozenset(i for kind, i in at if kind == "switch") | before.switching)
         return True
 
     def _open(self):
@@ -237,51 +269,96 @@ class EventIntegration(ContinuousIntegration):
             return t0
         return _root(lambda t: self._gap_at(dense, i, t) + self.atol, t0, t1, g0 + self.atol, g1 + self.atol)
 
-    def _releasing(self, dense, i, t0, t1, f0, f1):
-        """Where the held gap i's force, f0 at t0 and f1 < 0 at t1, falls to zero."""
+    def _crossing(self, dense, key, reference, t0, t1, f0, f1):
+        """Where the watched value ``key`` (``_watched``), f0 at t0 and f1 < 0 at t1, falls
+        to zero."""
         if f0 <= 0:
             return t0
-        return _root(lambda t: self._forces(t, *self.form.to_state(dense(t)))[i], t0, t1, f0, f1)
+        return _root(lambda t: self._watched(t, *self.form.to_state(dense(t)), reference)[key], t0, t1, f0, f1)
 
     # ---- the motion with some gaps held
 
-    def _held_motion(self, t, q, qd, rows):
-        """(q̈, λ of the gap rows ``rows``, g̈ of every gap, the size of each g̈'s terms, the
-        size of the forces) of (2.14) with the gaps ``rows`` held beside the model's rows (its
-        KKT form, solvers.py). The sizes judge signs: a gap's acceleration is measured against
-        its row times the larger of q̈ and the forces over the largest mass (a state at rest has
-        q̈ = 0 to rounding), a multiplier against the largest |Q + C| and |λ|."""
-        arrays = self.base.evaluate(t, q, qd)
-        A_gaps, b_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)
+    def _held_motion(self, t, q, qd, rows, sliding=None):
+        """The ``Held`` motion of (2.14) with the gaps ``rows`` held beside the model's rows
+        (its KKT form, solvers.py): of those with friction, the ones in ``sliding`` (default:
+        the run's) slide, C = −μ λ_n Tᵀû (λ_n affine in the C assumed: found exactly by one
+        solve more per sliding contact), the others stick, their slip rows held. The sizes
+        judge signs: a gap's acceleration is measured against its row times the larger of q̈
+        and the forces over the largest mass (a state at rest has q̈ = 0 to rounding), a
+        multiplier against the largest |Q + C| and |λ|."""
+        sliding = self.sliding if sliding is None else sliding
+        arrays, p = self.base.evaluate(t, q, qd), self.base.parameter_values
+        A_gaps, b_gaps = self.gaps.rows(t, q, qd, p)
         rows = list(rows)
-        A = np.vstack([arrays.A, A_gaps[rows]])
-        b = np.concatenate([arrays.b, b_gaps[rows]])
-        names = list(self.base.system.constraint_names) + [self.gaps.names[i] for i in rows]
-        motion = kkt_acceleration(arrays.M, arrays.Q, A, b, arrays.C, coordinates=self.base.system.coordinates,
-                                  constraints=names)
-        lam = multipliers(A, arrays.M @ motion.qdd - arrays.Q - arrays.C)[0]
+        rough = [i for i in rows if self.gaps.friction[i] > 0]
+        sticking, slipping = [i for i in rough if i not in sliding], [i for i in rough if i in sliding]
+        slips = {i: self.gaps.slip_arrays(t, q, qd, p, i) for i in rough}
+        A = np.vstack([arrays.A, A_gaps[rows], *(slips[i][0] for i in sticking)])
+        b = np.concatenate([arrays.b, b_gaps[rows], *(slips[i][1] for i in sticking)])
+        names = list(self.base.system.constraint_names) + [self.gaps.names[i] for i in rows] + \
+            [f"{self.gaps.names[i]}.slip" for i in sticking for _ in slips[i][1]]
+        speed = np.abs(qd).max(initial=0.0)
+        per_unit = [-self.gaps.friction[i] * slips[i][0].T @ slip_direction(slips[i][0], qd, sliding[i], speed)
+                    for i in slipping]
+        at = [len(arrays.b) + rows.index(i) for i in slipping]
+
+        def solve(x):
+            C = arrays.C + sum((xj * d for xj, d in zip(x, per_unit)), np.zeros(len(q)))
+            motion = kkt_acceleration(arrays.M, arrays.Q, A, b, C, coordinates=self.base.system.coordinates,
+                                      constraints=names)
+            return motion, multipliers(A, arrays.M @ motion.qdd - arrays.Q - C)[0], C
+
+        motion, lam, C = solve(np.zeros(len(slipping)))
+        if slipping:
+            alpha = lam[at]
+            B = np.column_stack([solve(unit)[1][at] - alpha for unit in np.eye(len(slipping))])
+            try:
+                motion, lam, C = solve(np.linalg.solve(np.eye(len(slipping)) - B, alpha))
+            except np.linalg.LinAlgError:
+                raise self._fail(t, slipping, "no consistent sliding contact (the friction force undoes the normal "
+                                              "force: Painlevé-type)") from None
         gdd = A_gaps @ motion.qdd - b_gaps
-        force = np.abs(arrays.Q + arrays.C).max(initial=0.0)
+        force = np.abs(arrays.Q + C).max(initial=0.0)
         acceleration = max(np.abs(motion.qdd).max(initial=0.0), force / (np.abs(arrays.M).max(initial=0.0) +
                                                                            DIVISION_GUARD))
         scale = np.abs(A_gaps).sum(axis=1) * acceleration + np.abs(b_gaps)
-        return motion.qdd, lam[len(arrays.b):], gdd, scale, force + np.abs(lam).max(initial=0.0)
+        tangential, start = {}, len(arrays.b) + len(rows)
+        for i in sticking:
+            tangential[i], start = lam[start:start + len(slips[i][1])], start + len(slips[i][1])
+        return Held(motion.qdd, lam[len(arrays.b):len(arrays.b) + len(rows)], gdd, scale,
+                    force + np.abs(lam).max(initial=0.0), tangential)
 
-    def _forces(self, t, q, qd):
-        """{held gap: its force λ} at (t, q, q̇) (λ > 0 pushes the gap open)."""
+    def _slip_references(self, t, q, qd):
+        """{sliding contact: the unit direction its slip's component along is watched}: the
+        slip's direction at (t, q, q̇), or its onset's where it has no speed there."""
+        speed, found = np.abs(qd).max(initial=0.0), {}
+        for i, d in self.sliding.items():
+            T = self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i)
+            found[i] = T.T @ slip_direction(T, qd, d, speed)
+        return found
+
+    def _watched(self, t, q, qd, reference):
+        """{(kind, held gap): a value whose sign change is an event}: ("release", i) its force
+        λ; ("switch", i) of a sliding contact, its slip along its ``reference`` direction
+        (T q̇)·û, given on the generalized side as Tᵀû (it stops)."""
         held = sorted(self.active)
-        return dict(zip(held, self._held_motion(t, q, qd, held)[1]))
+        motion = self._held_motion(t, q, qd, held)
+        found = {("release", i): lam for i, lam in zip(held, motion.lam)}
+        for i, direction in reference.items():
+            found[("switch", i)] = float(direction @ qd)
+        return found
 
     # ---- settling the state at an event
 
-    def settle(self, t, q, qd, released=frozenset()):
+    def settle(self, t, q, qd, released=frozenset(), switching=frozenset()):
         """(q, q̇⁺, whether anything changed) at an event at t: the impacts, then the
         persistent contacts (module docstring); ``released``: held gaps whose force fell
-        to zero here (they open). Records the events."""
+        to zero here (they open); ``switching``: sliding contacts whose slip stops
+        here. Records the events."""
         p, changed = self.base.parameter_values, False
         for _ in range(ROUNDS):
             g, gd = self.gaps.values(t, q, qd, p)
-            gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
+            gdd = self._held_motion(t, q, qd, sorted(self.active)).gdd
             rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
             floor = self._rounding(t, q, qd)
             striking = [i for i in self._open() if g[i] <= self.atol and gd[i] < -max(rest[i], floor[i])]
@@ -294,7 +371,7 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, striking, f"{ROUNDS} impacts at one instant")
         g, gd = self.gaps.values(t, q, qd, p)
         floor = self._rounding(t, q, qd)
-        gdd = self._held_motion(t, q, qd, sorted(self.active))[2]
+        gdd = self._held_motion(t, q, qd, sorted(self.active)).gdd
         rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
@@ -303,9 +380,41 @@ class EventIntegration(ContinuousIntegration):
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
             self.events.append(Event(float(t), self.gaps.names[i], "release", 0.0))
-        changed |= active != self.active
-        self._switch(active)
+        sliding = self._modes(t, q, qd, active, switching)
+        sticking = [i for i in sorted(active) if self.gaps.friction[i] > 0 and i not in sliding]
+        if sticking:
+            raise self._fail(t, sticking, "a held contact with friction sticks here (|λ_t| ≤ μ λ_n): sticking while "
+                                          "it holds is not modelled (sliding is)")
+        for i in sorted(set(sliding) - set(self.sliding)):
+            self.events.append(Event(float(t), self.gaps.names[i], "slip", 0.0))
+        changed |= active != self.active or sliding.keys() != self.sliding.keys()
+        self._switch(active, sliding)
         return q, qd, changed
+
+    def _modes(self, t, q, qd, active, switching):
+        """{held contact that slides from t: its slip's direction} among the held contacts
+        with friction ``active``: one sliding goes on sliding unless it is ``switching``
+        (its slip stopped) here; a newly held one slides where it moves. The others would
+        stick where |λ_t| ≤ μ λ_n with their slip rows held, and otherwise slide against λ_t."""
+        speed, sliding, trial = np.abs(qd).max(initial=0.0), {}, []
+        for i in sorted(i for i in active if self.gaps.friction[i] > 0):
+            moving = slip_direction(self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i), qd, None, speed)
+            if i in self.sliding and i not in switching:
+                sliding[i] = self.sliding[i] if moving is None else moving
+            elif i not in self.active and moving is not None:
+                sliding[i] = moving
+            else:
+                trial.append(i)
+        if not trial:
+            return sliding
+        motion = self._held_motion(t, q, qd, sorted(active), sliding)
+        held = sorted(active)
+        for i in trial:
+            lam_t, lam_n = motion.tangential[i], motion.lam[held.index(i)]
+            size = np.linalg.norm(lam_t)
+            if size > self.gaps.friction[i] * lam_n * (1 + COMPLEMENTARITY_RTOL):
+                sliding[i] = -lam_t / size
+        return sliding
 
     def _bilateral(self, t, q, qd):
         """(A, target, names) of the model's velocity-level rows at (t, q, q̇): A q̇ = target
@@ -333,22 +442,22 @@ class EventIntegration(ContinuousIntegration):
         failed = None
         for chosen in _subsets(rows):
             target = np.array([-e[i] * gd[i] if i in striking else 0.0 for i in chosen])
-            A = np.vstack([A_b, A_gaps[list(chosen)]])
+            rough = Rough(self.gaps, t, q, qd, self.base.parameter_values, chosen)
             try:
-                jump = velocity_jump(M, qd, A, np.concatenate([v_b, target]), coordinates=coordinates,
-                                     constraints=names_b + [self.gaps.names[i] for i in chosen])
+                qd_after, impulses, modes = rough.jump(M, qd, A_b, v_b, names_b, A_gaps, target, coordinates)
             except SolveError as err:
                 failed = err
                 continue
-            impulses = jump.impulses[len(v_b):]
-            after = A_gaps @ jump.qd
+            after = A_gaps @ qd_after
             others = [i for i in rows if i not in chosen]
             if (impulses >= -COMPLEMENTARITY_RTOL * np.abs(impulses).max(initial=0.0)).all() and \
                     all(after[i] + e[i] * gd[i] >= -COMPLEMENTARITY_RTOL * abs(gd[i]) - floor[i] for i in others):
                 for i, impulse in zip(chosen, impulses):
                     if i in striking:
                         self.events.append(Event(float(t), self.gaps.names[i], "impact", float(impulse)))
-                return jump.qd
+                    if i in modes:
+                        self.events.append(Event(float(t), self.gaps.names[i], *modes[i]))
+                return qd_after
         if failed is not None:
             raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
@@ -360,7 +469,7 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
         for chosen in _subsets(candidates):
-            _, lam, gdd, scale, force = self._held_motion(t, q, qd, chosen)
+            _, lam, gdd, scale, force, _ = self._held_motion(t, q, qd, chosen)
             others = [i for i in candidates if i not in chosen]
             if (lam >= -COMPLEMENTARITY_RTOL * force).all() and \
                     all(gdd[i] >= -COMPLEMENTARITY_RTOL * scale[i] for i in others):

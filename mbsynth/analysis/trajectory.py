@@ -46,7 +46,9 @@ COMPLETED = "completed"
 class Event(NamedTuple):
     """What happened at a unilateral constraint (analysis/impacts.py) at time ``t``: ``kind``
     "impact" (a velocity jump, ``impulse`` its Λ), "contact" (the gap closed and holds: a
-    persistent contact, ``impulse`` what brought it to rest) or "release" (it opened)."""
+    persistent contact, ``impulse`` what brought it to rest), "release" (it opened), or at an
+    impact of a contact with friction "stick" or "slip" (``impulse`` the tangential |Λ_t|),
+    "slip" too where a held one starts to slide (``impulse`` 0)."""
 
     t: float
     name: str

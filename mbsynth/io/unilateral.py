@@ -8,7 +8,9 @@ import sympy as sp
 
 from ..core.joint_kinds import KINDS
 from ..core.tolerances import ASSEMBLED_TOL
-from ..model.unilateral import Unilateral, gap_row
+from ..model.constraints.base import Constraint
+from ..model.parts.base import frame_velocity
+from ..model.unilateral import Unilateral, gap_row, tangent_basis
 from .joints import frame_reference
 
 CONTACT_KINDS = {"plane": "contact_plane", "spheres": "contact_spheres"}  # contact type -> schema section
@@ -57,8 +59,28 @@ def read_contacts(builder):
         gap = _plane_gap(builder, spec, path) if kind == "plane" else _spheres_gap(builder, spec, path)
         full = builder.full_name(name)
         row = gap_row(full, gap, builder.q, builder.qd, builder.parameter_symbols)
-        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row), path))
+        mu, slip = _friction(builder, spec, path, full) if kind == "plane" else (sp.S.Zero, None)
+        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip), path))
     return found
+
+
+def _friction(builder, spec, path, name):
+    """(μ, the slip rows) of a plane contact's ``friction: μ`` (μ ≥ 0, 0 by default): the
+    rows ψ = t_k·ṗ, the velocity of the contact point along two unit tangents t1, t2 of the
+    plane (None without friction). Friction needs a point (radius 0): a sphere's contact
+    point moves with its spin, which the point's velocity leaves out."""
+    if "friction" not in spec:
+        return sp.S.Zero, None
+    mu = builder.constant(spec["friction"], path + ("friction",))
+    if builder.value(mu) < 0:
+        builder.fail(path + ("friction",), f"friction must be ≥ 0, got {builder.value(mu):g}")
+    if builder.value(builder.constant(spec.get("radius", 0), path + ("radius",))) != 0:
+        builder.fail(path + ("friction",), "friction is modelled at a point contact (radius 0), not at a sphere")
+    p = _centre(builder, spec["child"], path + ("child",))
+    velocity = frame_velocity(p, builder.q, builder.qd)
+    rows = [t.dot(velocity) for t in tangent_basis(_normal(builder, spec, path), builder.value)]
+    return mu, Constraint.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
+                                      row_labels=["t1", "t2"])
 
 
 def _plane_gap(builder, spec, path):
@@ -66,14 +88,19 @@ def _plane_gap(builder, spec, path):
     if not builder.placement.identity:
         builder.fail(path, "a ground contact in an included file with a placement: give it in the including file")
     p = _centre(builder, spec["child"], path + ("child",))
+    unit = _normal(builder, spec, path)
+    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
+    ground = builder.constant(spec.get("ground", 0), path + ("ground",))
+    return unit.dot(p) - ground - radius
+
+
+def _normal(builder, spec, path):
+    """The plane's unit normal n (sympy, an expression of parameters)."""
     normal = builder.constants(spec.get("normal", [0, 0, 1]), path + ("normal",), 3)
     length = sum(builder.value(x) ** 2 for x in normal) ** 0.5
     if not length > 0:
         builder.fail(path + ("normal",), "the plane's normal is zero")
-    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
-    ground = builder.constant(spec.get("ground", 0), path + ("ground",))
-    unit = (normal / sp.sqrt(sum(x**2 for x in normal))).evalf()  # a number's root as a float, not an integer's
-    return unit.dot(p) - ground - radius
+    return (normal / sp.sqrt(sum(x**2 for x in normal))).evalf()  # a number's root as a float, not an integer's
 
 
 def _spheres_gap(builder, spec, path):

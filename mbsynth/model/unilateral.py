@@ -6,12 +6,16 @@ point or sphere on a part's frame against a ground plane, g = n·p − h − r; 
 g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Constraint with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
+A point contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·ṗ, the
+contact point's velocity along two unit tangents of the plane (``tangent_basis``): an
+impulse Λ_k on them is the tangential impulse Λ_k t_k at the point.
 
 While a gap is open the row is no constraint; while it holds (persistent contact) it is one
 of the System's rows: ``with_active`` makes the System of an active set (its ``constraints``
 followed by the active rows), which the run loop switches between (analysis/impacts.py).
 """
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,17 +23,21 @@ import sympy as sp
 
 from .constraints.base import Constraint
 from ..core.errors import ModelError
+from ..core.tolerances import SPEED_ROUNDING
 
 
 @dataclass(frozen=True)
 class Unilateral:
     """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), its restitution e (a
-    sympy expression of the parameters), its holonomic ``row`` (φ = g)."""
+    sympy expression of the parameters), its holonomic ``row`` (φ = g), Coulomb's
+    ``friction`` μ and the nonholonomic ``slip`` rows (None without friction)."""
 
     name: str
     kind: str
     restitution: sp.Expr
     row: Constraint
+    friction: sp.Expr = sp.S.Zero
+    slip: Constraint = None
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
@@ -39,18 +47,72 @@ class Unilateral:
                              f"values; it must be between 0 and 1")
         return e
 
+    def friction_at(self, system, p):
+        """μ at the parameter values ``p`` of ``system``; ModelError unless μ ≥ 0."""
+        mu = float(sp.sympify(self.friction).xreplace(dict(zip(system.parameter_symbols, p))))
+        if not mu >= 0:
+            raise ModelError(f"model '{system.name}': the friction of '{self.name}' is {mu:g} at these parameter "
+                             f"values; it must be ≥ 0")
+        return mu
+
+
+def tangent_basis(n, value=float):
+    """Two unit tangents t1, t2 of the unit normal ``n`` (a sympy column, an expression of
+    parameters; ``value`` its number): t1 = the first of e_x, e_y least along n at its value,
+    made orthogonal to n; t2 = n × t1: a right-handed (t1, t2, n)."""
+    axis = sp.Matrix(np.eye(3)[int(np.argmin([abs(value(n[0])), abs(value(n[1]))]))])
+    t1 = axis - axis.dot(n) * n
+    t1 = t1 / sp.sqrt(t1.dot(t1))
+    return t1, n.cross(t1)
+
 
 def gap_row(name, gap, q, qd, params):
     """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed)."""
     return Constraint.holonomic(name, [gap], q, qd, params)
 
 
-def with_active(system, names):
+def with_active(system, names, sliding=None):
     """``system`` with the rows of its unilaterals named in ``names`` appended to its
-    constraints, in the order of ``system.unilaterals``: the System of that active set."""
+    constraints, in the order of ``system.unilaterals``: the System of that active set. A
+    contact named in ``sliding`` ({name: (μ, the slip's direction where it has no speed)})
+    carries its Coulomb friction."""
+    sliding = sliding or {}
     if not names:
         return system
-    return system.with_constraints(u.row for u in system.unilaterals if u.name in names)
+    rows = []
+    for u in system.unilaterals:
+        if u.name in names:
+            row = u.row
+            if u.name in sliding:
+                row = copy.copy(row)
+                row.coulomb = Sliding(u, *sliding[u.name])
+            rows.append(row)
+    return system.with_constraints(rows)
+
+
+class Sliding:
+    """Coulomb's friction of a held contact that slides, as friction.py's ``coulomb`` of its
+    gap row: C = −μ N Tᵀû (N the gap row's force, T its slip rows, û the unit slip T q̇/|T q̇|,
+    or ``direction`` where the slip's speed is rounding: at its onset from rest)."""
+
+    def __init__(self, unilateral, mu, direction):
+        self.joint, self.slip, self.mu = unilateral.name, unilateral.slip, mu
+        self.indices = unilateral.slip.indices
+        self.direction = np.asarray(direction, dtype=float)
+        self.load_rows = np.array([0])
+
+    def evaluate(self, t, q, qd, p):
+        """(1, μ Tᵀû on ``indices``): friction.py's (w, direction) with w > 0."""
+        T = self.slip.evaluate(t, q, qd, p)[0]
+        return 1.0, self.mu * T.T @ slip_direction(T, qd[self.indices], self.direction, np.abs(qd).max(initial=0.0))
+
+
+def slip_direction(T, qd, direction, speed):
+    """The unit slip T q̇/|T q̇|, or ``direction`` where |T q̇| is rounding (SPEED_ROUNDING ×
+    ‖T‖₁ × ``speed``, the largest |q̇|)."""
+    u = T @ qd
+    size = np.linalg.norm(u)
+    return u / size if size > SPEED_ROUNDING * np.abs(T).sum(axis=1).max() * speed else direction
 
 
 class Gaps:
@@ -61,6 +123,8 @@ class Gaps:
         self.unilaterals, self.n = tuple(system.unilaterals), system.n
         self.names = tuple(u.name for u in self.unilaterals)
         self.restitution = np.array([u.restitution_at(system, p) for u in self.unilaterals], dtype=float)
+        self.friction = np.array([u.friction_at(system, p) if u.slip is not None else 0.0
+                                  for u in self.unilaterals], dtype=float)
 
     def __len__(self):
         return len(self.unilaterals)
@@ -78,3 +142,15 @@ class Gaps:
             a, b_row, _ = u.row.evaluate(t, q, qd, p)
             A[i, u.row.indices], b[i] = a[0], b_row[0]
         return A, b
+
+    def slip_rows(self, t, q, qd, p, i):
+        """The (2, n) rows T of gap i's slip velocity T q̇ (its tangential velocity)."""
+        return self.slip_arrays(t, q, qd, p, i)[0]
+
+    def slip_arrays(self, t, q, qd, p, i):
+        """(T, b) of gap i's slip rows: T q̈ = b holds them at rest."""
+        u = self.unilaterals[i]
+        T = np.zeros((u.slip.size, self.n))
+        a, b, _ = u.slip.evaluate(t, q, qd, p)
+        T[:, u.slip.indices] = a
+        return T, b
