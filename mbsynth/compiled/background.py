@@ -67,7 +67,7 @@ def default_path():
     """The path of a Data made without one: "kkt" where MBSYNTH_FAST=off, else the
     ``default_path_as`` block's where MBSYNTH_FAST is unset, else "compiled"."""
     given = os.environ.get("MBSYNTH_FAST")
-    if mode(given) == "off":
+    if given is not None and mode(given) == "off":  # unset: "on" (``mode``), without reading it again
         return "kkt"
     block = _default_path.get()
     return block if given is None and block is not None else "compiled"

@@ -158,8 +158,9 @@ class Engine:
             if status != kernel.OK:
                 return None
             qdd, Qc = self.W.qdd.copy(), self.W.Qc.copy()
-        if self.mode != kernel.CHECKED:
-            residual = functools.partial(self.checked_residual, t, q.copy(), qd.copy(), bshift.copy(), drift)
+        if self.mode != kernel.CHECKED:  # the state as it is now, for the residual when read
+            residual = functools.partial(self.checked_residual, t, q.copy(), qd.copy(),
+                                         bshift.copy() if bshift.size else EMPTY, drift)
         return Motion.made(qdd, True, self.no_freedom, Qc, residual, "tree (Baraff)")
 
     def checked_residual(self, t, q, qd, bshift, drift):
