@@ -77,10 +77,11 @@ def mode(value=None):
 def default_path():
     """The path of a Data made without one: "kkt" where MBSYNTH_COMPILED=off, else the
     ``default_path_as`` block's where MBSYNTH_COMPILED is unset, else "compiled"."""
-    if mode() == "off":
+    text = given()[1]
+    if text is not None and mode() == "off":  # unset: "on" (``mode``), without reading it again
         return "kkt"
     block = _default_path.get()
-    return block if given()[1] is None and block is not None else "compiled"
+    return block if text is None and block is not None else "compiled"
 
 
 def template(system, slot):

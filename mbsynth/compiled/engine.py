@@ -11,11 +11,22 @@ Engines share one set of buffers, ``Engine.at``). ``Template.engine(p)`` makes t
 at parameter values p: its numbers and work buffers. An Engine holds no reference to a System.
 
 ``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
-send the problem to the exact treatment (kernel.py's status); ``motion_batch`` evaluates
-many states in parallel.
+send the problem to the exact treatment (kernel.py's status); ``derivative`` is the same
+call for an integrator's stage, without the Motion; ``motion_batch`` evaluates many states
+in parallel. Each is one call into the kernel, which leaves q̈ and Qc in the Engine's own
+buffers (its Work); a Motion holds copies of them, so that the next call leaves it as it is.
+
+The kernel's residual check (kernel.CHECKED) runs per call where it can fail: loops, extra
+coordinates, particles. On a rigid tree (``Template.mode``) the kernel eliminates by the
+articulated-body recursion, a Cholesky factorization of each joint's S^T H^A S (positive
+definite, its pivots checked) with bases from closed forms or fully pivoted Gauss–Jordan,
+which is backward stable: the relative residual of the equilibrated equations is a small
+multiple of the rounding unit at every state the pivot checks accept. There the check is
+decided once, at layout time, and a Motion's ``residual`` is computed when first read.
 """
 
 import copy
+import functools
 import threading
 
 import numpy as np
@@ -54,6 +65,8 @@ class Template:
         self.rows_depend_on_time = any(T_SYMBOL in sp.sympify(expr).free_symbols
                                        for expr in exprs[L.gen_q.size + L.gen_c.size:] if expr is not None)
         self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
+        # the kernel's mode per call: the residual checked where it can fail (module docstring)
+        self.mode = kernel.UNCHECKED if self.general is kernel.RIGID_TREE else kernel.CHECKED
         used = layout.number_parameters(L, self.sources, system.parameters)
         # the parameters the Layout's numbers use: values that differ only in others share L as it is
         self.number_parameters = np.array([self.names.index(n) for n in sorted(used)], dtype=np.int64)
@@ -86,7 +99,7 @@ class Engine:
     def __init__(self, template, L, p):
         self.template, self.L, self.p = template, L, p
         self.n, self.outputs, self.module = template.n, template.outputs, template.module
-        self.closes_loops, self.general = template.closes_loops, template.general
+        self.closes_loops, self.general, self.mode = template.closes_loops, template.general, template.mode
         self.gen = np.zeros(self.outputs)
         self.packed = pack(L)
         self.work, self.W = self.new_work()
@@ -139,12 +152,23 @@ class Engine:
         """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
         bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ); ``drift``: the
         state may lie off the constraint manifold (an integrator's stage: the drift rule,
-        kernel.motion)."""
+        kernel.motion). Its q̈ and Qc are new arrays; its residual is computed when first
+        read where the kernel's mode does not check it per call (module docstring)."""
+        bshift = EMPTY if bshift is None else bshift
         with self.lock:
-            status, residual = self._solved(t, q, qd, EMPTY if bshift is None else bshift, drift)
+            status, residual = self._solved(t, q, qd, bshift, drift, self.mode)
             if status != kernel.OK:
                 return None
-            return Motion.made(self.W.qdd.copy(), True, self.no_freedom, self.W.Qc.copy(), residual, "tree (Baraff)")
+            qdd, Qc = self.W.qdd.copy(), self.W.Qc.copy()
+        if self.mode != kernel.CHECKED:  # the state as it is now, for the residual when read
+            residual = functools.partial(self.checked_residual, t, q.copy(), qd.copy(),
+                                         bshift.copy() if bshift.size else EMPTY, drift)
+        return Motion.made(qdd, True, self.no_freedom, Qc, residual, "tree (Baraff)")
+
+    def checked_residual(self, t, q, qd, bshift, drift):
+        """The kernel's relative residual (kernel.motion, CHECKED) of the motion at (t, q, q̇)."""
+        with self.lock:
+            return self._solved(t, q, qd, bshift, drift, kernel.CHECKED)[1]
 
     def derivative(self, t, y):
         """(q̇, q̈) stacked at the state y = (q, q̇) (a contiguous float array), as an
@@ -153,17 +177,17 @@ class Engine:
         y = np.ascontiguousarray(y, dtype=float)
         q, qd = y[:self.n], y[self.n:]
         with self.lock:
-            status, _ = self._solved(t, q, qd, EMPTY, True)
+            status, _ = self._solved(t, q, qd, EMPTY, True, self.mode)
             return np.concatenate((qd, self.W.qdd)) if status == kernel.OK else None
 
-    def _solved(self, t, q, qd, bshift, drift):
-        """kernel.motion's (status, residual) at (t, q, q̇), its q̈ and Qc left in this
-        Engine's Work (the caller holds the lock): the generated function, then the kernel,
-        with the state's relative drift where ``drift`` and the model closes loops."""
+    def _solved(self, t, q, qd, bshift, drift, mode):
+        """kernel.motion's (status, residual) at (t, q, q̇) in ``mode``, its q̈ and Qc left
+        in this Engine's Work (the caller holds the lock): the generated function, then the
+        kernel, with the state's relative drift where ``drift`` and the model closes loops."""
         if self.module is not None:
             self.module.evaluate(float(t), q, qd, self.p, self.gen)
         delta = self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
-        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, kernel.CHECKED, delta, self.general)
+        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general)
 
     def relative_drift(self, q, qd):
         """The state's largest |φ| (the kernel's rows and the extra rows, from ``gen`` as the
@@ -188,7 +212,7 @@ class Engine:
                 b = min(a + size, count)
                 if self.module is not None:
                     self.module.evaluate_rows(t[a:b], q[a:b], qd[a:b], self.p, gen[:b - a])
-                kernel.motion_rows(q[a:b], qd[a:b], gen[:b - a], *self.packed, *work, self.general, qdd[a:b],
+                kernel.motion_rows(q[a:b], qd[a:b], gen[:b - a], *self.packed, *work, self.general, self.mode, qdd[a:b],
                                    status[a:b])
 
         threads = max(1, min(THREADS, -(-count // size)))

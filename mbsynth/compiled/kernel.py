@@ -662,11 +662,12 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, qdd, status):
-    """q̈ of each state (row of q, q̇, gen) into qdd and its status into status. Releases
-    the GIL: engine.py runs blocks of rows in threads, each with its own Work."""
+def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, mode, qdd, status):
+    """q̈ of each state (row of q, q̇, gen) into qdd and its status into status, ``motion``
+    in ``mode`` (CHECKED or UNCHECKED). Releases the GIL: engine.py runs blocks of rows in
+    threads, each with its own Work."""
     empty = np.zeros(0)
     qdd_view = view1(WF, WX, WORK.qdd)
     for row in range(q.shape[0]):
-        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, CHECKED, -1.0, general)[0]
+        status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, mode, -1.0, general)[0]
         _copy(qdd_view, qdd[row])

@@ -132,7 +132,8 @@ class Motion:
     directions at this state (a singular position near; empty elsewhere); ``C``: the
     non-ideal force used where it depends on q̈ (Coulomb friction), else None;
     ``lam``: the multipliers, one per row of A, with Qc − C = Aᵀλ (reactions.py),
-    computed on first use where the Motion knows its rows (System.motion).
+    computed on first use where the Motion knows its rows (System.motion). Each Motion
+    holds its own arrays: a later call leaves them as they are.
     """
 
     qdd: np.ndarray
@@ -150,22 +151,32 @@ class Motion:
         dependent); None where the Motion was made without its rows."""
         if "_lam" not in self.__dict__:
             source = self.__dict__.get("_lam_source")
-            self.__dict__["_lam"] = None if source is None else source()
+            self.__dict__["_lam"] = None if source is None else source(self)
         return self.__dict__["_lam"]
 
     def with_multipliers(self, source):
-        """This Motion, with ``source()`` giving ``lam`` on first use."""
+        """This Motion, with ``source(motion)`` giving ``lam`` on first use."""
         self.__dict__["_lam_source"] = source
         self.__dict__.pop("_lam", None)
         return self
 
+    def __getattr__(self, name):
+        """``residual`` of a Motion ``made`` with a source of it: computed on first read."""
+        source = self.__dict__.get("_residual_source") if name == "residual" else None
+        if source is None:
+            raise AttributeError(f"'Motion' object has no attribute {name!r}")
+        self.__dict__["residual"] = value = source()
+        return value
+
     @classmethod
     def made(cls, qdd, unique, nullspace, Qc, residual, method, singular=()):
         """The same Motion without the frozen dataclass's __init__ (one object.__setattr__
-        per field): for the compiled path, which makes one per call."""
+        per field): for the compiled path, which makes one per call. ``residual``: a number, or
+        a callable that gives it when first read (compiled/engine.py)."""
         motion = object.__new__(cls)
-        motion.__dict__.update(qdd=qdd, unique=unique, nullspace=nullspace, Qc=Qc, residual=residual, method=method,
-                               singular=singular, C=None)
+        motion.__dict__.update(qdd=qdd, unique=unique, nullspace=nullspace, Qc=Qc, method=method, singular=singular,
+                               C=None)
+        motion.__dict__["_residual_source" if callable(residual) else "residual"] = residual
         return motion
 
 

@@ -25,6 +25,7 @@ joint kinematics, linearize's derivatives) is kept in the one cache (core/memo.p
 changes how fast a Data is made, never what it computes.
 """
 
+import functools
 import warnings
 from dataclasses import dataclass
 
@@ -212,7 +213,7 @@ class Data:
 
     def motion(self, t, q, qd, method="kkt", baumgarte=None, drift=False):
         """The constrained acceleration at (t, q, q̇): a ``Motion`` (``System.motion`` says
-        what each argument means); its ``lam`` is computed when first read."""
+        what each argument means) of its own arrays; its ``lam`` is computed when first read."""
         if method in OLD_METHODS:
             warnings.warn(f"method={method!r} is the old name of method={OLD_METHODS[method]!r}", DeprecationWarning,
                           stacklevel=2)
@@ -221,7 +222,11 @@ class Data:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
         motion = self._solved(t, q, qd, method, baumgarte, drift)
-        return motion.with_multipliers(lambda: self._multipliers(t, q, qd, motion)[0])
+        return motion.with_multipliers(functools.partial(self._lam, t, q, qd))
+
+    def _lam(self, t, q, qd, motion):
+        """λ of ``motion`` at (t, q, q̇): ``Motion.lam``'s source (it holds no Motion: no cycle)."""
+        return self._multipliers(t, q, qd, motion)[0]
 
     def _solved(self, t, q, qd, method, baumgarte, drift):
         """The Motion of ``motion``, without its multipliers."""

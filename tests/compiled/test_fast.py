@@ -422,6 +422,24 @@ def test_random_chains(seed):
         assert_same_motion(system, 0.0, q, qd)
 
 
+def test_a_rigid_tree_of_uneven_masses_is_solved_unchecked_and_its_residual_is_small():
+    """A rigid tree's motion comes without the kernel's residual check per call (engine.py:
+    the articulated elimination is backward stable, so the check is decided at layout time);
+    on a chain whose masses span six decades its residual, computed when read by the checked
+    kernel, is still within rounding, and the motion is (2.15)'s."""
+    from mbsynth.compiled import kernel
+    from mbsynth.core.tolerances import KERNEL_RESIDUAL_MAX
+
+    rng = np.random.default_rng(4)
+    system = chain(4, ["revolute", "spherical", "fixed", "universal"], [1.0, 1e-3, 1e-6, 1.0], rng)
+    assert engine_for(system).mode == kernel.UNCHECKED
+    for _ in range(3):
+        q, qd = random_state(system, rng)
+        fast = assert_same_motion(system, 0.0, q, qd, rtol=agreement(system, 0.0, q, qd))
+        assert "residual" not in vars(system.motion(0.0, q, qd))  # not computed until read
+        assert fast.residual < 1e-6 * KERNEL_RESIDUAL_MAX
+
+
 def test_indeterminate_and_inconsistent_cases_fall_back():
     """A massless leaf body on a spherical joint can spin freely (not unique); a row
     contradicting a fixed joint (no motion); a force on a massless particle (no motion):

@@ -23,6 +23,7 @@ from mbsynth.robots.build import describe, fix_base, robot_files
 from mbsynth.robots.twin import Twin
 from mbsynth.robots.validate import sample_pinocchio_state, validate_system
 from mbsynth.core.tolerances import VALIDATION_RTOL
+from tests.helpers.compare import rel
 
 pytestmark = pytest.mark.skipif(not robot_files(), reason="example-robot-data is not installed")
 SAMPLES = 4
@@ -71,6 +72,29 @@ def test_tree_path_equals_pinocchio_aba(name, request):
             exact = twin.accelerations(q, v, np.zeros(twin.model.nv))
             assert fast is not None
             assert np.abs(twin.to_pinocchio(qm, qdm, fast.qdd)[2] - exact).max() <= 1e-10 * np.abs(exact).max()
+
+
+def test_consecutive_motions_keep_their_own_arrays_and_equal_aba(ur5):
+    """Two motion() calls in a row on the compiled tree path: the kernel writes into the
+    Engine's buffers, and each Motion holds copies, so the second call leaves the first
+    Motion's q̈ and Qc as they were; each q̈ equals pinocchio.aba's and Qc the reference
+    path's (the literal (2.14)), to the tolerances of tests/compiled/test_fast.py."""
+    twin, rng = Twin(ur5), np.random.default_rng(5)
+    data = ur5.data(path="compiled")
+    states = [sample_pinocchio_state(twin, rng) for _ in range(2)]
+    maximal = [twin.to_maximal(q, v) for q, v in states]
+    first = data.motion(0.0, *maximal[0])
+    kept = first.qdd.copy(), first.Qc.copy()
+    second = data.motion(0.0, *maximal[1])
+    assert first.method == second.method == "tree (Baraff)"
+    assert not np.shares_memory(first.qdd, second.qdd) and not np.shares_memory(first.Qc, second.Qc)
+    assert np.array_equal(first.qdd, kept[0]) and np.array_equal(first.Qc, kept[1])
+    assert not np.allclose(first.qdd, second.qdd)  # two different states: an overwrite would show
+    for motion, (q, v), (qm, qdm) in zip((first, second), states, maximal):
+        exact = twin.accelerations(q, v, np.zeros(twin.model.nv))
+        assert np.abs(twin.to_pinocchio(qm, qdm, motion.qdd)[2] - exact).max() <= 1e-10 * np.abs(exact).max()
+        reference = data.motion(0.0, qm, qdm, method="reference")
+        assert rel(motion.qdd, reference.qdd) < 1e-10 and rel(motion.Qc, reference.Qc) < 1e-7  # as tests/compiled
 
 
 def test_parts_are_the_links_with_their_masses(ur5):
