@@ -23,6 +23,7 @@ MODES = {
     "contact/bouncing_ball.yaml": ([], 1, "does not rest at this configuration"),  # dropped
     "contact/pendulum_stop.yaml": ([], 1, "does not rest at this configuration"),  # released from an angle
     "contact/newtons_cradle.yaml": ([], 1, "does not rest at this configuration"),  # the first ball pulled out
+    "contact/block_on_slope.yaml": ([], 1, "does not rest at this configuration"),  # it slides down the slope
     "flexible/cantilever.yaml": "rests",
     "flexible/slider_crank.yaml": "equilibrium",  # the crank hanging, the rod sagging
     "flexible/spin_up_beam.yaml": "rests",  # at rest at t = 0, the hub held by its servo row
