@@ -23,7 +23,7 @@ class Recorder:
     def __init__(self, data, rows, out=None):
         self.data, self.out = data, out
         self.run = run_of(data)
-        self.powered = bool(data.system.working_forces())  # else every row's power is 0: none evaluated
+        self.powered = bool(data.model.working_forces(data.parameter_values))  # else every row's power is 0
         self.outputs = OutputEvaluator(data)
         n, m = len(data.model.coordinates), len(self.outputs.names)
         _check_fits(rows, row_bytes(n, m), out)

@@ -263,7 +263,7 @@ class _Merit:
 
     def __init__(self, data, t, nearest):
         self.data, self.t, self.nearest = data, t, nearest
-        self.potential = not nearest and not data.model.working_forces()
+        self.potential = not nearest and not data.model.working_forces(data.parameter_values)
         self.name = "force balance's residual" if nearest else "potential"
 
     def at(self, q, qdd):

@@ -36,6 +36,7 @@ class ForceElement(Keyed):
         self.name, self.joint = name, joint
         self._defined_by = (sp.sympify(V), freeze(efforts), tuple(q), tuple(qd))
         self.conservative = all(sp.sympify(effort) == 0 for effort, _ in efforts)  # all of Q from V
+        self.efforts = tuple(sp.sympify(effort) for effort, _ in efforts)
         self.V = sp.sympify(V)
         self._Q = Q = generalized_force(self.V, efforts, q, qd)
         used = Q.free_symbols | self.V.free_symbols
@@ -61,6 +62,7 @@ class ForceElement(Keyed):
         local = sorted(local, key=coordinates.__getitem__)
         element = cls.__new__(cls)
         element.name, element.joint, element.conservative, element.V = name, joint, False, sp.S.Zero
+        element.efforts = tuple(sp.sympify(effort) for effort in efforts)
         element._power = element._power_terms = None
         constants = {**constants, **dict(zip(marks, efforts))}
         element._Q, element._placed = None, (column, slots, coordinates, constants, q, qd)
@@ -96,6 +98,12 @@ class ForceElement(Keyed):
         """Whether all of Q_e is the efforts' (no potential, not conservative): its power is
         q̇ᵀQ_e, from the values ``evaluate`` gives (evaluation.py sums it over all elements)."""
         return not self.conservative and self._power_terms is None
+
+    def idle_at(self, values):
+        """Whether the element's efforts are all identically zero with the parameters at
+        ``values`` ({symbol: number}): then it does no work (its power is 0 at every state)
+        and is conservative there."""
+        return all(effort.xreplace(values).is_zero for effort in self.efforts)
 
     def power(self, t, q, qd, p):
         """The power q̇ᵀ(Q_e + ∂V/∂q) = Σ effort·rate of the element's efforts at the full

@@ -453,18 +453,22 @@ class System:
                 names.update({f"{con.name}.{key}": expr for key, expr in value_expressions(con).items()})
         return names
 
-    def working_forces(self):
-        """The names of what can change the total energy T + V: force elements with efforts
+    def working_forces(self, p=None):
+        """The names of what can change the total energy T + V at the parameter values ``p``
+        (default: the model's): force elements with efforts not all zero there
         (actuation, dampers), parts with forces beyond T and V (generalized forces, modal or
         Rayleigh damping, a spring's damper) or an explicit t, constraints with a non-ideal C
-        (friction) or an explicit t (a prescribed motion), limits and contacts whose impacts
+        not zero there (friction) or an explicit t (a prescribed motion), limits and contacts whose impacts
         lose energy (restitution below 1). Empty: the energy is conserved, and its change
         along a run is drift."""
-        found = [e.name for e in self.forces if not e.conservative or T_SYMBOL in e.V.free_symbols]
+        values = {symbol: sp.Float(v) for symbol, v in zip(self.parameter_symbols,
+                                                           self.parameter_values if p is None else p)}
+        found = [e.name for e in self.forces
+                 if not (e.conservative or e.idle_at(values)) or T_SYMBOL in e.V.free_symbols]
         found += [part.name for part in self.parts if part.working or _time_in_part(part)]
-        found += [con.name for con in self.constraints
-                  if getattr(con, "coulomb", None) or any(x != 0 for x in con.C.values()) or _time_in_rows(con)]
-        return found + self._inelastic()
+        found += [con.name for con in self.constraints if getattr(con, "coulomb", None)
+                  or any(not sp.sympify(x).xreplace(values).is_zero for x in con.C.values()) or _time_in_rows(con)]
+        return found + self._inelastic(p)
 
     def unaccounted_work(self):
         """The names among ``working_forces`` whose work a run does not integrate
@@ -475,9 +479,11 @@ class System:
         found += [con.name for con in self.constraints if getattr(con, "coulomb", None) or _time_in_rows(con)]
         return found + self._inelastic()
 
-    def _inelastic(self):
-        """The names of the limits and contacts whose impacts lose energy (restitution below 1)."""
-        return [u.name for u in self.unilaterals if u.restitution_at(self, self.parameter_values) < 1]
+    def _inelastic(self, p=None):
+        """The names of the limits and contacts whose impacts lose energy (restitution below 1
+        at the parameter values ``p``, default the model's)."""
+        p = self.parameter_values if p is None else p
+        return [u.name for u in self.unilaterals if u.restitution_at(self, p) < 1]
 
 
 _DEFAULT_DATA = MEMO.table("default data", DEFAULT_DATA_KEPT)

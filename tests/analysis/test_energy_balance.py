@@ -67,3 +67,28 @@ def test_damped_oscillator_dissipates_what_the_exact_motion_loses(tmp_path, text
     assert traj.work[-1] == pytest.approx(lost, rel=1e-6)
     np.testing.assert_allclose(traj.work, exact_energy(traj.t) - exact_energy(0.0), atol=1e-7 * exact_energy(0.0))
     assert traj.energy_drift < 1e-7
+
+
+def test_a_constant_torque_does_its_work_and_a_zero_one_none():
+    """The driven pendulum without its damper: at tau0 = 0 (a Data's values) nothing works
+    (no power recorded, T + V conserved); at tau0 = 0.4 the recorded work is tau0·Δθ, the
+    work of a constant torque through the hinge's turn."""
+    from pathlib import Path
+
+    from mbsynth.model.joint_values import along
+
+    path = Path(__file__).resolve().parents[2] / "models" / "joints" / "driven_pendulum.yaml"
+    system = mb.load(path, parameters={"A": 0.0, "c": 0.0})
+    data = system.data()
+    data.set_parameters({"tau0": 0.0})
+    assert data.model.working_forces(data.parameter_values) == []
+    idle = mb.simulate(data, 1.0)
+    assert not np.any(idle.power) and idle.energy_drift < 1e-8
+    data.set_parameters({"tau0": 0.4})
+    assert data.model.working_forces(data.parameter_values) == ["hinge.actuation"]
+    driven = mb.simulate(data, 1.0)
+    angle = along(data, driven.t, driven.q, driven.qd)["hinge"].position[:, 0]
+    turned = angle - angle[0]
+    assert np.ptp(turned) > 0.3
+    np.testing.assert_allclose(driven.work, 0.4 * turned, atol=1e-7)
+    np.testing.assert_allclose(driven.energy - driven.energy[0], driven.work, atol=1e-7)
