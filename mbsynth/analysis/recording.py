@@ -80,8 +80,7 @@ class Recorder:
         c = self.columns
         c["t"][rows_at], c["q"][rows_at], c["qd"][rows_at] = times, q, qd
         c["kinetic"][rows_at], c["energy"][rows_at] = kinetic, kinetic + potential
-        c["power"][rows_at] = ([self.data.power(t, q_row, qd_row) for t, q_row, qd_row in zip(times, q, qd)]
-                               if self.powered else 0.0)
+        c["power"][rows_at] = self.data.powers(times, q, qd) if self.powered else 0.0
         c["residual_position"][rows_at], c["residual_velocity"][rows_at] = residual_position, residual_velocity
         if self.outputs:
             for i, (t, q_row, qd_row) in enumerate(zip(times, q, qd)):

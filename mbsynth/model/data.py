@@ -194,6 +194,11 @@ class Data:
         q, qd = self._state(q, qd)
         return self.evaluator.power(t, q, qd, self.parameter_values)
 
+    def powers(self, times, q, qd):
+        """``power`` at each row of (times, q, q̇) (q, q̇: arrays of a row per time)."""
+        return self.evaluator.powers(times, np.asarray(q, dtype=float), np.asarray(qd, dtype=float),
+                                     self.parameter_values)
+
     def branch_problems(self, q=None, t=0.0):
         """``System.branch_problems`` at this Data's parameter values."""
         return self.system.branch_problems(q, t, self.parameter_values)

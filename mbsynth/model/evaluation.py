@@ -21,6 +21,7 @@ import numpy as np
 from ..compiled.grouped import Batch
 from .parts.base import Part
 from ..symbolic.derive import Compiled
+from ..core.tolerances import STACKED_CHECK_RTOL
 
 DENSE_ENTRIES = 40000  # rows × coordinates up to which dense arrays beat scipy.sparse's overhead
 
@@ -74,6 +75,8 @@ class Evaluator:
         # the entries of the stacked Q_e whose elements' power is q̇ᵀQ_e (one batched evaluation)
         self.effort_entries = np.concatenate([np.zeros(0, bool)] + [np.full(len(f.indices), f.efforts_only)
                                                                      for f in forces])
+        self.effort_elements = [f for f in forces if f.efforts_only]
+        self.over_rows = OverRows()
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
@@ -124,6 +127,24 @@ class Evaluator:
         T, V = self.energy(t, q, qd, p)
         return float(T.sum()), float(V.sum() + self.forces(t, q, qd, p)[1].sum())
 
+    def powers(self, times, q, qd, p):
+        """``power`` at each row of (times, q, q̇) (q, q̇: a row per time), one value per
+        row: the compiled power functions of the parts and the force elements' efforts
+        called once over all the rows where their numpy form broadcasts along them
+        (``OverRows``); a part with a power of its own, an element with a potential and a
+        non-ideal C are evaluated row by row."""
+        parts, elements, nonideal = self.working
+        if nonideal or elements or any(type(part).power is not Part.power for part, _ in parts):
+            return np.array([self.power(t, q_row, qd_row, p) for t, q_row, qd_row in zip(times, q, qd)])
+        args = (np.asarray(times, dtype=float), q, qd, p)
+        total = np.zeros(len(times))
+        for part, r in parts:
+            total += self.over_rows(part.power_function(), args, r, 1)[0]
+        for element in self.effort_elements:
+            efforts = self.over_rows(element._evaluate, args, element.indices, len(element.indices))
+            total += np.einsum("ij,ji->i", qd[:, element.indices], efforts)
+        return total
+
     def power(self, t, q, qd, p):
         """q̇ᵀ Q_nc at (t, q, q̇): the power of the parts' forces beyond T and V (dampers,
         generalized forces), of the force elements' efforts and of the constraints' non-ideal
@@ -138,3 +159,52 @@ class Evaluator:
             total += float(qd @ np.bincount(self.c_cols, weights=self.rows(t, q, qd, p)[2], minlength=self.n))
         return float(total)
 
+
+
+class OverRows:
+    """A compiled function (``symbolic.derive.Compiled``) called once for many states,
+    its numpy form broadcasting along the rows, where that reproduces calling it state by
+    state (checked at the first call, per function, as grouped.Batch checks its stacked
+    calls); row by row otherwise."""
+
+    def __init__(self):
+        self.broadcasts = {}  # function -> whether its call over rows reproduces the single calls
+
+    def __call__(self, function, args, columns, count):
+        """The first ``count`` outputs of ``function(t, q[columns], q̇[columns], p)`` at
+        each row of ``args`` = (times, q, q̇, p), as a (count, rows) array."""
+        times, q, qd, p = args
+        q, qd = q[:, columns], qd[:, columns]
+        verdict = self.broadcasts.get(function)
+        if verdict is None:  # judged at the first call of more than one row
+            single = _one_by_one(function, times, q, qd, p, count)
+            if len(times) > 1:
+                self.broadcasts[function] = (isinstance(function, Compiled)
+                                             and _stacked_agrees(function, times, q, qd, p, count, single))
+            return single
+        return _stacked(function, times, q, qd, p, count) if verdict else _one_by_one(function, times, q, qd, p, count)
+
+
+def _one_by_one(function, times, q, qd, p, count):
+    rows = [np.concatenate([np.ravel(x) for x in function(t, q_row, qd_row, p)])[:count]
+            for t, q_row, qd_row in zip(times, q, qd)]
+    return np.array(rows, dtype=float).reshape(len(times), count).T
+
+
+def _stacked(function, times, q, qd, p, count):
+    """One call of the function's numpy form with a column per row (lambdify unpacks the
+    coordinates as rows): its first ``count`` outputs, a value per row each."""
+    given = (times, q.T, qd.T, p)
+    with np.errstate(all="ignore"):  # NaN and inf are reported where the rows are used
+        out = function.raw(*given, function.values(*given), function.fixed)
+    return np.array([np.broadcast_to(np.asarray(x, dtype=float), times.shape) for x in out[:count]])
+
+
+def _stacked_agrees(function, times, q, qd, p, count, single):
+    try:
+        got = _stacked(function, times, q, qd, p, count)
+    except Exception:  # noqa: BLE001 - a numpy form that does not broadcast is called row by row
+        return False
+    scale = np.abs(single[np.isfinite(single)]).max(initial=0.0)
+    return got.shape == single.shape and np.allclose(got, single, rtol=STACKED_CHECK_RTOL,
+                                                     atol=STACKED_CHECK_RTOL * scale, equal_nan=True)

@@ -92,3 +92,21 @@ def test_a_constant_torque_does_its_work_and_a_zero_one_none():
     assert np.ptp(turned) > 0.3
     np.testing.assert_allclose(driven.work, 0.4 * turned, atol=1e-7)
     np.testing.assert_allclose(driven.energy - driven.energy[0], driven.work, atol=1e-7)
+
+
+@pytest.mark.parametrize("model", ["joints/driven_pendulum.yaml", "joints/pd_pendulum.yaml", "mechanisms/andrews.yaml",
+                                   "flexible/cantilever.yaml"])
+def test_power_over_many_rows_is_the_power_at_each(model):
+    """``Data.powers`` (the recorder's: a compiled power called once over the rows where it
+    broadcasts) equals ``Data.power`` state by state, at states along a run, twice (the
+    second call on the path the first one chose)."""
+    from pathlib import Path
+
+    system = mb.load(Path(__file__).resolve().parents[2] / "models" / model)
+    data = system.data()
+    traj = mb.simulate(data, 0.01, rtol=1e-8, atol=1e-8)
+    one_by_one = np.array([data.power(t, q, qd) for t, q, qd in zip(traj.t, traj.q, traj.qd)])
+    assert np.abs(one_by_one).max() > 1e-6  # the models' forces work along the run
+    for _ in range(2):
+        np.testing.assert_allclose(data.powers(traj.t, traj.q, traj.qd), one_by_one, rtol=1e-12,
+                                   atol=1e-12 * np.abs(one_by_one).max())

@@ -146,6 +146,11 @@ class Part(Keyed):
     def power(self, t, q, qd, p):
         """The power q̇ᵀ Q_nc of the part's forces beyond T and V (``power_expression``) at
         its own coordinates q, velocities qd: what they add to d(T + V)/dt."""
+        return float(self.power_function()(t, q, qd, p)[0])
+
+    def power_function(self):
+        """The compiled ``power_expression`` of (t, q, q̇, p) at the part's own coordinates,
+        made at the first call."""
         if self._power is None:
             args, constants = self._power_args
             expression = self.power_expression
@@ -153,7 +158,7 @@ class Part(Keyed):
                 q_slots, qd_slots = self._shared[1]
                 expression = sp.sympify(expression).xreplace({**dict(zip(self.q, q_slots)), **dict(zip(self.qd, qd_slots))})
             self._power = compile_function(args, [expression], constants, picked=PARAMETERS)
-        return float(self._power(t, q, qd, p)[0])
+        return self._power
 
     def symbolic(self):
         """(M, Q) as sympy matrices of the model's symbols."""
