@@ -101,14 +101,14 @@ class _Group:
         self.raw, self.dest = first.raw, dest
         self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
         self.fixed = np.ascontiguousarray(np.array([f.fixed for f in functions], dtype=float).T)
-        # constants that are numbers and arguments (symbolic.gather): stacked, and per pick k the
-        # argument a and each member's position in it (None: a scalar), put in per call
+        # constants that are numbers and arguments (symbolic.gather): stacked, and per argument a
+        # the rows of the constants read from it and, per row and member, where in it (None: the
+        # argument is a scalar, t), put in per call by one indexing per argument
         self.picks = None
         self.values = first.values
         if hasattr(first.values, "picks"):
             self.values = np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
-            self.picks = [(k, a, None if i is None else np.array([f.values.picks[n][2] for f in functions]))
-                          for n, (k, a, i) in enumerate(first.values.picks)]
+            self.picks = _picks(first.values.picks, [f.values.picks for f in functions], self.columns)
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
         self.kernel = None  # the numba kernel once it is ready and checked
         self.refused = not compiled  # numpy for good (also when the kernel disagreed with numpy)
@@ -130,15 +130,9 @@ class _Group:
 
     def _gathered(self, t, q, qd, p):
         """The stacked constants with each member's arguments put in."""
-        values, members = self.values.copy(), np.arange(self.dest.shape[1])
-        for k, a, at in self.picks:
-            given = (t, q, qd, p)[a]
-            if at is None:
-                values[k] = given
-            elif a in (1, 2):  # a coordinate or velocity slot: the member's column
-                values[k] = given[self.columns[at, members]]
-            else:
-                values[k] = given[at]
+        values, given = self.values.copy(), (t, q, qd, p)
+        for a, rows, at in self.picks:
+            values[rows] = given[a] if at is None else given[a][at]
         return values
 
     def _take_kernel(self, t, q, qd, p, values):
@@ -187,6 +181,22 @@ class _Group:
         except Exception:  # noqa: BLE001 - a raw function that does not broadcast is called singly
             return False
         return _agree(got, expected[self.dest])
+
+
+def _picks(first, every, columns):
+    """[(argument a, rows of the constants read from it, their places in it: None for a
+    scalar argument, else rows × members)] from the picks (k, a, i) of the first member and of
+    every member (``every``): a coordinate or velocity slot i is the member's column of
+    ``columns``, a position in the parameters is the member's own."""
+    members = np.arange(len(every))
+    by_argument = {}
+    for n, (k, a, i) in enumerate(first):
+        at = None if i is None else np.array([picks[n][2] for picks in every])
+        if at is not None and a in (1, 2):
+            at = columns[at, members]
+        by_argument.setdefault(a, []).append((k, at))
+    return [(a, np.array([k for k, _ in found]), None if found[0][1] is None else np.array([at for _, at in found]))
+            for a, found in by_argument.items()]
 
 
 def _agree(got, want):

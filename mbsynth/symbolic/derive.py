@@ -501,13 +501,15 @@ def _values(args, values, picks=()):
     if all(v.is_Number or v in where for v in values):  # numbers, and arguments (a joint's effort τ)
         fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
         picks = tuple((k, *where[v]) for k, v in enumerate(values) if not v.is_Number)
+        by_argument = _by_argument(picks)
 
         def gathered(*given):
             if not picks:
                 return fixed
-            out = fixed.astype(np.result_type(fixed, *(np.asarray(given[a]) for _, a, _ in picks)))
-            for k, a, i in picks:
-                out[k] = given[a] if i is None else given[a][i]
+            read = [(np.asarray(given[a]), rows, at) for a, rows, at in by_argument]
+            out = fixed.astype(np.result_type(fixed, *(x for x, _, _ in read)))
+            for x, rows, at in read:
+                out[rows] = x if at is None else x[at]
             return out
         gathered.fixed, gathered.picks = fixed, picks  # grouped.py stacks these instead of calling
         return gathered
@@ -518,6 +520,16 @@ def _values(args, values, picks=()):
 
     raw = remembered_function("values", (args, values), derive)
     return lambda *given: np.asarray(raw(*given), dtype=float)
+
+
+def _by_argument(picks):
+    """The picks (k, argument a, position i or None) as one (a, rows k, positions i or None)
+    per argument: one indexing per argument puts them in."""
+    found = {}
+    for k, a, i in picks:
+        found.setdefault(a, []).append((k, i))
+    return [(a, np.array([k for k, _ in pairs]), None if pairs[0][1] is None else np.array([i for _, i in pairs]))
+            for a, pairs in found.items()]
 
 
 def _positional(args, forms):
