@@ -66,19 +66,20 @@ def read_contacts(builder):
 
 def _friction(builder, spec, path, name):
     """(μ, the slip rows) of a plane contact's ``friction: μ`` (μ ≥ 0, 0 by default): the
-    rows ψ = t_k·ṗ, the velocity of the contact point along two unit tangents t1, t2 of the
-    plane (None without friction). Friction needs a point (radius 0): a sphere's contact
-    point moves with its spin, which the point's velocity leaves out."""
+    rows ψ = t_k·v_c, the velocity of the contact point along two unit tangents t1, t2 of the
+    plane (None without friction). The contact point of a sphere of radius r is c = p − r n
+    on the part, so v_c = ṗ + ω × (−r n) with ω the part's angular velocity (a point: r = 0)."""
     if "friction" not in spec:
         return sp.S.Zero, None
     mu = builder.constant(spec["friction"], path + ("friction",))
     if builder.value(mu) < 0:
         builder.fail(path + ("friction",), f"friction must be ≥ 0, got {builder.value(mu):g}")
-    if builder.value(builder.constant(spec.get("radius", 0), path + ("radius",))) != 0:
-        builder.fail(path + ("friction",), "friction is modelled at a point contact (radius 0), not at a sphere")
-    p = _centre(builder, spec["child"], path + ("child",))
-    velocity = frame_velocity(p, builder.q, builder.qd)
-    rows = [t.dot(velocity) for t in tangent_basis(_normal(builder, spec, path), builder.value)]
+    part, frame = frame_reference(builder, spec["child"], path + ("child",))
+    unit = _normal(builder, spec, path)
+    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
+    velocity = frame_velocity(part.pose(frame)[0], builder.q, builder.qd) + \
+        part.frame_angular_velocity(frame).cross(-radius * unit)
+    rows = [t.dot(velocity) for t in tangent_basis(unit, builder.value)]
     return mu, Constraint.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
                                       row_labels=["t1", "t2"])
 
