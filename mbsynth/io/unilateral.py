@@ -56,11 +56,12 @@ def read_contacts(builder):
         if name in names:
             builder.fail(path + ("name",), f"duplicate contact name '{name}'")
         names.add(name)
-        gap = _plane_gap(builder, spec, path) if kind == "plane" else _spheres_gap(builder, spec, path)
+        gap, point, normal = (_plane_gap if kind == "plane" else _spheres_gap)(builder, spec, path)
         full = builder.full_name(name)
         row = gap_row(full, gap, builder.q, builder.qd, builder.parameter_symbols)
         mu, slip = _friction(builder, spec, path, full) if kind == "plane" else (sp.S.Zero, None)
-        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip), path))
+        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip, point, normal),
+                      path))
     return found
 
 
@@ -85,14 +86,15 @@ def _friction(builder, spec, path, name):
 
 
 def _plane_gap(builder, spec, path):
-    """n·p − ground − r of a sphere on the ``child`` frame against the plane n·x = ground."""
+    """(n·p − ground − r, the contact point p − r n, n) of a sphere on the ``child`` frame
+    against the plane n·x = ground."""
     if not builder.placement.identity:
         builder.fail(path, "a ground contact in an included file with a placement: give it in the including file")
     p = _centre(builder, spec["child"], path + ("child",))
     unit = _normal(builder, spec, path)
     radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
     ground = builder.constant(spec.get("ground", 0), path + ("ground",))
-    return unit.dot(p) - ground - radius
+    return unit.dot(p) - ground - radius, p - radius * unit, unit
 
 
 def _normal(builder, spec, path):
@@ -105,14 +107,17 @@ def _normal(builder, spec, path):
 
 
 def _spheres_gap(builder, spec, path):
-    """|p_B − p_A| − r_A − r_B of two spheres on two parts."""
+    """(|p_B − p_A| − r_A − r_B, the contact point p_A + r_A u, u = (p_B − p_A)/|p_B − p_A|)
+    of two spheres on two parts."""
     between = builder.sized_list(spec["between"], path + ("between",), 2)
     radii = builder.sized_list(spec["radius"], path + ("radius",), 2)
     (part_a, p_a), (part_b, p_b) = (_centre(builder, x, path + ("between", k), True) for k, x in enumerate(between))
     if part_a is part_b:
         builder.fail(path + ("between",), "the two spheres must be on two parts")
     d = p_b - p_a
-    return sp.sqrt(d.dot(d)) - sum(_radius(builder, r, path + ("radius", k)) for k, r in enumerate(radii))
+    r_a, r_b = (_radius(builder, r, path + ("radius", k)) for k, r in enumerate(radii))
+    unit = d / sp.sqrt(d.dot(d))
+    return sp.sqrt(d.dot(d)) - r_a - r_b, p_a + r_a * unit, unit
 
 
 def _centre(builder, text, path, with_part=False):

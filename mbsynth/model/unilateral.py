@@ -30,7 +30,9 @@ from ..core.tolerances import SPEED_ROUNDING
 class Unilateral:
     """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), its restitution e (a
     sympy expression of the parameters), its holonomic ``row`` (φ = g), Coulomb's
-    ``friction`` μ and the nonholonomic ``slip`` rows (None without friction)."""
+    ``friction`` μ and the nonholonomic ``slip`` rows (None without friction); a contact's
+    ``point`` (where it touches, world) and ``normal`` (the unit direction its impulse
+    pushes the child, or the second sphere), sympy columns of q, for the viewer."""
 
     name: str
     kind: str
@@ -38,6 +40,8 @@ class Unilateral:
     row: Constraint
     friction: sp.Expr = sp.S.Zero
     slip: Constraint = None
+    point: sp.Matrix = None
+    normal: sp.Matrix = None
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
