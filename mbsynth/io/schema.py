@@ -464,7 +464,10 @@ SECTIONS = {section.name: section for section in (
             (Key("reaction", "string", "``<joint>.force``, ``.torque`` or ``.multipliers``", "pin.force"),
              Key("position", "frame", "world position of a frame", "link.tip"),
              Key("velocity", "frame", "world velocity of a frame", "link.tip"),
-             Key("energy", "string", "``kinetic``, ``potential`` or ``total``", "total"))),
+             Key("energy", "string", "``kinetic``, ``potential`` or ``total``", "total"),
+             Key("contact", "string", "``<contact>.force`` (its normal force, 0 while open) or ``.impulse`` (its "
+                 "normal impulses since the previous row); a joint limit as ``<joint>.upper.force``",
+                 "floor.force"))),
 )}
 
 PART_SECTIONS = tuple(_TYPE)  # the part sections, by the value of their ``type`` key
