@@ -30,6 +30,10 @@ A model made of model files (``System.substructures``) draws each top-level subs
 under a path of its own (``cell[0]/...``: meshcat shows and hides it as one), and the parts
 of each in one colour of the palette, the next substructure in the next.
 
+A run's contacts are drawn at their events: a point where each struck and an arrow of its
+impulse (view/contacts.py), shown for a while after the event and at a vanishing scale
+between.
+
 The camera looks at ``Scene.targets``, one point per drawn time: the centre of mass
 (mass-weighted over bodies and particles; the middle of the drawn points if nothing has
 mass) when the view follows the model, else the middle of the box that holds the whole
