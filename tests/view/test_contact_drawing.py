@@ -4,6 +4,8 @@ in the scene and in the saved HTML (meshcat's commands decoded, no browser)."""
 
 import base64
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -83,3 +85,16 @@ def test_the_saved_html_holds_the_contact_objects_and_the_arrow_lengths(ball, tm
     lengths = [scales[np.flatnonzero(times >= ev.t - start - 1e-12)[0], 0] for ev in impacts]
     assert [x / lengths[0] for x in lengths] == pytest.approx([ev.impulse / impacts[0].impulse for ev in impacts],
                                                               rel=1e-6)
+
+
+def test_mbsynth_view_writes_the_contacts_into_its_html(tmp_path):
+    """``mbsynth view models/contact/bouncing_ball.yaml --t-end 0.6 --html FILE``: its one
+    impact (t1 = 0.44 s) drawn under /meshcat/model/contacts/floor/."""
+    out = tmp_path / "ball.html"
+    done = subprocess.run([sys.executable, "-m", "mbsynth.cli", "view", str(MODELS / "bouncing_ball.yaml"),
+                           "--t-end", "0.6", "--html", str(out)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert f"wrote {out}" in done.stdout
+    paths = {umsgpack.unpackb(base64.b64decode(blob)).get("path")
+             for blob in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", out.read_text())}
+    assert {"/meshcat/model/contacts/floor/point/0.0", "/meshcat/model/contacts/floor/impulse/0.1"} <= paths
