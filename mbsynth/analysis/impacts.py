@@ -190,6 +190,15 @@ class EventIntegration(ContinuousIntegration):
             y = self.form.to_integrator(q, qd_new)
             stepper.move(solver, y, self.f(t, y))
 
+    def contact_forces(self, t, q, qd, held):
+        """{gap name: its force λ} at (t, q, q̇) with the gaps named in ``held`` held (those of
+        them sliding now slide)."""
+        rows = sorted(self.gaps.names.index(name) for name in held)
+        if not rows:
+            return {}
+        sliding = {i: d for i, d in self.sliding.items() if i in rows}
+        return {self.gaps.names[i]: float(lam) for i, lam in zip(rows, self._held_motion(t, q, qd, rows, sliding).lam)}
+
     def stats(self):
         counts = super().stats()
         counts["events"] = len(self.events)

@@ -33,6 +33,9 @@ class Recorder:
                             residual_velocity=np.empty(rows), outputs=np.empty((rows, m)))
         self.writer = None
         self.events = []  # trajectory.Event, appended by a run with unilateral constraints (impacts.py)
+        self.contact_forces = None  # the run's {gap name: λ} of (t, q, q̇, held gaps) (impacts.py): contact outputs
+        self.counted = 0  # the events up to the last row (contact outputs)
+        self.held = set()  # the gaps held at the last row, by its events
 
     def open(self):
         """Start the file, if one was asked for (a path that cannot be written fails here)."""
@@ -84,10 +87,31 @@ class Recorder:
         c["residual_position"][rows_at], c["residual_velocity"][rows_at] = residual_position, residual_velocity
         if self.outputs:
             for i, (t, q_row, qd_row) in enumerate(zip(times, q, qd)):
-                c["outputs"][self.count + i] = self.outputs.evaluate(t, q_row, qd_row)
+                c["outputs"][self.count + i] = self.outputs.evaluate(t, q_row, qd_row,
+                                                                     contacts=self._contacts(t, q_row, qd_row))
         self.count += len(times)
         if self.writer is not None:
             self.writer.append(self.trajectory("running", rows=rows_at))
+
+    def _contacts(self, t, q, qd):
+        """{gap name: (force, impulse)} at a row at t, from the run's events up to t (rows
+        come in time order, the run's events ahead of them): the forces of the gaps held
+        there (a "contact" event holds a gap, a "release" opens it), and the normal impulses
+        ("impact", "contact") since the previous row; None without unilateral gaps."""
+        if self.contact_forces is None:
+            return None
+        impulses = {}
+        while self.counted < len(self.events) and self.events[self.counted].t <= t:
+            event = self.events[self.counted]
+            if event.kind == "contact":
+                self.held.add(event.name)
+            elif event.kind == "release":
+                self.held.discard(event.name)
+            if event.kind in ("impact", "contact"):
+                impulses[event.name] = impulses.get(event.name, 0.0) + event.impulse
+            self.counted += 1
+        forces = self.contact_forces(t, q, qd, self.held)
+        return {name: (forces.get(name, 0.0), impulses.get(name, 0.0)) for name in set(forces) | set(impulses)}
 
     def close(self, status):
         """Finish the file, if any, with the run's ``status``."""

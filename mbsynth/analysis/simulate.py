@@ -101,6 +101,7 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
     run = _strategy(data.model, method, stabilization)(data, method, rtol, atol, stabilization, baumgarte, schedule)
     if isinstance(run, EventIntegration):
         run.events = recorder.events
+        recorder.contact_forces = run.contact_forces
     recorder.open()
     started = time.perf_counter()
     status = "stopped"

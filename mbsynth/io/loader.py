@@ -306,14 +306,15 @@ class _Builder:
         fixed = set().union(*(builder.read_initial_fixed(given) for builder in self.builders))
         system = System.build(name, parts, constraints, model.q, model.qd, self.parameters_by_name(), initial,
                               initial_fixed=fixed, forces=forces)
-        outputs = [output for builder in self.included_first for output in read_outputs(builder, constraints)]
+        unilaterals = [(u, path, builder) for builder in self.included_first for u, path in builder.unilaterals()]
+        gaps = [u.name for u, _, _ in unilaterals]
+        outputs = [output for builder in self.included_first for output in read_outputs(builder, constraints, gaps)]
         system = replace(system, definitions=model.definitions, initial_definitions=definitions,
                          initial_given=frozenset(given), source=self.doc.text, source_folder=str(self.doc.folder),
                          robots=tuple(entry.robot for b in self.builders for entry in b.robots.values()),
                          outputs=tuple(outputs), fixed_parameters=dict(model.fixed),
                          load_parameters=dict(model.overrides), built_parameters=dict(system.parameters),
                          substructures=self.substructures())
-        unilaterals = [(u, path, builder) for builder in self.included_first for u, path in builder.unilaterals()]
         if unilaterals:
             system = replace(system, unilaterals=tuple(u for u, _, _ in unilaterals))
         self.check_parts(system)

@@ -3,16 +3,18 @@
 import functools
 
 from ..core.errors import ModelError
-from ..model.outputs import BUILT_IN_COLUMNS, energy_output, expression_output, frame_output, reaction_output
+from ..model.outputs import (BUILT_IN_COLUMNS, contact_output, energy_output, expression_output, frame_output,
+                             reaction_output)
 from .joints import frame_reference
 from .schema import SECTIONS
 
 KINDS = tuple(key.name for key in SECTIONS["output"].keys)
 
 
-def read_outputs(builder, constraints):
+def read_outputs(builder, constraints, gaps=()):
     """The Outputs the file declares (under their full names, ``left_leg.height``);
-    ``constraints``: the model's constraints."""
+    ``constraints``: the model's constraints; ``gaps``: the full names of its unilateral
+    gaps (contacts, joint limits)."""
     node = builder.root.get("outputs")
     if node is None:
         return ()
@@ -40,6 +42,12 @@ def read_outputs(builder, constraints):
                 builder.fail(kpath, f"unknown joint or constraint '{constraint}' in '{value}' (write "
                                     f"'<joint>.force', '.torque' or '.multipliers'); known: {', '.join(by_name)}")
             make = functools.partial(reaction_output, name, by_name[constraint], which)
+        elif kind == "contact":
+            gap, _, which = str(value).rpartition(".")
+            if builder.full_name(gap) not in gaps:
+                builder.fail(kpath, f"unknown contact or limit '{gap}' in '{value}' (write '<contact>.force' or "
+                                    f"'.impulse'); known: {', '.join(gaps) or 'none'}")
+            make = functools.partial(contact_output, name, builder.full_name(gap), which)
         elif kind == "energy":
             make = functools.partial(energy_output, name, value)
         else:

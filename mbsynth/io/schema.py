@@ -401,8 +401,8 @@ SECTIONS = {section.name: section for section in (
              Key("normal", "list of 3 " + _EXPRS, "the plane's normal, pointing out of the ground", "[0, 0, 1]",
                  default="[0, 0, 1]"),
              Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution", "0.8", default="0"),
-             Key("friction", _EXPR + ", ≥ 0", "Coulomb's coefficient μ at a point (radius 0): tangential "
-                 "impulses at impacts, stick or slip", "0.5", default="0"),
+             Key("friction", _EXPR + ", ≥ 0", "Coulomb's coefficient μ at the contact point (a sphere's "
+                 "moves with its spin): tangential impulses at impacts, stick or slip; sliding", "0.5", default="0"),
              _DESCRIPTION)),
     Section("contact_spheres", "an entry of ``contacts:`` with ``type: spheres``",
             "Two spheres on two parts: the gap |p_B − p_A| − r_A − r_B stays ≥ 0.",
@@ -464,7 +464,10 @@ SECTIONS = {section.name: section for section in (
             (Key("reaction", "string", "``<joint>.force``, ``.torque`` or ``.multipliers``", "pin.force"),
              Key("position", "frame", "world position of a frame", "link.tip"),
              Key("velocity", "frame", "world velocity of a frame", "link.tip"),
-             Key("energy", "string", "``kinetic``, ``potential`` or ``total``", "total"))),
+             Key("energy", "string", "``kinetic``, ``potential`` or ``total``", "total"),
+             Key("contact", "string", "``<contact>.force`` (its normal force, 0 while open) or ``.impulse`` (its "
+                 "normal impulses since the previous row); a joint limit as ``<joint>.upper.force``",
+                 "floor.force"))),
 )}
 
 PART_SECTIONS = tuple(_TYPE)  # the part sections, by the value of their ``type`` key

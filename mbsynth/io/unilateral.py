@@ -56,42 +56,45 @@ def read_contacts(builder):
         if name in names:
             builder.fail(path + ("name",), f"duplicate contact name '{name}'")
         names.add(name)
-        gap = _plane_gap(builder, spec, path) if kind == "plane" else _spheres_gap(builder, spec, path)
+        gap, point, normal = (_plane_gap if kind == "plane" else _spheres_gap)(builder, spec, path)
         full = builder.full_name(name)
         row = gap_row(full, gap, builder.q, builder.qd, builder.parameter_symbols)
         mu, slip = _friction(builder, spec, path, full) if kind == "plane" else (sp.S.Zero, None)
-        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip), path))
+        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip, point, normal),
+                      path))
     return found
 
 
 def _friction(builder, spec, path, name):
     """(μ, the slip rows) of a plane contact's ``friction: μ`` (μ ≥ 0, 0 by default): the
-    rows ψ = t_k·ṗ, the velocity of the contact point along two unit tangents t1, t2 of the
-    plane (None without friction). Friction needs a point (radius 0): a sphere's contact
-    point moves with its spin, which the point's velocity leaves out."""
+    rows ψ = t_k·v_c, the velocity of the contact point along two unit tangents t1, t2 of the
+    plane (None without friction). The contact point of a sphere of radius r is c = p − r n
+    on the part, so v_c = ṗ + ω × (−r n) with ω the part's angular velocity (a point: r = 0)."""
     if "friction" not in spec:
         return sp.S.Zero, None
     mu = builder.constant(spec["friction"], path + ("friction",))
     if builder.value(mu) < 0:
         builder.fail(path + ("friction",), f"friction must be ≥ 0, got {builder.value(mu):g}")
-    if builder.value(builder.constant(spec.get("radius", 0), path + ("radius",))) != 0:
-        builder.fail(path + ("friction",), "friction is modelled at a point contact (radius 0), not at a sphere")
-    p = _centre(builder, spec["child"], path + ("child",))
-    velocity = frame_velocity(p, builder.q, builder.qd)
-    rows = [t.dot(velocity) for t in tangent_basis(_normal(builder, spec, path), builder.value)]
+    part, frame = frame_reference(builder, spec["child"], path + ("child",))
+    unit = _normal(builder, spec, path)
+    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
+    velocity = frame_velocity(part.pose(frame)[0], builder.q, builder.qd) + \
+        part.frame_angular_velocity(frame).cross(-radius * unit)
+    rows = [t.dot(velocity) for t in tangent_basis(unit, builder.value)]
     return mu, Constraint.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
                                       row_labels=["t1", "t2"])
 
 
 def _plane_gap(builder, spec, path):
-    """n·p − ground − r of a sphere on the ``child`` frame against the plane n·x = ground."""
+    """(n·p − ground − r, the contact point p − r n, n) of a sphere on the ``child`` frame
+    against the plane n·x = ground."""
     if not builder.placement.identity:
         builder.fail(path, "a ground contact in an included file with a placement: give it in the including file")
     p = _centre(builder, spec["child"], path + ("child",))
     unit = _normal(builder, spec, path)
     radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
     ground = builder.constant(spec.get("ground", 0), path + ("ground",))
-    return unit.dot(p) - ground - radius
+    return unit.dot(p) - ground - radius, p - radius * unit, unit
 
 
 def _normal(builder, spec, path):
@@ -104,14 +107,17 @@ def _normal(builder, spec, path):
 
 
 def _spheres_gap(builder, spec, path):
-    """|p_B − p_A| − r_A − r_B of two spheres on two parts."""
+    """(|p_B − p_A| − r_A − r_B, the contact point p_A + r_A u, u = (p_B − p_A)/|p_B − p_A|)
+    of two spheres on two parts."""
     between = builder.sized_list(spec["between"], path + ("between",), 2)
     radii = builder.sized_list(spec["radius"], path + ("radius",), 2)
     (part_a, p_a), (part_b, p_b) = (_centre(builder, x, path + ("between", k), True) for k, x in enumerate(between))
     if part_a is part_b:
         builder.fail(path + ("between",), "the two spheres must be on two parts")
     d = p_b - p_a
-    return sp.sqrt(d.dot(d)) - sum(_radius(builder, r, path + ("radius", k)) for k, r in enumerate(radii))
+    r_a, r_b = (_radius(builder, r, path + ("radius", k)) for k, r in enumerate(radii))
+    unit = d / sp.sqrt(d.dot(d))
+    return sp.sqrt(d.dot(d)) - r_a - r_b, p_a + r_a * unit, unit
 
 
 def _centre(builder, text, path, with_part=False):

@@ -8,11 +8,15 @@
       tip: {position: rod.tip}              # a frame's origin in the world (x, y, z)
       tip_velocity: {velocity: rod.tip}     # its velocity in the world
       kinetic: {energy: kinetic}            # kinetic, potential or total
+      push: {contact: floor.force}          # a contact's or limit's normal force λ (0 while open)
+      hits: {contact: floor.impulse}        #   and its normal impulses since the previous row
 
 An output with several components gives one column each, named ``tip[x]``, ``tip[y]``,
 ``tip[z]`` (``load[0]``, … for multipliers). Expressions, positions and velocities are
 compiled together into one function of the state; reactions need the motion and are
-computed from it (reactions.py). An output that evaluates to inf or NaN is written as it
+computed from it (reactions.py). Contact forces and impulses come from the run
+(analysis/impacts.py: the held gaps' forces, the impulses of its events), handed to
+``evaluate`` as ``contacts``. An output that evaluates to inf or NaN is written as it
 is, with a warning (logged once per output and run) naming it and the first such time.
 """
 
@@ -30,6 +34,7 @@ AXES = ("x", "y", "z")
 BUILT_IN_COLUMNS = ("t", "energy")  # a trajectory file's columns besides the coordinates and velocities
 ENERGIES = ("kinetic", "potential", "total")
 REACTION_PARTS = ("force", "torque", "multipliers")
+CONTACT_PARTS = ("force", "impulse")
 
 log = logging.getLogger(__name__)
 
@@ -50,7 +55,7 @@ class Output:
 
     @property
     def columns(self):
-        if self.size == 1 and self.kind in ("expression", "energy"):
+        if self.size == 1 and self.kind in ("expression", "energy", "contact"):
             return [self.name]
         labels = AXES if self.kind in ("position", "velocity") or self.part in ("force", "torque") else range(self.size)
         return [f"{self.name}[{label}]" for label in labels]
@@ -79,6 +84,15 @@ def reaction_output(name, constraint, which):
                   size=constraint.size if which == "multipliers" else 3)
 
 
+def contact_output(name, gap, which):
+    """``which`` (force or impulse) of the unilateral gap named ``gap`` (a contact or a
+    joint's limit): its normal force λ at each row (0 while it is open), or the sum of its
+    normal impulses (impact and contact events) since the previous row."""
+    if which not in CONTACT_PARTS:
+        raise ModelError(f"output '{name}': a contact output is '<contact>.force' or '.impulse', not '.{which}'")
+    return Output(name, "contact", constraint=gap, part=which)
+
+
 def energy_output(name, which):
     if which not in ENERGIES:
         raise ModelError(f"output '{name}': energy is one of {', '.join(ENERGIES)}, not {which!r}")
@@ -103,9 +117,10 @@ class OutputEvaluator:
     def __bool__(self):
         return bool(self.outputs)
 
-    def evaluate(self, t, q, qd, motion=None):
+    def evaluate(self, t, q, qd, motion=None, contacts=None):
         """One row: every output's columns at (t, q, q̇); ``motion`` (System.motion at that
-        state) for reactions, computed when not given."""
+        state) for reactions, computed when not given; ``contacts`` ({gap name: (force,
+        impulse)}, the run's; a gap not in it has neither) for contact outputs."""
         data, p = self.data, self.data.parameter_values
         compiled = iter(self._compiled(t, q, qd, p)[0].ravel()) if self._compiled else iter(())
         reactions = None
@@ -116,6 +131,8 @@ class OutputEvaluator:
         for output in self.outputs:
             if output.kind == "reaction":
                 row += list(getattr(reactions[output.constraint], output.part))
+            elif output.kind == "contact":
+                row.append((contacts or {}).get(output.constraint, (0.0, 0.0))[CONTACT_PARTS.index(output.part)])
             elif output.kind == "energy":
                 energies = data.energy(t, q, qd) if energies is None else energies
                 kinetic, potential = energies

@@ -6,9 +6,10 @@ point or sphere on a part's frame against a ground plane, g = n·p − h − r; 
 g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Constraint with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
-A point contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·ṗ, the
-contact point's velocity along two unit tangents of the plane (``tangent_basis``): an
-impulse Λ_k on them is the tangential impulse Λ_k t_k at the point.
+A plane contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·v_c, the
+contact point's velocity (a sphere's: its centre's plus ω × (−r n)) along two unit tangents
+of the plane (``tangent_basis``): an impulse Λ_k on them is the tangential impulse Λ_k t_k
+at the point.
 
 While a gap is open the row is no constraint; while it holds (persistent contact) it is one
 of the System's rows: ``with_active`` makes the System of an active set (its ``constraints``
@@ -30,7 +31,9 @@ from ..core.tolerances import SPEED_ROUNDING
 class Unilateral:
     """A gap g(q) ≥ 0 named ``name`` (``kind``: "limit" or "contact"), its restitution e (a
     sympy expression of the parameters), its holonomic ``row`` (φ = g), Coulomb's
-    ``friction`` μ and the nonholonomic ``slip`` rows (None without friction)."""
+    ``friction`` μ and the nonholonomic ``slip`` rows (None without friction); a contact's
+    ``point`` (where it touches, world) and ``normal`` (the unit direction its impulse
+    pushes the child, or the second sphere), sympy columns of q, for the viewer."""
 
     name: str
     kind: str
@@ -38,6 +41,8 @@ class Unilateral:
     row: Constraint
     friction: sp.Expr = sp.S.Zero
     slip: Constraint = None
+    point: sp.Matrix = None
+    normal: sp.Matrix = None
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""

@@ -30,6 +30,10 @@ A model made of model files (``System.substructures``) draws each top-level subs
 under a path of its own (``cell[0]/...``: meshcat shows and hides it as one), and the parts
 of each in one colour of the palette, the next substructure in the next.
 
+A run's contacts are drawn at their events: a point where each struck and an arrow of its
+impulse (view/contacts.py), shown for a while after the event and at a vanishing scale
+between.
+
 The camera looks at ``Scene.targets``, one point per drawn time: the centre of mass
 (mass-weighted over bodies and particles; the middle of the drawn points if nothing has
 mass) when the view follows the model, else the middle of the box that holds the whole
@@ -43,6 +47,7 @@ import sympy as sp
 
 from ..core.errors import ModelError
 from ..core.joint_kinds import KINDS
+from .contacts import contact_items
 from ..io.parts import COLORS
 from ..model.constraints.rolling import KnifeEdge, RollingDisk
 from ..model.parts import Frame
@@ -172,7 +177,18 @@ def build_scene(system, trajectory, axes=False, joints=False, fps=FPS, follow=No
     for path, a, b, color, radius in lines:
         scene.nodes.append(Node(grouped(path, groups), segment_transforms(positions[a], positions[b]),
                                 [{"shape": "line", "size": [radius * length], "color": color}]))
+    for item in contact_items(system, trajectory, scene.times, length):
+        T = segment_transforms(item.start, item.end) if item.end is not None else _translations(item.start)
+        T[~item.shown, :3, :3] *= SEGMENT_SCALE_FLOOR  # not drawn at this row
+        scene.nodes.append(Node(item.path, T, item.shapes))
     return scene
+
+
+def _translations(points):
+    """(rows, 4, 4) transforms moving the origin to each of ``points``."""
+    T = np.tile(np.eye(4), (len(points), 1, 1))
+    T[:, :3, 3] = points
+    return T
 
 
 def group_of(name, groups):

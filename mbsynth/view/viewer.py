@@ -301,6 +301,8 @@ def _pose(position=(0, 0, 0), rotation=np.eye(3), scale=(1, 1, 1)):
     return T
 
 
+ARROW_HEAD = 0.2  # an arrow's head, of its length
+ARROW_WIDTH = 2.5  # an arrow's head, of its shaft's radius
 ROTATE_Y_TO_Z = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])  # three.js cylinders lie along y
 ROTATE_Y_TO_X = np.array([[0.0, 1, 0], [-1, 0, 0], [0, 0, 1]])
 
@@ -310,6 +312,11 @@ def _pieces(shape, g):
     kind = shape["shape"]
     if kind == "line":  # a thin cylinder over the unit segment (0, 0, 0)-(1, 0, 0), scaled by its node
         return [(g.Cylinder(1.0, shape["size"][0]), _pose([0.5, 0, 0], ROTATE_Y_TO_X))]
+    if kind == "arrow":  # a line whose last ARROW_HEAD is a cone ARROW_WIDTH times as wide, pointing to (1, 0, 0)
+        r, shaft = shape["size"][0], 1.0 - ARROW_HEAD
+        return [(g.Cylinder(shaft, r), _pose([shaft / 2, 0, 0], ROTATE_Y_TO_X)),
+                (g.Cylinder(ARROW_HEAD, radiusTop=0.0, radiusBottom=ARROW_WIDTH * r),
+                 _pose([shaft + ARROW_HEAD / 2, 0, 0], ROTATE_Y_TO_X))]
     origin = _pose(shape.get("position", (0, 0, 0)), shape.get("rotation", np.eye(3)))
     size = shape.get("size")
     if kind == "box":

@@ -104,7 +104,7 @@ contacts:
 
 @pytest.mark.parametrize("entry, message", [
     ("friction: -0.2", "contacts[0].friction: friction must be ≥ 0, got -0.2"),
-    ("friction: 0.3, radius: 0.1", "contacts[0].friction: friction is modelled at a point contact (radius 0)"),
+    ("friction: 0.3, radius: -0.1", "contacts[0].radius: a radius is ≥ 0, got -0.1"),
 ])
 def test_bad_friction_is_refused_at_its_line(entry, message):
     text = f"""name: bad
