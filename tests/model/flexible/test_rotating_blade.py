@@ -1,14 +1,9 @@
 """A blade spinning at a constant rate (models/flexible/rotating_blade.yaml: a uniform
 cantilever turned by angles, its spin cyclic, stiffening on) is a steady motion, and its
 rotating frequencies from ``modes(steady=True)`` are those of the rotating Euler–Bernoulli
-cantilever with zero hub radius, computed here independently by Rayleigh–Ritz.
-
-The reference: the transverse deflection w(ξ), ξ = x/L, in the power basis ξ², …, ξ¹¹,
-with T = ½ ∫ ẇ² (ρA L) and U = ½ ∫ w''² (EI/L³) + ½ ∫ N w'² (1/L), N = ½ ρAΩ²L²(1 − ξ²) the
-centrifugal tension; in the rotation plane (lead-lag) the centrifugal force's component
-along w adds −½ ρAΩ² ∫ w². In λ = Ω/√(EI/ρAL⁴) the lowest frequency converges to 1e-11
-in the basis size (it is 3.5160 at λ = 0, the clamped-free (βL)², and 3.6817 at λ = 1,
-4.7973 at λ = 3 flapwise: Wright, Smith, Thompson and Worley 1982's table). Southwell's
+cantilever with zero hub radius, computed independently by Rayleigh–Ritz
+(tests/helpers/rotating_beam.py: 3.5160 at λ = 0, the clamped-free (βL)², 3.6817 at λ = 1,
+4.7973 at λ = 3 flapwise, as tabulated by Wright et al. 1982 and Hodges & Rutkowski 1981). Southwell's
 coefficient, the slope dω²/dΩ² at Ω = 0, is that of the reference (1.1933 flapwise): the
 test reports how far Southwell's ω² = ω₀² + 1.193Ω² lies from the converged frequencies.
 """
@@ -17,31 +12,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import scipy.linalg
 
 import mbsynth as mb
 from mbsynth.model.data import Data
+from tests.helpers.rotating_beam import EI, LENGTH, LINE_MASS, reference
 
 MODEL = Path(__file__).resolve().parents[3] / "models" / "flexible" / "rotating_blade.yaml"
-LENGTH, LINE_MASS = 10.0, 3000 * 4e-4           # the model file's beam
-EI = {"flap": 7e10 * 2e-7, "lag": 7e10 * 8e-7}  # about the section's y axis (out of plane), z (in plane)
-TERMS = 10  # the reference's basis size
-
-
-def reference(omega, plane):
-    """The lowest frequency (rad/s) of the rotating cantilever at the spin rate ``omega``, in
-    ``plane`` "flap" or "lag" (module docstring)."""
-    scale = np.sqrt(EI[plane] / (LINE_MASS * LENGTH ** 4))
-    lam = omega / scale
-    p = np.arange(2, TERMS + 2, dtype=float)
-    P, Q = np.meshgrid(p, p, indexing="ij")
-    bending = P * Q * (P - 1) * (Q - 1) / (P + Q - 3)
-    tension = P * Q * (1 / (P + Q - 1) - 1 / (P + Q + 1)) / 2
-    mass = 1 / (P + Q + 1)
-    K = bending + lam ** 2 * (tension - (mass if plane == "lag" else 0))
-    return scale * np.sqrt(scipy.linalg.eigh(K, mass, eigvals_only=True)[0])
-
-
 @pytest.fixture(scope="module")
 def blade():
     return Data(mb.load(MODEL))
