@@ -145,34 +145,44 @@ def format_campbell(result):
     return "\n".join(lines)
 
 
+def figure(result, top=None):
+    """The diagram as a matplotlib figure: the branches, the order lines (labelled kP), the
+    crossings circled; the frequency axis up to ``top`` (Hz; default: the highest frequency)."""
+    import matplotlib.pyplot as plt
+
+    drawing, axes = plt.subplots(figsize=(7, 5))
+    x = result.values
+    if top is None:
+        top = 1.05 * np.nanmax(result.frequencies) if result.frequencies.size else 1.0
+    for j in range(result.frequencies.shape[1]):
+        axes.plot(x, result.frequencies[:, j], "o-", markersize=3, label=f"mode {j + 1}")
+    for k in range(1, result.orders + 1):
+        axes.plot(x, k * x / (2 * np.pi), "--", color="grey", linewidth=0.8)
+        end = min(x[-1], 0.95 * 2 * np.pi * top / k)
+        axes.annotate(f"{k}P", (end, k * end / (2 * np.pi)), color="grey", fontsize=8)
+    if result.crossings:
+        axes.plot([c.rate for c in result.crossings], [c.frequency for c in result.crossings], "o", markersize=9,
+                  markerfacecolor="none", markeredgecolor="red", label="crossings")
+    axes.set_ylim(0, top)
+    axes.set_xlim(x[0], x[-1])
+    axes.set_xlabel(f"{result.parameter} [rad/s]")
+    axes.set_ylabel("frequency [Hz]")
+    axes.set_title(f"Campbell diagram: {result.system_name}")
+    axes.legend(fontsize=8)
+    drawing.tight_layout()
+    return drawing
+
+
 def plot(result, path):
-    """The diagram as an image (matplotlib, Agg; the format from the file's suffix): the
-    branches, the order lines, the crossings circled; written whole or not at all."""
+    """``figure(result)`` written to ``path`` (matplotlib's Agg; the format from the file's
+    suffix), whole or not at all."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from ..core.files import write_atomically
 
-    figure, axes = plt.subplots(figsize=(7, 5))
-    x = result.values
-    top = np.nanmax(result.frequencies) if result.frequencies.size else 1.0
-    for j in range(result.frequencies.shape[1]):
-        axes.plot(x, result.frequencies[:, j], "o-", markersize=3, label=f"mode {j + 1}")
-    for k in range(1, result.orders + 1):
-        axes.plot(x, k * x / (2 * np.pi), "--", color="grey", linewidth=0.8)
-        end = min(x[-1], 2 * np.pi * top * 1.05 / k)
-        axes.annotate(f"{k}P", (end, k * end / (2 * np.pi)), color="grey", fontsize=8)
-    if result.crossings:
-        axes.plot([c.rate for c in result.crossings], [c.frequency for c in result.crossings], "o", markersize=9,
-                  markerfacecolor="none", markeredgecolor="red", label="crossings")
-    axes.set_ylim(0, top * 1.05)
-    axes.set_xlim(x[0], x[-1])
-    axes.set_xlabel(f"{result.parameter} [rad/s]")
-    axes.set_ylabel("frequency [Hz]")
-    axes.set_title(f"Campbell diagram: {result.system_name}")
-    axes.legend(fontsize=8)
-    figure.tight_layout()
-    suffix = str(path).rsplit(".", 1)[-1]
-    write_atomically(path, lambda temporary: figure.savefig(temporary, format=suffix, dpi=120))
-    plt.close(figure)
+    drawing = figure(result)
+    suffix = str(path).rsplit(".", 1)[-1].lower()
+    write_atomically(path, lambda temporary: drawing.savefig(temporary, format=suffix, dpi=120))
+    plt.close(drawing)
