@@ -49,8 +49,8 @@ class Campbell:
 
 
 def campbell(model, parameter, values, orders=4):
-    """The ``Campbell`` diagram of ``model`` (a System, a Data) over the spin rates ``values``
-    (rad/s) of its parameter ``parameter``. ModelError for an unknown parameter, fewer than
+    """The ``Campbell`` diagram of ``model`` (a System, a Data; its parameter left as it was)
+    over the spin rates ``values`` (rad/s) of its parameter ``parameter``. ModelError for an unknown parameter, fewer than
     two values, or a value at which the model does not move steadily (the value named)."""
     data = workspace(model)
     system = data.model
@@ -62,14 +62,17 @@ def campbell(model, parameter, values, orders=4):
         raise ModelError(f"model '{system.name}': --campbell needs at least two increasing finite values of "
                          f"{parameter}, got {values.tolist()}")
     branches, shapes = [], None  # branches[j]: list of (value index, Mode)
-    for i, value in enumerate(values):
-        data.set_parameters({parameter: float(value)})
-        try:
-            found = modes(data, steady=True).modes
-        except NoEquilibrium as err:
-            raise ModelError(f"at {parameter} = {value:g}: {err}") from None
-        found = [m for m in found if m.kind != "free"]
-        shapes = _follow(branches, shapes, found, i)
+    kept = data.parameters[parameter]
+    try:
+        for i, value in enumerate(values):
+            data.set_parameters({parameter: float(value)})
+            try:
+                found = modes(data, steady=True).modes
+            except NoEquilibrium as err:
+                raise ModelError(f"at {parameter} = {value:g}: {err}") from None
+            shapes = _follow(branches, shapes, [m for m in found if m.kind != "free"], i)
+    finally:
+        data.set_parameters({parameter: kept})  # the model's (or the Data's) value, as it was
     frequencies = np.full((values.size, len(branches)), np.nan)
     damping = np.full_like(frequencies, np.nan)
     for j, branch in enumerate(branches):

@@ -90,3 +90,19 @@ def test_the_spinning_blade_moves_alike_on_both_paths(blade):
     expected = kkt.motion(0.0, q, qd).qdd
     found = fast.motion(0.0, q, qd).qdd
     assert np.abs(expected).max() > 1 and np.abs(found - expected).max() < 1e-9 * np.abs(expected).max()
+
+
+def test_campbell_follows_the_modes_and_leaves_the_parameter(blade):
+    """``mb.campbell`` over 0 … 2ω₀: branch 1 is the flapwise mode throughout, branch 2 the
+    lead-lag one, though the first overtakes the second (their frequencies the reference's
+    at every value, 1e-3 flapwise, 2e-3 lead-lag at 2ω₀ with its two modes of 6); the Data's
+    Omega is as it was."""
+    blade.set_parameters({"Omega": 1.5})
+    omega0 = reference(0.0, "flap")
+    result = mb.campbell(blade, "Omega", np.linspace(0.0, 2 * omega0, 9), orders=2)
+    assert blade.parameters["Omega"] == 1.5
+    flap = 2 * np.pi * result.frequencies[:, 0]
+    lag = 2 * np.pi * result.frequencies[:, 1]
+    assert flap[0] < lag[0] and flap[-1] > lag[-1]
+    for rate, f, g in zip(result.values, flap, lag):
+        assert f == pytest.approx(reference(rate, "flap"), rel=1e-3) and g == pytest.approx(reference(rate, "lag"), rel=2e-3)
