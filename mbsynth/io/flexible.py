@@ -8,8 +8,8 @@ import numpy as np
 
 from ..core.errors import ModelError
 from ..model.parts import EulerFlexibleBody, FlexibleBody
-from ..model.parts.euler_body import coordinates as angle_coordinates
 from ..model.parts.flexible_body import coordinates, modal_damping, rayleigh_damping
+from ..model.parts.flexible_euler_body import coordinates as angle_coordinates
 from .parts import read_body_initial, read_geometry, read_rotation, read_sequence
 from .source import LineDict
 
@@ -29,7 +29,7 @@ def read_flexible_body(builder, name, spec, path):
     sequence = read_sequence(builder, spec, path)
     euler = sequence != "quaternion"
     initial = _read_initial(builder, spec.get("initial"), path + ("initial",), r, sequence if euler else None)
-    names = (*angle_coordinates(sequence), *coordinates(r)[7:]) if euler else coordinates(r)
+    names = angle_coordinates(sequence, r) if euler else coordinates(r)
     q, qd = builder.part_symbols(name, names)
     geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
     options = dict(frames=frames, damping=damping, geometry=geometry, initial=initial, stiffening=stiffening)

@@ -22,6 +22,12 @@ from .flexible_body import FlexibleBody
 from .part_type import ANGLES, EXTRA_NODE, FE_MESH, PartType, check
 
 
+def coordinates(sequence, modes):
+    """The coordinate names of a flexible body turned by ``sequence`` with ``modes`` reduced
+    coordinates: x, y, z, the angles (euler_body.py's names), eta1 … eta<modes>."""
+    return (*angle_coordinates(sequence), *(f"eta{k + 1}" for k in range(modes)))
+
+
 class EulerFlexibleBody(FlexibleBody):
     """FlexibleBody (its arguments) turned by the angles of ``sequence`` (one of SEQUENCES)."""
 
@@ -41,7 +47,7 @@ class EulerFlexibleBody(FlexibleBody):
         super().__init__(name, q, qd, reduction, gravity, params, **options)
 
     def coordinate_names(self, modes):
-        return (*angle_coordinates(self.sequence), *(f"eta{k + 1}" for k in range(modes)))
+        return coordinates(self.sequence, modes)
 
     def frame_axes(self):
         return euler_rotation(self.sequence, self.q[3:6])

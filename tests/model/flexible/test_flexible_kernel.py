@@ -15,9 +15,8 @@ from mbsynth.analysis.linearization import BlockFunction
 from mbsynth.compiled import ahead, flexible
 from mbsynth.model.data import Data
 from mbsynth.model.flexible.reduction import craig_bampton
-from mbsynth.model.parts.euler_body import coordinates as angle_coordinates
 from mbsynth.model.parts.flexible_body import FlexibleBody, coordinates, rayleigh_damping
-from mbsynth.model.parts.flexible_euler_body import EulerFlexibleBody
+from mbsynth.model.parts.flexible_euler_body import EulerFlexibleBody, coordinates as angle_coordinates
 
 MODELS = Path(__file__).resolve().parents[3] / "models" / "flexible"
 G = sp.Symbol("g")
@@ -36,7 +35,7 @@ def body(r, stiffening, damping, gravity, seed=0, sequence=None):
         S = rng.normal(size=(3, 3, r, r))
         S = (S + S.transpose(1, 0, 2, 3)) / 2
         S = (S + S.transpose(0, 1, 3, 2)) / 2
-    names = coordinates(r) if sequence is None else (*angle_coordinates(sequence), *coordinates(r)[7:])
+    names = coordinates(r) if sequence is None else angle_coordinates(sequence, r)
     q = [sp.Symbol(f"beam.{c}") for c in names]
     qd = [sp.Symbol(f"beam.{c}_dot") for c in names]
     g = sp.Matrix([0.3, -G, 1.2]) if gravity else sp.zeros(3, 1)
