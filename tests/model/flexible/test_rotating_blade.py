@@ -106,3 +106,14 @@ def test_campbell_follows_the_modes_and_leaves_the_parameter(blade):
     assert flap[0] < lag[0] and flap[-1] > lag[-1]
     for rate, f, g in zip(result.values, flap, lag):
         assert f == pytest.approx(reference(rate, "flap"), rel=1e-3) and g == pytest.approx(reference(rate, "lag"), rel=2e-3)
+
+
+def test_the_modes_table_names_the_coordinates_a_mode_moves_where_it_moves_no_joint(blade):
+    """The driven hub's joint does not move in the blade's bending modes (its rate is rounding,
+    1e-17): the table's "largest motion" names the elastic coordinates, not the hub."""
+    from mbsynth.analysis.modes import format_modes
+
+    blade.set_parameters({"Omega": 3.0})
+    rows = [line for line in format_modes(mb.modes(blade, steady=True)).splitlines() if "vibration" in line]
+    assert len(rows) == 6 and all("hub" not in row for row in rows)
+    assert rows[0].split("vibration")[1].split()[1:3] == ["blade.eta1", "1,"]
