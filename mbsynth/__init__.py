@@ -24,6 +24,7 @@ _LAZY = {
     "load_trajectory": "analysis.trajectory", "equilibrium": "analysis.statics",
     "linearize": "analysis.linearization", "Linearization": "analysis.linearization",
     "modes": "analysis.modes", "Modes": "analysis.modes", "steady_motion": "analysis.steady",
+    "campbell": "analysis.campbell", "Campbell": "analysis.campbell",
     "compose": "io.compose", "substructure": "io.compose",
 }
 # Public submodules imported on first use: mb.viewer.show, mb.viewer.to_html.

@@ -345,12 +345,14 @@ def _verdict_line(result, steady):
 
 
 def _largest(result, mode):
-    """The SHOWN joint values (where the model has joints with values) or coordinates that
-    move most in ``mode``, relative to the largest."""
+    """The SHOWN joint values (where the model has joints with values and the mode moves them:
+    beyond MODE_SHOWN_RTOL of the shape's largest coordinate, 1) or coordinates that move most
+    in ``mode``, relative to the largest (a blade bending on its driven hub moves no joint)."""
     names, values = list(result.coordinates), mode.shape
-    if mode.joint_shape:
+    joints = np.concatenate(list(mode.joint_shape.values())) if mode.joint_shape else np.zeros(0)
+    if np.abs(joints).max(initial=0.0) > MODE_SHOWN_RTOL:
         names = [f"{j}[{c}]" if len(v) > 1 else j for j, v in mode.joint_shape.items() for c in range(len(v))]
-        values = np.concatenate(list(mode.joint_shape.values()))
+        values = joints
     top = np.abs(values).max(initial=0.0)
     if top == 0:
         return ""

@@ -5,16 +5,21 @@ import json
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 from ..analysis.modes import format_modes, mode_motion, modes, to_dict
+from ..core.errors import ModelError
 from ..core.files import write_atomically
 from .outputs import Output
 from .parsers import model_of
 
-OUTPUTS = (Output("--html", (".html",)),)
+OUTPUTS = (Output("--html", (".html",)), Output("--plot", (".png", ".svg", ".pdf")))
 
 
 def run(args):
     system = model_of(args)
+    if args.campbell is not None or args.plot is not None:
+        return run_campbell(args, system)
     result = modes(system, equilibrium=args.equilibrium, steady=args.steady)
     if args.html:
         write_html(system, result, args.html)
@@ -24,6 +29,33 @@ def run(args):
         print(format_modes(result))
         if args.html:
             print(f"wrote {args.html}")
+    return 0
+
+
+def run_campbell(args, system):
+    """``--campbell NAME=START:STOP:COUNT`` (analysis/campbell.py): the table or JSON, and
+    the ``--plot`` image."""
+    from ..analysis.campbell import campbell, format_campbell, plot, to_dict
+    from ..core.ranges import parse_range
+
+    if args.campbell is None:
+        raise ModelError("--plot draws a Campbell diagram: give --campbell NAME=START:STOP:COUNT")
+    if args.html or args.equilibrium:
+        raise ModelError("--campbell sweeps steady motions: it takes neither --html nor --equilibrium")
+    if args.orders < 1:
+        raise ModelError(f"--orders must be a positive integer, got {args.orders}")
+    name, (start, stop, count) = parse_range(args.campbell, "--campbell")
+    if count < 2 or not stop > start:
+        raise ModelError(f"--campbell {args.campbell}: an empty range; give START < STOP and COUNT ≥ 2")
+    result = campbell(system, name, np.linspace(start, stop, count), args.orders)
+    if args.plot:
+        plot(result, args.plot)
+    if args.json:
+        print(json.dumps(to_dict(result), indent=2))
+    else:
+        print(format_campbell(result))
+        if args.plot:
+            print(f"wrote {args.plot}")
     return 0
 
 

@@ -227,6 +227,15 @@ def _modes(commands):
     modes.add_argument("--json", action="store_true", help="print one JSON object")
     modes.add_argument("--html", metavar="FILE.html",
                        help="write an HTML page animating each mode in meshcat (a selector per mode)")
+    modes.add_argument("--campbell", metavar="NAME=START:STOP:COUNT",
+                       help="a Campbell diagram: sweep the spin-rate parameter NAME (rad/s; the initial state "
+                            "follows it, e.g. initial: {blade.angle_z_dot: Omega}) over COUNT values, linearize "
+                            "each steady motion, follow each mode by its shape and list where it meets the "
+                            "order lines f = kΩ/2π (implies --steady)")
+    modes.add_argument("--orders", type=int, default=4, metavar="K",
+                       help="with --campbell: the order lines 1P … KP (default 4)")
+    modes.add_argument("--plot", metavar="FILE.png",
+                       help="with --campbell: write the diagram as an image (.png, .svg or .pdf)")
     return modes
 
 

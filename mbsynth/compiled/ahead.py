@@ -50,10 +50,10 @@ GENERAL_ONLY = (  # what a rigid tree's motion leaves out, per group
 # the kernels of parts that evaluate their own M and Q (flexible.py), one for every model: compiled
 # with the others by ``python -m mbsynth.cli.compile_ahead`` (``compile_parts``), else at first use
 PARTS = (
-    ("flexible", "fill", "f1 f1 f1 int64 int64 int64 int64 f2 f1 f2 f2 f4"),
-    ("flexible", "fill_rows", "f2 f2 f2 int64 int64 int64 int64 f2 f1 f2 f2 f4"),
-    ("flexible", "equations", "f1 f1 f1 f2 f1 f2 f2 f4 f2 f1 f2 f1"),
-    ("flexible", "equations", "c1 c1 c1 f2 f1 f2 f2 f4 c2 c1 c2 c1"),  # complex: a linearization's complex step
+    ("flexible", "fill", "f1 f1 f1 int64 int64 int64 int64 i1 f2 f1 f2 f2 f4"),
+    ("flexible", "fill_rows", "f2 f2 f2 int64 int64 int64 int64 i1 f2 f1 f2 f2 f4"),
+    ("flexible", "equations", "f1 f1 f1 i1 f2 f1 f2 f2 f4 f2 f1 f2 f1"),
+    ("flexible", "equations", "c1 c1 c1 i1 f2 f1 f2 f2 f4 c2 c1 c2 c1"),  # complex: a linearization's complex step
 )
 VARIANTS = {"rigid_tree": None, "general": True}  # kernel.RIGID_TREE, kernel.GENERAL
 TIMEOUT = 600  # seconds a helper may take before it is stopped

@@ -2,11 +2,13 @@
 as arrays: one compiled function for every flexible part (model/parts/flexible_body.py,
 whose module docstring gives the formulas; model/flexible/invariants.py the invariants).
 
-``equations(q, qd, g, W, s0, K, D, S, M, Q, Mnu, nu)``: the part's own coordinates q =
-(R, u, η) and velocities q̇ (7 + r each), the gravity vector g (world), the Gram matrix W
+``equations(q, qd, g, axes, W, s0, K, D, S, M, Q, Mnu, nu)``: the part's own coordinates q =
+(R, u, η) and velocities q̇ (7 + r each; u a unit quaternion where ``axes`` is empty, else
+three angles of the intrinsic sequence ``axes`` (3 axis indices), 6 + r each), the gravity
+vector g (world), the Gram matrix W
 ((6 + 4r) square, entries below GRAM_ZERO_RTOL of the largest zeroed), the undeformed first
-moment s0, K_r, D (r × r) and the stiffening S (3 × 3 × r × r) give M_q ((7 + r) square) and
-Q_q (7 + r) in M and Q, and M(η) ((6 + r) square) and ν = (V, ω, η̇) in Mnu and nu (the
+moment s0, K_r, D (r × r) and the stiffening S (3 × 3 × r × r) give M_q (square) and
+Q_q in M and Q, and M(η) ((6 + r) square) and ν = (V, ω, η̇) in Mnu and nu (the
 energies: T = ½ νᵀ M(η) ν). Cost O(r²): W P(η) is formed on the three ω columns only and
 ∂M/∂η_k = Z_k + Z_kᵀ − ∂Σ(η)/∂η_k needs only the rows X_k of W P(η) (Z_k: those rows put
 at the ω rows). q, q̇, g and the outputs may be complex (the complex step of a
@@ -58,18 +60,82 @@ def _cross(a, b, out):
 
 
 @njit(**OPTIONS)
-def equations(q, qd, g, W, s0, K, D, S, M, Q, Mnu, nu):
+def _axis_turn(axis, angle, R):
+    """R_axis(angle), the turn about the body axis ``axis`` (0, 1, 2: x, y, z), into R."""
+    c, s = np.cos(angle), np.sin(angle)
+    j, k = (axis + 1) % 3, (axis + 2) % 3
+    for a in range(3):
+        for b in range(3):
+            R[a, b] = 0.0 * c
+    R[axis, axis] = 1.0 + 0.0 * c
+    R[j, j], R[k, k], R[j, k], R[k, j] = c, c, -s, s
+
+
+@njit(**OPTIONS)
+def _transposed_times(R, v, out):
+    """out = Rᵀ v."""
+    for a in range(3):
+        out[a] = R[0, a] * v[0] + R[1, a] * v[1] + R[2, a] * v[2]
+
+
+@njit(**OPTIONS)
+def _angles_frame(alpha, rates, axes, A, B, c):
+    """The frame turned by the intrinsic sequence ``axes`` (core/kinematics.py
+    ``euler_rotation``): A = R₁(α₁) R₂(α₂) R₃(α₃); B = H(α) (``euler_rate_matrix``: ω = H α̇
+    in the body's axes, columns h₁ = R₃ᵀR₂ᵀe₁, h₂ = R₃ᵀe₂, h₃ = e₃); c = Ḣ α̇ = α̇₁ ḣ₁ + α̇₂ ḣ₂
+    with ḣ₁ = −α̇₃ e₃ × h₁ − α̇₂ R₃ᵀ(e₂ × R₂ᵀe₁), ḣ₂ = −α̇₃ e₃ × h₂ (d(Rᵢᵀ)/dt = −α̇ᵢ[eᵢ]× Rᵢᵀ)."""
+    dt = A.dtype
+    R1, R2, R3 = np.zeros((3, 3), dt), np.zeros((3, 3), dt), np.zeros((3, 3), dt)
+    _axis_turn(axes[0], alpha[0], R1)
+    _axis_turn(axes[1], alpha[1], R2)
+    _axis_turn(axes[2], alpha[2], R3)
+    for a in range(3):
+        for b in range(3):
+            A[a, b] = 0.0 * alpha[0]
+            for m in range(3):
+                for l in range(3):
+                    A[a, b] += R1[a, m] * R2[m, l] * R3[l, b]
+    e1, e2, e3 = np.zeros(3, dt), np.zeros(3, dt), np.zeros(3, dt)
+    e1[axes[0]], e2[axes[1]], e3[axes[2]] = 1.0, 1.0, 1.0
+    vectors = np.zeros((7, 3), dt)
+    t, h1, h2, w, dh1, dh2, x = vectors[0], vectors[1], vectors[2], vectors[3], vectors[4], vectors[5], vectors[6]
+    _transposed_times(R2, e1, t)
+    _transposed_times(R3, t, h1)
+    _transposed_times(R3, e2, h2)
+    for a in range(3):
+        B[a, 0], B[a, 1], B[a, 2] = h1[a], h2[a], e3[a]
+    _cross(e2, t, w)
+    _transposed_times(R3, w, x)
+    _cross(e3, h1, dh1)
+    _cross(e3, h2, dh2)
+    for a in range(3):
+        c[a] = rates[0] * (-rates[2] * dh1[a] - rates[1] * x[a]) - rates[1] * rates[2] * dh2[a]
+
+
+@njit(**OPTIONS)
+def equations(q, qd, g, axes, W, s0, K, D, S, M, Q, Mnu, nu):
     """M_q, Q_q into M, Q; M(η), ν into Mnu, nu (module docstring)."""
     r = K.shape[0]
     n, X, Eo = 6 + r, 6, 6 + 3 * r  # ν's size; W's first row of Ξ_1 and of Φ
     dt = q.dtype
-    eta, eta_dot = q[7:], qd[7:]
-    A, E = np.zeros((3, 3), dt), np.zeros((3, 4), dt)
-    _rotation(q[3:7], A)
-    _rate_matrix(q[3:7], E)
-    for a in range(3):  # ν = (AᵀṘ, 2E u̇, η̇)
+    turns = 4 if axes.shape[0] == 0 else 3  # the orientation's coordinates: a quaternion, or three angles
+    o = 3 + turns  # the first η
+    eta, eta_dot = q[o:], qd[o:]
+    A, B, turn = np.zeros((3, 3), dt), np.zeros((3, turns), dt), np.zeros(3, dt)  # turn: Ḃq̇'s ω part
+    if turns == 4:  # ω = 2E(u) u̇, and Ḃ q̇ = 2E(u̇) u̇ = 0
+        _rotation(q[3:7], A)
+        _rate_matrix(q[3:7], B)
+        for a in range(3):
+            for b in range(4):
+                B[a, b] *= 2.0
+    else:
+        _angles_frame(q[3:6], qd[3:6], axes, A, B, turn)
+    for a in range(3):  # ν = (AᵀṘ, B u̇, η̇)
         nu[a] = A[0, a] * qd[0] + A[1, a] * qd[1] + A[2, a] * qd[2]
-        nu[3 + a] = 2.0 * (E[a, 0] * qd[3] + E[a, 1] * qd[4] + E[a, 2] * qd[5] + E[a, 3] * qd[6])
+        s = 0.0 * qd[0]
+        for b in range(turns):
+            s += B[a, b] * qd[3 + b]
+        nu[3 + a] = s
     for k in range(r):
         nu[6 + k] = eta_dot[k]
     # Y = W P(η) on the ω columns: W[:, 3 + a] + Σ_k η_k W[:, X_k + a], every row of W
@@ -177,69 +243,76 @@ def equations(q, qd, g, W, s0, K, D, S, M, Q, Mnu, nu):
             s -= K[k, l] * eta[l] + D[k, l] * eta_dot[l]
         f[6 + k] += s
     _cross(omega, V, c1)
-    for i in range(n):
+    for i in range(n):  # Ḃq̇ = (−ω × V, turn, 0) moved to the right
         f[i] += Mnu[i, 0] * c1[0] + Mnu[i, 1] * c1[1] + Mnu[i, 2] * c1[2]
-    _mapped(A, E, Mnu, f, mass, M, Q)
+        f[i] -= Mnu[i, 3] * turn[0] + Mnu[i, 4] * turn[1] + Mnu[i, 5] * turn[2]
+    _mapped(A, B, Mnu, f, mass, M, Q)
 
 
 @njit(**OPTIONS)
-def _mapped(A, E, Mnu, f, mass, M, Q):
-    """M_q = Bᵀ M(η) B, Q_q = Bᵀ f with B = blockdiag(Aᵀ, 2E, I); the R–R block m I (A m Aᵀ
-    for a unit quaternion, the unit-norm row holding it there)."""
+def _mapped(A, B, Mnu, f, mass, M, Q):
+    """M_q = B̄ᵀ M(η) B̄, Q_q = B̄ᵀ f with B̄ = blockdiag(Aᵀ, B, I) (B: 2E(u) of a quaternion,
+    H(α) of angles); the R–R block m I (A m Aᵀ: A is orthogonal, a quaternion's kept so by
+    its unit-norm row)."""
     n = f.shape[0]
     r = n - 6
+    turns = B.shape[1]
+    o = 3 + turns  # the first η among the part's coordinates
     dt = f.dtype
     AM = np.zeros((3, n), dt)  # A M(η)[V, :]
-    EM = np.zeros((4, n), dt)  # 2Eᵀ M(η)[ω, :]
+    BM = np.zeros((turns, n), dt)  # Bᵀ M(η)[ω, :]
     for i in range(3):
         for j in range(n):
             AM[i, j] = A[i, 0] * Mnu[0, j] + A[i, 1] * Mnu[1, j] + A[i, 2] * Mnu[2, j]
-    for i in range(4):
+    for i in range(turns):
         for j in range(n):
-            EM[i, j] = 2.0 * (E[0, i] * Mnu[3, j] + E[1, i] * Mnu[4, j] + E[2, i] * Mnu[5, j])
+            BM[i, j] = B[0, i] * Mnu[3, j] + B[1, i] * Mnu[4, j] + B[2, i] * Mnu[5, j]
     for i in range(3):
         for j in range(3):
             M[i, j] = mass if i == j else 0.0
-        for j in range(4):
-            s = 2.0 * (AM[i, 3] * E[0, j] + AM[i, 4] * E[1, j] + AM[i, 5] * E[2, j])
+        for j in range(turns):
+            s = AM[i, 3] * B[0, j] + AM[i, 4] * B[1, j] + AM[i, 5] * B[2, j]
             M[i, 3 + j] = s
             M[3 + j, i] = s
         for k in range(r):
-            M[i, 7 + k] = AM[i, 6 + k]
-            M[7 + k, i] = AM[i, 6 + k]
+            M[i, o + k] = AM[i, 6 + k]
+            M[o + k, i] = AM[i, 6 + k]
         Q[i] = A[i, 0] * f[0] + A[i, 1] * f[1] + A[i, 2] * f[2]
-    for i in range(4):
-        for j in range(4):
-            M[3 + i, 3 + j] = 2.0 * (EM[i, 3] * E[0, j] + EM[i, 4] * E[1, j] + EM[i, 5] * E[2, j])
+    for i in range(turns):
+        for j in range(turns):
+            M[3 + i, 3 + j] = BM[i, 3] * B[0, j] + BM[i, 4] * B[1, j] + BM[i, 5] * B[2, j]
         for k in range(r):
-            M[3 + i, 7 + k] = EM[i, 6 + k]
-            M[7 + k, 3 + i] = EM[i, 6 + k]
-        Q[3 + i] = 2.0 * (E[0, i] * f[3] + E[1, i] * f[4] + E[2, i] * f[5])
+            M[3 + i, o + k] = BM[i, 6 + k]
+            M[o + k, 3 + i] = BM[i, 6 + k]
+        Q[3 + i] = B[0, i] * f[3] + B[1, i] * f[4] + B[2, i] * f[5]
     for k in range(r):
         for l in range(r):
-            M[7 + k, 7 + l] = Mnu[6 + k, 6 + l]
-        Q[7 + k] = f[6 + k]
+            M[o + k, o + l] = Mnu[6 + k, 6 + l]
+        Q[o + k] = f[6 + k]
 
 
 @njit(**OPTIONS)
-def fill(q, qd, out, start, m0, q0, g0, W, s0, K, D, S):
+def fill(q, qd, out, start, m0, q0, g0, axes, W, s0, K, D, S):
     """One flexible part's M_q (row by row from out[m0]) and Q_q (from out[q0]) at its
     coordinates from ``start``, its gravity read from out[g0:g0 + 3] (the generated
-    function's inputs), made positive definite: the part's unit-norm row holds uᵀq̈ = −u̇ᵀu̇,
-    so c u uᵀ q̈ = −c (u̇ᵀu̇) u added to both sides (c: M_q's quaternion block's trace over
-    uᵀu) changes no motion, only that row's multiplier off the manifold, and the kernel
-    then solves the extra coordinates through their mass (kernel._close_reduced)."""
-    n = 7 + K.shape[0]
-    M, Q, Mnu, nu = np.zeros((n, n)), np.zeros(n), np.zeros((n - 1, n - 1)), np.zeros(n - 1)
-    u, u_dot = q[start + 3:start + 7], qd[start + 3:start + 7]
-    equations(q[start:start + n], qd[start:start + n], out[g0:g0 + 3], W, s0, K, D, S, M, Q, Mnu, nu)
-    norm = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]
-    c = (M[3, 3] + M[4, 4] + M[5, 5] + M[6, 6]) / norm
-    rate = u_dot[0] * u_dot[0] + u_dot[1] * u_dot[1] + u_dot[2] * u_dot[2] + u_dot[3] * u_dot[3]
-    for a in range(4):
-        Q[3 + a] -= c * rate * u[a]
-        for b in range(4):
-            M[3 + a, 3 + b] += c * u[a] * u[b]
+    function's inputs). A part turned by a quaternion (``axes`` empty) has M_q made positive
+    definite: its unit-norm row holds uᵀq̈ = −u̇ᵀu̇, so c u uᵀ q̈ = −c (u̇ᵀu̇) u added to both
+    sides (c: M_q's quaternion block's trace over uᵀu) changes no motion, only that row's
+    multiplier off the manifold, and the kernel then solves the extra coordinates through
+    their mass (kernel._close_reduced); one turned by angles has a regular M_q already (away
+    from the angles' singular position)."""
+    n = (7 if axes.shape[0] == 0 else 6) + K.shape[0]
+    M, Q, Mnu, nu = np.zeros((n, n)), np.zeros(n), np.zeros((K.shape[0] + 6, K.shape[0] + 6)), np.zeros(K.shape[0] + 6)
+    equations(q[start:start + n], qd[start:start + n], out[g0:g0 + 3], axes, W, s0, K, D, S, M, Q, Mnu, nu)
+    if axes.shape[0] == 0:
+        u, u_dot = q[start + 3:start + 7], qd[start + 3:start + 7]
+        norm = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]
+        c = (M[3, 3] + M[4, 4] + M[5, 5] + M[6, 6]) / norm
+        rate = u_dot[0] * u_dot[0] + u_dot[1] * u_dot[1] + u_dot[2] * u_dot[2] + u_dot[3] * u_dot[3]
+        for a in range(4):
+            Q[3 + a] -= c * rate * u[a]
+            for b in range(4):
+                M[3 + a, 3 + b] += c * u[a] * u[b]
     for i in range(n):
         out[q0 + i] = Q[i]
         for j in range(n):
@@ -247,10 +320,10 @@ def fill(q, qd, out, start, m0, q0, g0, W, s0, K, D, S):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def fill_rows(q, qd, out, start, m0, q0, g0, W, s0, K, D, S):
+def fill_rows(q, qd, out, start, m0, q0, g0, axes, W, s0, K, D, S):
     """``fill`` per row of q, q̇ and out."""
     for row in range(q.shape[0]):
-        fill(q[row], qd[row], out[row], start, m0, q0, g0, W, s0, K, D, S)
+        fill(q[row], qd[row], out[row], start, m0, q0, g0, axes, W, s0, K, D, S)
 
 
 class Filled:

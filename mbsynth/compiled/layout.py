@@ -54,7 +54,7 @@ def _node(part):
 class Own(NamedTuple):
     """A part whose M and Q flexible.py's kernel writes into the generated outputs: its first
     coordinate, the outputs of its M (row by row) and Q, of its gravity vector (inputs), and
-    its arrays (W, s0, K, D, S: the part's ``kernel_arrays``)."""
+    its arrays (axes, W, s0, K, D, S: the part's ``kernel_arrays``)."""
 
     start: int
     m0: int
@@ -454,7 +454,7 @@ class _Builder:
                  + [e for *_, e in rows] + [e for _, e in b] + inputs + phi)
         m_start = len(Q) + len(own_q) + len(C)
         g_start = m_start + len(M) + len(rows) + len(b)
-        own = [Own(start, m_start + m0, len(Q) + q0, g_start + 3 * k, tuple(part.kernel_arrays[:5]))
+        own = [Own(start, m_start + m0, len(Q) + q0, g_start + 3 * k, tuple(part.kernel_arrays[:6]))
                for k, (part, start, m0, q0) in enumerate(own)]
         gen = dict(gen_q=_ints(list(Q) + own_q), gen_c=_ints(list(C)), gen_mi=_ints([x[0] for x in M]),
                    gen_mj=_ints([x[1] for x in M]), gen_arow=_ints([x[0] for x in rows]),

@@ -7,9 +7,10 @@ FE layer is reported at the key that caused it, with the model file and line."""
 import numpy as np
 
 from ..core.errors import ModelError
-from ..model.parts import FlexibleBody
+from ..model.parts import EulerFlexibleBody, FlexibleBody
 from ..model.parts.flexible_body import coordinates, modal_damping, rayleigh_damping
-from .parts import read_body_initial, read_geometry, read_rotation
+from ..model.parts.flexible_euler_body import coordinates as angle_coordinates
+from .parts import read_body_initial, read_geometry, read_rotation, read_sequence
 from .source import LineDict
 
 BEAM_NUMBERS = ("length", "area", "Iy", "Iz", "J", "E", "density", "G", "nu", "shear_factor")
@@ -25,11 +26,18 @@ def read_flexible_body(builder, name, spec, path):
     stiffening = _read_stiffening(builder, reduction, stress_stiffness, spec.get("stiffening", False),
                                   path + ("stiffening",))
     frames = _read_frames(builder, fe, reduction.interface, spec.get("frames"), path + ("frames",))
-    initial = _read_initial(builder, spec.get("initial"), path + ("initial",), r)
-    q, qd = builder.part_symbols(name, coordinates(r))
+    sequence = read_sequence(builder, spec, path)
+    euler = sequence != "quaternion"
+    initial = _read_initial(builder, spec.get("initial"), path + ("initial",), r, sequence if euler else None)
+    names = angle_coordinates(sequence, r) if euler else coordinates(r)
+    q, qd = builder.part_symbols(name, names)
     geometry = read_geometry(builder, spec.get("geometry"), path + ("geometry",))
+    options = dict(frames=frames, damping=damping, geometry=geometry, initial=initial, stiffening=stiffening)
+    if euler:
+        return _fe_layer(builder, path, EulerFlexibleBody, name, sequence, q, qd, reduction, builder.gravity,
+                         builder.parameter_symbols, **options)
     return _fe_layer(builder, path, FlexibleBody, name, q, qd, reduction, builder.gravity,
-                     builder.parameter_symbols, frames, damping, geometry, initial, stiffening)
+                     builder.parameter_symbols, **options)
 
 
 def _read_fe(builder, spec, path):
@@ -218,12 +226,13 @@ def _read_frames(builder, fe, interface, node, path):
     return frames
 
 
-def _read_initial(builder, node, path, modes):
-    """The frame's pose and rates (as a rigid body's, for the frame's origin) and the modal
-    amplitudes and their rates (lists of the reduction's size)."""
+def _read_initial(builder, node, path, modes, sequence=None):
+    """The frame's pose and rates (as a rigid body's, for the frame's origin; the angles of
+    ``sequence`` where it turns by angles) and the modal amplitudes and their rates (lists
+    of the reduction's size)."""
     node = builder.section(node, path, "initial_flexible_body")
     rigid = LineDict({k: v for k, v in node.items() if k not in AMPLITUDES})
-    values = read_body_initial(builder, rigid, path, planar=False)
+    values = read_body_initial(builder, rigid, path, planar=False, sequence=sequence)
     for key, suffix in zip(AMPLITUDES, ("", "_dot")):
         if key in node:
             if not isinstance(node[key], list) or len(node[key]) != modes:

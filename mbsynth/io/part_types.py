@@ -12,7 +12,7 @@ substructure) is read by substructures.py, not here.
 
 from typing import Callable, NamedTuple
 
-from ..model.parts import EulerBody, FlexibleBody, LagrangianPart, Particle, PlanarBody, RigidBody, Spring
+from ..model.parts import EulerBody, EulerFlexibleBody, FlexibleBody, LagrangianPart, Particle, PlanarBody, RigidBody, Spring
 from .flexible import read_flexible_body
 from .parts import read_lagrangian, read_particle, read_planar_body, read_rigid_body, read_spring
 from .robot import read_robot
@@ -41,7 +41,7 @@ FILE_TYPES = {t.name: t for t in (
     file_type(_OWN_SECTIONS["planar_body"], read_planar_body, PlanarBody),
     file_type(_OWN_SECTIONS["spring"], read_spring, Spring),
     file_type(_OWN_SECTIONS["robot"], read_robot, RigidBody),
-    file_type(_OWN_SECTIONS["flexible_body"], read_flexible_body, FlexibleBody),
+    file_type(_OWN_SECTIONS["flexible_body"], read_flexible_body, FlexibleBody, EulerFlexibleBody),
     file_type(SOLID, read_solid, RigidBody),
 )}
 SECTIONS = {**_OWN_SECTIONS, **{t.section.name: t.section for t in FILE_TYPES.values()}}

@@ -61,9 +61,7 @@ def read_rigid_body(builder, name, spec, path):
     builder.section(spec, path, "rigid_body")
     mass = read_mass(builder, spec, path)
     inertia = read_inertia(builder, spec["inertia"], path + ("inertia",))
-    sequence = spec.get("rotation", "quaternion")
-    if sequence != "quaternion" and sequence not in SEQUENCES:
-        builder.fail(path + ("rotation",), f"rotation {sequence!r}: quaternion or one of {', '.join(SEQUENCES)}")
+    sequence = read_sequence(builder, spec, path)
     euler = sequence != "quaternion"
     q, qd = builder.part_symbols(name, coordinates(sequence) if euler else RigidBody.COORDINATES)
     frames = read_frames(builder, name, spec.get("frames"), path + ("frames",), offsets=True)
@@ -75,6 +73,14 @@ def read_rigid_body(builder, name, spec, path):
                          frames, geometry, initial)
     return RigidBody(name, q, qd, mass, inertia, builder.gravity, builder.parameter_symbols, frames,
                      geometry, initial)
+
+
+def read_sequence(builder, spec, path):
+    """``rotation:`` of a part turned in space: ``quaternion`` or an angle sequence (SEQUENCES)."""
+    sequence = spec.get("rotation", "quaternion")
+    if sequence != "quaternion" and sequence not in SEQUENCES:
+        builder.fail(path + ("rotation",), f"rotation {sequence!r}: quaternion or one of {', '.join(SEQUENCES)}")
+    return sequence
 
 
 def read_particle(builder, name, spec, path):

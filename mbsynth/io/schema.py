@@ -84,6 +84,9 @@ _TYPE_KEY = {kind: _required("type", "string", f"``{kind}``: {meaning}", kind) f
 _MASS = _required("mass", _EXPR + ", ≥ 0", "mass [kg]; zero is allowed (a massless part)", "m")
 _BETWEEN = _required("between", "list of 2 frames", "the two frames joined (at most one on the world)",
                      "[body.tip, world.anchor]")
+_ROTATION = Key("rotation", "string", "``quaternion``, or an intrinsic angle sequence: three different "
+               "axes (xyz, xzy, yxz, yzx, zxy, zyx) or proper Euler (xyx, xzx, yxy, yzy, zxz, zyz)", "zxy",
+               default="quaternion")
 _FORCE_KEYS = (_NAME, Key("type", "string", "the kind of force element", "spring", required=True), _DESCRIPTION)
 # the keys a part type's section written in the type's own module (io/solid.py) shares with those here
 SHARED_KEYS = {key.name: key for key in (_DESCRIPTION, _FRAMES, _GEOMETRY)}
@@ -178,9 +181,7 @@ SECTIONS = {section.name: section for section in (
              _required("inertia", "list of 3, or 3 × 3 list, of " + _EXPRS,
                        "principal moments [Ixx, Iyy, Izz] or the inertia matrix about the centre of mass",
                        "[0.1, 0.1, 0.2]"),
-             Key("rotation", "string", "``quaternion``, or an intrinsic angle sequence: three different "
-                 "axes (xyz, xzy, yxz, yzx, zxy, zyx) or proper Euler (xyx, xzx, yxy, yzy, zxz, zyz)", "zxy", default="quaternion"),
-             _FRAMES, _GEOMETRY,
+             _ROTATION, _FRAMES, _GEOMETRY,
              Key("initial", "mapping (section *initial_rigid_body*)", "initial pose and velocities",
                  "{position: [0, 0, 1]}", default="at rest at the origin"), _DESCRIPTION)),
     Section("particle", "``parts: {NAME: {type: particle, ...}}``",
@@ -221,9 +222,11 @@ SECTIONS = {section.name: section for section in (
     Section("flexible_body", "``parts: {NAME: {type: flexible_body, ...}}``",
             "A flexible body: a finite-element model (``beam`` or ``fe``, exactly one) reduced to a few "
             "coordinates, on a floating frame. Coordinates x, y, z (the frame's origin, which is the FE "
-            "model's origin), the unit quaternion qw, qx, qy, qz of its axes and the reduced coordinates "
-            "eta1, eta2, …; every interface node is a frame ``node_<index>``, whose pose follows the "
-            "node's elastic displacement and rotation.",
+            "model's origin), the unit quaternion qw, qx, qy, qz of its axes (with ``rotation: zxy`` or "
+            "another intrinsic sequence three angles instead, as a rigid body's: the spin axis last makes a "
+            "spinning part's spin angle cyclic, for ``modes --steady`` and Campbell diagrams) and the reduced "
+            "coordinates eta1, eta2, …; every interface node is a frame ``node_<index>``, whose pose follows "
+            "the node's elastic displacement and rotation.",
             (_TYPE_KEY["flexible_body"],
              Key("beam", "mapping (section *flexible_beam*)", "a straight beam from the built-in generator",
                  "{length: 1.0, elements: 20, area: 1e-4, Iy: 1e-9, Iz: 1e-9, J: 2e-9, E: 2.1e11, nu: 0.3, "
@@ -236,6 +239,7 @@ SECTIONS = {section.name: section for section in (
                  "coordinates", "{modal: 0.02}", default="none"),
              Key("stiffening", "true or false", "centrifugal stiffening of a spinning part: the geometric "
                  "stiffness of the spin's member forces (beam parts; docs/flexible.md)", "true", default="false"),
+             _ROTATION,
              Key("frames", "mapping name → node frame (section *flexible_frame*)", "named frames at FE nodes, "
                  "besides the interface nodes' ``node_<index>``", "{tip: {node: 20}}", default="{}"),
              _GEOMETRY,

@@ -82,7 +82,7 @@ class AngleParts:
         self.coordinates = list(system.coordinates)
         index = {c: i for i, c in enumerate(self.coordinates)}
         self.parts = [p for p in system.parts if p.part_type.orientation == ANGLES]
-        self.angles = np.array([[index[f"{p.name}.{c}"] for c in p.coordinates[3:]] for p in self.parts],
+        self.angles = np.array([[index[f"{p.name}.{c}"] for c in p.coordinates[3:6]] for p in self.parts],
                                dtype=np.int64).reshape(-1, 3)
         self.middle = self.angles[:, 1].copy()
         self.proper = np.array([proper_euler(p.sequence) for p in self.parts], dtype=np.bool_)

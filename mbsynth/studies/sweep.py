@@ -38,6 +38,7 @@ from ..core.errors import ModelError, SolveError
 from ..core.expressions import ExpressionError, parse
 from ..core.files import file_format, write_atomically
 from ..core.memo import MEMO
+from ..core.ranges import parse_range
 from ..io import load, loads
 from ..analysis.simulate import simulate
 from ..model.data import workspace
@@ -121,18 +122,6 @@ def parse_ranges(texts):
                              "give each parameter once")
         ranges[name] = spec
     return ranges
-
-
-def parse_range(text):
-    """'NAME=START:STOP:COUNT' -> (name, (start, stop, count))."""
-    name, sep, spec = text.partition("=")
-    parts = spec.split(":")
-    try:
-        if not sep or len(parts) != 3:
-            raise ValueError
-        return name.strip(), (float(parts[0]), float(parts[1]), int(parts[2]))
-    except ValueError:
-        raise ModelError(f"--param {text!r}: expected NAME=START:STOP:COUNT, e.g. k1=10:100:20") from None
 
 
 def read_samples(path):

@@ -113,3 +113,9 @@ def test_craig_bampton_of_a_solid_is_refused_with_the_right_advice(tmp_path, int
             "reduction.method", ["these nodes have 3 (translations)", "Use method: free_interface"])
     status, stderr = check(tmp_path, "fe: {bundle: rod.npz}", "{method: free_interface, interface: [0], modes: 2}")
     assert status == 0, stderr
+
+
+def test_an_unknown_rotation_sequence_is_refused_at_its_key(tmp_path):
+    """``rotation:`` takes quaternion or an intrinsic sequence, as a rigid body's."""
+    refused(tmp_path, f"beam: {BEAM}\n    rotation: xzq", CB, 6, "rotation",
+            ["rotation 'xzq': quaternion or one of xyz"])

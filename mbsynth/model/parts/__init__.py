@@ -12,6 +12,7 @@ here and its line below.
 from .base import LINK_FRAME, Frame, Part
 from .euler_body import EulerBody
 from .flexible_body import FlexibleBody
+from .flexible_euler_body import EulerFlexibleBody
 from .lagrangian import LagrangianPart
 from .particle import Particle
 from .planar_body import PlanarBody
@@ -26,6 +27,7 @@ PART_TYPES = {cls.part_type.name: cls.part_type for cls in (
     PlanarBody,
     Spring,
     FlexibleBody,
+    EulerFlexibleBody,
 )}
 
-__all__ = ["LINK_FRAME", "PART_TYPES", "EulerBody", "FlexibleBody", "Frame", "Part", "LagrangianPart", "Particle", "PlanarBody", "RigidBody", "Spring"]
+__all__ = ["LINK_FRAME", "PART_TYPES", "EulerBody", "EulerFlexibleBody", "FlexibleBody", "Frame", "Part", "LagrangianPart", "Particle", "PlanarBody", "RigidBody", "Spring"]

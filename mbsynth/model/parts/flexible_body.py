@@ -45,6 +45,7 @@ from ...core.tolerances import COMPLEX_STEP, GRAM_ZERO_RTOL
 class PartArrays(NamedTuple):
     """What compiled/flexible.py's kernel reads of a flexible part (``kernel_arrays``)."""
 
+    axes: np.ndarray     # the frame's turns: empty for a quaternion, the 3 axis indices of an angle sequence
     W: np.ndarray        # the Gram matrix, (6 + 4r) square, rounding-level entries zeroed (``_gram``)
     s0: np.ndarray       # the undeformed first moment (3,)
     K: np.ndarray        # K_r (r × r)
@@ -70,6 +71,7 @@ class FlexibleBody(Part):
                                shared_pose=False, drawing=FE_MESH))
     groups = (("x", "y", "z"), ("qw", "qx", "qy", "qz"))
     defaults = {"qw": 1.0}
+    axes = np.zeros(0, np.int64)  # the kernel's sign of a quaternion (PartArrays.axes)
 
     def __init__(self, name, q, qd, reduction, gravity, params, frames=None, damping=None, geometry=(),
                  initial=None, stiffening=None):
@@ -77,10 +79,11 @@ class FlexibleBody(Part):
         if r == 0:
             raise ModelError(f"flexible body '{name}': its reduction has no elastic coordinate: a part without one "
                              "is a rigid_body")
-        if len(q) != 7 + r:
-            raise ModelError(f"flexible body '{name}': {len(q)} coordinate symbols, its reduction needs {7 + r}")
+        names = self.coordinate_names(r)
+        if len(q) != len(names):
+            raise ModelError(f"flexible body '{name}': {len(q)} coordinate symbols, its reduction needs {len(names)}")
         self.reduction, self.gravity = reduction, sp.Matrix(gravity)
-        self.elastic = slice(len(FRAME_COORDINATES), len(FRAME_COORDINATES) + r)
+        self.elastic = slice(len(names) - r, len(names))
         self.invariants = invariants(reduction)
         self.damping = np.zeros((r, r)) if damping is None else np.asarray(damping, float)
         if self.damping.shape != (r, r):
@@ -93,7 +96,7 @@ class FlexibleBody(Part):
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
         self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
         made = [self._node_frame(name, label, spec, q[self.elastic], qd[self.elastic]) for label, spec in named.items()]
-        self.kernel_arrays = PartArrays(_gram(self.invariants), np.array(self.invariants.first_moment, float),
+        self.kernel_arrays = PartArrays(self.axes, _gram(self.invariants), np.array(self.invariants.first_moment, float),
                                         np.ascontiguousarray(reduction.stiffness, float),
                                         np.ascontiguousarray(self.damping), np.ascontiguousarray(self.stiffening),
                                         self.gravity)
@@ -101,12 +104,26 @@ class FlexibleBody(Part):
         self._gravity = compile_function((T_SYMBOL, list(q), list(qd), self._params), [self.gravity],
                                          picked=PARAMETERS)
         self._gravity_last = None  # (p, the gravity vector at p), ``gravity_at``
-        super().__init__(name, coordinates(r), q, qd, None, None, None, None, params, made, geometry, initial)
+        super().__init__(name, names, q, qd, None, None, None, None, params, made, geometry, initial)
+
+    @staticmethod
+    def coordinate_names(modes):
+        """The part's coordinate names with ``modes`` reduced coordinates."""
+        return coordinates(modes)
+
+    def turning(self):
+        """(A, B, c) in sympy: the frame's axes A (world), ω = B u̇ in them over the orientation's
+        coordinates u, and c = Ḃ u̇ (zero for a quaternion: 2E(u̇)u̇ = 0)."""
+        return self.frame_axes(), 2 * body_rate_matrix(self.q[3:7]), sp.zeros(3, 1)
+
+    def frame_axes(self):
+        """The frame's axes A (world) in sympy."""
+        return rotation(self.q[3:7])
 
     def reference(self):
         """(M, Q, T, V) in sympy (the module's formulas): the kernel's test reference."""
         return _equations(self.invariants, self.reduction.stiffness, self.damping, self.stiffening, self.q,
-                          self.qd, self.gravity)
+                          self.qd, self.gravity, self.turning())
 
     def gravity_at(self, t, p):
         """The gravity vector (world) at parameter values p (the last one kept while t does not enter)."""
@@ -128,10 +145,14 @@ class FlexibleBody(Part):
         q, qd = np.asarray(q, float), np.asarray(qd, float)
         g = self.gravity_at(t, p)
         _, _, Mnu, nu = equations(q, qd, g, self.kernel_arrays)
-        W, s0, K = self.kernel_arrays[:3]
-        eta = q[7:]
+        W, s0, K = self.kernel_arrays[1:4]
+        eta = q[self.elastic]
         first = s0 + W[:3, 6 + 3 * len(eta):] @ eta
-        return float(nu @ Mnu @ nu) / 2, float(eta @ K @ eta / 2 - g @ (W[0, 0] * q[:3] + _rotation(q[3:7]) @ first))
+        return float(nu @ Mnu @ nu) / 2, float(eta @ K @ eta / 2 - g @ (W[0, 0] * q[:3] + self.axes_of(q) @ first))
+
+    def axes_of(self, q):
+        """The frame's axes A (numeric) at the part's coordinates q."""
+        return _rotation(q[3:7])
 
     @property
     def working(self):
@@ -139,7 +160,7 @@ class FlexibleBody(Part):
 
     def power(self, t, q, qd, p):
         """The damping's power −η̇ᵀ D η̇."""
-        eta_dot = np.asarray(qd, float)[7:]
+        eta_dot = np.asarray(qd, float)[self.elastic]
         return float(-eta_dot @ self.damping @ eta_dot)
 
     def reads(self, symbols):
@@ -172,7 +193,7 @@ class FlexibleBody(Part):
                                  [where[s] for s in self.q[3:7]], q, qd, params)]
 
     def pose(self, frame):
-        A = rotation(self.q[3:7])
+        A = self.frame_axes()
         return sp.Matrix(self.q[:3]) + _product(A, frame.position), _product(A, frame.rotation)
 
     def angular_velocity(self):
@@ -183,7 +204,7 @@ class FlexibleBody(Part):
         the node's elastic turn's (turned to world axes)."""
         rate = self._turn_rates.get(frame.name) if frame.part == self.name else None
         own = self.angular_velocity()
-        return own if rate is None else own + rotation(self.q[3:7]) * rate
+        return own if rate is None else own + self.frame_axes() * rate
 
     def idle_directions(self, q):
         """The quaternion's own direction: scaling u turns nothing."""
@@ -264,12 +285,14 @@ def _product(*factors):
     return out
 
 
-def _equations(inv, K, D, S, q, qd, gravity):
-    """(M, Q, T, V) of the part in its coordinates q = (R, u, η): the module's formulas."""
+def _equations(inv, K, D, S, q, qd, gravity, turning):
+    """(M, Q, T, V) of the part in its coordinates q = (R, u, η): the module's formulas, the
+    frame turned by ``turning`` = (A, B, c) (``FlexibleBody.turning``)."""
     r = inv.modes
-    u, eta = sp.Matrix(q[3:7]), sp.Matrix(q[7:])
-    R_dot, u_dot, eta_dot = sp.Matrix(qd[:3]), sp.Matrix(qd[3:7]), sp.Matrix(qd[7:])
-    A, E = rotation(u), body_rate_matrix(u)
+    A, B_omega, c = turning
+    o = 3 + B_omega.cols  # the first η
+    eta = sp.Matrix(q[o:])
+    R_dot, u_dot, eta_dot = sp.Matrix(qd[:3]), sp.Matrix(qd[3:o]), sp.Matrix(qd[o:])
     W = _gram(inv)
     # M(η) = Pᵀ W P with P = P0 + Σ η_k P_k (invariants.py): P_k puts I₃ at rows 6 + 3k, columns 3:6
     P0 = np.zeros((6 + 4 * r, 6 + r))
@@ -284,7 +307,7 @@ def _equations(inv, K, D, S, q, qd, gravity):
     M_nu = _polynomial(P0.T @ W @ P0, linear, quadratic, eta)  # M(η), ν = (V, ω, η̇)
     slopes = [_polynomial(linear[k], quadratic[k] + quadratic[:, k], np.zeros((r, r) + linear.shape[1:]), eta)
               for k in range(r)]  # ∂M/∂η_k
-    V, omega = _product(A.T, R_dot), _product(2 * E, u_dot)
+    V, omega = _product(A.T, R_dot), _product(B_omega, u_dot)
     nu = sp.Matrix.vstack(V, omega, eta_dot)
     p = _product(M_nu, nu)
     h = -_product(sp.Matrix.hstack(*(_product(S, nu) for S in slopes)), eta_dot)  # −Ṁν
@@ -297,10 +320,10 @@ def _equations(inv, K, D, S, q, qd, gravity):
     first = _numbers(inv.first_moment).T + _product(_numbers(W[:3, 6 + 3 * r:]), eta)  # s(η)
     F = sp.Matrix.vstack(mass * a, first.cross(a), _product(_numbers(W[6 + 3 * r:, :3]), a)
                          - _product(_numbers(K), eta) - _product(_numbers(D), eta_dot))
-    f = h + F + _product(M_nu[:, :3], omega.cross(V))
-    B = sp.diag(A.T, 2 * E, sp.eye(r))
+    f = h + F + _product(M_nu[:, :3], omega.cross(V)) - _product(M_nu[:, 3:6], c)  # Ḃq̇ = (−ω × V, c, 0)
+    B = sp.diag(A.T, B_omega, sp.eye(r))
     M = _product(B.T, M_nu, B)
-    M[:3, :3] = mass * sp.eye(3)  # A m Aᵀ for a unit quaternion
+    M[:3, :3] = mass * sp.eye(3)  # A m Aᵀ: A orthogonal
     Q = _product(B.T, f)
     T = _product(nu.T, M_nu, nu)[0] / 2
     potential = (_product(eta.T, _numbers(K), eta)[0] / 2
@@ -316,8 +339,9 @@ def equations(q, qd, g, arrays):
     dtype = np.result_type(q, qd, g, float)
     n = len(q)
     M, Q = np.zeros((n, n), dtype), np.zeros(n, dtype)
-    Mnu, nu = np.zeros((n - 1, n - 1), dtype), np.zeros(n - 1, dtype)
-    flexible.equations(*(np.ascontiguousarray(x, dtype) for x in (q, qd, g)), *arrays[:5], M, Q, Mnu, nu)
+    size = 6 + arrays.K.shape[0]  # ν = (V, ω, η̇)
+    Mnu, nu = np.zeros((size, size), dtype), np.zeros(size, dtype)
+    flexible.equations(*(np.ascontiguousarray(x, dtype) for x in (q, qd, g)), *arrays[:6], M, Q, Mnu, nu)
     return M, Q, Mnu, nu
 
 

@@ -16,6 +16,7 @@ from mbsynth.compiled import ahead, flexible
 from mbsynth.model.data import Data
 from mbsynth.model.flexible.reduction import craig_bampton
 from mbsynth.model.parts.flexible_body import FlexibleBody, coordinates, rayleigh_damping
+from mbsynth.model.parts.flexible_euler_body import EulerFlexibleBody, coordinates as angle_coordinates
 
 MODELS = Path(__file__).resolve().parents[3] / "models" / "flexible"
 G = sp.Symbol("g")
@@ -23,9 +24,10 @@ PARAMETERS, VALUES = [G], np.array([9.81])
 STATES = 2  # random states per case
 
 
-def body(r, stiffening, damping, gravity, seed=0):
+def body(r, stiffening, damping, gravity, seed=0, sequence=None):
     """A strip held at node 0 with r fixed-interface modes; a random S symmetric in (a, b)
-    and in (k, l), Rayleigh damping, gravity (0.3, −g, 1.2) with g a parameter."""
+    and in (k, l), Rayleigh damping, gravity (0.3, −g, 1.2) with g a parameter; its frame
+    turned by a quaternion, or by the angles of ``sequence``."""
     reduction = craig_bampton(strip(6), [0], count=r).hold(0)
     rng = np.random.default_rng(seed)
     S = None
@@ -33,20 +35,22 @@ def body(r, stiffening, damping, gravity, seed=0):
         S = rng.normal(size=(3, 3, r, r))
         S = (S + S.transpose(1, 0, 2, 3)) / 2
         S = (S + S.transpose(0, 1, 3, 2)) / 2
-    names = coordinates(r)
+    names = coordinates(r) if sequence is None else angle_coordinates(sequence, r)
     q = [sp.Symbol(f"beam.{c}") for c in names]
     qd = [sp.Symbol(f"beam.{c}_dot") for c in names]
     g = sp.Matrix([0.3, -G, 1.2]) if gravity else sp.zeros(3, 1)
-    return FlexibleBody("beam", q, qd, reduction, g, PARAMETERS, stiffening=S,
-                        damping=rayleigh_damping(reduction, 0.3, 2e-4) if damping else None)
+    options = dict(stiffening=S, damping=rayleigh_damping(reduction, 0.3, 2e-4) if damping else None)
+    if sequence is None:
+        return FlexibleBody("beam", q, qd, reduction, g, PARAMETERS, **options)
+    return EulerFlexibleBody("beam", sequence, q, qd, reduction, g, PARAMETERS, **options)
 
 
-def states(r, rng):
-    """(q, q̇): any quaternion (not of unit norm: the formulas hold for every u), η and
-    rates of the size a motion has."""
+def states(r, rng, turns=4):
+    """(q, q̇): any quaternion (not of unit norm: the formulas hold for every u) or any
+    ``turns`` = 3 angles, η and rates of the size a motion has."""
     for _ in range(STATES):
-        q = np.concatenate([rng.normal(size=7), 1e-2 * rng.normal(size=r)])
-        yield q, rng.normal(size=7 + r)
+        q = np.concatenate([rng.normal(size=3 + turns), 1e-2 * rng.normal(size=r)])
+        yield q, rng.normal(size=3 + turns + r)
 
 
 def relative(found, expected):
@@ -60,10 +64,23 @@ CASES = [(r, s, d, g) for r in (1, 4, 8) for s, d, g in ((False, False, False), 
 @pytest.mark.parametrize("r, stiffening, damping, gravity", CASES)
 def test_the_kernels_M_Q_and_energies_are_the_sympy_formulas(r, stiffening, damping, gravity):
     """M, Q, T, V and the damping's power at random states equal sympy's to 1e-12 relative."""
-    part = body(r, stiffening, damping, gravity)
-    expressions = (*part.reference(), (-sp.Matrix(part.qd[7:]).T * sp.Matrix(part.damping.tolist())
-                                       * sp.Matrix(part.qd[7:]))[0])
-    for q, qd in states(r, np.random.default_rng(r)):
+    same_as_sympy(body(r, stiffening, damping, gravity), r, 4)
+
+
+@pytest.mark.parametrize("sequence, r", [("zxy", 4), ("xyz", 1), ("zxz", 4)])
+def test_the_kernel_turned_by_angles_is_the_sympy_formulas(sequence, r):
+    """A part turned by the angles of ``sequence`` (Tait–Bryan or proper Euler: the kernel's
+    H(α) and Ḣα̇ against core/kinematics.py's sympy euler_rotation and euler_rate_matrix):
+    M, Q, T, V at random states equal sympy's to 1e-12 relative, stiffening, damping and
+    gravity on."""
+    same_as_sympy(body(r, True, True, True, sequence=sequence), r, 3)
+
+
+def same_as_sympy(part, r, turns):
+    """Assert M, Q, T, V and the power of ``part`` equal its sympy form's at random states."""
+    eta_dot = sp.Matrix(part.qd[part.elastic])
+    expressions = (*part.reference(), (-eta_dot.T * sp.Matrix(part.damping.tolist()) * eta_dot)[0])
+    for q, qd in states(r, np.random.default_rng(r), turns):
         values = {s: sp.Float(v) for s, v in zip(part.q + part.qd + PARAMETERS, np.concatenate([q, qd, VALUES]))}
         M_ref, Q_ref, T_ref, V_ref, power = (x.xreplace(values) for x in expressions)
         M_found, Q_found = part.evaluate(0.0, q, qd, VALUES)
@@ -75,17 +92,18 @@ def test_the_kernels_M_Q_and_energies_are_the_sympy_formulas(r, stiffening, damp
         assert part.power(0.0, q, qd, VALUES) == pytest.approx(float(power), rel=1e-12, abs=1e-300)
 
 
-@pytest.mark.parametrize("r", (1, 4))
-def test_the_parts_jacobians_are_the_complex_step_of_its_sympy_form(r):
+@pytest.mark.parametrize("r, sequence", [(1, None), (4, None), (4, "zxy")])
+def test_the_parts_jacobians_are_the_complex_step_of_its_sympy_form(r, sequence):
     """∂(M q̈ − Q)/∂q, ∂q̇ and ∂g of ``derivatives()`` equal the complex step through the
     sympy M and Q (linearization.py's BlockFunction) to 1e-10 relative."""
-    part = body(r, True, True, True)
+    part = body(r, True, True, True, sequence=sequence)
     M, Q, _, _ = part.reference()
-    qdd = [sp.Symbol(f"qdd{i}") for i in range(7 + r)]
+    n = len(part.q)
+    qdd = [sp.Symbol(f"qdd{i}") for i in range(n)]
     reference = BlockFunction(part.q, part.qd, qdd, [], PARAMETERS, M * sp.Matrix(qdd) - Q)
     rng = np.random.default_rng(7)
-    for q, qd in states(r, rng):
-        a = rng.normal(size=7 + r)
+    for q, qd in states(r, rng, n - 3 - r):
+        a = rng.normal(size=n)
         expected = reference.jacobians(0.0, q, qd, a, np.zeros(0), VALUES, [0])
         found = part.derivatives().jacobians(0.0, q, qd, a, np.zeros(0), VALUES, [0])
         for f, e in zip(found, expected):
