@@ -364,8 +364,9 @@ class EventIntegration(ContinuousIntegration):
     def settle(self, t, q, qd, released=frozenset(), switching=frozenset()):
         """(q, q̇⁺, whether anything changed) at an event at t: the impacts, then the
         persistent contacts (module docstring); ``released``: held gaps whose force fell
-        to zero here (they open, as do held ones an impact here left opening); ``switching``: sliding contacts whose slip stops
-        here, sticking ones that reach their friction cone's edge. Records the events."""
+        to zero here (they open, as do held ones an impact here left opening);
+        ``switching``: sliding contacts whose slip stops here, sticking ones that reach
+        their friction cone's edge. Records the events."""
         p, changed = self.base.parameter_values, False
         for _ in range(ROUNDS):
             g, gd = self.gaps.values(t, q, qd, p)
