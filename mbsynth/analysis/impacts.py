@@ -48,6 +48,7 @@ from scipy.optimize import brentq
 
 from . import stepper
 from .continuous import ContinuousIntegration
+from .derivative import Crawl
 from .impulse import Rough, velocity_jump
 from .trajectory import Event
 from ..core.errors import EventError, ModelError, SolveError
@@ -59,6 +60,7 @@ from ..model.unilateral import Gaps, slip_direction, with_active
 
 ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once is chattering (no hang)
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
+INSTANT_EVENTS = 100  # events in a row at one instant: held contacts switch between stick and slip without end
 ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
 
 
@@ -101,6 +103,7 @@ class EventIntegration(ContinuousIntegration):
         self.pending = None
         self.events = []  # trajectory.Event (simulate hands the recorder's list)
         self.idle = 0  # events in a row that changed nothing
+        self.instant = (None, 0)  # the time of the last event and how many in a row came at it
 
     # ---- the phases: the System with the held rows appended
 
@@ -163,6 +166,21 @@ class EventIntegration(ContinuousIntegration):
                              f"integrated cut near a singular position)", constraints=passed)
         return q, qd
 
+    def _reach(self, t_next, q, qd, t_stop):
+        """ContinuousIntegration._reach; where its integrator collapses or crawls while held
+        contacts with friction stick or slide, an EventError there naming them: no interval
+        integrated cut holds their modes (its stages would crawl on through the friction's
+        switching instead)."""
+        try:
+            return super()._reach(t_next, q, qd, t_stop)
+        except (Crawl, SolveError) as stop:
+            rough = [i for i in sorted(self.active) if self.gaps.friction[i] > 0]
+            if isinstance(stop, EventError) or not rough:
+                raise
+            t = self.t_now if self.solver is None else self.solver.t
+            raise self._fail(t, rough, f"the run cannot go on with these contacts held in their friction modes "
+                                       f"(no consistent stick or slip: {stop})") from None
+
     def _check_start(self, t, q, qd):
         """ModelError where the state the run starts from penetrates a gap by more than
         ASSEMBLED_TOL (io/unilateral.py's check of a model file's initial state, for a state
@@ -194,6 +212,12 @@ class EventIntegration(ContinuousIntegration):
             names = [self.gaps.names[i] for i in sorted(pending.closing | pending.released | pending.switching)]
             raise EventError(f"the gaps {', '.join(names)} chatter at t = {t:.9g}: {IDLE_EVENTS} events in a row "
                              f"changed nothing", constraints=names)
+        self.instant = (t, self.instant[1] + 1 if self.instant[0] == t else 1)
+        if self.instant[1] > INSTANT_EVENTS:
+            raise self._fail(t, sorted(pending.switching | pending.closing | pending.released),
+                             f"{INSTANT_EVENTS} events at this instant: held contacts switch between stick and slip "
+                             f"without end (no consistent friction mode: several held contacts share the tangential "
+                             f"load, which their rows do not determine)")
         if changed:
             y = self.form.to_integrator(q, qd_new)
             stepper.move(solver, y, self.f(t, y))

@@ -84,3 +84,34 @@ def test_ramping_push_breaks_a_sticking_block_free_where_the_friction_cone_is_re
     after = np.maximum(traj.t - t_slip, 0.0)
     assert np.abs(s + np.sign(k) * abs(k) * after**3 / (6 * m)).max() < 1e-9
     assert np.abs(off).max() < 1e-12
+
+
+def test_contacts_that_switch_between_stick_and_slip_without_end_stop_the_run_naming_them():
+    """A box on three sticking corners, its centre over the diagonal of two (k2, k3), turned
+    about that diagonal: as it tips, the two held contacts share a tangential load that their
+    rows do not determine, and each switch of one between stick and slip calls for the other
+    at the same instant. The run stops there naming them (no hang)."""
+    system = mb.loads("""name: tipping_box
+parameters: {m: 1.0, a: 0.1, g: 9.81, mu: 0.5, w: 3.0}
+gravity: [0, 0, -g]
+parts:
+  box:
+    type: rigid_body
+    mass: m
+    inertia: [m*a**2/6, m*a**2/6, m*a**2/6]
+    frames:
+      c1: {position: [a/2, a/2, -a/2]}
+      c2: {position: [-a/2, a/2, -a/2]}
+      c3: {position: [a/2, -a/2, -a/2]}
+    initial: {position: [0, 0, a/2], velocity: [-w*a/sqrt(8), -w*a/sqrt(8), 0],
+              angular_velocity: [w/sqrt(2), -w/sqrt(2), 0]}
+contacts:
+  - {name: k1, type: plane, child: box.c1, friction: mu}
+  - {name: k2, type: plane, child: box.c2, friction: mu}
+  - {name: k3, type: plane, child: box.c3, friction: mu}
+""")
+    with pytest.raises(mb.SimulationError) as err:
+        mb.simulate(system, 1.0, rtol=1e-10, atol=1e-10)
+    assert "k2, k3: 100 events at this instant: held contacts switch between stick and slip" in str(err.value)
+    assert [(ev.name, ev.kind) for ev in err.value.trajectory.events[:4]] == \
+        [("k2", "contact"), ("k3", "contact"), ("k2", "stick"), ("k3", "stick")]
