@@ -189,7 +189,7 @@ class ContinuousIntegration(CutIntegration):
             self.next_step = stepper.proposed_step(solver)
         q, qd = self.form.to_state(solver.y)
         self.f.check(solver.t, q, qd)
-        drift, arrays = self._drift(solver.t, q, qd)
+        drift, arrays = self._drift(solver.t, q, qd, taken)
         redo, cap = next_cap(drift, taken, solver.max_step, solver.t_bound - solver.t, self.f.span)
         if redo:
             stepper.rewind(solver, start, cap)
@@ -255,15 +255,16 @@ class ContinuousIntegration(CutIntegration):
                 m = self.projection.measure(q, qd)
             self.crossing.passed(t, m)
 
-    def _drift(self, t, q, qd):
-        """(the state's relative drift off the constraints, its ConstraintArrays or None):
+    def _drift(self, t, q, qd, span):
+        """(the relative drift off the constraints of the state a step of length ``span``
+        reached, its ConstraintArrays or None):
         the kernel's rows where it projects the model, else projection.py's."""
         if self.projection is not None:
             return self.projection.drift(q, qd), None
         if not self.has_rows:
             return 0.0, None
         arrays = self.data.constraint_arrays(t, q, qd, sparse=None)
-        return relative_drift(self.data, t, q, qd, arrays), arrays
+        return relative_drift(self.data, t, q, qd, arrays, span), arrays
 
     def _on_constraints(self, t, q, qd, projected, arrays=None):
         """The state (q, q̇) on the constraints: ``projected``'s where the kernel's projection

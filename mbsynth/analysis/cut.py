@@ -55,7 +55,7 @@ class CutIntegration(Integration):
             if self.stabilization == "projection":
                 self.f.t_failed = t_to
                 arrays = self.data.constraint_arrays(t_to, q_to, qd_to, sparse=None)
-                drift = relative_drift(self.data, t_to, q_to, qd_to, arrays)
+                drift = relative_drift(self.data, t_to, q_to, qd_to, arrays, t_to - t)
                 redo, self.drift_span = next_cap(drift, t_to - t, self.drift_span, interval, interval)
                 if redo:
                     continue

@@ -27,11 +27,13 @@ the state there is ``settle``d:
 A striking contact with Coulomb friction μ sticks or slips through its impact
 (impulse.Rough): Newton's law on its normal, and either its slip rows held at zero
 (stick: |Λ_t| ≤ μ Λ_n) or the tangential impulse μ Λ_n along the impulse stick would need
-(slip: Brach's algebraic impact law). A held contact with friction slides: C = −μ λ_n Tᵀû
-(T its slip rows, û the unit slip; λ_n found exactly, ``_held_motion``), from rest against
-the tangential force λ_t sticking would need where |λ_t| > μ λ_n; its slip stopping is an
-event found on the dense output. Where it would stick (|λ_t| ≤ μ λ_n at rest) the run stops
-with EventError: sticking while a contact holds is not modelled.
+(slip: Brach's algebraic impact law). A held contact with friction sticks or slides
+(``_modes``): sticking, its slip rows T q̇ = 0 are held beside its gap's row (bilateral
+rows, unilateral.with_active) while |λ_t| ≤ μ λ_n, and where μ λ_n − |λ_t| falls to zero
+(an event found on the dense output) it slides from there against λ_t; sliding, C =
+−μ λ_n Tᵀû (T its slip rows, û the unit slip; λ_n found exactly, ``_held_motion``), and
+where its slip stops (an event) it sticks again, or slides on against λ_t where |λ_t| >
+μ λ_n there.
 
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
 A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
@@ -46,6 +48,7 @@ from scipy.optimize import brentq
 
 from . import stepper
 from .continuous import ContinuousIntegration
+from .derivative import Crawl
 from .impulse import Rough, velocity_jump
 from .trajectory import Event
 from ..core.errors import EventError, ModelError, SolveError
@@ -57,13 +60,14 @@ from ..model.unilateral import Gaps, slip_direction, with_active
 
 ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once is chattering (no hang)
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
+INSTANT_EVENTS = 100  # events in a row at one instant: held contacts switch between stick and slip without end
 ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
 
 
 class Pending(NamedTuple):
     """The next event: at ``t`` the open gaps ``closing`` touch, the held ``released`` ones
-    lose their force, the sliding contacts ``switching`` stop sliding (indices into
-    Gaps)."""
+    lose their force, the held contacts with friction ``switching`` stop sliding or reach
+    their friction cone's edge (indices into Gaps)."""
 
     t: float
     closing: frozenset
@@ -99,22 +103,29 @@ class EventIntegration(ContinuousIntegration):
         self.pending = None
         self.events = []  # trajectory.Event (simulate hands the recorder's list)
         self.idle = 0  # events in a row that changed nothing
+        self.instant = (None, 0)  # the time of the last event and how many in a row came at it
 
     # ---- the phases: the System with the held rows appended
 
     def _phase(self, active, sliding):
         """The Data of the active set (``sliding``: its contacts with friction, which slide),
         at the run's parameter values."""
-        key = (active, tuple(sorted((i, tuple(d)) for i, d in sliding.items())))
+        sticking = self._sticking(active, sliding)
+        key = (active, tuple(sorted((i, tuple(d)) for i, d in sliding.items())), sticking)
         data = self.phases.get(key)
         if data is None:
             names = {self.gaps.names[i] for i in active}
             slid = {self.gaps.names[i]: (self.gaps.friction[i], d) for i, d in sliding.items()}
-            data = self.phases[key] = with_active(self.base.system, names, slid).data(self.base.path)
+            stuck = {self.gaps.names[i] for i in sticking}
+            data = self.phases[key] = with_active(self.base.system, names, slid, stuck).data(self.base.path)
         if not np.array_equal(data.parameter_values, self.base.parameter_values):
             defined = self.base.system.definitions or {}
             data.set_parameters({k: v for k, v in self.base.parameters.items() if k not in defined})
         return data
+
+    def _sticking(self, active, sliding):
+        """The held contacts with friction among ``active`` that stick (do not slide)."""
+        return tuple(i for i in sorted(active) if self.gaps.friction[i] > 0 and i not in sliding)
 
     def restart(self):
         if self.active:  # new parameter values at a control sample: the phase's Data follows the run's
@@ -155,6 +166,21 @@ class EventIntegration(ContinuousIntegration):
                              f"integrated cut near a singular position)", constraints=passed)
         return q, qd
 
+    def _reach(self, t_next, q, qd, t_stop):
+        """ContinuousIntegration._reach; where its integrator collapses or crawls while held
+        contacts with friction stick or slide, an EventError there naming them: no interval
+        integrated cut holds their modes (its stages would crawl on through the friction's
+        switching instead)."""
+        try:
+            return super()._reach(t_next, q, qd, t_stop)
+        except (Crawl, SolveError) as stop:
+            rough = [i for i in sorted(self.active) if self.gaps.friction[i] > 0]
+            if isinstance(stop, EventError) or not rough:
+                raise
+            t = self.t_now if self.solver is None else self.solver.t
+            raise self._fail(t, rough, f"the run cannot go on with these contacts held in their friction modes "
+                                       f"(no consistent stick or slip: {stop})") from None
+
     def _check_start(self, t, q, qd):
         """ModelError where the state the run starts from penetrates a gap by more than
         ASSEMBLED_TOL (io/unilateral.py's check of a model file's initial state, for a state
@@ -186,6 +212,12 @@ class EventIntegration(ContinuousIntegration):
             names = [self.gaps.names[i] for i in sorted(pending.closing | pending.released | pending.switching)]
             raise EventError(f"the gaps {', '.join(names)} chatter at t = {t:.9g}: {IDLE_EVENTS} events in a row "
                              f"changed nothing", constraints=names)
+        self.instant = (t, self.instant[1] + 1 if self.instant[0] == t else 1)
+        if self.instant[1] > INSTANT_EVENTS:
+            raise self._fail(t, sorted(pending.switching | pending.closing | pending.released),
+                             f"{INSTANT_EVENTS} events at this instant: held contacts switch between stick and slip "
+                             f"without end (no consistent friction mode: several held contacts share the tangential "
+                             f"load, which their rows do not determine)")
         if changed:
             y = self.form.to_integrator(q, qd_new)
             stepper.move(solver, y, self.f(t, y))
@@ -349,12 +381,15 @@ class EventIntegration(ContinuousIntegration):
     def _watched(self, t, q, qd, reference):
         """{(kind, held gap): a value whose sign change is an event}: ("release", i) its force
         λ; ("switch", i) of a sliding contact, its slip along its ``reference`` direction
-        (T q̇)·û, given on the generalized side as Tᵀû (it stops)."""
+        (T q̇)·û, given on the generalized side as Tᵀû (it stops); of a sticking one, μ λ_n −
+        |λ_t| (it reaches its friction cone's edge)."""
         held = sorted(self.active)
         motion = self._held_motion(t, q, qd, held)
         found = {("release", i): lam for i, lam in zip(held, motion.lam)}
         for i, direction in reference.items():
             found[("switch", i)] = float(direction @ qd)
+        for i, lam_t in motion.tangential.items():
+            found[("switch", i)] = self.gaps.friction[i] * motion.lam[held.index(i)] - float(np.linalg.norm(lam_t))
         return found
 
     # ---- settling the state at an event
@@ -362,8 +397,9 @@ class EventIntegration(ContinuousIntegration):
     def settle(self, t, q, qd, released=frozenset(), switching=frozenset()):
         """(q, q̇⁺, whether anything changed) at an event at t: the impacts, then the
         persistent contacts (module docstring); ``released``: held gaps whose force fell
-        to zero here (they open); ``switching``: sliding contacts whose slip stops
-        here. Records the events."""
+        to zero here (they open, as do held ones an impact here left opening);
+        ``switching``: sliding contacts whose slip stops here, sticking ones that reach
+        their friction cone's edge. Records the events."""
         p, changed = self.base.parameter_values, False
         for _ in range(ROUNDS):
             g, gd = self.gaps.values(t, q, qd, p)
@@ -384,18 +420,18 @@ class EventIntegration(ContinuousIntegration):
         rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
-        active = self._contact_set(t, q, qd, sorted((self.active - released) | set(resting)))
+        leaving = {i for i in self.active if gd[i] > max(rest[i], floor[i])}  # an impact left it opening
+        active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)))
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
             self.events.append(Event(float(t), self.gaps.names[i], "release", 0.0))
         sliding = self._modes(t, q, qd, active, switching)
-        sticking = [i for i in sorted(active) if self.gaps.friction[i] > 0 and i not in sliding]
-        if sticking:
-            raise self._fail(t, sticking, "a held contact with friction sticks here (|λ_t| ≤ μ λ_n): sticking while "
-                                          "it holds is not modelled (sliding is)")
+        sticking = self._sticking(active, sliding)
         for i in sorted(set(sliding) - set(self.sliding)):
             self.events.append(Event(float(t), self.gaps.names[i], "slip", 0.0))
+        for i in sorted(set(sticking) - set(self._sticking(self.active, self.sliding))):
+            self.events.append(Event(float(t), self.gaps.names[i], "stick", 0.0))
         changed |= active != self.active or sliding.keys() != self.sliding.keys()
         self._switch(active, sliding)
         return q, qd, changed
@@ -403,9 +439,11 @@ class EventIntegration(ContinuousIntegration):
     def _modes(self, t, q, qd, active, switching):
         """{held contact that slides from t: its slip's direction} among the held contacts
         with friction ``active``: one sliding goes on sliding unless it is ``switching``
-        (its slip stopped) here; a newly held one slides where it moves. The others would
-        stick where |λ_t| ≤ μ λ_n with their slip rows held, and otherwise slide against λ_t."""
+        (its slip stopped) here; a newly held one slides where it moves; a sticking one
+        ``switching`` (at its friction cone's edge) slides against λ_t. The others stick
+        where |λ_t| ≤ μ λ_n with their slip rows held, and otherwise slide against λ_t."""
         speed, sliding, trial = np.abs(qd).max(initial=0.0), {}, []
+        stuck = self._sticking(self.active, self.sliding)
         for i in sorted(i for i in active if self.gaps.friction[i] > 0):
             moving = slip_direction(self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i), qd, None, speed)
             if i in self.sliding and i not in switching:
@@ -421,7 +459,8 @@ class EventIntegration(ContinuousIntegration):
         for i in trial:
             lam_t, lam_n = motion.tangential[i], motion.lam[held.index(i)]
             size = np.linalg.norm(lam_t)
-            if size > self.gaps.friction[i] * lam_n * (1 + COMPLEMENTARITY_RTOL):
+            breaks = i in switching and i in stuck  # its friction cone's edge reached: it slips from here
+            if breaks or size > self.gaps.friction[i] * lam_n * (1 + COMPLEMENTARITY_RTOL):
                 sliding[i] = -lam_t / size
         return sliding
 

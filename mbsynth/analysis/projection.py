@@ -23,7 +23,7 @@ from ..core.equations import term_scales
 from ..model.data import workspace
 from ..model.evaluation import DENSE_ENTRIES
 from ..core.errors import SolveError
-from ..core.tolerances import (COLUMN_FLOOR, CURVATURE_STEP, DIVISION_GUARD, DRIFT_FLOOR, NEAR_SINGULAR,
+from ..core.tolerances import (COLUMN_FLOOR, CURVATURE_STEP, DIVISION_GUARD, DRIFT_FLOOR, DRIFT_TARGET, NEAR_SINGULAR,
                                PROJECTION_DIVERGED, PROJECTION_RCOND, PROJECTION_RTOL, SPARSE_ACCEPT, VELOCITY_ACCEPT)
 from ..core.memo import MEMO
 
@@ -191,9 +191,11 @@ def project_velocities(data, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, ar
     if not (np.abs(psi[rows]) > tolerance * term_scales(arrays.A, qd)[rows]).any():
         return qd
     A = arrays.A[rows]
+    before = np.abs(qd)
     qd[free] -= _least_change(A[:, free], psi[rows], data.model.coordinate_groups[free])  # ψ is affine in q̇, slope A
     _, psi = data.constraint_residuals(t, q, qd)
-    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, qd)
+    # the step's rounding is that of the rates it subtracted from, not of what is left (at rest: rounding alone)
+    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, np.maximum(before, np.abs(qd)))
     if unmet.any():
         raise SolveError(_unmet(data, psi, "velocities", free),
                          constraints=[n for n, u in zip(np.array(data.model.constraint_names)[rows], unmet) if u])
@@ -202,21 +204,45 @@ def project_velocities(data, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, ar
 
 
 
-def relative_drift(data, t, q, qd, arrays=None):
+def relative_drift(data, t, q, qd, arrays=None, span=None):
     """The largest residual of φ or ψ relative to its row's terms (module docstring), at
     least DRIFT_FLOOR of the row's norm times the largest coordinate (or rate): how far
-    the state lies off the manifold, alike at every scale. ``arrays``: the
-    ConstraintArrays at (q, q̇), if at hand."""
+    the state lies off the manifold, alike at every scale. ``span``: the length of the
+    span integrated to (q, q̇); a drift above DRIFT_TARGET is then judged again with each
+    row's terms at least its norm times how far the span's motion moves a coordinate and
+    a rate (``_span_motion``): a span's drift is the rounding of the motion it integrated,
+    and a state at rest on its rows (a contact that sticks: q̇ = 0 to rounding) is
+    otherwise judged against its own rounding and reads as drifted however small it is.
+    ``arrays``: the ConstraintArrays at (q, q̇), if at hand."""
     data = workspace(data)
     if arrays is None:
         arrays = data.constraint_arrays(t, q, qd, sparse=None)
+    drift = _relative_drift(arrays, q, qd, (0.0, 0.0))
+    if span is None or drift <= DRIFT_TARGET:
+        return drift
+    return _relative_drift(arrays, q, qd, _span_motion(data, t, q, qd, span))
+
+
+def _relative_drift(arrays, q, qd, moved):
+    """``relative_drift`` with each row's terms at least its norm times ``moved``'s
+    (position, rate)."""
     worst = 0.0
-    for residual, x in ((arrays.phi, q), (arrays.psi, qd)):
+    norms = np.asarray(abs(arrays.A).sum(axis=1)).ravel()
+    for residual, x, floor in ((arrays.phi, q, moved[0]), (arrays.psi, qd, moved[1])):
         rows = np.isfinite(residual)
-        scale = term_scales(arrays.A, x, floor=DRIFT_FLOOR)[rows]
+        scale = np.maximum(term_scales(arrays.A, x, floor=DRIFT_FLOOR), floor * norms)[rows]
         relative = np.abs(residual[rows]) / np.maximum(scale, np.finfo(float).tiny)
         worst = max(worst, float(relative.max(initial=0.0)))
     return worst
+
+
+def _span_motion(data, t, q, qd, span):
+    """(position, rate): how far a span of length h ending at (t, q, q̇) moves a
+    coordinate and a rate under the applied forces, from their acceleration a = max |Q| /
+    max |M|: (|q̇|∞ h + a h², a h)."""
+    arrays = data.evaluate(t, q, qd)
+    a = np.abs(arrays.Q).max(initial=0.0) / max(np.abs(arrays.M).max(initial=0.0), np.finfo(float).tiny)
+    return np.abs(qd).max(initial=0.0) * span + a * span**2, a * span
 
 
 def project(data, t, q, qd, fixed_q=None, fixed_qd=None, arrays=None):

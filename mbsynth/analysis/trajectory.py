@@ -48,7 +48,7 @@ class Event(NamedTuple):
     "impact" (a velocity jump, ``impulse`` its Λ), "contact" (the gap closed and holds: a
     persistent contact, ``impulse`` what brought it to rest), "release" (it opened), or at an
     impact of a contact with friction "stick" or "slip" (``impulse`` the tangential |Λ_t|),
-    "slip" too where a held one starts to slide (``impulse`` 0)."""
+    "slip" and "stick" too where a held one starts to slide or to stick (``impulse`` 0)."""
 
     t: float
     name: str

@@ -76,11 +76,12 @@ def gap_row(name, gap, q, qd, params):
     return Constraint.holonomic(name, [gap], q, qd, params)
 
 
-def with_active(system, names, sliding=None):
+def with_active(system, names, sliding=None, sticking=()):
     """``system`` with the rows of its unilaterals named in ``names`` appended to its
     constraints, in the order of ``system.unilaterals``: the System of that active set. A
     contact named in ``sliding`` ({name: (μ, the slip's direction where it has no speed)})
-    carries its Coulomb friction."""
+    carries its Coulomb friction; one named in ``sticking`` also has its slip rows held
+    (T q̇ = 0, bilateral while it sticks), after its gap's row."""
     sliding = sliding or {}
     if not names:
         return system
@@ -92,6 +93,8 @@ def with_active(system, names, sliding=None):
                 row = copy.copy(row)
                 row.coulomb = Sliding(u, *sliding[u.name])
             rows.append(row)
+            if u.name in sticking:
+                rows.append(u.slip)
     return system.with_constraints(rows)
 
 

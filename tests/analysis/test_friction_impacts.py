@@ -87,8 +87,10 @@ def test_rod_striking_on_one_end_gets_the_classical_impulse(mu, expected):
     assert np.abs(_angular_velocity(q[3:], qd[3:]) - [0, omega_after, 0]).max() < 1e-10
 
 
-def test_a_rough_contact_that_comes_to_rest_stops_the_run_naming_it():
-    """A ball dropped 0.1 m with e = 0 rests at its first impact, t = sqrt(0.2/g)."""
+def test_a_rough_contact_that_comes_to_rest_sticks_where_it_landed():
+    """A ball dropped 0.1 m with e = 0 and speed 0.3 along the ground lands at t = sqrt(0.2/g)
+    with normal impulse sqrt(0.2 g); it needs tangential impulse 0.3 ≤ μ Λ_n, so it sticks
+    through the impact, comes to rest, and sticks on the ground where it landed (x = 0.3 t)."""
     system = mb.loads("""name: rough_ball
 gravity: [0, 0, -9.81]
 parts:
@@ -96,10 +98,12 @@ parts:
 contacts:
   - {name: floor, type: plane, child: ball, friction: 0.5}
 """)
-    with pytest.raises(mb.SimulationError) as err:
-        mb.simulate(system, 1.0)
-    assert f"at t = {np.sqrt(0.2 / 9.81):.9g}, floor: a held contact with friction sticks here" in str(err.value)
-    assert err.value.trajectory.events[0].kind == "impact"
+    traj = mb.simulate(system, 1.0)
+    t_land = np.sqrt(0.2 / 9.81)
+    assert [ev.kind for ev in traj.events] == ["impact", "stick", "contact", "stick"]
+    assert all(abs(ev.t - t_land) < 1e-10 for ev in traj.events)
+    assert abs(traj.events[0].impulse - np.sqrt(0.2 * 9.81)) < 1e-10 and abs(traj.events[1].impulse - 0.3) < 1e-12
+    assert np.abs(traj.q[-1] - [0.3 * t_land, 0, 0]).max() < 1e-10 and np.abs(traj.qd[-1]).max() < 1e-12
 
 
 @pytest.mark.parametrize("entry, message", [

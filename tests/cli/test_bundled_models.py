@@ -24,6 +24,8 @@ MODES = {
     "contact/pendulum_stop.yaml": ([], 1, "does not rest at this configuration"),  # released from an angle
     "contact/newtons_cradle.yaml": ([], 1, "does not rest at this configuration"),  # the first ball pulled out
     "contact/block_on_slope.yaml": ([], 1, "does not rest at this configuration"),  # it slides down the slope
+    "contact/rimless_wheel.yaml": ([], 2, NOT_UNIQUE),  # its mass at the hub: its turn is free with no foot held
+    "contact/simplest_walker.yaml": ([], 1, "does not rest at this configuration"),  # it walks
     "flexible/cantilever.yaml": "rests",
     "flexible/slider_crank.yaml": "equilibrium",  # the crank hanging, the rod sagging
     "flexible/spin_up_beam.yaml": "rests",  # at rest at t = 0, the hub held by its servo row
