@@ -676,7 +676,7 @@ def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, mode, qdd, status):
 @njit(**OPTIONS)
 def motion_rates(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general, starts, out):
     """``motion`` at an integrator's stage, its rates written for the integrator: on OK, out
-    (2n less 3 per entry of ``starts``) ← (q̇, v̇), v̇ being q̈ with the four quaternion
+    (2n less one entry per entry of ``starts``) ← (q̇, v̇), v̇ being q̈ with the four quaternion
     accelerations of each rigid body whose quaternion starts at an entry of ``starts``
     replaced by the integrator's three (bodies.velocities; none: v̇ = q̈); else out is left
     as it was. Returns the status."""
