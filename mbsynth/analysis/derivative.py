@@ -68,7 +68,7 @@ class StateDerivative:
     def use(self, engine):
         """Its motion from the Data's parameter values as they are now (new at a control
         sample), ``engine`` the compiled Engine serving the stages (Data.engine) or None."""
-        # the compiled engine's (q̇, q̈) where stage_motion would call it anyway: no Motion per stage
+        # the compiled engine's ẏ (Engine.derivative) where stage_motion would call it anyway: no Motion per stage
         self.fast = None if engine is None or self.baumgarte is not None else engine.derivative
         # a stage the engine declined goes to the KKT path at once
         self.stage_motion = self.data.stage_motion(self.baumgarte, drift=True, compiled=self.fast is None)
@@ -97,8 +97,8 @@ class StateDerivative:
             self.angle_calls += 1
             if self.angle_calls > ANGLES_CRAWL_CALLS:
                 raise self._angles_crawl(t, y)
-        found = None if self.fast is None else self.fast(t, self.form.stage_state(y))  # unique, far from singular
-        if found is None:
+        found = None if self.fast is None else self.fast(t, self.form.stage_state(y), self.form.starts)
+        if found is None:  # the compiled engine declined the stage (or serves none): the Data's stage motion
             if not np.abs(y).max(initial=0.0) <= MAX_STATE:  # a stage of a trial step gone wild (NaN included):
                 return np.full(self.form.size, np.nan)  # its error estimate, NaN, makes the integrator reject the step
             q, qd = self.form.to_state(y)
@@ -107,9 +107,10 @@ class StateDerivative:
             if motion.singular:
                 self.singular.append((t, motion.singular))
                 self.singular_call = self.calls if self.singular_call is None else self.singular_call
+            found = self.form.rates(y, np.concatenate([qd, motion.qdd]))
         if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
             raise Crawl if self.may_crawl else self._stuck(t, y)
-        return self.form.rates(y, found if found is not None else np.concatenate([qd, motion.qdd]))
+        return found
 
     def _on_manifold(self, y):
         """The stage y put on the constraints by ``on_manifold`` (as it is where that declines)."""

@@ -29,6 +29,8 @@ then views and copies, no per-body work.
 import numpy as np
 from numba import njit
 
+from ..compiled.bodies import velocities as _velocities
+
 
 class VelocityForm:
     """The conversions between a run's state (q, q̇) and the integrator's y = (q, v) of
@@ -94,28 +96,6 @@ class VelocityForm:
             return state_rates
         _rates_into(y, state_rates, self.starts)
         return state_rates[:self.size]
-
-
-@njit(cache=True)
-def _velocities(q, rates, starts, v):
-    """v from a state's q and its rates (q̇ or q̈): each body's four quaternion rates r
-    replaced by E(u) r / |u|², the other entries copied. v may be ``rates`` itself, written
-    over: each entry is written at or before the one read, a body's four read first."""
-    i, j = 0, 0  # where v and rates are read from
-    for s in starts:
-        while j < s:
-            v[i] = rates[j]
-            i, j = i + 1, j + 1
-        w, x, y, z = q[s], q[s + 1], q[s + 2], q[s + 3]
-        a, b, c, d = rates[s], rates[s + 1], rates[s + 2], rates[s + 3]
-        scale = 1.0 / (w * w + x * x + y * y + z * z)
-        v[i] = scale * (-x * a + w * b + z * c - y * d)
-        v[i + 1] = scale * (-y * a - z * b + w * c + x * d)
-        v[i + 2] = scale * (-z * a + y * b - x * c + w * d)
-        i, j = i + 3, s + 4
-    while j < rates.size:
-        v[i] = rates[j]
-        i, j = i + 1, j + 1
 
 
 @njit(cache=True)

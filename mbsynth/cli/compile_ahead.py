@@ -3,12 +3,13 @@ kernels (mbsynth.compiled) into the cache ahead of use, on warm-up models read a
 (hence here, on the floor that may read them).
 
 On two cores: first the kernel's largest parts for both variants of ``kernel.motion`` in
-helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows, the
-projection) in a helper (``python -m mbsynth.cli.compile_ahead rigid``) while this process compiles the
-general ones; then each warm-up model here, loading what is missing from the cache (all of
-it, unless a helper failed); then the flexible parts' kernel (ahead.PARTS). Each stage says
-on stderr what it compiles and how far it is (``[k/N]``); when the cache holds the kernels
-already, it says so and only loads them.
+helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows,
+motion_rates of an integrator's stage, the projection) in a helper (``python -m
+mbsynth.cli.compile_ahead rigid``) while this process compiles the general ones; then each
+warm-up model here, loading what is missing from the cache (all of it, unless a helper
+failed); then the flexible parts' kernel (ahead.PARTS). Each stage says on stderr what it
+compiles and how far it is (``[k/N]``); when the cache holds the kernels already, it says so
+and only loads them.
 """
 
 import os
@@ -31,6 +32,7 @@ def warm(texts):
         engine = background.build(system)
         q, qd = system.initial_state()
         engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
+        engine.derivative(0.0, np.concatenate([q, qd]))  # simulate's stages (kernel.motion_rates)
         projection = engine.projection()
         if projection is not None:  # simulate's rows and projections, one by one and fitted (row_fit.py)
             projection(q, qd)

@@ -157,3 +157,26 @@ def reduce_row(c, u, nu, s, out):
         out[i] = c[i]
         out[3 + i] = e[i] / nu
     return -(c[3] * u[0] + c[4] * u[1] + c[5] * u[2] + c[6] * u[3]) * s / nu
+
+
+@njit(**OPTIONS)
+def velocities(q, rates, starts, v):
+    """v from a state's q and its rates (q̇ or q̈), the integrator's form (analysis/velocity_form.py):
+    each rigid body's four quaternion rates r (its quaternion at q[s:s + 4], s in ``starts``)
+    replaced by E(u) r / |u|², the other entries copied. v may be ``rates`` itself, written
+    over: each entry is written at or before the one read, a body's four read first."""
+    i, j = 0, 0  # where v and rates are read from
+    for s in starts:
+        while j < s:
+            v[i] = rates[j]
+            i, j = i + 1, j + 1
+        w, x, y, z = q[s], q[s + 1], q[s + 2], q[s + 3]
+        a, b, c, d = rates[s], rates[s + 1], rates[s + 2], rates[s + 3]
+        scale = 1.0 / (w * w + x * x + y * y + z * z)
+        v[i] = scale * (-x * a + w * b + z * c - y * d)
+        v[i + 1] = scale * (-y * a - z * b + w * c + x * d)
+        v[i + 2] = scale * (-z * a + y * b - x * c + w * d)
+        i, j = i + 3, s + 4
+    while j < rates.size:
+        v[i] = rates[j]
+        i, j = i + 1, j + 1

@@ -43,6 +43,7 @@ from .packing import pack, views
 from .threads import THREADS, pool
 
 EMPTY = np.zeros(0)
+NO_BODIES = np.zeros(0, dtype=np.int64)  # ``derivative``'s ``starts`` of a state in (q, q̇) itself
 CHUNK = 16  # fewest rows a thread takes at a time
 
 
@@ -170,24 +171,34 @@ class Engine:
         with self.lock:
             return self._solved(t, q, qd, bshift, drift, kernel.CHECKED)[1]
 
-    def derivative(self, t, y):
-        """(q̇, q̈) stacked at the state y = (q, q̇) (a contiguous float array), as an
-        integrator's stage wants it (off the manifold: ``motion``'s drift), or None for the
-        exact path: ``motion`` without a Motion."""
-        y = np.ascontiguousarray(y, dtype=float)
-        q, qd = y[:self.n], y[self.n:]
+    def derivative(self, t, state, starts=NO_BODIES):
+        """ẏ at an integrator's stage, the state (q, q̇) stacked in ``state`` (off the manifold:
+        ``motion``'s drift): a new array (q̇, v̇), v̇ being q̈ with the quaternion accelerations
+        of the rigid bodies whose quaternions start at ``starts`` in the integrator's form
+        (analysis/velocity_form.py; none: (q̇, q̈)), or None for the exact path. ``motion``
+        without a Motion: the generated function, then one call into the kernel."""
+        state = np.ascontiguousarray(state, dtype=float)
+        q, qd = state[:self.n], state[self.n:]
+        out = np.empty(state.size - starts.size)  # a body's four quaternion rates are three there
         with self.lock:
-            status, _ = self._solved(t, q, qd, EMPTY, True, self.mode)
-            return np.concatenate((qd, self.W.qdd)) if status == kernel.OK else None
+            delta = self._generated(t, q, qd, True)
+            status = kernel.motion_rates(q, qd, self.gen, EMPTY, *self.buffers, self.mode, delta, self.general,
+                                         starts, out)
+        return out if status == kernel.OK else None
 
     def _solved(self, t, q, qd, bshift, drift, mode):
         """kernel.motion's (status, residual) at (t, q, q̇) in ``mode``, its q̈ and Qc left
-        in this Engine's Work (the caller holds the lock): the generated function, then the
-        kernel, with the state's relative drift where ``drift`` and the model closes loops."""
+        in this Engine's Work (the caller holds the lock)."""
+        delta = self._generated(t, q, qd, drift)
+        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general)
+
+    def _generated(self, t, q, qd, drift):
+        """The generated function's outputs at (t, q, q̇) into ``gen`` (the caller holds the
+        lock); returns kernel.motion's ``drift``: the state's relative drift where ``drift``
+        and the model closes loops, else −1."""
         if self.module is not None:
             self.module.evaluate(float(t), q, qd, self.p, self.gen)
-        delta = self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
-        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general)
+        return self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
 
     def relative_drift(self, q, qd):
         """The state's largest |φ| (the kernel's rows and the extra rows, from ``gen`` as the

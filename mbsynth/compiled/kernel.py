@@ -38,7 +38,7 @@ from numba import njit
 
 from . import banded
 from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
-from .bodies import INLINE, OPTIONS, rate_transpose
+from .bodies import INLINE, OPTIONS, rate_transpose, velocities
 from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
@@ -671,3 +671,19 @@ def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, mode, qdd, status):
     for row in range(q.shape[0]):
         status[row] = motion(q[row], qd[row], gen[row], empty, LI, LF, LX, WI, WF, WX, mode, -1.0, general)[0]
         _copy(qdd_view, qdd[row])
+
+
+@njit(**OPTIONS)
+def motion_rates(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general, starts, out):
+    """``motion`` at an integrator's stage, its rates written for the integrator: on OK, out
+    (2n less one entry per entry of ``starts``) ← (q̇, v̇), v̇ being q̈ with the four quaternion
+    accelerations of each rigid body whose quaternion starts at an entry of ``starts``
+    replaced by the integrator's three (bodies.velocities; none: v̇ = q̈); else out is left
+    as it was. Returns the status."""
+    status = motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general)[0]
+    if status == OK:
+        n = q.shape[0]
+        for c in range(n):
+            out[c] = qd[c]
+        velocities(q, view1(WF, WX, WORK.qdd), starts, out[n:])
+    return status

@@ -35,7 +35,9 @@ from mbsynth.compiled.tree import _components_closed, _null_space_components
 from mbsynth.core import kinematics
 from mbsynth.core.kinematics import body_rate_matrix
 
+from mbsynth.analysis.velocity_form import VelocityForm
 from tests.helpers.compare import rel
+from tests.helpers.rotations import E
 from tests.helpers.literal import literal_2_14
 from tests.helpers.states import random_state
 
@@ -541,6 +543,25 @@ def test_an_integrators_stage_equals_the_motion(all_joints):
     assert np.array_equal(engine.derivative(0.7, strided[::2]), found)
     y[3] = np.nan
     assert engine.derivative(0.7, y) is None
+
+
+def test_an_integrators_stage_in_its_own_form(all_joints):
+    """Engine.derivative with the integrator's form's ``starts`` (analysis/velocity_form.py)
+    gives ẏ = (q̇, v̇) in one call: q̇ as it is, each rigid body's v̇ = E(u) ü / |u|² from
+    System.motion's ü (E by hand, tests/helpers/rotations.py), the other entries q̈."""
+    engine, form = engine_for(all_joints), VelocityForm(all_joints)
+    q, qd = random_state(all_joints, np.random.default_rng(12))
+    qdd = all_joints.motion(0.3, q, qd).qdd
+    found = engine.derivative(0.3, np.concatenate([q, qd]), form.starts)
+    n, bodies = all_joints.n, list(form.starts)
+    assert bodies and found.shape == (form.size,)
+    assert np.array_equal(found[:n], qd)
+    expected, j = [], 0
+    for s in bodies:
+        expected += list(qdd[j:s]) + list(E(q[s:s + 4]) @ qdd[s:s + 4] / (q[s:s + 4] @ q[s:s + 4]))
+        j = s + 4
+    expected += list(qdd[j:])
+    assert rel(found[n:], np.array(expected)) < 1e-13
 
 
 def test_baumgarte_and_parameters(all_joints):

@@ -140,17 +140,22 @@ def test_the_rigid_n_four_bar_passes_its_singular_positions_on_the_exact_motion(
     path.write_text(rigid_n_four_bar(2))
     system = mb.load(path)
     statuses = set()
-    original = kernel.motion
+    originals = kernel.motion, kernel.motion_rates  # motion(): (status, residual); a stage's ẏ: status
 
     def counted(*args):
-        found = original(*args)
+        found = originals[0](*args)
         statuses.add(int(found[0]))
         return found
-    kernel.motion = counted
+
+    def counted_stage(*args):
+        status = originals[1](*args)
+        statuses.add(int(status))
+        return status
+    kernel.motion, kernel.motion_rates = counted, counted_stage
     try:
         trajectory = mb.simulate(system, 8.0, dt=0.05)
     finally:
-        kernel.motion = original
+        kernel.motion, kernel.motion_rates = originals
     assert trajectory.status == "completed" and not trajectory.stats["relaxed_spans"]
     assert len(ref.n_four_bar_singular_times(2, 8.0)) == 8
     assert kernel.OK in statuses and statuses <= {kernel.OK, kernel.NEAR_SINGULAR}
