@@ -47,7 +47,7 @@ from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve, spd_inverse
 from ..core.tolerances import (DIVISION_GUARD, DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL,
                                KERNEL_NULL_RTOL, KERNEL_RESIDUAL_MAX, NEAR_SINGULAR as NEAR_SINGULAR_RTOL,
-                               SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
+                               SCHUR_CONDITION_MAX, SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE, NEAR_SINGULAR = range(7)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
@@ -203,9 +203,10 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
     leaving the rows' Schur matrix A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ (positive semi-definite,
     m_x × m_x) for λ. The motion is unique (the masses are), so dropped directions are
     dependent rows, judged for consistency. Off the manifold (``drift`` ≥ 0) ``motion`` comes
-    here only with rows certified (certify.py): the drift rule keeps every direction, its
-    answer is this plain one, and a direction dropped here (a Schur eigenvalue at rounding
-    level in the mass metric) is left to the exact treatment (NEAR_SINGULAR)."""
+    here only with rows certified (certify.py): the drift rule keeps every direction and its
+    answer is this plain one, which this solve gives to about ε κ of the Schur matrix; a
+    stage whose κ exceeds SCHUR_CONDITION_MAX (a singular position near: κ grows as σ_min⁻²),
+    or with a direction dropped here, is left to the exact treatment (NEAR_SINGULAR)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     Sc, Vc = S[:mx, :mx], vectors[:mx, :mx]
     qx, W = np.zeros(nx), np.zeros((mx, nx))  # Mx⁻¹ F_x; Mx⁻¹ A_xᵀ, a row per extra row
@@ -229,6 +230,8 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
         rhs[x] = total
     values = np.zeros(mx)
     symmetric_eigen(Sc, Vc, values)
+    if drift >= 0.0 and mx and not values.min() * SCHUR_CONDITION_MAX >= values.max():
+        return NEAR_SINGULAR  # its solve's rounding, ε κ, is the exact rule's to avoid
     top = max(np.abs(values).max(), 1.0) if mx else 1.0
     lam[:] = 0.0
     dropped = size = 0.0

@@ -10,24 +10,17 @@ import numpy as np
 import pytest
 
 import mbsynth as mb
+from benchmarks.flexible_startup import model_text
 from mbsynth.compiled import kernel
 
 ROOT = Path(__file__).resolve().parents[3]
-CANTILEVER = ROOT / "models" / "flexible" / "cantilever.yaml"
 SLIDER_CRANK = ROOT / "models" / "flexible" / "slider_crank.yaml"
-
-
-def strip(modes):
-    """models/flexible/cantilever.yaml with ``modes`` fixed-interface modes, the first struck."""
-    text = CANTILEVER.read_text().replace("modes: 4}", f"modes: {modes}}}")
-    rates = ", ".join(["0.05"] + ["0"] * (modes - 1))
-    return mb.loads(text.replace("amplitude_rates: [0.05, 0, 0, 0]", f"amplitude_rates: [{rates}]"),
-                    name=f"strip_{modes}")
 
 
 @pytest.fixture(scope="module")
 def models():
-    return {"strip": strip(20), "slider_crank": mb.load(SLIDER_CRANK)}
+    """The strip: models/flexible/cantilever.yaml with 20 fixed-interface modes, the first struck."""
+    return {"strip": mb.loads(model_text(20), name="strip_20"), "slider_crank": mb.load(SLIDER_CRANK)}
 
 
 @pytest.mark.parametrize("name", ["strip", "slider_crank"])
