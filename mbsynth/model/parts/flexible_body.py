@@ -158,10 +158,15 @@ class FlexibleBody(Part):
                                  [where[s] for s in self.q[3:7]], q, qd, params)]
 
     def pose(self, frame):
-        return self.frame_position(frame), _product(rotation(self.q[3:7]), frame.rotation)
+        return self.frame_position(frame), _product(self._axes, frame.rotation)
 
     def frame_position(self, frame):
-        return sp.Matrix(self.q[:3]) + _product(rotation(self.q[3:7]), frame.position)
+        return sp.Matrix(self.q[:3]) + _product(self._axes, frame.position)
+
+    @functools.cached_property
+    def _axes(self):
+        """A(u), the floating frame's rotation, in sympy (built once: every frame's pose reads it)."""
+        return rotation(self.q[3:7])
 
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:7]) * sp.Matrix(self.qd[3:7])
@@ -171,7 +176,7 @@ class FlexibleBody(Part):
         the node's elastic turn's (turned to world axes)."""
         rate = frame.turn_rate if frame.part == self.name and isinstance(frame, NodeFrame) else None
         own = self.angular_velocity()
-        return own if rate is None else own + rotation(self.q[3:7]) * rate
+        return own if rate is None else own + self._axes * rate
 
     def idle_directions(self, q):
         """The quaternion's own direction: scaling u turns nothing."""
@@ -187,8 +192,9 @@ class NodeFrame:
     and ``turn_rate`` (the Cayley map's angular velocity in the part's axes, None for a node
     without rotation DOFs) sympy expressions in the amplitudes ``eta`` built when first read:
     the sums over r modes cost seconds of sympy at r = 20, and a model reads few of them
-    (joints, outputs and drawings at a node). Equal when its part, name, node and turn are
-    (the reduction is its part's; the drawing ``geometry`` is not compared, as Frame's)."""
+    (joints, outputs and drawings at a node). Equal when what its expressions are made of is
+    (part, name, node, turn, the node's place and rows of Φ, the symbols; the drawing
+    ``geometry`` is not compared, as Frame's)."""
 
     def __init__(self, part, name, spec, reduction, eta, eta_dot):
         node, turn, geometry = (*spec, ())[:3] if isinstance(spec, tuple) else (spec, np.eye(3), ())
@@ -200,7 +206,8 @@ class NodeFrame:
         self._eta, self._eta_dot = list(eta), list(eta_dot)
 
     def content(self):
-        return (self.part, self.name, self.node, freeze(self.turn))
+        return (self.part, self.name, self.node, freeze(self.turn), freeze(self._place), freeze(self._basis),
+                tuple(self._eta), tuple(self._eta_dot))
 
     def __eq__(self, other):
         return type(other) is NodeFrame and self.content() == other.content()
