@@ -12,7 +12,10 @@ outside (the whole process, interpreter start included).
   model) and NUMBA_CACHE_DIR a fresh copy of the compiled kernels as ``python -m
   mbsynth.cli.compile_ahead`` (``make install``) leaves them: a model never seen, on an
   installed mbsynth;
-- warm: the same folders again, as the cold run left them.
+- warm: the same folders again, as the cold run left them;
+- beside them, models/rigid/solid_pendulum.yaml the same way with warm caches: the floor of
+  any run (interpreter, imports, the kernels' loading); and ``mbsynth simulate
+  models/flexible/cantilever.yaml --t-end 1`` with warm caches.
 
 Figures are medians of --runs (each cold run on new folders); on a shared machine the CPU time
 (user + system) is the steadier figure. Writes
@@ -35,6 +38,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 MODEL = ROOT / "models" / "flexible" / "cantilever.yaml"
+CLI = ["simulate", str(MODEL), "--t-end", "1"]  # the bundled 4-mode strip, 1 s, as a user types it
+RIGID = ROOT / "models" / "rigid" / "solid_pendulum.yaml"  # the floor: a rigid pendulum's whole process
 CHILD = """\
 import sys, time
 started = time.perf_counter()
@@ -101,6 +106,18 @@ def installed_kernels():
     return Path(found.stdout.strip())
 
 
+def command(arguments, cache, numba):
+    """(process wall, its CPU time [s]) of ``python -m mbsynth <arguments>`` in a new process."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    started = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "mbsynth", *arguments], env=env, cwd=ROOT, check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+
+
 def timed(path, cache, numba):
     """(process wall, its CPU time (user + system, its helpers included), load, simulate [s],
     output rows) of one new process."""
@@ -135,7 +152,12 @@ def main():
             warm.append(timed(path, cache, numba))
             print(f"run {k + 1}: cold {cold[-1][0]:.2f} s ({cold[-1][1]:.2f} s CPU), warm {warm[-1][0]:.2f} s "
                   f"({warm[-1][1]:.2f} s CPU)", flush=True)
-    rows = [("cold (model caches empty, kernels as installed)", cold), ("warm (the same caches again)", warm)]
+        timed(RIGID, cache, numba)  # its model's caches filled
+        rigid = [timed(RIGID, cache, numba) for _ in range(args.runs)]
+        command(CLI, cache, numba)
+        cli = [command(CLI, cache, numba) for _ in range(args.runs)]
+    rows = [("cold (model caches empty, kernels as installed)", cold), ("warm (the same caches again)", warm),
+            ("rigid pendulum (models/rigid/solid_pendulum.yaml), warm", rigid)]
     lines = [f"# Load + first 0.1 s of a {args.modes}-mode Craig–Bampton beam, new process",
              "",
              f"`benchmarks/flexible_startup.py --runs {args.runs} --modes {args.modes}`, "
@@ -151,6 +173,9 @@ def main():
     for name, found in rows:
         medians = [statistics.median(x[i] for x in found) for i in range(4)]
         lines.append(f"| {name} | " + " | ".join(f"{m:.2f}" for m in medians) + f" | {found[0][4]} |")
+    lines += ["", f"`mbsynth simulate models/flexible/cantilever.yaml --t-end 1` (4 modes), a new process with warm "
+              f"caches, median of {args.runs}: {statistics.median(x[0] for x in cli):.2f} s wall, "
+              f"{statistics.median(x[1] for x in cli):.2f} s CPU."]
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     kernel, motion, stage = map(float, subprocess.run([sys.executable, "-c", PER_CALL], env=env, cwd=ROOT, check=True,
                                                       capture_output=True, text=True).stdout.split())

@@ -7,9 +7,10 @@ starts: rows dependent throughout stay out), dips to about zero and rises again,
 and radians weigh alike and σ_r/σ₁ means the same at every scale. The stages of a
 continuous run rarely come within NEAR_SINGULAR σ₁ of it, where derivative.py lists them,
 so the run also reads σ_r/σ₁ at each accepted step's end (on the constraints). Where one
-end's ratio lies below both its neighbours', the dip lies between them: a golden-section
-search on the positions' cubic Hermite interpolant between the ends (q and q̇ at each)
-finds its bottom, listed as a singular position where the ratio falls below NEAR_SINGULAR
+end's ratio lies below both its neighbours' (by more than DIP_FLOOR, the SVD's rounding: rows
+that do not change, as a clamped part's, give ratios equal but for it), the dip lies between
+them: a golden-section search on the positions' cubic Hermite interpolant between the ends
+(q and q̇ at each) finds its bottom, listed as a singular position where the ratio falls below NEAR_SINGULAR
 there, with the rows of its nearly dependent direction. For models whose A is small enough
 to decompose at every step (WATCH_ENTRIES).
 """
@@ -22,6 +23,7 @@ from ..core.tolerances import NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
 WATCH_ENTRIES = 4096  # the largest A (rows × coordinates) watched: an SVD per step costs little beside the step
 SEARCH_STEPS = 60  # golden-section steps: the bracket shrinks to 0.618^60 ≈ 3e-13 of its width
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+DIP_FLOOR = 1e-12  # σ_r/σ₁ below its neighbours by less than this is the SVD's rounding (~n ε), not a dip
 
 
 class SingularWatch:
@@ -55,7 +57,7 @@ class SingularWatch:
         if not self.rank:
             return None
         self.ends = self.ends[-2:] + [(t, q.copy(), qd.copy(), self._measure(t, q, qd, A))]
-        if len(self.ends) < 3 or not self.ends[1][3] < min(self.ends[0][3], self.ends[2][3]):
+        if len(self.ends) < 3 or not self.ends[1][3] < min(self.ends[0][3], self.ends[2][3]) - DIP_FLOOR:
             return None
         t_star = self._bottom()
         q_star, qd_star = self._state(t_star)

@@ -21,10 +21,14 @@ import numpy as np
 from ..compiled import cache, row_fit
 
 COLD_TIME = "about 2-3 minutes on 2 cores"  # measured: `make install` on a 2-core machine
+WARM_RUN = 0.01  # [s] of each warm-up model's run: a few steps, every function of the run loop called
 
 
 def warm(texts):
-    """Build each model's Engine and run every kernel entry point on it."""
+    """Build each model's Engine and run every kernel entry point on it; then a short run of it,
+    so that the run loop's own numba functions (analysis/stepper.py's dense output,
+    velocity_form.py) are in the cache too, not compiled by a user's first run."""
+    from ..analysis.simulate import simulate
     from ..compiled import background
     from ..io import loads
     for text in texts:
@@ -38,6 +42,7 @@ def warm(texts):
             projection(q, qd)
             count = row_fit.MIN_ROWS
             projection.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
+        simulate(system, WARM_RUN)
 
 
 def main():

@@ -39,6 +39,7 @@ from numba import njit
 from . import banded
 from .assembly import Work, divide_masses, extra_rows, generated, nodes, transports, tree_rhs, tree_rows
 from .bodies import INLINE, OPTIONS, rate_transpose, velocities
+from .certify import rows_certified
 from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
@@ -46,7 +47,7 @@ from .packing import borrowed, fields, view1, view2, view3, view4
 from .tree import factor, solve, spd_inverse
 from ..core.tolerances import (DIVISION_GUARD, DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL,
                                KERNEL_NULL_RTOL, KERNEL_RESIDUAL_MAX, NEAR_SINGULAR as NEAR_SINGULAR_RTOL,
-                               SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
+                               SCHUR_CONDITION_MAX, SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
 
 OK, SINGULAR, INCONSISTENT, NOT_UNIQUE, RESIDUAL, NOT_FINITE, NEAR_SINGULAR = range(7)
 CHECKED, UNCHECKED, REUSED = (np.int64(m) for m in range(3))  # modes of ``motion`` (what a call factors and
@@ -119,7 +120,7 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         for x in range(nx):
             largest = max(largest, Mx[x, x])
         if spd_inverse(inverse, nx, np.full(nx, largest), work):
-            return _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, z0, y, w, z, S,
+            return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S,
                                   vectors, rhs, lam, multipliers, drift)
         if drift >= 0.0:
             return NEAR_SINGULAR  # a singular mass: the exact drift rule's to judge
@@ -195,16 +196,17 @@ def _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multiplie
 
 
 @njit(**OPTIONS)
-def _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
+def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
                    multipliers, drift):
     """``_close`` where the extra coordinates' mass Mx is positive definite (``inverse``: Mx⁻¹,
     tree.spd_inverse): their accelerations q̈_x = Mx⁻¹ (F_x − A_xᵀ λ) are eliminated,
     leaving the rows' Schur matrix A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ (positive semi-definite,
     m_x × m_x) for λ. The motion is unique (the masses are), so dropped directions are
-    dependent rows, judged for consistency. Off the manifold (``drift`` ≥ 0; ``motion``
-    lets only a model without kernel nodes come here, G = 0) the answer is the drift rule's
-    only where no direction of the rows is nearly dependent: ``_rows_certified``, else
-    NEAR_SINGULAR."""
+    dependent rows, judged for consistency. Off the manifold (``drift`` ≥ 0) ``motion`` comes
+    here only with rows certified (certify.py): the drift rule keeps every direction and its
+    answer is this plain one, which this solve gives to about ε κ of the Schur matrix; a
+    stage whose κ exceeds SCHUR_CONDITION_MAX (a singular position near: κ grows as σ_min⁻²),
+    or with a direction dropped here, is left to the exact treatment (NEAR_SINGULAR)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     Sc, Vc = S[:mx, :mx], vectors[:mx, :mx]
     qx, W = np.zeros(nx), np.zeros((mx, nx))  # Mx⁻¹ F_x; Mx⁻¹ A_xᵀ, a row per extra row
@@ -228,8 +230,8 @@ def _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, 
         rhs[x] = total
     values = np.zeros(mx)
     symmetric_eigen(Sc, Vc, values)
-    if drift >= 0.0 and not _rows_certified(values, Mx, inverse):
-        return NEAR_SINGULAR
+    if drift >= 0.0 and mx and not values.min() * SCHUR_CONDITION_MAX >= values.max():
+        return NEAR_SINGULAR  # its solve's rounding, ε κ, is the exact rule's to avoid
     top = max(np.abs(values).max(), 1.0) if mx else 1.0
     lam[:] = 0.0
     dropped = size = 0.0
@@ -242,6 +244,8 @@ def _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, 
         if abs(values[e]) > SCHUR_ZERO_RTOL * top:
             for c in range(mx):
                 lam[nx + c] += coef / values[e] * Vc[c, e]
+        elif drift >= 0.0:
+            return NEAR_SINGULAR
         else:
             dropped += coef * coef
     if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + DIVISION_GUARD):
@@ -253,21 +257,6 @@ def _close_reduced(topology, segs, seg6, factored, Mx, inverse, Ax, xb, Fx, ry, 
         lam[c] = total
     _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
     return OK
-
-
-@njit(**OPTIONS)
-def _rows_certified(values, Mx, inverse):
-    """Whether the equilibrated rows A_e of a Schur matrix S = A_e Mx⁻¹ A_eᵀ (eigenvalues
-    ``values``) certainly have no nearly dependent direction, σ_min ≥ NEAR_SINGULAR σ₁, so
-    that the drift rule of core/equations.py keeps every direction and its answer is the
-    plain solution of (2.12) this kernel gives. From xᵀSx = ‖Mx^-½ A_eᵀx‖²,
-    σ_min² / σ₁² ≥ (λ_min(S) / λ_max(S)) / κ(Mx), and κ₂(Mx) ≤ ‖Mx‖∞ ‖Mx⁻¹‖∞ (symmetric)."""
-    least, top = np.inf, 0.0
-    for e in range(values.shape[0]):
-        least, top = min(least, values[e]), max(top, values[e])
-    if not top > 0.0:
-        return False
-    return least / top >= NEAR_SINGULAR_RTOL ** 2 * _row_sum_norm(Mx) * _row_sum_norm(inverse)
 
 
 @njit(**OPTIONS)
@@ -326,18 +315,6 @@ def _close_banded(Mx, Ax, xb, Fx, lam, patterns, position, width, bands, work, r
             total -= Ax[xc_row[e], c] * lam[nx + xc_row[e]]
         lam[c] = total / Mx[c, c]
     return OK
-
-
-@njit(**OPTIONS)
-def _row_sum_norm(X):
-    """‖X‖∞, the largest row sum of |X|."""
-    top = 0.0
-    for r in range(X.shape[0]):
-        total = 0.0
-        for c in range(X.shape[1]):
-            total += abs(X[r, c])
-        top = max(top, total)
-    return top
 
 
 @njit(**OPTIONS)
@@ -548,13 +525,14 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
     largest is rows dependent on the manifold that the drift split, dropped with its part
     of the right side (least squares: no INCONSISTENT); one between that and
     SCHUR_ZERO_RTOL (a singular position near) is the exact rule's to judge
-    (NEAR_SINGULAR), as is every stage of a model with kernel nodes and extra rows whose
-    masses are uneven (``_uneven_masses``: a millimetre four-bar's bar inertias) or that has
-    extra coordinates too: there the Schur eigenvalues, in the mass metric, do not stand for
-    the rows' singular values that the drift rule judges. A model of extra coordinates alone
-    (planar bodies, energy-defined parts) keeps a stage only where the eigenvalues certify
-    that no direction is nearly dependent (``_rows_certified``), and so the drift rule would
-    keep every one. ``general``: RIGID_TREE for
+    (NEAR_SINGULAR), as is every stage of a model with kernel nodes, extra rows and no extra
+    coordinates whose masses are uneven (``_uneven_masses``: a millimetre four-bar's bar
+    inertias): there the Schur eigenvalues, in the mass metric, do not stand for the rows'
+    singular values that the drift rule judges. A model with extra coordinates (flexible parts,
+    planar bodies, energy-defined parts; rigid bodies beside them or not) keeps a stage only
+    where its equilibrated rows certainly have no nearly dependent direction (certify.py,
+    judged on the rows alone, whatever the masses), so that the drift rule keeps every one
+    and its answer is the plain one. ``general``: RIGID_TREE for
     a Layout of rigid bodies on tree joints only (compiled without the rest), else GENERAL."""
     q, qd, gen = borrowed(q), borrowed(qd), borrowed(gen)  # sliced below; the views carry no count already
     kind, start = view1(LI, LX, LAYOUT.node_kind), view1(LI, LX, LAYOUT.node_q)
@@ -621,14 +599,18 @@ def motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general):
         mu = max(mu, abs(Mx[gen_mi[e], gen_mj[e]]))
     mu = mu if mu > 0 else 1.0
     divide_masses(mu, H, F, Mx, Fx, gen_mi, gen_mj)
-    if drift >= 0.0 and xb.shape[0] and v.shape[0] and (x_coord.shape[0] or _uneven_masses(v, H, Mx)):
-        return NEAR_SINGULAR, 0.0  # the drift rule's to judge (``drift``); without nodes: ``_close``
+    if drift >= 0.0 and xb.shape[0] and v.shape[0] and not x_coord.shape[0] and _uneven_masses(v, H, Mx):
+        return NEAR_SINGULAR, 0.0  # the drift rule's to judge (``drift``)
     tree_rows(q, qd, bshift, kind, start, node_joint, view1(LI, LX, LAYOUT.node_end), parent,
               rows, nu, s, Rs, joints, joint_row, scratch, J, P, rb, rscale, general)
     if general is not None and xb.shape[0]:
         extra_rows(q, qd, gen[o:], bshift, kind, start, nu, s, Rs, joints, view1(LI, LX, LAYOUT.joint_xrow),
                    view2(LI, LX, LAYOUT.joint_xseg), xrow_row, xseg_ptr, xseg_node, gen_rows,
                    patterns[0], patterns[1], scratch, seg7, seg6, xb, xscale, Ax)
+        if drift >= 0.0 and x_coord.shape[0] and not band_width.shape[0] and \
+                not rows_certified(q, qd, kind, start, node_joint, joints, scratch, quat_row, xseg_ptr, xseg_node, seg7,
+                                   xscale, Ax, x_coord):
+            return NEAR_SINGULAR, 0.0  # the drift rule's to judge (certify.py)
     transports(q, start, parent, node_joint, view1(LI, LX, LAYOUT.node_end), transport,
                joints[4], Rs, factored[8])
     tree_rhs(v, k, yoff, rows, F, rb, ry)

@@ -38,6 +38,9 @@ SCHUR_DEPENDENT_RTOL = 1e-14  # kernel.py, off the manifold: Schur eigenvalues b
 # rounding of rows dependent on the manifold, whatever the drift
 DRIFT_MASS_SPREAD = 1e-4  # kernel.py, off the manifold: masses (diagonal, over the largest) spanning more than this
 # send a model's stages to the exact drift rule (the Schur eigenvalues mix masses with the rows' geometry)
+SCHUR_CONDITION_MAX = 1e8  # kernel.py, off the manifold with extra coordinates: a Schur matrix more ill-conditioned
+# than this sends the stage to the exact drift rule (the solve's relative error, about ε κ, would pass 1e-8: near a
+# singular position, where the exact rule's own solution keeps its accuracy, an integrator would crawl on the noise)
 SPLIT_MOVES = 1e4  # kernel.py, off the manifold: a dropped direction of Schur eigenvalue λ may move accelerations
 # up to this times √(λ / the largest) (the drift splits dependent rows by about that much)
 MASS_PROJECTION_RTOL = 1e-14  # compiled/projection.py: largest |φ| left, relative to the largest coordinate

@@ -61,7 +61,7 @@ def _between(builder, node, path):
     ends = [frame_reference(builder, text, path + (i,)) for i, text in enumerate(node)]
     if ends[0][0] is None and ends[1][0] is None:
         builder.fail(path, "both ends are on the world: at least one must be on a part")
-    return [frame.position if part is None else part.pose(frame)[0] for part, frame in ends]
+    return [frame.position if part is None else part.frame_position(frame) for part, frame in ends]
 
 
 def _force(builder, name, spec, path):
@@ -69,7 +69,7 @@ def _force(builder, name, spec, path):
     if part is None:
         builder.fail(path + ("at",), "a force must act on a part, not on the world")
     value = builder.vector(spec["value"], path + ("value",), 3, builder.global_symbols)
-    return applied_force(name, part.pose(frame)[0], value, *_args(builder))
+    return applied_force(name, part.frame_position(frame), value, *_args(builder))
 
 
 def _torque(builder, name, spec, path):

@@ -67,7 +67,7 @@ def expression_output(name, expr):
 
 def frame_output(name, kind, part, frame, q, qd):
     """The world position or velocity of ``frame`` on ``part`` (None: the world)."""
-    position = sp.Matrix(frame.position) if part is None else part.pose(frame)[0]
+    position = sp.Matrix(frame.position) if part is None else part.frame_position(frame)
     if kind == "velocity":
         position = sp.Matrix([time_derivative(x, q, qd) for x in position])
     return Output(name, kind, tuple(position), size=3)

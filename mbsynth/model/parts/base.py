@@ -182,6 +182,10 @@ class Part(Keyed):
         """(position, rotation) of ``frame`` in the world, as sympy expressions."""
         raise NotImplementedError(f"a {self.type_name} part has no frames")
 
+    def frame_position(self, frame):
+        """The world position of ``frame`` (``pose``'s first half), as sympy expressions."""
+        return self.pose(frame)[0]
+
     def angular_velocity(self):
         """The part's angular velocity in world axes (zero for point-like parts)."""
         return sp.zeros(3, 1)

@@ -26,6 +26,7 @@ I + [θ]× to first order — so joints and forces attach to them as to a rigid 
 frame's elastic turn rate (joint rates, actuation and springs along a joint, reaction frames).
 """
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -33,10 +34,11 @@ import sympy as sp
 
 from ..constraints.base import Constraint
 from ...core.errors import ModelError
+from ...core.values import freeze
 from ...core.kinematics import body_rate_matrix, rotation, world_rate_matrix
 from ...symbolic.derive import PARAMETERS, T_SYMBOL, compile_function, positions
 from ..flexible.invariants import invariants
-from .base import Frame, Part
+from .base import Part
 from .part_type import EXTRA_NODE, FE_MESH, PartType, QUATERNION, check
 from .rigid_body import COORDINATES as FRAME_COORDINATES, _unit_norm_rows
 from ...core.tolerances import COMPLEX_STEP, GRAM_ZERO_RTOL
@@ -94,8 +96,8 @@ class FlexibleBody(Part):
         named = {f"node_{j}": j for j in reduction.interface}
         named.update(frames or {})
         self.frame_nodes = {label: spec[0] if isinstance(spec, tuple) else spec for label, spec in named.items()}
-        self._turn_rates = {}  # frame name -> its elastic turn's angular velocity in the part's axes
-        made = [self._node_frame(name, label, spec, q[self.elastic], qd[self.elastic]) for label, spec in named.items()]
+        made = [NodeFrame(name, label, spec, reduction, q[self.elastic], qd[self.elastic])
+                for label, spec in named.items()]
         self.kernel_arrays = PartArrays(self.axes, _gram(self.invariants), np.array(self.invariants.first_moment, float),
                                         np.ascontiguousarray(reduction.stiffness, float),
                                         np.ascontiguousarray(self.damping), np.ascontiguousarray(self.stiffening),
@@ -169,22 +171,6 @@ class FlexibleBody(Part):
     def derivatives(self):
         return _Derivatives(self)
 
-    def _node_frame(self, part, label, spec, eta, eta_dot):
-        node, turn, geometry = (*spec, ())[:3] if isinstance(spec, tuple) else (spec, np.eye(3), ())
-        rows = self.reduction.node_rows(node)  # raises for a node the FE model lacks
-        Phi = np.asarray(self.reduction.basis[rows], float)
-        position = sp.Matrix(self.reduction.fe.nodes[node]) + _combination(Phi[:3], eta)
-        if len(rows) == 6:
-            half, half_rate = _combination(Phi[3:] / 2, eta), _combination(Phi[3:] / 2, eta_dot)
-            scale = 1 + sp.Add(*(x * x for x in half))
-            elastic = _cayley(half, scale)
-            # the Cayley map's angular velocity (Rodrigues parameters g = θ/2): 2(ġ + g × ġ)/(1 + gᵀg)
-            self._turn_rates[label] = 2 * (half_rate + half.cross(half_rate)) / scale
-        else:
-            elastic = sp.eye(3)
-        rotated = elastic if np.array_equal(turn, np.eye(3)) else _product(elastic, _numbers(turn))
-        return Frame(part, label, position, rotated, tuple(geometry))
-
     def own_constraints(self, q, qd, params):
         """The frame's quaternion has unit norm (the rigid body's row, rigid_body.py)."""
         where = positions(q, qd)
@@ -193,8 +179,15 @@ class FlexibleBody(Part):
                                  [where[s] for s in self.q[3:7]], q, qd, params)]
 
     def pose(self, frame):
-        A = self.frame_axes()
-        return sp.Matrix(self.q[:3]) + _product(A, frame.position), _product(A, frame.rotation)
+        return self.frame_position(frame), _product(self._axes, frame.rotation)
+
+    def frame_position(self, frame):
+        return sp.Matrix(self.q[:3]) + _product(self._axes, frame.position)
+
+    @functools.cached_property
+    def _axes(self):
+        """``frame_axes()``, built once: every frame's pose reads it."""
+        return self.frame_axes()
 
     def angular_velocity(self):
         return 2 * world_rate_matrix(self.q[3:7]) * sp.Matrix(self.qd[3:7])
@@ -202,15 +195,81 @@ class FlexibleBody(Part):
     def frame_angular_velocity(self, frame):
         """The floating frame's angular velocity plus, for a frame at a node with rotation DOFs,
         the node's elastic turn's (turned to world axes)."""
-        rate = self._turn_rates.get(frame.name) if frame.part == self.name else None
+        rate = frame.turn_rate if frame.part == self.name and isinstance(frame, NodeFrame) else None
         own = self.angular_velocity()
-        return own if rate is None else own + self.frame_axes() * rate
+        return own if rate is None else own + self._axes * rate
 
     def idle_directions(self, q):
         """The quaternion's own direction: scaling u turns nothing."""
         direction = np.zeros((len(self.coordinates), 1))
         direction[3:7, 0] = q[3:7] / np.linalg.norm(q[3:7])
         return direction
+
+
+class NodeFrame:
+    """A frame at FE node ``spec`` (a node, or (node, rotation 3 × 3[, drawing geometry])) of
+    part ``part`` with reduction ``reduction``: Frame's fields (base.py), its ``position``
+    x_j + Φ_j η, ``rotation`` (the Cayley map of the module docstring, then the given turn)
+    and ``turn_rate`` (the Cayley map's angular velocity in the part's axes, None for a node
+    without rotation DOFs) sympy expressions in the amplitudes ``eta`` built when first read:
+    the sums over r modes cost seconds of sympy at r = 20, and a model reads few of them
+    (joints, outputs and drawings at a node). Equal when what its expressions are made of is
+    (part, name, node, turn, the node's place and rows of Φ, the symbols; the drawing
+    ``geometry`` is not compared, as Frame's)."""
+
+    def __init__(self, part, name, spec, reduction, eta, eta_dot):
+        node, turn, geometry = (*spec, ())[:3] if isinstance(spec, tuple) else (spec, np.eye(3), ())
+        self.rows = reduction.node_rows(node)  # raises for a node the FE model lacks
+        self.part, self.name, self.node, self.geometry = part, name, node, tuple(geometry)
+        self.turn = np.array(turn, float)
+        self._basis = np.asarray(reduction.basis[self.rows], float)
+        self._place = np.asarray(reduction.fe.nodes[node], float)
+        self._eta, self._eta_dot = list(eta), list(eta_dot)
+
+    def content(self):
+        return (self.part, self.name, self.node, freeze(self.turn), freeze(self._place), freeze(self._basis),
+                tuple(self._eta), tuple(self._eta_dot))
+
+    def __eq__(self, other):
+        return type(other) is NodeFrame and self.content() == other.content()
+
+    def __hash__(self):
+        return hash(self.content())
+
+    @property
+    def label(self):
+        return f"{self.part}.{self.name}"
+
+    @functools.cached_property
+    def position(self):
+        return sp.Matrix(self._place.tolist()) + _combination(self._basis[:3], self._eta)
+
+    @functools.cached_property
+    def _cayley(self):
+        """(the elastic rotation, its angular velocity in the part's axes or None)."""
+        if len(self.rows) != 6:
+            return sp.eye(3), None
+        # Rodrigues parameters g = θ/2; the angular velocity 2(ġ + g × ġ)/(1 + gᵀg)
+        half, half_rate = _combination(self._basis[3:] / 2, self._eta), _combination(self._basis[3:] / 2, self._eta_dot)
+        scale = 1 + sp.Add(*(x * x for x in half))
+        return _cayley(half, scale), 2 * (half_rate + half.cross(half_rate)) / scale
+
+    @functools.cached_property
+    def rotation(self):
+        elastic = self._cayley[0]
+        return elastic if np.array_equal(self.turn, np.eye(3)) else _product(elastic, _numbers(self.turn))
+
+    @property
+    def turn_rate(self):
+        return self._cayley[1]
+
+    @functools.cached_property
+    def constant_rotation(self):
+        """``rotation`` as floats where it holds no amplitude (a node without rotation DOFs,
+        or one the reduction holds: all its rows of Φ zero), else None (Frame's)."""
+        if len(self.rows) == 6 and self._basis[3:].any():
+            return None
+        return np.array(self.turn)
 
 
 def coordinates(modes):
