@@ -107,6 +107,10 @@ def _check(commands):
     check.add_argument("--coordinates", choices=("joints", "maximal"), default="joints",
                        help="report accelerations per joint (default, where the model has joints) or per "
                             "coordinate of the parts ('maximal')")
+    check.add_argument("--t-end", type=float, default=1.0,
+                       help="the run's length [s] for the stiffness check (default 1): where the highest "
+                            "frequency of the flexible parts gives more periods than that check allows, "
+                            "an implicit method (--method Radau) is suggested")
     return check
 
 
