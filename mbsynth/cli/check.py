@@ -30,8 +30,8 @@ def run(args):
 def format_stiff(stiff, t_end):
     """The line suggesting an implicit method (analysis/stiffness.py)."""
     return (f"  stiff: highest frequency {stiff['omega']:.4g} rad/s (part {stiff['part']}), {stiff['periods']:.0f} "
-            f"periods in {t_end:g} s (> {stiff['threshold']}): an explicit method's steps crawl; "
-            f"simulate with --method {stiff['method']}")
+            f"periods in {t_end:g} s (> {stiff['threshold']}): an explicit method's steps follow that mode; "
+            f"where it is quasi-static, simulate with --method {stiff['method']}, which steps over it")
 
 
 def format_check(report, path, coordinates="joints"):
