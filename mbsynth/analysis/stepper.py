@@ -7,11 +7,12 @@ the next but its state (t, y), y's derivative f and its next step's size h_abs, 
 on from a moved state exactly as a new one started there with that first step would (the
 test of this module checks it bit for bit against scipy's own constructor). Radau IIA
 (MOVABLE, for stiff models) carries besides its Newton matrix — the Jacobian J and its LU
-factors at the step size — and its last step's collocation polynomial, the Newton iteration's
-first guess: a move by a projection (the drift, within the tolerance) leaves both good enough,
-so it goes on from the moved state too; where its step size is set here its factors are made
-afresh. This is the only module that writes an OdeSolver's attributes or reads its internals (DOP853's extra
-stages and interpolant, ``interpolate``); ``simulate`` calls these functions and ``step()``.
+factors at the step size — and its last step's collocation polynomial, the Newton
+iteration's first guess: a move by a projection (the drift, within the tolerance) leaves
+both good enough, so it goes on from the moved state too; where its step size is set here
+its factors are made afresh. This is the only module that writes an OdeSolver's attributes
+or reads its internals (DOP853's extra stages and interpolant, ``interpolate``); ``simulate``
+calls these functions and ``step()``.
 """
 
 import numpy as np

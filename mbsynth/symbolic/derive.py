@@ -166,9 +166,8 @@ def turn_residual(phi):
     if not angles:
         return phi
     phi = sp.sympify(phi)
-    coefficients = [sp.diff(phi, s) for s in angles]
-    sizes = {abs(c) for c in coefficients if c.is_number}
-    if len(sizes) != 1 or len(coefficients) != sum(1 for c in coefficients if c.is_number) or 0 in sizes:
+    sizes = {abs(sp.diff(phi, s)) for s in angles}
+    if len(sizes) != 1 or not all(c.is_number and c != 0 for c in sizes):
         return expand_joint_values(phi)
     period = 2 * sp.pi * sizes.pop()
     value = expand_joint_values(phi)
