@@ -1,5 +1,5 @@
 """The continuous strategy of the run loop: every run with ``stabilization="projection"``
-and an explicit Runge–Kutta pair (RK23, RK45, DOP853).
+and an explicit Runge–Kutta pair (RK23, RK45, DOP853) or Radau IIA (stepper.MOVABLE).
 
 The steps are chosen by the error control alone, up to the next control sample or the end;
 each accepted step is put back on the constraints and the integrator goes on from there,
@@ -68,7 +68,7 @@ class ContinuousIntegration(CutIntegration):
     def fits(method, stabilization):
         """Whether a run with the OdeSolver class ``method`` and ``stabilization`` can be
         integrated continuously."""
-        return issubclass(method, stepper.RESUMABLE) and stabilization == "projection"
+        return issubclass(method, stepper.MOVABLE) and stabilization == "projection"
 
     def __init__(self, *args):
         self.passed = None  # the states at the times the last step passed (Passed)
@@ -190,7 +190,7 @@ class ContinuousIntegration(CutIntegration):
         q, qd = self.form.to_state(solver.y)
         self.f.check(solver.t, q, qd)
         drift, arrays = self._drift(solver.t, q, qd, taken)
-        redo, cap = next_cap(drift, taken, solver.max_step, solver.t_bound - solver.t, self.f.span)
+        redo, cap = next_cap(drift, taken, solver.max_step, solver.t_bound - solver.t, self.f.span, self.drift_target)
         if redo:
             stepper.rewind(solver, start, cap)
             self.steps -= 1

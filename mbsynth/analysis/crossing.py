@@ -29,10 +29,15 @@ NAMED_SHARE = 0.1  # a crossing lists the rows whose weight in its least directi
 PRE_STEP = 0.1  # t* farther than θ* h by this share of h: a step first ends at t* − θ* h
 
 
+RADAU_NODES = ((4 - 6**0.5) / 10, (4 + 6**0.5) / 10, 1.0)  # Radau IIA (order 5)'s collocation points
+
+
 def nodes(method):
-    """The fractions of a step of ``method`` (an explicit Runge–Kutta pair) at which it
-    evaluates a stage (C, and C_EXTRA for its interpolant), with 0 and 1, sorted."""
-    return np.unique(np.concatenate([[0.0, 1.0], method.C, getattr(method, "C_EXTRA", [])]))
+    """The fractions of a step of ``method`` (an explicit Runge–Kutta pair, or Radau IIA) at
+    which it evaluates a stage (C, and C_EXTRA for its interpolant; Radau's collocation
+    points), with 0 and 1, sorted."""
+    stages = getattr(method, "C", RADAU_NODES)
+    return np.unique(np.concatenate([[0.0, 1.0], stages, getattr(method, "C_EXTRA", [])]))
 
 
 class Crossing:

@@ -56,7 +56,8 @@ class CutIntegration(Integration):
                 self.f.t_failed = t_to
                 arrays = self.data.constraint_arrays(t_to, q_to, qd_to, sparse=None)
                 drift = relative_drift(self.data, t_to, q_to, qd_to, arrays, t_to - t)
-                redo, self.drift_span = next_cap(drift, t_to - t, self.drift_span, interval, interval)
+                redo, self.drift_span = next_cap(drift, t_to - t, self.drift_span, interval, interval,
+                                                     self.drift_target)
                 if redo:
                     continue
                 q_on, qd_on = project(self.data, t_to, q_to, qd_to, arrays=arrays)

@@ -41,6 +41,7 @@ COLLAPSE_CALLS = 1000  # ~80 steps of an explicit pair
 CRAWL_CALLS = 240
 RELAXED_CRAWL_CALLS = 1000
 STUCK_CALLS = 20000  # an interval that crawls this long near a singular position at the loosest tolerance stops
+JACOBIAN_STEP = 1.5e-8  # √ε: a forward difference's truncation and rounding errors balance (per unit of y)
 ANGLES_CRAWL_CALLS = 5000  # ~400 steps of an explicit pair within ANGLES_NEAR in one interval: a body that
 # passes by needs a few, one that falls onto the position (a bicycle lying down) never gets past it
 
@@ -56,6 +57,7 @@ class StateDerivative:
     def __init__(self, data, baumgarte, form):
         self.data, self.n, self.baumgarte, self.form = data, data.model.n, baumgarte, form
         self.evaluations = 0
+        self.jacobians = 0  # Jacobians given to an implicit integrator (``jacobian``)
         self.t_failed = float("nan")  # where the run was when it failed: its last stage or state looked at
         self.non_unique = False
         self.singular = []  # (t, rows) of the interval's stages near a singular position
@@ -97,20 +99,55 @@ class StateDerivative:
             self.angle_calls += 1
             if self.angle_calls > ANGLES_CRAWL_CALLS:
                 raise self._angles_crawl(t, y)
+        rates = self._rates(t, y, True)
+        if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
+            raise Crawl if self.may_crawl else self._stuck(t, y)
+        return rates
+
+    def _rates(self, t, y, noted=False):
+        """ẏ at the stage (t, y): the compiled engine's (in the integrator's form) where it
+        covers the state (unique, far from singular), else the stage motion's, whose
+        non-unique and singular stages are noted where ``noted``; NaN where y is beyond
+        MAX_STATE."""
         found = None if self.fast is None else self.fast(t, self.form.stage_state(y), self.form.starts)
-        if found is None:  # the compiled engine declined the stage (or serves none): the Data's stage motion
-            if not np.abs(y).max(initial=0.0) <= MAX_STATE:  # a stage of a trial step gone wild (NaN included):
-                return np.full(self.form.size, np.nan)  # its error estimate, NaN, makes the integrator reject the step
-            q, qd = self.form.to_state(y)
-            motion = self.stage_motion(t, q, qd)
+        if found is not None:
+            return found
+        if not np.abs(y).max(initial=0.0) <= MAX_STATE:  # a stage of a trial step gone wild (NaN included):
+            return np.full(self.form.size, np.nan)  # its error estimate, NaN, makes the integrator reject the step
+        q, qd = self.form.to_state(y)
+        motion = self.stage_motion(t, q, qd)
+        if noted:
             self.non_unique |= not motion.unique
             if motion.singular:
                 self.singular.append((t, motion.singular))
                 self.singular_call = self.calls if self.singular_call is None else self.singular_call
-            found = self.form.rates(y, np.concatenate([qd, motion.qdd]))
-        if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
-            raise Crawl if self.may_crawl else self._stuck(t, y)
-        return found
+        return self.form.rates(y, np.concatenate([qd, motion.qdd]))
+
+    def jacobian(self, t, y):
+        """∂ẏ/∂y at the state (t, y), the Newton matrix of an implicit integrator (stepper.IMPLICIT):
+        forward differences of ``_rates`` — the compiled kernel's motion where it covers the
+        state — one evaluation per entry of y, each moved by JACOBIAN_STEP times its size (at
+        least 1). Counted in ``evaluations`` and ``jacobians``. Raises SolveError naming the
+        coordinates whose columns are not finite (a motion with no derivative there)."""
+        y = np.array(y, dtype=float)
+        base = self._rates(t, y).copy()
+        J = np.empty((y.size, y.size))
+        moved = y.copy()
+        for j in range(y.size):
+            moved[j] = y[j] + JACOBIAN_STEP * max(abs(y[j]), 1.0)
+            J[:, j] = (self._rates(t, moved) - base) / (moved[j] - y[j])
+            moved[j] = y[j]
+        self.evaluations += y.size + 1
+        self.jacobians += 1
+        bad = ~np.isfinite(J).all(axis=0)
+        if bad.any():
+            self.t_failed = t
+            names = self.form.names(self.data.model.coordinates)
+            culprits = [names[j] for j in np.flatnonzero(bad)]
+            raise SolveError(f"the Jacobian of the motion an implicit integrator needs is not finite at t = {t:.9g} "
+                             f"(by {', '.join(culprits[:6])}): the motion has no derivative there; use an explicit "
+                             f"method (DOP853)", coordinates=culprits)
+        return J
 
     def _on_manifold(self, y):
         """The stage y put on the constraints by ``on_manifold`` (as it is where that declines)."""

@@ -16,8 +16,9 @@ control sample): the integrator's f is computed afresh there.
   projected there and between as the drift asks.
 
 ``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share
-how an integrator goes on from a state: the same explicit pair where it can
-(stepper.RESUMABLE), else a new one. Both integrate y = (q, v), each rigid body's quaternion
+how an integrator goes on from a state: the same explicit pair or Radau where it can
+(stepper.MOVABLE), else a new one; an implicit one (stepper.IMPLICIT) is given the Jacobian
+of the motion (derivative.StateDerivative.jacobian). Both integrate y = (q, v), each rigid body's quaternion
 rates replaced by its angular velocity (velocity_form.py), and hand back (q, q̇).
 """
 
@@ -26,8 +27,12 @@ import logging
 from . import stepper
 from .derivative import StateDerivative
 from .velocity_form import VelocityForm
+from ..core.tolerances import DRIFT_TARGET
 
 log = logging.getLogger(__name__)
+
+IMPLICIT_DRIFT = 1.0  # an implicit method's drift target per unit of its rtol: its steps, long where the stiff
+# parts are quasi-static, drift by about their local error; DRIFT_TARGET would cut them to an explicit pair's length
 
 
 class Integration:
@@ -41,6 +46,9 @@ class Integration:
         self.form = VelocityForm(data.model)  # the integrator's y = (q, v) and (q, q̇)
         self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None, self.form)
         self.steps = 0
+        # the largest relative drift between projections (drift.py)
+        self.drift_target = max(DRIFT_TARGET, IMPLICIT_DRIFT * rtol) if issubclass(method, stepper.IMPLICIT) \
+            else DRIFT_TARGET
         self.solver = None  # the integrator, kept from interval to interval (``resumed``)
         self.solver_tolerances = None  # its (rtol, atol)
         self.next_step = None  # the step it proposed after its last step not cut short at an interval's end
@@ -74,18 +82,20 @@ class Integration:
     def resumed(self, t, q, qd, t_bound, rtol, atol):
         """The integrator at the state (t, q, q̇), bound for t_bound, its first step the one
         it last proposed: the same explicit pair where it stands at t with these tolerances
-        (stepper.RESUMABLE), moved to the state — given f there — where a projection moved it
+        (stepper.MOVABLE), moved to the state — given f there — where a projection moved it
         or the forces jumped; else a new one, as ``solve_ivp`` would start it."""
         first = None if self.next_step is None else min(self.next_step, t_bound - t)
         solver = self.solver
-        if isinstance(solver, stepper.RESUMABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
+        if isinstance(solver, stepper.MOVABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
             y = solver.y if self.form.represents(solver.y, q, qd) else self.form.to_integrator(q, qd)
             if self.forces_jumped or not stepper.stands_at(solver, y):
                 stepper.move(solver, y, self.f(t, y))
             stepper.resume(solver, t_bound, first)
         else:
             y = self.form.to_integrator(q, qd)
-            solver = self.solver = self.method(self.f, t, y, t_bound, rtol=rtol, atol=atol, first_step=first)
+            jacobian = dict(jac=self.f.jacobian) if issubclass(self.method, stepper.IMPLICIT) else {}
+            solver = self.solver = self.method(self.f, t, y, t_bound, rtol=rtol, atol=atol, first_step=first,
+                                               **jacobian)
             self.solver_tolerances = (rtol, atol)
         self.forces_jumped = False
         return solver
@@ -117,5 +127,5 @@ class Integration:
         if f.non_unique:
             log.warning("the motion was not unique somewhere on this run; the free directions got zero "
                         "acceleration (η = 0 in (2.14))")
-        return dict(steps=self.steps, evaluations=f.evaluations, non_unique=f.non_unique,
+        return dict(steps=self.steps, evaluations=f.evaluations, jacobians=f.jacobians, non_unique=f.non_unique,
                     singular_positions=f.singular_positions, relaxed_spans=self.relaxed_spans)

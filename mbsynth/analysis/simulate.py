@@ -38,7 +38,7 @@ import numpy as np
 import scipy.integrate
 
 from .control import SampledControl
-from ..core.errors import ControlError, SimulationError, SolveError
+from ..core.errors import ControlError, ModelError, SimulationError, SolveError
 from ..model.data import Data
 from . import stepper
 from .continuous import ContinuousIntegration
@@ -69,7 +69,11 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
     keeping every value the model sets; the changes are logged and kept in
     ``stats["initial_changes"]``). dt: output interval (default (t_end − t0)/500).
     method, rtol, atol: the integrator (a ``solve_ivp`` method name or a scipy OdeSolver class)
-    and its tolerances. out: a .npz or .csv path written as
+    and its tolerances: an explicit pair (DOP853, the default; RK45, RK23), or for a stiff
+    model — high frequencies that hold an explicit pair's steps down — Radau (Radau IIA of
+    order 5 on the continuous run loop, given the Jacobian of the motion through the compiled
+    kernel; BDF and LSODA too, cut at each output time). An implicit method refuses
+    (ModelError) a model with Coulomb friction at joints and a controller. out: a .npz or .csv path written as
     the run goes. progress: a callable(t) called at every output time.
     controller: ``f(t, joint_values) -> {parameter: value}``, called at t0 and every
     ``control_dt`` (default: the output interval), its values held in between (sampled
@@ -93,6 +97,7 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
         q = start_q if q0 is None else np.asarray(q0, dtype=float)
         qd = start_qd if qd0 is None else np.asarray(qd0, dtype=float)
         changes = {}
+    _check_implicit(data.system, method, controller)
     recorder = Recorder(data, _output_count(t0, t_end, dt), out)  # refused here if the rows cannot fit in memory
     times = _output_times(t0, t_end, dt)
     control = None if controller is None else \
@@ -163,12 +168,32 @@ def _strategy(system, method, stabilization):
     contacts (impacts.py), else continuous where it can be, else cut."""
     continuous = ContinuousIntegration.fits(method, stabilization)
     if system.unilaterals:
-        if not continuous:
+        if not (continuous and issubclass(method, stepper.RESUMABLE)):
             raise ValueError(f"model '{system.name}' has limits or contacts: its run needs an explicit "
                              f"Runge–Kutta method ({', '.join(k.__name__ for k in stepper.RESUMABLE)}) and "
                              f"stabilization='projection'")
         return EventIntegration
     return ContinuousIntegration if continuous else CutIntegration
+
+
+def _check_implicit(system, method, controller):
+    """Raise ModelError where an implicit method (stepper.IMPLICIT) cannot serve the run: its
+    Newton iteration needs the Jacobian of the motion, which Coulomb friction at a joint has
+    not (C jumps with the sign of the sliding rate, friction.py); a sampled controller's
+    forces jump at every sample, where it would start afresh (Jacobian, factors, a small
+    first step) each time."""
+    if not issubclass(method, stepper.IMPLICIT):
+        return
+    rubbing = [con.name for con in system.constraints if getattr(con, "coulomb", None)]
+    if rubbing:
+        raise ModelError(f"method={method.__name__}: model '{system.name}' has Coulomb friction at "
+                         f"{', '.join(rubbing)}, whose force jumps with the sign of the sliding rate: the motion has "
+                         f"no Jacobian there for the implicit method's Newton iteration; use an explicit method "
+                         f"(DOP853)")
+    if controller is not None:
+        raise ModelError(f"method={method.__name__}: a sampled controller's forces jump at every sample, where an "
+                         f"implicit method starts afresh (a new Jacobian, a small first step); use an explicit "
+                         f"method (DOP853)")
 
 
 def _record_ready(run, recorder, schedule, progress, q, qd):

@@ -5,9 +5,14 @@ the constraints between steps, stops at control samples and takes a step again w
 drifted too far. An explicit Runge–Kutta pair (RESUMABLE) carries nothing from one step to
 the next but its state (t, y), y's derivative f and its next step's size h_abs, so it goes
 on from a moved state exactly as a new one started there with that first step would (the
-test of this module checks it bit for bit against scipy's own constructor). This is the
-only module that writes an OdeSolver's attributes or reads its internals (DOP853's extra
-stages and interpolant, ``interpolate``); ``simulate`` calls these functions and ``step()``.
+test of this module checks it bit for bit against scipy's own constructor). Radau IIA
+(MOVABLE, for stiff models) carries besides its Newton matrix — the Jacobian J and its LU
+factors at the step size — and its last step's collocation polynomial, the Newton
+iteration's first guess: a move by a projection (the drift, within the tolerance) leaves
+both good enough, so it goes on from the moved state too; where its step size is set here
+its factors are made afresh. This is the only module that writes an OdeSolver's attributes
+or reads its internals (DOP853's extra stages and interpolant, ``interpolate``); ``simulate``
+calls these functions and ``step()``.
 """
 
 import numpy as np
@@ -24,6 +29,11 @@ METHODS = {kind.__name__: kind for kind in (scipy.integrate.RK23, scipy.integrat
 # integrators that go on from a moved state given its derivative: an explicit Runge–Kutta
 # pair carries nothing else from one step to the next
 RESUMABLE = (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853)
+# integrators that go on from a moved state given its derivative (module docstring): the
+# continuous run loop's (continuous.py)
+MOVABLE = RESUMABLE + (scipy.integrate.Radau,)
+# integrators given the Jacobian of the motion (derivative.StateDerivative.jacobian)
+IMPLICIT = (scipy.integrate.Radau, scipy.integrate.BDF, scipy.integrate.LSODA)
 
 
 def proposed_step(solver):
@@ -40,7 +50,8 @@ def saved(solver):
 def rewind(solver, state, max_step):
     """The solver back at ``state`` (``saved`` before a step), running, its steps capped at
     ``max_step`` (a step taken again, shorter)."""
-    solver.t, solver.y, solver.f, solver.h_abs = state
+    solver.t, solver.y, solver.f = state[:3]
+    _set_step(solver, state[3])
     solver.status, solver.max_step = "running", max_step
 
 
@@ -60,7 +71,7 @@ def resume(solver, t_bound, first_step=None):
     ``first_step`` when given."""
     solver.t_bound, solver.status = t_bound, "running"
     if first_step is not None:
-        solver.h_abs = first_step
+        _set_step(solver, first_step)
 
 
 def step_to(solver, t_to):
@@ -68,13 +79,22 @@ def step_to(solver, t_to):
     size set to reach t_to, its bound moved there for the step; a rejected trial shortens it
     as usual (the step then ends before t_to). ``step()``'s message."""
     bound = solver.t_bound
-    solver.t_bound, solver.h_abs = t_to, abs(t_to - solver.t)
+    solver.t_bound = t_to
+    _set_step(solver, abs(t_to - solver.t))
     try:
         return solver.step()
     finally:
         solver.t_bound = bound
         if solver.status == "finished" and solver.t != bound:
             solver.status = "running"
+
+
+def _set_step(solver, h_abs):
+    """The solver's next step size h_abs; Radau's Newton factors, made for another step
+    size, made afresh."""
+    if h_abs != solver.h_abs and isinstance(solver, scipy.integrate.Radau):
+        solver.LU_real = solver.LU_complex = None
+    solver.h_abs = h_abs
 
 
 def cap(solver, max_step):

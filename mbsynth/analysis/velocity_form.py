@@ -83,6 +83,17 @@ class VelocityForm:
         _states_into(rows, self.starts, q, qd)
         return q, qd
 
+    def names(self, coordinates):
+        """The names of y's entries, from the model's ``coordinates``: those, then their rates
+        (``<coordinate>_dot``), each rigid body's as its angular velocity (``<part>.omega[x]``...)."""
+        rates, j = [], 0
+        for s in self.starts:
+            rates += [f"{c}_dot" for c in coordinates[j:s]]
+            part = coordinates[s].rsplit(".", 1)[0]
+            rates += [f"{part}.omega[{axis}]" for axis in "xyz"]
+            j = s + 4
+        return [*coordinates, *rates, *(f"{c}_dot" for c in coordinates[j:])]
+
     def represents(self, y, q, qd):
         """Whether y converts to exactly (q, q̇)."""
         state = self.state(y)

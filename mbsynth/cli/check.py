@@ -5,6 +5,7 @@ import os
 import re
 
 from ..analysis.diagnose import diagnose
+from ..analysis.stiffness import suggestion
 from ..compiled.background import default_path_as
 from .parsers import model_of
 from ..core.tolerances import CHECK_RESIDUAL_TOL
@@ -16,11 +17,21 @@ def run(args):
     with default_path_as("kkt"):
         system = model_of(args)
         report = diagnose(system)
+    stiff = suggestion(system, args.t_end)
     if args.json:
-        print(json.dumps(report.to_dict(), indent=2))
+        print(json.dumps({**report.to_dict(), "stiff": stiff}, indent=2))
     else:
         print(format_check(report, args.model, args.coordinates))
+        if stiff is not None:
+            print(format_stiff(stiff, args.t_end))
     return 0 if report.consistent and not report.suggested_constraints and not report.angle_singularities else 1
+
+
+def format_stiff(stiff, t_end):
+    """The line suggesting an implicit method (analysis/stiffness.py)."""
+    return (f"  stiff: highest frequency {stiff['omega']:.4g} rad/s (part {stiff['part']}), {stiff['periods']:.0f} "
+            f"periods in {t_end:g} s (> {stiff['threshold']}): an explicit method's steps follow that mode; "
+            f"where it is quasi-static, simulate with --method {stiff['method']}, which steps over it")
 
 
 def format_check(report, path, coordinates="joints"):

@@ -107,6 +107,10 @@ def _check(commands):
     check.add_argument("--coordinates", choices=("joints", "maximal"), default="joints",
                        help="report accelerations per joint (default, where the model has joints) or per "
                             "coordinate of the parts ('maximal')")
+    check.add_argument("--t-end", type=float, default=1.0,
+                       help="the run's length [s] for the stiffness check (default 1): where the highest "
+                            "frequency of the flexible parts gives more periods than that check allows, "
+                            "an implicit method (--method Radau) is suggested")
     return check
 
 
@@ -124,7 +128,8 @@ def _simulate(commands):
     sim.add_argument("--plot-vars", nargs="+", metavar="NAME",
                      help="what the figure's top panel draws (with --plot): coordinates (part.c), velocities "
                           "(part.c_dot), outputs; a name the model lacks is refused before the run")
-    sim.add_argument("--method", default="DOP853", help="scipy solve_ivp method (default DOP853)")
+    sim.add_argument("--method", default="DOP853",
+                     help="scipy solve_ivp method (default DOP853; Radau for a stiff model, as `check` suggests)")
     sim.add_argument("--rtol", type=float, default=INTEGRATION_RTOL,
                      help=f"relative tolerance (default {INTEGRATION_RTOL:g})")
     sim.add_argument("--atol", type=float, default=INTEGRATION_ATOL,

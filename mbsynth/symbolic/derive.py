@@ -155,6 +155,25 @@ def expand_joint_values(expr):
     return sp.sympify(expr).xreplace({s: s.value for s in found}) if found else expr
 
 
+def turn_residual(phi):
+    """A position-level row φ with its JointValue angles replaced by their values, taken
+    modulo the turn where φ is affine in them with coefficients ±c (c a number): φ − P ⌊φ/P + ½⌋,
+    P = 2π|c|. A joint's angle is read in (−π, π], so a plain servo row ``angle − θ(t)``
+    would jump by P at each reading's wrap while θ(t) runs on; a rotation that meets θ(t)
+    meets it modulo a turn, and the row's residual is the nearest one (A and b, through
+    the rate, are the row's own). Other rows are as ``expand_joint_values`` gives them."""
+    angles = joint_values_in(phi)
+    if not angles:
+        return phi
+    phi = sp.sympify(phi)
+    sizes = {abs(sp.diff(phi, s)) for s in angles}
+    if len(sizes) != 1 or not all(c.is_number and c != 0 for c in sizes):
+        return expand_joint_values(phi)
+    period = 2 * sp.pi * sizes.pop()
+    value = expand_joint_values(phi)
+    return value - period * sp.floor(value / period + sp.Rational(1, 2))
+
+
 def time_derivative(expr, q, qd, t=T_SYMBOL):
     """d/dt of an expression of (q, t) along the motion: (∂e/∂q) q̇ + ∂e/∂t, and the
     chain rule Σ (∂e/∂s) ṡ through the JointValue symbols s it holds."""

@@ -206,15 +206,16 @@ def test_the_bundled_two_arms_model_closes_its_loop_within_the_urdf_digits():
 
 
 def test_a_servo_beyond_the_joints_range_is_named(tmp_path, capsys):
-    """``mbsynth simulate`` of a UR5 whose elbow must be at 4 rad (its angle lies in (−π, π]):
+    """``mbsynth simulate`` of a UR5 whose elbow's sine must be 2 (no angle gives it; a plain
+    servo at 4 rad is met at 4 − 2π, a row affine in the angle being taken modulo the turn):
     exit 2 naming the servo, unmet from the start, not the joint rows Newton's steps break."""
     path = tmp_path / "servo.yaml"
     path.write_text("name: ur5_servo\nparameters: {g: 9.81}\ngravity: [0, 0, -g]\n"
                     "parts:\n  arm: {type: robot, robot: ur5, base: {position: [0, 0, 1]}}\n"
-                    "constraints:\n  - {name: elbow_servo, holonomic: arm_elbow_joint.angle - 4}\n")
+                    "constraints:\n  - {name: elbow_servo, holonomic: 'sin(arm_elbow_joint.angle) - 2'}\n")
     assert main(["simulate", str(path), "--t-end", "0.1"]) == 2
     err = capsys.readouterr().err
-    assert "unmet elbow_servo (4);" in err and "(77 in all)" in err and "at best a residual of" in err
+    assert "unmet elbow_servo (2);" in err and "(77 in all)" in err and "at best a residual of 1 " in err
 
 
 def test_a_row_out_of_reach_says_it_is_at_its_least():

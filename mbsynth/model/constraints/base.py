@@ -5,7 +5,7 @@ import sympy as sp
 
 from ...core.values import Keyed
 from ...symbolic.derive import (PARAMETERS, T_SYMBOL, compile_function, differentiated, differentiated_template,
-    expand_joint_values, joint_values_in, placed_values, positions, symbols_in)
+    expand_joint_values, joint_values_in, placed_values, positions, symbols_in, turn_residual)
 
 from ...core.memo import MEMO
 
@@ -116,7 +116,7 @@ class Constraint(Keyed):
             return cls.placed(name, "holonomic", (a, b, forms, psi), slots, involved, q, qd, params, constants,
                               row_labels)
         a, b, psi = differentiated(phis, q, qd)
-        phis = [expand_joint_values(phi) for phi in phis]
+        phis = [turn_residual(phi) for phi in phis]
         return cls(name, "holonomic", a, b, _vector(C, len(q)), phis, psi, q, qd, params, row_labels)
 
     @classmethod
@@ -170,7 +170,7 @@ def mixed(holonomic, nonholonomic, q, qd):
     ψ(q, q̇, t) = 0 in one constraint (2.4): φ is NaN on the velocity-level rows, which
     have no position form."""
     a, b, psi = differentiated(list(holonomic) + list(nonholonomic), q, qd)
-    return a, b, [expand_joint_values(phi) for phi in holonomic] + [sp.nan] * len(nonholonomic), psi
+    return a, b, [turn_residual(phi) for phi in holonomic] + [sp.nan] * len(nonholonomic), psi
 
 
 def _vector(C, n):
