@@ -33,7 +33,7 @@ import numpy as np
 
 from ..core.errors import SolveError
 from ..model.angle_singularity import AngleParts, explain
-from ..core.tolerances import ANGLES_NEAR, COLLAPSE_SPAN, MAX_STATE, STEP_RESOLUTION
+from ..core.tolerances import ANGLES_NEAR, COLLAPSE_SPAN, JACOBIAN_STEP, MAX_STATE, STEP_RESOLUTION
 
 log = logging.getLogger(__name__)
 
@@ -41,7 +41,6 @@ COLLAPSE_CALLS = 1000  # ~80 steps of an explicit pair
 CRAWL_CALLS = 240
 RELAXED_CRAWL_CALLS = 1000
 STUCK_CALLS = 20000  # an interval that crawls this long near a singular position at the loosest tolerance stops
-JACOBIAN_STEP = 1.5e-8  # √ε: a forward difference's truncation and rounding errors balance (per unit of y)
 ANGLES_CRAWL_CALLS = 5000  # ~400 steps of an explicit pair within ANGLES_NEAR in one interval: a body that
 # passes by needs a few, one that falls onto the position (a bicycle lying down) never gets past it
 

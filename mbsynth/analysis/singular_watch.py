@@ -18,12 +18,11 @@ to decompose at every step (WATCH_ENTRIES).
 import numpy as np
 
 from ..core.equations import equilibrate_rows
-from ..core.tolerances import NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
+from ..core.tolerances import DIP_FLOOR, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
 
 WATCH_ENTRIES = 4096  # the largest A (rows × coordinates) watched: an SVD per step costs little beside the step
 SEARCH_STEPS = 60  # golden-section steps: the bracket shrinks to 0.618^60 ≈ 3e-13 of its width
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
-DIP_FLOOR = 1e-12  # σ_r/σ₁ below its neighbours by less than this is the SVD's rounding (~n ε), not a dip
 
 
 class SingularWatch:

@@ -114,6 +114,8 @@ INTEGRATION_RTOL = 1e-10  # simulate's (and the CLI's) default relative toleranc
 INTEGRATION_ATOL = 1e-10  # simulate's (and the CLI's) default absolute tolerance of the integrator
 LAST_INTERVAL_MERGE = 1e-12  # simulate.py: a last output interval shorter than this times dt joins the one before
 SAMPLE_ROUNDING = 1e-9  # schedule.py: a span within this many sample intervals of a whole number of them has that many
+JACOBIAN_STEP = 1.5e-8  # derivative.py: √ε, a forward difference's truncation and rounding errors balance (per unit of y)
+DIP_FLOOR = 1e-12  # singular_watch.py: σ_r/σ₁ below its neighbours by less than this is the SVD's rounding (~n ε), not a dip
 MAX_STATE = 1e12  # derivative.py: a coordinate or velocity beyond this (SI units) counts as an exploding state
 COLLAPSE_SPAN = 1e-8  # derivative.py: COLLAPSE_CALLS evaluations that advance t by less than this share of the
 # interval are a step-size collapse
