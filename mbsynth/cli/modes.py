@@ -14,11 +14,12 @@ from .outputs import Output
 from .parsers import model_of
 
 OUTPUTS = (Output("--html", (".html",)), Output("--plot", (".png", ".svg", ".pdf")))
+ORDERS = 4  # --campbell's order lines 1P … 4P where --orders is not given
 
 
 def run(args):
     system = model_of(args)
-    if args.campbell is not None or args.plot is not None:
+    if args.campbell is not None or args.plot is not None or args.orders is not None:
         return run_campbell(args, system)
     result = modes(system, equilibrium=args.equilibrium, steady=args.steady)
     if args.html:
@@ -39,15 +40,17 @@ def run_campbell(args, system):
     from ..core.ranges import parse_range
 
     if args.campbell is None:
-        raise ModelError("--plot draws a Campbell diagram: give --campbell NAME=START:STOP:COUNT")
+        given = "--plot" if args.plot is not None else "--orders"
+        raise ModelError(f"{given} belongs to a Campbell diagram: give --campbell NAME=START:STOP:COUNT")
     if args.html or args.equilibrium:
         raise ModelError("--campbell sweeps steady motions: it takes neither --html nor --equilibrium")
-    if args.orders < 1:
-        raise ModelError(f"--orders must be a positive integer, got {args.orders}")
+    orders = ORDERS if args.orders is None else args.orders
+    if orders < 1:
+        raise ModelError(f"--orders must be a positive integer, got {orders}")
     name, (start, stop, count) = parse_range(args.campbell, "--campbell")
     if count < 2 or not stop > start:
         raise ModelError(f"--campbell {args.campbell}: an empty range; give START < STOP and COUNT ≥ 2")
-    result = campbell(system, name, np.linspace(start, stop, count), args.orders)
+    result = campbell(system, name, np.linspace(start, stop, count), orders)
     if args.plot:
         plot(result, args.plot)
     if args.json:

@@ -237,7 +237,7 @@ def _modes(commands):
                             "follows it, e.g. initial: {blade.angle_z_dot: Omega}) over COUNT values, linearize "
                             "each steady motion, follow each mode by its shape and list where it meets the "
                             "order lines f = kΩ/2π (implies --steady)")
-    modes.add_argument("--orders", type=int, default=4, metavar="K",
+    modes.add_argument("--orders", type=int, metavar="K",
                        help="with --campbell: the order lines 1P … KP (default 4)")
     modes.add_argument("--plot", metavar="FILE.png",
                        help="with --campbell: write the diagram as an image (.png, .svg or .pdf)")

@@ -73,6 +73,7 @@ def test_the_flapwise_mode_never_meets_1P(swept):
     (BLADE, ["--campbell", "Omega=5:1:10"], "an empty range"),
     (BLADE, ["--campbell", "Omega=0:12"], "expected NAME=START:STOP:COUNT"),
     (BLADE, ["--plot", "c.png"], "give --campbell"),
+    (BLADE, ["--orders", "2"], "--orders belongs to a Campbell diagram"),
     (MODELS / "rolling" / "rolling_disk.yaml", ["--campbell", "m=1:2:3"], "at m = 1: model 'rolling_disk' does not "
                                                                            "move steadily"),
     (MODELS / "rolling" / "rolling_disk.yaml", ["--campbell", "Omega=1:2:3"], "built into the model"),
