@@ -24,13 +24,7 @@ def run(args):
     result = modes(system, equilibrium=args.equilibrium, steady=args.steady)
     if args.html:
         write_html(system, result, args.html)
-    if args.json:
-        print(json.dumps(to_dict(result), indent=2))
-    else:
-        print(format_modes(result))
-        if args.html:
-            print(f"wrote {args.html}")
-    return 0
+    return report(args.json, to_dict(result), format_modes(result), args.html)
 
 
 def run_campbell(args, system):
@@ -53,12 +47,18 @@ def run_campbell(args, system):
     result = campbell(system, name, np.linspace(start, stop, count), orders)
     if args.plot:
         plot(result, args.plot)
-    if args.json:
-        print(json.dumps(to_dict(result), indent=2))
+    return report(args.json, to_dict(result), format_campbell(result), args.plot)
+
+
+def report(as_json, record, text, written):
+    """Print the result as JSON (``record``) or as ``text`` with the file ``written`` (if
+    any) named after it; the exit status 0."""
+    if as_json:
+        print(json.dumps(record, indent=2))
     else:
-        print(format_campbell(result))
-        if args.plot:
-            print(f"wrote {args.plot}")
+        print(text)
+        if written:
+            print(f"wrote {written}")
     return 0
 
 

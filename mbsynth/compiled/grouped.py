@@ -147,7 +147,7 @@ class _Group:
         except Exception:  # noqa: BLE001 - arguments the kernel was not compiled for: numpy serves
             self.refused = True
             return
-        if _agree(result, self._numpy(t, q, qd, p, values)):
+        if stacked_agrees(result, self._numpy(t, q, qd, p, values)):
             self.kernel = found
         else:
             self.refused = True
@@ -180,7 +180,7 @@ class _Group:
                 got = self(t, q, qd, p)
         except Exception:  # noqa: BLE001 - a raw function that does not broadcast is called singly
             return False
-        return _agree(got, expected[self.dest])
+        return stacked_agrees(got, expected[self.dest])
 
 
 def _picks(first, every, columns):
@@ -199,7 +199,7 @@ def _picks(first, every, columns):
             for a, found in by_argument.items()]
 
 
-def _agree(got, want):
+def stacked_agrees(got, want):
     """Equal to STACKED_CHECK_RTOL of the largest finite value, NaN where NaN."""
     scale = np.abs(want[np.isfinite(want)]).max(initial=0.0)
     return got.shape == want.shape and np.allclose(got, want, rtol=STACKED_CHECK_RTOL,

@@ -18,10 +18,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..compiled.grouped import Batch
+from ..compiled.grouped import Batch, stacked_agrees
 from .parts.base import Part
 from ..symbolic.derive import Compiled
-from ..core.tolerances import STACKED_CHECK_RTOL
 
 DENSE_ENTRIES = 40000  # rows × coordinates up to which dense arrays beat scipy.sparse's overhead
 
@@ -180,7 +179,7 @@ class OverRows:
             single = _one_by_one(function, times, q, qd, p, count)
             if len(times) > 1:
                 self.broadcasts[function] = (isinstance(function, Compiled)
-                                             and _stacked_agrees(function, times, q, qd, p, count, single))
+                                             and _over_rows_agrees(function, times, q, qd, p, count, single))
             return single
         return _stacked(function, times, q, qd, p, count) if verdict else _one_by_one(function, times, q, qd, p, count)
 
@@ -200,11 +199,9 @@ def _stacked(function, times, q, qd, p, count):
     return np.array([np.broadcast_to(np.asarray(x, dtype=float), times.shape) for x in out[:count]])
 
 
-def _stacked_agrees(function, times, q, qd, p, count, single):
+def _over_rows_agrees(function, times, q, qd, p, count, single):
     try:
         got = _stacked(function, times, q, qd, p, count)
     except Exception:  # noqa: BLE001 - a numpy form that does not broadcast is called row by row
         return False
-    scale = np.abs(single[np.isfinite(single)]).max(initial=0.0)
-    return got.shape == single.shape and np.allclose(got, single, rtol=STACKED_CHECK_RTOL,
-                                                     atol=STACKED_CHECK_RTOL * scale, equal_nan=True)
+    return stacked_agrees(got, single)
