@@ -16,6 +16,7 @@ from . import structures
 from ..symbolic.derive import Compiled
 from ..core.tolerances import STACKED_CHECK_RTOL
 
+PARAMETERS = 3  # the position of the parameters p among a function's arguments (t, q, q̇, p)
 STACK_MIN = 8  # fewer instances than this are called one by one (numpy's per-call cost on small arrays)
 
 
@@ -103,12 +104,16 @@ class _Group:
         self.fixed = np.ascontiguousarray(np.array([f.fixed for f in functions], dtype=float).T)
         # constants that are numbers and arguments (symbolic.gather): stacked, and per argument a
         # the rows of the constants read from it and, per row and member, where in it (None: the
-        # argument is a scalar, t), put in per call by one indexing per argument
+        # argument is a scalar, t), put in by one indexing per argument: those read from the
+        # parameters once per read-only parameter array (_with_parameters), the others per call
         self.picks = None
         self.values = first.values
         if hasattr(first.values, "picks"):
             self.values = np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
-            self.picks = _picks(first.values.picks, [f.values.picks for f in functions], self.columns)
+            picks = _picks(first.values.picks, [f.values.picks for f in functions], self.columns)
+            self.picks = [pick for pick in picks if pick[0] != PARAMETERS]
+            self.parameter_picks = [pick for pick in picks if pick[0] == PARAMETERS]
+            self.gathered_at = (None, self.values)  # (the read-only parameter array, the values with it put in)
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
         self.kernel = None  # the numba kernel once it is ready and checked
         self.refused = not compiled  # numpy for good (also when the kernel disagreed with numpy)
@@ -116,10 +121,8 @@ class _Group:
     def __call__(self, t, q, qd, p):
         if self.picks is None:
             values = _stacked(self.values(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
-        elif self.picks:
-            values = self._gathered(t, q, qd, p)
         else:
-            values = self.values
+            values = self._gathered(t, q, qd, p)
         if self.kernel is None and not self.refused:
             self._take_kernel(t, q, qd, p, values)
         if self.kernel is not None:
@@ -130,9 +133,25 @@ class _Group:
 
     def _gathered(self, t, q, qd, p):
         """The stacked constants with each member's arguments put in."""
-        values, given = self.values.copy(), (t, q, qd, p)
-        for a, rows, at in self.picks:
-            values[rows] = given[a] if at is None else given[a][at]
+        values = self._with_parameters(p)
+        if self.picks:
+            values, given = values.copy(), (t, q, qd)
+            for a, rows, at in self.picks:
+                values[rows] = given[a] if at is None else given[a][at]
+        return values
+
+    def _with_parameters(self, p):
+        """The stacked constants with the parameters ``p`` put in: kept for the next call when
+        ``p`` is a read-only array owning its numbers (a Data's parameter values), whose
+        identity then stands for its content."""
+        kept, values = self.gathered_at
+        if p is kept or not self.parameter_picks:
+            return values
+        values = self.values.copy()
+        for _, rows, at in self.parameter_picks:
+            values[rows] = p[at]
+        if isinstance(p, np.ndarray) and not p.flags.writeable and p.flags.owndata:
+            self.gathered_at = (p, values)
         return values
 
     def _take_kernel(self, t, q, qd, p, values):

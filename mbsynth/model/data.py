@@ -35,6 +35,7 @@ from ..compiled import background
 from ..core import equations, solvers
 from ..core.memo import MEMO
 from ..core.errors import SolveError
+from ..core.values import read_only
 from . import friction, reactions
 from .evaluation import Evaluator
 from .joint_values import JointValuesBatch
@@ -101,8 +102,9 @@ _STRUCTURES = MEMO.table("model structures", STRUCTURES_KEPT)
 
 class Data:
     """The workspace of computations on ``system`` at its ``parameter_values`` (an array in
-    the model's parameter order; ``parameters``: the same as {name: value}), on the
-    ``path`` "compiled" or "kkt" (``PATHS``; None: ``background.default_path()``)."""
+    the model's parameter order, read-only: ``set_parameters`` replaces it; ``parameters``:
+    the same as {name: value}), on the ``path`` "compiled" or "kkt" (``PATHS``; None:
+    ``background.default_path()``)."""
 
     def __init__(self, system, path=None):
         path = background.default_path() if path is None else path
@@ -110,7 +112,7 @@ class Data:
             raise ValueError(f"path must be one of {PATHS}, got {path!r}")
         self.system = self.model = system
         self.path = path
-        self.parameter_values = system.parameter_values.copy()
+        self.parameter_values = read_only(system.parameter_values)
         self._shared = shared(system)
         self._evaluator = None  # made on first use: a compiled run may never need it
         self._joint_values = None  # joint_values.JointValuesBatch, made on first use
@@ -145,7 +147,7 @@ class Data:
         those defined by expressions of others follow. Raises ModelError for an unknown
         name, a non-finite value, or a part whose M or Q the values make unusable
         (``System.resolved_parameters``)."""
-        self.parameter_values = self.system.resolved_parameters(values, self.parameter_values)
+        self.parameter_values = read_only(self.system.resolved_parameters(values, self.parameter_values))
         if self._engine is not None and self._engine is not UNSET:
             self._engine = self._engine.template.engine(self.parameter_values)
 

@@ -102,3 +102,41 @@ def test_a_robots_joint_torques_share_one_call_and_equal_their_sympy_force():
         assert np.abs(stacked - Q).max() <= 1e-12 * np.abs(Q).max()
     groups, singles = forces.forces.layout[1], forces.forces.layout[2]
     assert len(torques) == len(system.forces) == 32 and len(groups) + len(singles) <= 3
+
+
+def test_each_parameter_array_is_read_for_itself_by_the_shared_groups():
+    """Two Datas of one model share the stacked calls; each call reads the values of the array
+    it is given: the Datas' read-only arrays in turn, and a writeable array changed in place
+    between calls. Q against the elements' sympy Q put in numbers by substitution."""
+    import sympy as sp
+    system = mb.from_robot("ur5")
+    torques = sorted(k for k in system.parameters if k.startswith("tau_"))
+    first, second = system.data(), system.data()
+    second.set_parameters({k: 0.2 + 0.05 * i for i, k in enumerate(torques)})
+    q, qd = system.initial_state()
+    qd = qd + RNG.normal(size=qd.size)
+    forces = first.evaluator
+    assert forces is second.evaluator
+
+    def expected(p):
+        values = dict(zip((sp.Symbol(k) for k in system.parameters), p))
+        values.update(zip(system.q_symbols + system.qd_symbols, np.concatenate([q, qd])))
+        Q = np.zeros(system.n)
+        for element in system.forces:
+            for (i, _), x in element.Q.todok().items():
+                Q[i] += float(x.xreplace(values))
+        return Q
+
+    def stacked(p):
+        return np.bincount(forces.f_cols, weights=forces.forces(0.0, q, qd, p)[0], minlength=system.n)
+
+    writeable = second.parameter_values.copy()
+    for data in (first, second, first, second):
+        assert not data.parameter_values.flags.writeable
+        Q = expected(data.parameter_values)
+        assert np.abs(stacked(data.parameter_values) - Q).max() <= 1e-12 * np.abs(Q).max()
+    for value in (0.7, -1.3):
+        writeable[system.parameter_index[torques[0]]] = value
+        Q = expected(writeable)
+        assert np.abs(stacked(writeable) - Q).max() <= 1e-12 * np.abs(Q).max()
+    assert not np.allclose(expected(first.parameter_values), expected(second.parameter_values))
