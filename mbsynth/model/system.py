@@ -55,6 +55,7 @@ class Substructure:
 
 
 DEFAULT_DATA_KEPT = 16  # models whose default-path Data (``System._data``) the one cache keeps
+FLOAT = np.dtype(float)  # the dtype of a state ``_state`` passes on as given
 
 
 class Structure:
@@ -354,6 +355,11 @@ class System:
                        appended_balances=self.appended_balances + tuple(balances))
 
     def _state(self, q, qd):
+        """(q, q̇) as 1-d contiguous float arrays of n entries (the arrays given, where they
+        are such: no copy), or ValueError naming the shapes."""
+        if (type(q) is np.ndarray and type(qd) is np.ndarray and q.dtype is FLOAT and qd.dtype is FLOAT
+                and q.shape == qd.shape == (self.n,) and q.flags.c_contiguous and qd.flags.c_contiguous):
+            return q, qd  # an integrator's or a controller's own arrays, every call
         q, qd = np.asarray(q, dtype=float).ravel(), np.asarray(qd, dtype=float).ravel()
         if q.shape != (self.n,) or qd.shape != (self.n,):
             raise ValueError(f"model '{self.name}' has {self.n} coordinates; got q of shape "

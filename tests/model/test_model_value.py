@@ -77,6 +77,23 @@ def test_the_path_is_chosen_explicitly_and_both_give_the_motion():
         model.data(path="fast")
 
 
+def test_a_state_is_taken_as_given_or_as_an_array_of_n():
+    """A state of 1-d contiguous float arrays is used as given (no copy per call); a list,
+    a column or a strided view gives the same motion; a wrong size is a ValueError naming
+    the shapes."""
+    model = mb.load(FOUR_BAR)
+    q, qd = model.initial_state()
+    qd = qd + 0.3
+    assert all(a is b for a, b in zip(model._state(q, qd), (q, qd)))
+    wide = np.repeat(np.stack([q, qd]), 2, axis=1)  # q, q̇ as every other entry of a row
+    expected = model.motion(0.1, q, qd).qdd
+    for given in [(q.tolist(), qd.tolist()), (q[:, None], qd[:, None]), (wide[0, ::2], wide[1, ::2])]:
+        np.testing.assert_array_equal(model.motion(0.1, *given).qdd, expected)
+    with pytest.raises(ValueError, match=rf"^model 'four_bar' has {model.n} coordinates; got q of shape "
+                                         rf"\({model.n - 1},\) and qd of shape \({model.n},\)$"):
+        model.motion(0.1, q[1:], qd)
+
+
 def test_the_one_cache_can_be_emptied_without_changing_an_answer():
     model = mb.load(FOUR_BAR)
     q, qd = model.initial_state()
