@@ -8,8 +8,9 @@ singular value σ_i below NEAR_SINGULAR σ₁; elsewhere it keeps every row and 
 the plain solution of (2.12), which the kernel gives. ``rows_certified`` builds A_e
 densely — the tree joints' rows over q (joints.py), the extra rows (their coefficients
 on the nodes' coordinates and on the extra coordinates) and each rigid body's unit-norm row
-u/|u| — and takes the eigenvalues σ_i² of A_e A_eᵀ. This judges the rows alone, in the
-coordinates the exact rule uses, so it holds for any mass matrix: a flexible part's
+u/|u| — and takes the eigenvalues σ_i² of A_e A_eᵀ, where a Cholesky factor of A_e A_eᵀ
+less NEAR_SINGULAR² m (its trace m bounds σ₁²) does not already certify them. This judges
+the rows alone, in the coordinates the exact rule uses, so it holds for any mass matrix: a flexible part's
 M, whose condition number (10⁶ and more: a strip's torsional inertia beside its bending
 inertia) says nothing about its rows, is not in it.
 """
@@ -88,7 +89,7 @@ def rows_certified(q, qd, kind, start, node_joint, joints, scratch, quat_row, xs
         scale = 1.0 / math.sqrt(total)
         for c in range(A.shape[1]):
             A[r, c] *= scale
-    T, V, values = np.zeros((m, m)), np.zeros((m, m)), np.zeros(m)
+    T = np.zeros((m, m))
     for r in range(m):
         for s in range(r + 1):
             total = 0.0
@@ -96,8 +97,31 @@ def rows_certified(q, qd, kind, start, node_joint, joints, scratch, quat_row, xs
                 total += A[r, c] * A[s, c]
             T[r, s] = total
             T[s, r] = total
+    if _above(T, NEAR_SINGULAR ** 2 * m):
+        return True  # λ_min ≥ NEAR_SINGULAR² m ≥ NEAR_SINGULAR² λ_max: the rows have unit norms, trace(T) = m
+    V, values = np.zeros((m, m)), np.zeros(m)
     symmetric_eigen(T, V, values)
     least, top = np.inf, 0.0
     for e in range(m):
         least, top = min(least, values[e]), max(top, values[e])
     return top > 0.0 and least >= NEAR_SINGULAR ** 2 * top
+
+
+@njit(**OPTIONS)
+def _above(T, floor):
+    """Whether T − floor·I is positive definite (its Cholesky factor found, T left as it
+    was): λ_min(T) > floor, decided by a Cholesky rather than an eigensolve."""
+    m = T.shape[0]
+    L = np.zeros((m, m))
+    for r in range(m):
+        for c in range(r + 1):
+            total = T[r, c] - (floor if r == c else 0.0)
+            for k in range(c):
+                total -= L[r, k] * L[c, k]
+            if r == c:
+                if not total > 0.0:
+                    return False
+                L[r, r] = math.sqrt(total)
+            else:
+                L[r, c] = total / L[c, c]
+    return True
