@@ -13,10 +13,10 @@ import operator
 import numpy as np
 
 from . import structures
-from ..symbolic.derive import Compiled
+from ..core.values import frozen
+from ..symbolic.derive import PARAMETERS, Compiled
 from ..core.tolerances import STACKED_CHECK_RTOL
 
-PARAMETERS = 3  # the position of the parameters p among a function's arguments (t, q, q̇, p)
 STACK_MIN = 8  # fewer instances than this are called one by one (numpy's per-call cost on small arrays)
 
 
@@ -142,15 +142,14 @@ class _Group:
 
     def _with_parameters(self, p):
         """The stacked constants with the parameters ``p`` put in: kept for the next call when
-        ``p`` is a read-only array owning its numbers (a Data's parameter values), whose
-        identity then stands for its content."""
+        ``p`` is ``frozen`` (a Data's parameter values)."""
         kept, values = self.gathered_at
         if p is kept or not self.parameter_picks:
             return values
         values = self.values.copy()
         for _, rows, at in self.parameter_picks:
             values[rows] = p[at]
-        if isinstance(p, np.ndarray) and not p.flags.writeable and p.flags.owndata:
+        if frozen(p):
             self.gathered_at = (p, values)
         return values
 

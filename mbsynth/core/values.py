@@ -77,6 +77,12 @@ def read_only(array):
     return out
 
 
+def frozen(array):
+    """Whether ``array`` is a read-only array owning its numbers (a Data's parameter values):
+    its content cannot change while it lives, so its identity stands for its content."""
+    return isinstance(array, np.ndarray) and not array.flags.writeable and array.flags.owndata
+
+
 def frozen_mapping(mapping):
     """``mapping`` as a read-only mapping (None stays None)."""
     return None if mapping is None else types.MappingProxyType(dict(mapping))

@@ -19,6 +19,7 @@ import sympy as sp
 
 from .cache import Unstable, fingerprint, placeholder, remembered, remembered_function
 from ..core.memo import MEMO
+from ..core.values import frozen
 
 T_SYMBOL = sp.Symbol("t")
 LAMBDIFIED_KEPT = 65536  # structures whose numpy function the one cache keeps (far above a model's count)
@@ -522,13 +523,21 @@ def _values(args, values, picks=()):
         picks = tuple((k, *where[v]) for k, v in enumerate(values) if not v.is_Number)
         by_argument = _by_argument(picks)
 
+        from_parameters = bool(picks) and all(a == PARAMETERS for a, _, _ in by_argument)
+        kept = [(None, None)]  # (a frozen parameter array, the values read from it)
+
         def gathered(*given):
             if not picks:
                 return fixed
+            if from_parameters and kept[0][0] is given[PARAMETERS]:
+                return kept[0][1]
             read = [(np.asarray(given[a]), rows, at) for a, rows, at in by_argument]
             out = fixed.astype(np.result_type(fixed, *(x for x, _, _ in read)))
             for x, rows, at in read:
                 out[rows] = x if at is None else x[at]
+            if from_parameters and frozen(given[PARAMETERS]):  # its identity stands for its content
+                out.flags.writeable = False
+                kept[0] = (given[PARAMETERS], out)
             return out
         gathered.fixed, gathered.picks = fixed, picks  # grouped.py stacks these instead of calling
         return gathered
