@@ -97,9 +97,9 @@ def ramp(t):
 rotation = tumbling_rotation(SPIN, PRECESSION, TAU)
 
 
-def local(times, world):
-    """The tip's elastic displacement in the frame's axes from its world places."""
-    return np.array([rotation(t).T @ p for t, p in zip(times, world)]) - [1.0, 0.0, 0.0]
+def local(times, world, turn=rotation):
+    """The tip's elastic displacement in the frame's axes (turned by ``turn(t)``) from its world places."""
+    return np.array([turn(t).T @ p for t, p in zip(times, world)]) - [1.0, 0.0, 0.0]
 
 
 def fe_model(mass="consistent"):
@@ -184,7 +184,8 @@ class ExudynRotor:
         data = mbs.GetSensorStoredData(sensor)
         rows = [int(np.argmin(np.abs(data[:, 0] - t))) for t in TIMES]
         assert np.abs(data[rows, 0] - TIMES).max() < 1e-9
-        return local(TIMES, data[rows, 1:4]), wall, f"{it.currentStepIndex} steps, {it.newtonStepsCount} Newton it."
+        history = local(TIMES, data[rows, 1:4], tumbling_rotation(SPIN, self.precession, TAU))
+        return history, wall, f"{it.currentStepIndex} steps, {it.newtonStepsCount} Newton it."
 
 
 def exudyn_own_invariants(fe, basis):
@@ -355,7 +356,7 @@ def sources(result, ref):
             f"integration error {r['own']:.1e} m), {errors(r['history'], ref)[1]:.1e} of the largest out-of-plane "
             "deflection; with lumped mass, where the identities hold, the two codes agree (Checks).")
     for (code, _, _), r in rows.items():
-        why = {"Exudyn, its own invariants": "its own invariants move a rotation DOF as a point (ω × x for ω)",
+        why = {"Exudyn, its own invariants": "its own invariants move a rotation DOF as a point (at ω × x where a section turns at ω)",
                "Exudyn, NodeRigidBodyRxyz frame": "the same object on a Tait–Bryan node, nothing else changed"}.get(code)
         if why:
             tip, z = errors(r["history"], ref)
