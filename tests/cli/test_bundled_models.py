@@ -30,6 +30,7 @@ MODES = {
     "flexible/slider_crank.yaml": "equilibrium",  # the crank hanging, the rod sagging
     "flexible/spin_up_beam.yaml": "rests",  # at rest at t = 0, the hub held by its servo row
     "flexible/rotating_blade.yaml": "steady",  # spinning at Omega, turned by angles: the spin is cyclic
+    "flexible/precessing_rotor.yaml": "rests",  # at rest at t = 0, its angles' rows at rest to second order there
     "forces/spring_part_chain.yaml": "equilibrium",
     "forces/spring_pendulum.yaml": (["--equilibrium"], 1, NOT_ISOLATED),  # the rod spins freely about itself
     "joints/cart_pole_servo.yaml": ([], 1, "rows ['servo'] prescribe a motion at t = 0"),
