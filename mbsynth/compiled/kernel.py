@@ -18,6 +18,9 @@ must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 Where the extra coordinates' mass block is positive definite (planar bodies, energy-defined
 parts of positive mass), their accelerations are eliminated first and the Schur matrix is the
 rows' alone, A_x M_x⁻¹ A_xᵀ + G K⁻¹ Gᵀ (``_close_reduced``): smaller, and semi-definite.
+Otherwise the bordered matrix is solved whole (``_close``); a flexible part's stiffening
+term makes its mass indefinite along a direction the rows hold (the spin-up beam's torsion
+about its axis), which leaves the bordered matrix regular.
 
 Off the manifold (an integrator's stage, ``motion``'s ``drift``) the Schur step follows the
 drift rule of core/equations.py instead: directions the drift splits off dependent rows are
@@ -112,7 +115,10 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     where ``multipliers``: tree.solve). Returns a status. ``drift``: negative on the
     manifold (the rules of the module docstring), else the state's relative drift δ
     (``motion``). The Schur matrix's eigenvectors and eigenvalues stay in ``vectors`` and
-    ``values`` (``_close_solve`` solves with them again)."""
+    ``values`` (``_close_solve`` solves with them again). Off the manifold with extra
+    coordinates whose mass is not positive definite (rows certified by ``motion``: the drift
+    rule's answer is the plain one), the bordered matrix must have a condition of at most
+    SCHUR_CONDITION_MAX, else NEAR_SINGULAR (its solve's rounding, ε κ)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     if nx > 0:
         inverse, work = Mx.copy(), np.zeros((nx, nx))
@@ -122,8 +128,6 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         if spd_inverse(inverse, nx, np.full(nx, largest), work):
             return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S,
                                   vectors, rhs, lam, multipliers, drift)
-        if drift >= 0.0:
-            return NEAR_SINGULAR  # a singular mass: the exact drift rule's to judge
     S[:, :] = 0.0
     for x in range(nx):
         for c in range(nx):
@@ -139,6 +143,8 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         for r in range(mx):
             S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
     symmetric_eigen(S, vectors, values)
+    if drift >= 0.0 and nx and not np.abs(values).min() * SCHUR_CONDITION_MAX >= np.abs(values).max():
+        return NEAR_SINGULAR  # a mass not definite and a bordered matrix near singular: the exact drift rule's
     return _close_solve(topology, segs, seg6, factored, Fx, xb, ry, z0, y, w, z, vectors, values, rhs, lam, nx, mx,
                         multipliers, drift)
 
