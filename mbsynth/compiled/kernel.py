@@ -18,6 +18,10 @@ must move no acceleration (else the motion is not unique: NOT_UNIQUE).
 Where the extra coordinates' mass block is positive definite (planar bodies, energy-defined
 parts of positive mass), their accelerations are eliminated first and the Schur matrix is the
 rows' alone, A_x M_x⁻¹ A_xᵀ + G K⁻¹ Gᵀ (``_close_reduced``): smaller, and semi-definite.
+A flexible part's stiffening term can make its mass indefinite along a direction the rows
+hold (the spin-up beam's torsion about its axis): off the manifold, with every row kept,
+M_x + A_xᵀA_x (``_augmented``) has the same motion and multipliers and is positive definite.
+Otherwise the bordered matrix is solved whole (``_close``).
 
 Off the manifold (an integrator's stage, ``motion``'s ``drift``) the Schur step follows the
 drift rule of core/equations.py instead: directions the drift splits off dependent rows are
@@ -112,7 +116,12 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     where ``multipliers``: tree.solve). Returns a status. ``drift``: negative on the
     manifold (the rules of the module docstring), else the state's relative drift δ
     (``motion``). The Schur matrix's eigenvectors and eigenvalues stay in ``vectors`` and
-    ``values`` (``_close_solve`` solves with them again)."""
+    ``values`` (``_close_solve`` solves with them again). Off the manifold with extra
+    coordinates whose mass is not positive definite (rows certified by ``motion``: the drift
+    rule keeps every row, its answer the plain one), the mass augmented by the rows on no
+    tree unknown (``_augmented``) is tried first; where it is not positive definite either,
+    the bordered matrix must have a condition of at most SCHUR_CONDITION_MAX, else
+    NEAR_SINGULAR (its solve's rounding, ε κ)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     if nx > 0:
         inverse, work = Mx.copy(), np.zeros((nx, nx))
@@ -123,7 +132,10 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
             return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S,
                                   vectors, rhs, lam, multipliers, drift)
         if drift >= 0.0:
-            return NEAR_SINGULAR  # a singular mass: the exact drift rule's to judge
+            Fa = _augmented(Mx, Ax, xb, Fx, segs, inverse)
+            if spd_inverse(inverse, nx, np.full(nx, largest + 1.0), work):
+                return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fa, ry, z0, y, w, z, S,
+                                      vectors, rhs, lam, multipliers, drift)
     S[:, :] = 0.0
     for x in range(nx):
         for c in range(nx):
@@ -139,8 +151,37 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
         for r in range(mx):
             S[nx + r, nx + x] = -_row_dot(r, segs, seg6, w)
     symmetric_eigen(S, vectors, values)
+    if drift >= 0.0 and nx and not np.abs(values).min() * SCHUR_CONDITION_MAX >= np.abs(values).max():
+        return NEAR_SINGULAR  # a mass not definite and a bordered matrix near singular: the exact drift rule's
     return _close_solve(topology, segs, seg6, factored, Fx, xb, ry, z0, y, w, z, vectors, values, rhs, lam, nx, mx,
                         multipliers, drift)
+
+
+@njit(**OPTIONS)
+def _augmented(Mx, Ax, xb, Fx, segs, out):
+    """out ← Mx + Σ A_xᵀA_x over the extra rows on no tree unknown; returns F_x + Σ A_xᵀ b_x over
+    them. Where those rows hold (A_x q̈_x = b_x, every row kept: ``_close`` off the manifold,
+    rows certified) the added terms cancel, so the motion and the multipliers are Mx's, and a
+    mass indefinite only along directions the rows hold (a flexible part's stiffening term
+    along its torsion) becomes positive definite (weight 1: the rows have unit norm, the
+    masses are over the largest)."""
+    nx = Mx.shape[0]
+    Fa = Fx.copy()
+    for c in range(nx):
+        for d in range(nx):
+            out[c, d] = Mx[c, d]
+    ptr = segs[0]
+    for x in range(Ax.shape[0]):
+        if ptr[x + 1] > ptr[x]:
+            continue
+        for c in range(nx):
+            a = Ax[x, c]
+            if a == 0.0:
+                continue
+            Fa[c] += a * xb[x]
+            for d in range(nx):
+                out[c, d] += a * Ax[x, d]
+    return Fa
 
 
 @njit(**OPTIONS)

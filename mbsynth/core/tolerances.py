@@ -38,7 +38,7 @@ SCHUR_DEPENDENT_RTOL = 1e-14  # kernel.py, off the manifold: Schur eigenvalues b
 # rounding of rows dependent on the manifold, whatever the drift
 DRIFT_MASS_SPREAD = 1e-4  # kernel.py, off the manifold: masses (diagonal, over the largest) spanning more than this
 # send a model's stages to the exact drift rule (the Schur eigenvalues mix masses with the rows' geometry)
-SCHUR_CONDITION_MAX = 1e8  # kernel.py, off the manifold with extra coordinates: a Schur matrix more ill-conditioned
+SCHUR_CONDITION_MAX = 1e8  # kernel.py, off the manifold with extra coordinates: a Schur (or bordered) matrix more ill-conditioned
 # than this sends the stage to the exact drift rule (the solve's relative error, about ε κ, would pass 1e-8: near a
 # singular position, where the exact rule's own solution keeps its accuracy, an integrator would crawl on the noise)
 SPLIT_MOVES = 1e4  # kernel.py, off the manifold: a dropped direction of Schur eigenvalue λ may move accelerations
