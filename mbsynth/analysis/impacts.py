@@ -44,7 +44,7 @@ import itertools
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from . import stepper
 from .continuous import ContinuousIntegration
@@ -223,13 +223,24 @@ class EventIntegration(ContinuousIntegration):
             stepper.move(solver, y, self.f(t, y))
 
     def contact_forces(self, t, q, qd, held):
-        """{gap name: its force λ} at (t, q, q̇) with the gaps named in ``held`` held (those of
-        them sliding now slide)."""
+        """{gap name: (its normal force λ, its friction force, world x, y, z)} at (t, q, q̇)
+        with the gaps named in ``held`` held (those of them sliding now slide): a sticking
+        contact's friction is its slip rows' forces λ_t along its tangents, a sliding one's
+        −μ λ_n û (û the unit slip); zero without friction."""
         rows = sorted(self.gaps.names.index(name) for name in held)
         if not rows:
             return {}
         sliding = {i: d for i, d in self.sliding.items() if i in rows}
-        return {self.gaps.names[i]: float(lam) for i, lam in zip(rows, self._held_motion(t, q, qd, rows, sliding).lam)}
+        motion = self._held_motion(t, q, qd, rows, sliding)
+        p, speed, found = self.base.parameter_values, np.abs(qd).max(initial=0.0), {}
+        for i, lam in zip(rows, motion.lam):
+            along = motion.tangential.get(i)
+            if i in sliding:
+                along = -self.gaps.friction[i] * lam * slip_direction(self.gaps.slip_rows(t, q, qd, p, i), qd,
+                                                                     sliding[i], speed)
+            friction = np.zeros(3) if along is None else self.gaps.tangents[i] @ along
+            found[self.gaps.names[i]] = (float(lam), friction)
+        return found
 
     def stats(self):
         counts = super().stats()
@@ -242,26 +253,39 @@ class EventIntegration(ContinuousIntegration):
         """Whether the step from ``start`` passed an event (an open gap closing, a held one's
         force turning negative): then ``pending`` holds the earliest, found by Brent's
         method on the step's dense output. A step aimed at the pending event ignores its
-        rows and gaps that touch (within atol) at its end: ``settle`` takes them there."""
+        rows and gaps that touch (within atol) at its end: ``settle`` takes them there. An
+        open gap that is open at both ends but turns from closing to opening within the step
+        (ġ < 0 at its start, > 0 at its end: a free flight past a contact in one step) is
+        looked at where g is least (Brent's bounded minimization; ġ may have no value where
+        two centres pass through each other): it closed within the step where g < 0 there."""
         t0, t1 = start[0], solver.t
         aiming = self.pending is not None and target == self.pending.t
         ignore = (self.pending.closing | self.pending.released | self.pending.switching) if aiming else frozenset()
         q1, qd1 = self.form.to_state(solver.y)
-        p = self.base.parameter_values
-        g1 = self.gaps.values(t1, q1, qd1, p)[0]
-        limit = -self.atol if aiming else 0.0
-        closing = [i for i in self._open() if i not in ignore and g1[i] < limit]
         q0, qd0 = self.form.to_state(start[1])
+        p = self.base.parameter_values
+        (g0, gd0), (g1, gd1) = self.gaps.values(t0, q0, qd0, p), self.gaps.values(t1, q1, qd1, p)
+        limit = -self.atol if aiming else 0.0
+        ends = {i: (t1, g1[i]) for i in self._open() if i not in ignore and g1[i] < limit}
+        turning = [i for i in self._open() if i not in ignore and i not in ends and g0[i] > self.atol and
+                   gd0[i] < 0 < gd1[i]]
+        dense = solver.dense_output() if turning else None
+        for i in turning:
+            lowest = minimize_scalar(lambda t: self._gap_at(dense, i, t), bounds=(t0, t1), method="bounded",
+                                     options={"xatol": EVENT_TIME_RTOL * abs(t1)})
+            if lowest.fun < limit:
+                ends[i] = (lowest.x, lowest.fun)
+        closing = list(ends)
         held = self.active - ignore
         reference = self._slip_references(t0, q0, qd0)
         watched1 = {k: x for k, x in self._watched(t1, q1, qd1, reference).items() if k[1] in held} if held else {}
         crossing = [k for k, x in watched1.items() if x < 0]
         if not closing and not crossing:
             return False
-        dense = solver.dense_output()
-        g0, gd0 = self.gaps.values(t0, q0, qd0, p)
+        dense = solver.dense_output() if dense is None else dense
         floor = self._rounding(t0, q0, qd0)
-        roots = {("close", i): self._closing(dense, i, t0, t1, g0[i], gd0[i], g1[i], floor[i]) for i in closing}
+        roots = {("close", i): self._closing(dense, i, t0, ends[i][0], g0[i], gd0[i], ends[i][1], floor[i])
+                 for i in closing}
         roots = {k: t for k, t in roots.items() if t is not None}
         if crossing:
             watched0 = self._watched(t0, q0, qd0, reference)

@@ -33,7 +33,9 @@ class Unilateral:
     sympy expression of the parameters), its holonomic ``row`` (φ = g), Coulomb's
     ``friction`` μ and the nonholonomic ``slip`` rows (None without friction); a contact's
     ``point`` (where it touches, world) and ``normal`` (the unit direction its impulse
-    pushes the child, or the second sphere), sympy columns of q, for the viewer."""
+    pushes the child, or the second sphere), sympy columns of q, for the viewer; with
+    friction, its slip rows' unit ``tangents`` t1, t2 (the columns of a sympy (3, 2) of the
+    parameters)."""
 
     name: str
     kind: str
@@ -43,6 +45,7 @@ class Unilateral:
     slip: Constraint = None
     point: sp.Matrix = None
     normal: sp.Matrix = None
+    tangents: sp.Matrix = None
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
@@ -133,6 +136,9 @@ class Gaps:
         self.restitution = np.array([u.restitution_at(system, p) for u in self.unilaterals], dtype=float)
         self.friction = np.array([u.friction_at(system, p) if u.slip is not None else 0.0
                                   for u in self.unilaterals], dtype=float)
+        values = dict(zip(system.parameter_symbols, p))
+        self.tangents = [None if u.tangents is None else np.array(u.tangents.xreplace(values), dtype=float)
+                         for u in self.unilaterals]  # (3, 2): a contact's unit tangents t1, t2 as columns
 
     def __len__(self):
         return len(self.unilaterals)
