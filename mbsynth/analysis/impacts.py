@@ -445,7 +445,10 @@ class EventIntegration(ContinuousIntegration):
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
         leaving = {i for i in self.active if gd[i] > max(rest[i], floor[i])}  # an impact left it opening
-        active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)))
+        # sunk to where the event of a gap sinking from rest puts it (−atol) and still sinking: left open it
+        # would come back here again and again
+        sunk = {i for i in resting if g[i] < -self.atol / 2 and gd[i] <= 0}
+        active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)), sunk)
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
@@ -534,13 +537,16 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
 
-    def _contact_set(self, t, q, qd, candidates):
+    def _contact_set(self, t, q, qd, candidates, sunk=frozenset()):
         """The gaps among ``candidates`` (touching, at rest or held) that hold from t: the
-        first active set, smallest first, with λ ≥ 0 on its rows and g̈ ≥ 0 on the others."""
+        first active set, smallest first, with λ ≥ 0 on its rows and g̈ ≥ 0 on the others;
+        those ``sunk`` (sinking from rest into their gap, found where it is atol deep: a body
+        tipping over an edge of its supports at a rate g̈ below the tolerance) are held in
+        every set tried."""
         if len(candidates) > ENUMERATED:
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
-        for chosen in _subsets(candidates):
+        for chosen in (x for x in _subsets(candidates) if sunk <= set(x)):
             _, lam, gdd, scale, force, _ = self._held_motion(t, q, qd, chosen)
             others = [i for i in candidates if i not in chosen]
             if (lam >= -COMPLEMENTARITY_RTOL * force).all() and \

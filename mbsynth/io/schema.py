@@ -390,10 +390,17 @@ SECTIONS = {section.name: section for section in (
                  "at a revolute or prismatic joint", "{stiffness: k, rest: 0.1}"),
              Key("friction", "mapping (section *joint_friction*)", "viscous and Coulomb friction at a "
                  "revolute or prismatic joint (non-ideal C)", "{viscous: 0.05}"),
-             Key("limits", "list of 2 " + _EXPRS + ", lo ≤ hi", "stops on the angle (revolute) or displacement "
-                 "(prismatic): unilateral rows ``<joint>.lower``, ``<joint>.upper``", "[-0.5, 0.5]"),
+             Key("limits", "list of 2 " + _EXPRS + ", lo ≤ hi; universal: 2 such lists; spherical: mapping "
+                 "(section *cone_limit*)", "stops on the angle (revolute) or displacement (prismatic): unilateral "
+                 "rows ``<joint>.lower``, ``<joint>.upper``; on a universal joint's angle1 and angle2: "
+                 "``.lower1``, ``.upper1``, ``.lower2``, ``.upper2``; on a spherical joint's swing: ``.cone``",
+                 "[-0.5, 0.5]"),
              Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution at the limits",
                  "0.5", default="0"))),
+    Section("cone_limit", "``limits:`` of a spherical joint",
+            "The swing, the angle between the frames' z axes (z_A on the parent, z_B on the child), stays at "
+            "most the cone's half-angle: the gap z_A·z_B − cos(cone) ≥ 0, row ``<joint>.cone``.",
+            (_required("cone", _EXPR + ", in (0, π]", "the cone's half-angle [rad]", "0.5"),)),
     Section("contact_plane", "an entry of ``contacts:`` with ``type: plane``",
             "A point (radius 0) or sphere on a part's frame against the plane n·x = ground (n the unit "
             "normal): the gap n·p − ground − radius stays ≥ 0. A ``capsule`` is its two end spheres "

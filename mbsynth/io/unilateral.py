@@ -9,6 +9,7 @@ import sympy as sp
 from ..core.joint_kinds import KINDS
 from ..core.tolerances import ASSEMBLED_TOL
 from ..model.constraints.base import Constraint
+from ..model.joint_templates import pose
 from ..model.parts.base import frame_velocity
 from ..model.unilateral import Unilateral, gap_row, tangent_basis
 from .joints import frame_reference
@@ -18,23 +19,56 @@ SHAPES = {"radius": 1, "capsule": 2, "box": 3}  # a plane contact's shape keys -
 
 
 def read_limits(builder, spec, path, joint, own_name):
-    """The Unilaterals of a joint's ``limits: [lo, hi]`` (``own_name``: the joint's name in
-    the file): ``<joint>.lower`` (g = value − lo) and ``<joint>.upper`` (g = hi − value)."""
+    """The Unilaterals of a joint's ``limits`` (``own_name``: the joint's name in the file):
+
+    - revolute, prismatic ``[lo, hi]`` on its angle or displacement x: ``<joint>.lower``
+      (g = x − lo) and ``<joint>.upper`` (g = hi − x);
+    - universal ``[[lo1, hi1], [lo2, hi2]]`` on angle1 and angle2: ``<joint>.lower1``,
+      ``.upper1``, ``.lower2``, ``.upper2`` alike;
+    - spherical ``{cone: θ}`` (0 < θ ≤ π) on the swing, the angle between the two frames'
+      z axes: ``<joint>.cone``, g = z_A·z_B − cos θ (its rate is −sin(swing) × the swing's
+      rate, so Newton's law on it is Newton's law on the swing angle)."""
     if "limits" not in spec:
         if "restitution" in spec:
-            builder.fail(path + ("restitution",), "restitution needs limits: [lo, hi] on the joint")
+            builder.fail(path + ("restitution",), "restitution needs limits on the joint")
         return []
-    value = KINDS[joint.joint_kind].limited
-    if value is None:
-        builder.fail(path + ("limits",), f"a {joint.joint_kind} joint takes no limits (revolute and prismatic joints do)")
-    lo, hi = builder.constants(spec["limits"], path + ("limits",), 2)
-    if builder.value(lo) > builder.value(hi):
-        builder.fail(path + ("limits",), f"lo = {builder.value(lo):g} is above hi = {builder.value(hi):g}")
+    where, kind = path + ("limits",), joint.joint_kind
+    if kind == "spherical":
+        gaps = [("cone", _cone(builder, spec["limits"], where, joint))]
+    elif kind == "universal":
+        pairs = builder.sized_list(spec["limits"], where, 2)
+        gaps = [gap for k, pair in enumerate(pairs, 1)
+                for gap in _range(builder, pair, where + (k - 1,), f"{own_name}.angle{k}", str(k))]
+    elif KINDS[kind].limited is not None:
+        gaps = _range(builder, spec["limits"], where, f"{own_name}.{KINDS[kind].limited}", "")
+    else:
+        builder.fail(where, f"a {kind} joint takes no limits (revolute, prismatic, universal and spherical "
+                            f"joints do)")
     e = _restitution(builder, spec, path)
-    x = builder.expression(f"{own_name}.{value}", path + ("limits",), builder.constraint_symbols)
     args = (builder.q, builder.qd, builder.parameter_symbols)
-    return [(Unilateral(f"{joint.name}.{side}", "limit", e, gap_row(f"{joint.name}.{side}", gap, *args)),
-             path + ("limits",)) for side, gap in (("lower", x - lo), ("upper", hi - x))]
+    return [(Unilateral(f"{joint.name}.{side}", "limit", e, gap_row(f"{joint.name}.{side}", gap, *args)), where)
+            for side, gap in gaps]
+
+
+def _range(builder, node, path, value, suffix):
+    """[("lower" + suffix, x − lo), ("upper" + suffix, hi − x)] of ``[lo, hi]`` on the joint
+    value ``value`` (``<joint>.<name>``)."""
+    lo, hi = builder.constants(node, path, 2)
+    if builder.value(lo) > builder.value(hi):
+        builder.fail(path, f"lo = {builder.value(lo):g} is above hi = {builder.value(hi):g}")
+    x = builder.expression(value, path, builder.constraint_symbols)
+    return [("lower" + suffix, x - lo), ("upper" + suffix, hi - x)]
+
+
+def _cone(builder, node, path, joint):
+    """z_A·z_B − cos θ of a spherical joint's ``{cone: θ}``."""
+    node = builder.section(node, path, "cone_limit")
+    angle = builder.constant(node["cone"], path + ("cone",))
+    if not 0 < builder.value(angle) <= float(sp.pi):
+        builder.fail(path + ("cone",), f"a cone's half-angle is in (0, π], got {builder.value(angle):g}")
+    (parent, child), (frame_a, frame_b) = joint.parts, joint.frames
+    z_a, z_b = (sp.Matrix(pose(part, frame)[1])[:, 2] for part, frame in ((parent, frame_a), (child, frame_b)))
+    return z_a.dot(z_b) - sp.cos(angle)
 
 
 def read_contacts(builder):

@@ -3,6 +3,8 @@ spheres against the ground, a sphere against a capsule, against the classical ri
 impact formulas (Newton's law on the normal rate, the impulse P along the unit normal n at
 a point r from the centre of mass: P = (1 + e) v_n / (1/m + (r × n)ᵀ I⁻¹ (r × n)))."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -245,3 +247,18 @@ def test_a_contact_shape_without_its_sizes_or_with_bad_ones_is_refused_at_its_li
     with pytest.raises(ModelError) as err:
         mb.loads(HEAD + f"  - {entry}\n", name="bad.yaml")
     assert str(err.value).startswith("bad.yaml:6: at " + message), str(err.value)
+
+
+@pytest.mark.parametrize("roll, pitch", [(0.3, 0.0), (0.3, 0.2)])
+def test_a_tipped_box_falls_over_onto_its_face_and_rests_there_carrying_its_weight(roll, pitch):
+    """models/contact/box_drop.yaml with e = 0, tipped: it lands on an edge or a corner,
+    falls over onto its face and rests on its corners (a corner tipping in from rest below
+    the contact tolerance is held, not left to sink: no chatter), the centre at c/2 and the
+    corners' forces adding up to m g."""
+    text = (Path(__file__).resolve().parents[2] / "models" / "contact" / "box_drop.yaml").read_text()
+    forces = "".join(f"  f{k}: {{contact: 'floor[{k}].force'}}\n" for k in range(8))
+    system = mb.loads(text + forces, parameters={"e": 0.0, "roll": roll, "pitch": pitch})
+    traj = mb.simulate(system, 1.0, rtol=1e-10, atol=1e-10)
+    assert traj.status == "completed"
+    assert traj.q[-1, 2] == pytest.approx(C / 2, abs=1e-9)
+    assert sum(traj.column(f"f{k}") for k in range(8))[-1] == pytest.approx(M * G, rel=1e-8)
