@@ -3,6 +3,8 @@ spheres against the ground, a sphere against a capsule, against the classical ri
 impact formulas (Newton's law on the normal rate, the impulse P along the unit normal n at
 a point r from the centre of mass: P = (1 + e) v_n / (1/m + (r × n)ᵀ I⁻¹ (r × n)))."""
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -262,3 +264,13 @@ def test_a_tipped_box_falls_over_onto_its_face_and_rests_there_carrying_its_weig
     assert traj.status == "completed"
     assert traj.q[-1, 2] == pytest.approx(C / 2, abs=1e-9)
     assert sum(traj.column(f"f{k}") for k in range(8))[-1] == pytest.approx(M * G, rel=1e-8)
+
+
+def test_the_command_line_refuses_a_box_with_a_negative_size_with_one_line(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text(HEAD + "  - {name: floor, type: plane, child: block, box: [0.4, -0.2, 0.1]}\n")
+    done = subprocess.run([sys.executable, "-m", "mbsynth.cli", "simulate", str(path), "--t-end", "1"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2
+    assert done.stderr.strip().count("\n") == 0
+    assert "bad.yaml:6: at contacts[0].box[1]: a contact's dimensions are > 0, got -0.2" in done.stderr
