@@ -21,8 +21,9 @@ the state there is ``settle``d:
 2. persistent contact: the touching gaps at rest and the held ones form the acceleration
    complementarity problem 0 ≤ λ ⊥ g̈ ≥ 0, again solved by enumeration; the rows of its
    solution hold (a System with them appended: unilateral.with_active), each newly held
-   one brought to rest first (an e = 0 jump). A held row is released where its force
-   falls to zero.
+   one brought to rest first (an e = 0 jump); one that sank from rest (its g̈ below the
+   tolerance: a box tipping over the diagonal it rests on) is held in every set tried. A
+   held row is released where its force falls to zero.
 
 A striking contact with Coulomb friction μ sticks or slips through its impact
 (impulse.Rough): Newton's law on its normal, and either its slip rows held at zero
@@ -62,6 +63,7 @@ ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once i
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
 INSTANT_EVENTS = 100  # events in a row at one instant: held contacts switch between stick and slip without end
 ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
+SUNK = 0.5  # a gap at rest this many atol deep (an event puts a gap sinking from rest at 1 atol) is held
 
 
 class Pending(NamedTuple):
@@ -272,7 +274,7 @@ class EventIntegration(ContinuousIntegration):
         dense = solver.dense_output() if turning else None
         for i in turning:
             lowest = minimize_scalar(lambda t: self._gap_at(dense, i, t), bounds=(t0, t1), method="bounded",
-                                     options={"xatol": EVENT_TIME_RTOL * abs(t1)})
+                                     options={"xatol": EVENT_TIME_RTOL * max(abs(t0), abs(t1))})
             if lowest.fun < limit:
                 ends[i] = (lowest.x, lowest.fun)
         closing = list(ends)
@@ -445,9 +447,9 @@ class EventIntegration(ContinuousIntegration):
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
         leaving = {i for i in self.active if gd[i] > max(rest[i], floor[i])}  # an impact left it opening
-        # sunk to where the event of a gap sinking from rest puts it (−atol) and still sinking: left open it
-        # would come back here again and again
-        sunk = {i for i in resting if g[i] < -self.atol / 2 and gd[i] <= 0}
+        # sunk to where the event of a gap sinking from rest puts it and still sinking: left open it would
+        # come back here again and again
+        sunk = {i for i in resting if g[i] < -SUNK * self.atol and gd[i] <= 0}
         active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)), sunk)
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
