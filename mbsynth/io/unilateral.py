@@ -104,9 +104,9 @@ def read_contacts(builder):
         for suffix, centre, radius, omega in _plane_spheres(builder, spec, path):
             full = builder.full_name(name + suffix)
             slip, tangents = (None, None) if mu is None else _slip(builder, full, centre, radius, omega, unit)
-            found.append((Unilateral(full, "contact", e, _row(builder, name + suffix, unit.dot(centre) - ground - radius),
-                                     sp.S.Zero if mu is None else mu, slip, centre - radius * unit, unit, tangents),
-                          path))
+            row = _row(builder, name + suffix, unit.dot(centre) - ground - radius)
+            found.append((Unilateral(full, "contact", e, row, sp.S.Zero if mu is None else mu, slip,
+                                     centre - radius * unit, unit, tangents), path))
     return found
 
 
