@@ -21,8 +21,9 @@ the state there is ``settle``d:
 2. persistent contact: the touching gaps at rest and the held ones form the acceleration
    complementarity problem 0 ≤ λ ⊥ g̈ ≥ 0, again solved by enumeration; the rows of its
    solution hold (a System with them appended: unilateral.with_active), each newly held
-   one brought to rest first (an e = 0 jump). A held row is released where its force
-   falls to zero.
+   one brought to rest first (an e = 0 jump); one that sank from rest (its g̈ below the
+   tolerance: a box tipping over the diagonal it rests on) is held in every set tried. A
+   held row is released where its force falls to zero.
 
 A striking contact with Coulomb friction μ sticks or slips through its impact
 (impulse.Rough): Newton's law on its normal, and either its slip rows held at zero
@@ -44,7 +45,7 @@ import itertools
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from . import stepper
 from .continuous import ContinuousIntegration
@@ -62,6 +63,7 @@ ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once i
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
 INSTANT_EVENTS = 100  # events in a row at one instant: held contacts switch between stick and slip without end
 ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
+SUNK = 0.5  # a gap at rest this many atol deep (an event puts a gap sinking from rest at 1 atol) is held
 
 
 class Pending(NamedTuple):
@@ -223,13 +225,24 @@ class EventIntegration(ContinuousIntegration):
             stepper.move(solver, y, self.f(t, y))
 
     def contact_forces(self, t, q, qd, held):
-        """{gap name: its force λ} at (t, q, q̇) with the gaps named in ``held`` held (those of
-        them sliding now slide)."""
+        """{gap name: (its normal force λ, its friction force, world x, y, z)} at (t, q, q̇)
+        with the gaps named in ``held`` held (those of them sliding now slide): a sticking
+        contact's friction is its slip rows' forces λ_t along its tangents, a sliding one's
+        −μ λ_n û (û the unit slip); zero without friction."""
         rows = sorted(self.gaps.names.index(name) for name in held)
         if not rows:
             return {}
         sliding = {i: d for i, d in self.sliding.items() if i in rows}
-        return {self.gaps.names[i]: float(lam) for i, lam in zip(rows, self._held_motion(t, q, qd, rows, sliding).lam)}
+        motion = self._held_motion(t, q, qd, rows, sliding)
+        p, speed, found = self.base.parameter_values, np.abs(qd).max(initial=0.0), {}
+        for i, lam in zip(rows, motion.lam):
+            along = motion.tangential.get(i)
+            if i in sliding:
+                along = -self.gaps.friction[i] * lam * slip_direction(self.gaps.slip_rows(t, q, qd, p, i), qd,
+                                                                     sliding[i], speed)
+            friction = np.zeros(3) if along is None else self.gaps.tangents[i] @ along
+            found[self.gaps.names[i]] = (float(lam), friction)
+        return found
 
     def stats(self):
         counts = super().stats()
@@ -242,26 +255,39 @@ class EventIntegration(ContinuousIntegration):
         """Whether the step from ``start`` passed an event (an open gap closing, a held one's
         force turning negative): then ``pending`` holds the earliest, found by Brent's
         method on the step's dense output. A step aimed at the pending event ignores its
-        rows and gaps that touch (within atol) at its end: ``settle`` takes them there."""
+        rows and gaps that touch (within atol) at its end: ``settle`` takes them there. An
+        open gap that is open at both ends but turns from closing to opening within the step
+        (ġ < 0 at its start, > 0 at its end: a free flight past a contact in one step) is
+        looked at where g is least (Brent's bounded minimization; ġ may have no value where
+        two centres pass through each other): it closed within the step where g < 0 there."""
         t0, t1 = start[0], solver.t
         aiming = self.pending is not None and target == self.pending.t
         ignore = (self.pending.closing | self.pending.released | self.pending.switching) if aiming else frozenset()
         q1, qd1 = self.form.to_state(solver.y)
-        p = self.base.parameter_values
-        g1 = self.gaps.values(t1, q1, qd1, p)[0]
-        limit = -self.atol if aiming else 0.0
-        closing = [i for i in self._open() if i not in ignore and g1[i] < limit]
         q0, qd0 = self.form.to_state(start[1])
+        p = self.base.parameter_values
+        (g0, gd0), (g1, gd1) = self.gaps.values(t0, q0, qd0, p), self.gaps.values(t1, q1, qd1, p)
+        limit = -self.atol if aiming else 0.0
+        ends = {i: (t1, g1[i]) for i in self._open() if i not in ignore and g1[i] < limit}
+        turning = [i for i in self._open() if i not in ignore and i not in ends and g0[i] > self.atol and
+                   gd0[i] < 0 < gd1[i]]
+        dense = solver.dense_output() if turning else None
+        for i in turning:
+            lowest = minimize_scalar(lambda t: self._gap_at(dense, i, t), bounds=(t0, t1), method="bounded",
+                                     options={"xatol": EVENT_TIME_RTOL * max(abs(t0), abs(t1))})
+            if lowest.fun < limit:
+                ends[i] = (lowest.x, lowest.fun)
+        closing = list(ends)
         held = self.active - ignore
         reference = self._slip_references(t0, q0, qd0)
         watched1 = {k: x for k, x in self._watched(t1, q1, qd1, reference).items() if k[1] in held} if held else {}
         crossing = [k for k, x in watched1.items() if x < 0]
         if not closing and not crossing:
             return False
-        dense = solver.dense_output()
-        g0, gd0 = self.gaps.values(t0, q0, qd0, p)
+        dense = solver.dense_output() if dense is None else dense
         floor = self._rounding(t0, q0, qd0)
-        roots = {("close", i): self._closing(dense, i, t0, t1, g0[i], gd0[i], g1[i], floor[i]) for i in closing}
+        roots = {("close", i): self._closing(dense, i, t0, ends[i][0], g0[i], gd0[i], ends[i][1], floor[i])
+                 for i in closing}
         roots = {k: t for k, t in roots.items() if t is not None}
         if crossing:
             watched0 = self._watched(t0, q0, qd0, reference)
@@ -421,7 +447,10 @@ class EventIntegration(ContinuousIntegration):
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
         leaving = {i for i in self.active if gd[i] > max(rest[i], floor[i])}  # an impact left it opening
-        active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)))
+        # sunk to where the event of a gap sinking from rest puts it and still sinking: left open it would
+        # come back here again and again
+        sunk = {i for i in resting if g[i] < -SUNK * self.atol and gd[i] <= 0}
+        active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)), sunk)
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
@@ -510,13 +539,16 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
 
-    def _contact_set(self, t, q, qd, candidates):
+    def _contact_set(self, t, q, qd, candidates, sunk=frozenset()):
         """The gaps among ``candidates`` (touching, at rest or held) that hold from t: the
-        first active set, smallest first, with λ ≥ 0 on its rows and g̈ ≥ 0 on the others."""
+        first active set, smallest first, with λ ≥ 0 on its rows and g̈ ≥ 0 on the others;
+        those ``sunk`` (sinking from rest into their gap, found where it is atol deep: a body
+        tipping over an edge of its supports at a rate g̈ below the tolerance) are held in
+        every set tried."""
         if len(candidates) > ENUMERATED:
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
-        for chosen in _subsets(candidates):
+        for chosen in (x for x in _subsets(candidates) if sunk <= set(x)):
             _, lam, gdd, scale, force, _ = self._held_motion(t, q, qd, chosen)
             others = [i for i in candidates if i not in chosen]
             if (lam >= -COMPLEMENTARITY_RTOL * force).all() and \

@@ -33,7 +33,7 @@ class Recorder:
                             residual_velocity=np.empty(rows), outputs=np.empty((rows, m)))
         self.writer = None
         self.events = []  # trajectory.Event, appended by a run with unilateral constraints (impacts.py)
-        self.contact_forces = None  # the run's {gap name: λ} of (t, q, q̇, held gaps) (impacts.py): contact outputs
+        self.contact_forces = None  # the run's {gap name: (λ, friction)} of (t, q, q̇, held gaps) (impacts.py)
         self.counted = 0  # the events up to the last row (contact outputs)
         self.held = set()  # the gaps held at the last row, by its events
 
@@ -94,7 +94,7 @@ class Recorder:
             self.writer.append(self.trajectory("running", rows=rows_at))
 
     def _contacts(self, t, q, qd):
-        """{gap name: (force, impulse)} at a row at t, from the run's events up to t (rows
+        """{gap name: (force, impulse, friction)} at a row at t, from the run's events up to t (rows
         come in time order, the run's events ahead of them): the forces of the gaps held
         there (a "contact" event holds a gap, a "release" opens it), and the normal impulses
         ("impact", "contact") since the previous row; None without unilateral gaps."""
@@ -111,7 +111,11 @@ class Recorder:
                 impulses[event.name] = impulses.get(event.name, 0.0) + event.impulse
             self.counted += 1
         forces = self.contact_forces(t, q, qd, self.held)
-        return {name: (forces.get(name, 0.0), impulses.get(name, 0.0)) for name in set(forces) | set(impulses)}
+        found = {}
+        for name in set(forces) | set(impulses):
+            force, friction = forces.get(name, (0.0, np.zeros(3)))
+            found[name] = (force, impulses.get(name, 0.0), friction)
+        return found
 
     def close(self, status):
         """Finish the file, if any, with the run's ``status``."""

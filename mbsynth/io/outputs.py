@@ -45,8 +45,8 @@ def read_outputs(builder, constraints, gaps=()):
         elif kind == "contact":
             gap, _, which = str(value).rpartition(".")
             if builder.full_name(gap) not in gaps:
-                builder.fail(kpath, f"unknown contact or limit '{gap}' in '{value}' (write '<contact>.force' or "
-                                    f"'.impulse'); known: {', '.join(gaps) or 'none'}")
+                builder.fail(kpath, f"unknown contact or limit '{gap}' in '{value}' (write '<contact>.force', "
+                                    f"'.impulse' or '.friction'); known: {', '.join(gaps) or 'none'}")
             make = functools.partial(contact_output, name, builder.full_name(gap), which)
         elif kind == "energy":
             make = functools.partial(energy_output, name, value)

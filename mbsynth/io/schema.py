@@ -390,17 +390,32 @@ SECTIONS = {section.name: section for section in (
                  "at a revolute or prismatic joint", "{stiffness: k, rest: 0.1}"),
              Key("friction", "mapping (section *joint_friction*)", "viscous and Coulomb friction at a "
                  "revolute or prismatic joint (non-ideal C)", "{viscous: 0.05}"),
-             Key("limits", "list of 2 " + _EXPRS + ", lo ≤ hi", "stops on the angle (revolute) or displacement "
-                 "(prismatic): unilateral rows ``<joint>.lower``, ``<joint>.upper``", "[-0.5, 0.5]"),
+             Key("limits", "list of 2 " + _EXPRS + ", lo ≤ hi; universal: 2 such lists; spherical: mapping "
+                 "(section *cone_limit*)", "stops on the angle (revolute) or displacement (prismatic): unilateral "
+                 "rows ``<joint>.lower``, ``<joint>.upper``; on a universal joint's angle1 and angle2: "
+                 "``.lower1``, ``.upper1``, ``.lower2``, ``.upper2``; on a spherical joint's swing: ``.cone``",
+                 "[-0.5, 0.5]"),
              Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution at the limits",
                  "0.5", default="0"))),
+    Section("cone_limit", "``limits:`` of a spherical joint",
+            "The swing, the angle between the frames' z axes (z_A on the parent, z_B on the child), stays at "
+            "most the cone's half-angle: the gap z_A·z_B − cos(cone) ≥ 0, row ``<joint>.cone``.",
+            (_required("cone", _EXPR + ", in (0, π]", "the cone's half-angle [rad]", "0.5"),)),
     Section("contact_plane", "an entry of ``contacts:`` with ``type: plane``",
             "A point (radius 0) or sphere on a part's frame against the plane n·x = ground (n the unit "
-            "normal): the gap n·p − ground − radius stays ≥ 0.",
+            "normal): the gap n·p − ground − radius stays ≥ 0. A ``capsule`` is its two end spheres "
+            "(contacts ``NAME[0]``, ``NAME[1]``), a ``box`` its eight corners (``NAME[0]`` … ``NAME[7]``), "
+            "each a contact of its own.",
             (_required("name", "plain name", "the contact's name", "floor"),
              _required("type", "string", "``plane``", "plane"),
              _required("child", "frame", "the sphere's centre: a frame on a part", "ball"),
              Key("radius", _EXPR + ", ≥ 0", "the sphere's radius (0: a point)", "r", default="0"),
+             Key("capsule", "list of 2 " + _EXPRS + ", > 0", "instead of a sphere, a capsule [radius, length] "
+                 "along the frame's z, centred on it: ``NAME[0]`` its end sphere at −length/2, ``NAME[1]`` at "
+                 "+length/2", "[0.02, 0.5]"),
+             Key("box", "list of 3 " + _EXPRS + ", > 0", "instead of a sphere, a box of these sizes along the "
+                 "frame's x, y, z, centred on it: ``NAME[k]`` its corner (±x/2, ±y/2, ±z/2), bit j of k the sign "
+                 "of axis j (0: −)", "[0.4, 0.2, 0.1]"),
              Key("ground", _EXPR, "the plane's offset along its normal", "0", default="0"),
              Key("normal", "list of 3 " + _EXPRS, "the plane's normal, pointing out of the ground", "[0, 0, 1]",
                  default="[0, 0, 1]"),
@@ -409,11 +424,15 @@ SECTIONS = {section.name: section for section in (
                  "moves with its spin): tangential impulses at impacts, stick or slip; sliding", "0.5", default="0"),
              _DESCRIPTION)),
     Section("contact_spheres", "an entry of ``contacts:`` with ``type: spheres``",
-            "Two spheres on two parts: the gap |p_B − p_A| − r_A − r_B stays ≥ 0.",
+            "Two spheres on two parts: the gap |p_B − p_A| − r_A − r_B stays ≥ 0. With a ``length``, one of "
+            "them is a capsule (its segment along its frame's z, centred on it): the gap is the distance "
+            "from the sphere's centre to the segment less both radii.",
             (_required("name", "plain name", "the contact's name", "c12"),
              _required("type", "string", "``spheres``", "spheres"),
              _required("between", "list of 2 frames", "the spheres' centres, on two parts", "[ball1, ball2]"),
              _required("radius", "list of 2 " + _EXPRS + ", ≥ 0", "their radii", "[r, r]"),
+             Key("length", "list of 2 " + _EXPRS + ", ≥ 0, one of them 0", "their segments' lengths (0: a "
+                 "sphere; > 0: a capsule along its frame's z)", "[0, 0.5]", default="[0, 0]"),
              Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution", "1", default="0"),
              _DESCRIPTION)),
     Section("rolling_disk", "an entry of ``joints:`` with ``type: rolling_disk``",

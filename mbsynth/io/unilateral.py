@@ -9,35 +9,71 @@ import sympy as sp
 from ..core.joint_kinds import KINDS
 from ..core.tolerances import ASSEMBLED_TOL
 from ..model.constraints.base import Constraint
+from ..model.joint_templates import pose
 from ..model.parts.base import frame_velocity
 from ..model.unilateral import Unilateral, gap_row, tangent_basis
 from .joints import frame_reference
 
 CONTACT_KINDS = {"plane": "contact_plane", "spheres": "contact_spheres"}  # contact type -> schema section
+SHAPES = {"radius": 1, "capsule": 2, "box": 3}  # a plane contact's shape keys -> their sizes (_plane_spheres)
 
 
 def read_limits(builder, spec, path, joint, own_name):
-    """The Unilaterals of a joint's ``limits: [lo, hi]`` (``own_name``: the joint's name in
-    the file): ``<joint>.lower`` (g = value − lo) and ``<joint>.upper`` (g = hi − value)."""
+    """The Unilaterals of a joint's ``limits`` (``own_name``: the joint's name in the file):
+
+    - revolute, prismatic ``[lo, hi]`` on its angle or displacement x: ``<joint>.lower``
+      (g = x − lo) and ``<joint>.upper`` (g = hi − x);
+    - universal ``[[lo1, hi1], [lo2, hi2]]`` on angle1 and angle2: ``<joint>.lower1``,
+      ``.upper1``, ``.lower2``, ``.upper2`` alike;
+    - spherical ``{cone: θ}`` (0 < θ ≤ π) on the swing, the angle between the two frames'
+      z axes: ``<joint>.cone``, g = z_A·z_B − cos θ (its rate is −sin(swing) × the swing's
+      rate, so Newton's law on it is Newton's law on the swing angle)."""
     if "limits" not in spec:
         if "restitution" in spec:
-            builder.fail(path + ("restitution",), "restitution needs limits: [lo, hi] on the joint")
+            builder.fail(path + ("restitution",), "restitution needs limits on the joint")
         return []
-    value = KINDS[joint.joint_kind].limited
-    if value is None:
-        builder.fail(path + ("limits",), f"a {joint.joint_kind} joint takes no limits (revolute and prismatic joints do)")
-    lo, hi = builder.constants(spec["limits"], path + ("limits",), 2)
-    if builder.value(lo) > builder.value(hi):
-        builder.fail(path + ("limits",), f"lo = {builder.value(lo):g} is above hi = {builder.value(hi):g}")
+    where, kind = path + ("limits",), joint.joint_kind
+    if kind == "spherical":
+        gaps = [("cone", _cone(builder, spec["limits"], where, joint))]
+    elif kind == "universal":
+        pairs = builder.sized_list(spec["limits"], where, 2)
+        gaps = [gap for k, pair in enumerate(pairs, 1)
+                for gap in _range(builder, pair, where + (k - 1,), f"{own_name}.angle{k}", str(k))]
+    elif KINDS[kind].limited is not None:
+        gaps = _range(builder, spec["limits"], where, f"{own_name}.{KINDS[kind].limited}", "")
+    else:
+        builder.fail(where, f"a {kind} joint takes no limits (revolute, prismatic, universal and spherical "
+                            f"joints do)")
     e = _restitution(builder, spec, path)
-    x = builder.expression(f"{own_name}.{value}", path + ("limits",), builder.constraint_symbols)
     args = (builder.q, builder.qd, builder.parameter_symbols)
-    return [(Unilateral(f"{joint.name}.{side}", "limit", e, gap_row(f"{joint.name}.{side}", gap, *args)),
-             path + ("limits",)) for side, gap in (("lower", x - lo), ("upper", hi - x))]
+    return [(Unilateral(f"{joint.name}.{side}", "limit", e, gap_row(f"{joint.name}.{side}", gap, *args)), where)
+            for side, gap in gaps]
+
+
+def _range(builder, node, path, value, suffix):
+    """[("lower" + suffix, x − lo), ("upper" + suffix, hi − x)] of ``[lo, hi]`` on the joint
+    value ``value`` (``<joint>.<name>``)."""
+    lo, hi = builder.constants(node, path, 2)
+    if builder.value(lo) > builder.value(hi):
+        builder.fail(path, f"lo = {builder.value(lo):g} is above hi = {builder.value(hi):g}")
+    x = builder.expression(value, path, builder.constraint_symbols)
+    return [("lower" + suffix, x - lo), ("upper" + suffix, hi - x)]
+
+
+def _cone(builder, node, path, joint):
+    """z_A·z_B − cos θ of a spherical joint's ``{cone: θ}``."""
+    node = builder.section(node, path, "cone_limit")
+    angle = builder.constant(node["cone"], path + ("cone",))
+    if not 0 < builder.value(angle) <= float(sp.pi):
+        builder.fail(path + ("cone",), f"a cone's half-angle is in (0, π], got {builder.value(angle):g}")
+    (parent, child), (frame_a, frame_b) = joint.parts, joint.frames
+    z_a, z_b = (sp.Matrix(pose(part, frame)[1])[:, 2] for part, frame in ((parent, frame_a), (child, frame_b)))
+    return z_a.dot(z_b) - sp.cos(angle)
 
 
 def read_contacts(builder):
-    """The Unilaterals of the file's ``contacts:`` list."""
+    """The Unilaterals of the file's ``contacts:`` list: one per sphere or point, per end of
+    a capsule and per corner of a box (``NAME[k]``, ``_plane_spheres``)."""
     node = builder.root.get("contacts")
     if node is None:
         return []
@@ -56,45 +92,87 @@ def read_contacts(builder):
         if name in names:
             builder.fail(path + ("name",), f"duplicate contact name '{name}'")
         names.add(name)
-        gap, point, normal = (_plane_gap if kind == "plane" else _spheres_gap)(builder, spec, path)
-        full = builder.full_name(name)
-        row = gap_row(full, gap, builder.q, builder.qd, builder.parameter_symbols)
-        mu, slip = _friction(builder, spec, path, full) if kind == "plane" else (sp.S.Zero, None)
-        found.append((Unilateral(full, "contact", _restitution(builder, spec, path), row, mu, slip, point, normal),
-                      path))
+        e = _restitution(builder, spec, path)
+        if kind == "spheres":
+            gap, point, normal = _spheres_gap(builder, spec, path)
+            found.append((Unilateral(builder.full_name(name), "contact", e, _row(builder, name, gap), point=point,
+                                     normal=normal), path))
+            continue
+        unit = _normal(builder, spec, path)
+        mu = _friction(builder, spec, path)
+        ground = builder.constant(spec.get("ground", 0), path + ("ground",))
+        for suffix, centre, radius, omega in _plane_spheres(builder, spec, path):
+            full = builder.full_name(name + suffix)
+            slip, tangents = (None, None) if mu is None else _slip(builder, full, centre, radius, omega, unit)
+            row = _row(builder, name + suffix, unit.dot(centre) - ground - radius)
+            found.append((Unilateral(full, "contact", e, row, sp.S.Zero if mu is None else mu, slip,
+                                     centre - radius * unit, unit, tangents), path))
     return found
 
 
-def _friction(builder, spec, path, name):
-    """(μ, the slip rows) of a plane contact's ``friction: μ`` (μ ≥ 0, 0 by default): the
-    rows ψ = t_k·v_c, the velocity of the contact point along two unit tangents t1, t2 of the
-    plane (None without friction). The contact point of a sphere of radius r is c = p − r n
-    on the part, so v_c = ṗ + ω × (−r n) with ω the part's angular velocity (a point: r = 0)."""
+def _row(builder, name, gap):
+    return gap_row(builder.full_name(name), gap, builder.q, builder.qd, builder.parameter_symbols)
+
+
+def _friction(builder, spec, path):
+    """A plane contact's ``friction: μ`` (μ ≥ 0; None where it has none)."""
     if "friction" not in spec:
-        return sp.S.Zero, None
+        return None
     mu = builder.constant(spec["friction"], path + ("friction",))
     if builder.value(mu) < 0:
         builder.fail(path + ("friction",), f"friction must be ≥ 0, got {builder.value(mu):g}")
-    part, frame = frame_reference(builder, spec["child"], path + ("child",))
-    unit = _normal(builder, spec, path)
-    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
-    velocity = frame_velocity(part.pose(frame)[0], builder.q, builder.qd) + \
-        part.frame_angular_velocity(frame).cross(-radius * unit)
-    rows = [t.dot(velocity) for t in tangent_basis(unit, builder.value)]
-    return mu, Constraint.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
-                                      row_labels=["t1", "t2"])
+    return mu
 
 
-def _plane_gap(builder, spec, path):
-    """(n·p − ground − r, the contact point p − r n, n) of a sphere on the ``child`` frame
-    against the plane n·x = ground."""
+def _slip(builder, name, centre, radius, omega, unit):
+    """(the slip rows, their tangents) of a sphere of radius r centred at ``centre`` (world,
+    on a part turning at ω) against a plane of unit normal n: the rows ψ = t_k·v_c, the
+    velocity of the contact point c = centre − r n along two unit tangents t1, t2 of the
+    plane (the columns of a (3, 2) matrix), v_c = ċentre + ω × (−r n)."""
+    velocity = frame_velocity(centre, builder.q, builder.qd) + omega.cross(-radius * unit)
+    tangents = tangent_basis(unit, builder.value)
+    rows = [t.dot(velocity) for t in tangents]
+    return Constraint.nonholonomic(f"{name}.slip", rows, builder.q, builder.qd, builder.parameter_symbols,
+                                   row_labels=["t1", "t2"]), sp.Matrix.hstack(*tangents)
+
+
+def _plane_spheres(builder, spec, path):
+    """[(name suffix, centre (world), radius, the part's ω)] of a plane contact: the ``child``
+    frame's sphere of ``radius`` (a point where 0), or a ``capsule: [r, length]`` along the
+    frame's z about its origin (its two end spheres, ``[0]`` at −length/2, ``[1]`` at
+    +length/2), or a ``box: [x, y, z]`` (sizes along the frame's axes, about its origin:
+    its eight corners, ``[k]`` at (±x/2, ±y/2, ±z/2), the signs of x, y, z from bits 0, 1, 2
+    of k, 0 for −). A gap of each is n·centre − ground − radius."""
     if not builder.placement.identity:
         builder.fail(path, "a ground contact in an included file with a placement: give it in the including file")
-    p = _centre(builder, spec["child"], path + ("child",))
-    unit = _normal(builder, spec, path)
-    radius = _radius(builder, spec.get("radius", 0), path + ("radius",))
-    ground = builder.constant(spec.get("ground", 0), path + ("ground",))
-    return unit.dot(p) - ground - radius, p - radius * unit, unit
+    shapes = [key for key in SHAPES if key in spec]
+    if len(shapes) > 1:
+        builder.fail(path + (shapes[1],), f"a contact has one of {', '.join(SHAPES)}, got {' and '.join(shapes)}")
+    part, frame = frame_reference(builder, spec["child"], path + ("child",))
+    if part is None:
+        builder.fail(path + ("child",), "a contact's sphere sits on a part, not on the world")
+    origin, rotation = part.pose(frame)
+    omega = part.frame_angular_velocity(frame)
+    shape = shapes[0] if shapes else "radius"
+    if shape == "radius":
+        return [("", origin, _radius(builder, spec.get("radius", 0), path + ("radius",)), omega)]
+    where = path + (shape,)
+    sizes = [_size(builder, x, where + (k,)) for k, x in enumerate(builder.sized_list(spec[shape], where,
+                                                                                      SHAPES[shape]))]
+    if shape == "capsule":
+        radius, length = sizes
+        axis = sp.Matrix(rotation)[:, 2]
+        return [(f"[{k}]", origin + sign * length / 2 * axis, radius, omega) for k, sign in enumerate((-1, 1))]
+    half = sp.Matrix(sizes) / 2
+    return [(f"[{k}]", origin + sp.Matrix(rotation) * sp.Matrix([(2 * (k >> j & 1) - 1) * half[j] for j in range(3)]),
+             sp.S.Zero, omega) for k in range(8)]
+
+
+def _size(builder, text, path):
+    size = builder.constant(text, path)
+    if not builder.value(size) > 0:
+        builder.fail(path, f"a contact's dimensions are > 0, got {builder.value(size):g}")
+    return size
 
 
 def _normal(builder, spec, path):
@@ -107,32 +185,62 @@ def _normal(builder, spec, path):
 
 
 def _spheres_gap(builder, spec, path):
-    """(|p_B − p_A| − r_A − r_B, the contact point p_A + r_A u, u = (p_B − p_A)/|p_B − p_A|)
-    of two spheres on two parts."""
+    """(gap, contact point, unit normal u) of a sphere against a sphere or a capsule on
+    another part: two spheres, |p_B − p_A| − r_A − r_B; a sphere of centre p against a
+    capsule (``length: [L_A, L_B]``, one of them > 0: its segment c ± (L/2) z along its
+    frame's z), the distance from p to the segment (to its nearest point s, closed form)
+    less both radii. u points from the first's nearest point to the second's; the contact
+    point is the first's surface there."""
     between = builder.sized_list(spec["between"], path + ("between",), 2)
     radii = builder.sized_list(spec["radius"], path + ("radius",), 2)
-    (part_a, p_a), (part_b, p_b) = (_centre(builder, x, path + ("between", k), True) for k, x in enumerate(between))
+    lengths = builder.sized_list(spec.get("length", [0, 0]), path + ("length",), 2)
+    (part_a, pose_a), (part_b, pose_b) = (_centre(builder, x, path + ("between", k))
+                                          for k, x in enumerate(between))
     if part_a is part_b:
         builder.fail(path + ("between",), "the two spheres must be on two parts")
-    d = p_b - p_a
     r_a, r_b = (_radius(builder, r, path + ("radius", k)) for k, r in enumerate(radii))
-    unit = d / sp.sqrt(d.dot(d))
-    return sp.sqrt(d.dot(d)) - r_a - r_b, p_a + r_a * unit, unit
+    l_a, l_b = (_radius(builder, x, path + ("length", k), "length") for k, x in enumerate(lengths))
+    if builder.value(l_a) > 0 and builder.value(l_b) > 0:
+        builder.fail(path + ("length",), "a contact between two capsules is not available (one of the two "
+                                         "lengths must be 0: a sphere against a capsule)")
+    p_a, p_b = pose_a[0], pose_b[0]
+    if builder.value(l_a) > 0:
+        distance, p_a = _to_segment(p_b, p_a, sp.Matrix(pose_a[1])[:, 2], l_a / 2)
+    elif builder.value(l_b) > 0:
+        distance, p_b = _to_segment(p_a, p_b, sp.Matrix(pose_b[1])[:, 2], l_b / 2)
+    else:
+        distance = sp.sqrt((p_b - p_a).dot(p_b - p_a))
+    unit = (p_b - p_a) / sp.sqrt((p_b - p_a).dot(p_b - p_a))
+    return distance - r_a - r_b, p_a + r_a * unit, unit
 
 
-def _centre(builder, text, path, with_part=False):
-    """The world position (sympy) of the frame ``text`` on a part (not the world)."""
+def _to_segment(p, c, axis, half):
+    """(the distance from p to the segment c + s·axis, |s| ≤ ``half`` (axis a unit column),
+    its point nearest to p): with s = (p − c)·axis, |p − c ∓ half·axis| beyond an end, else
+    |p − c − s·axis| (one Piecewise of three smooth branches, each differentiated on its
+    own; the distance's gradient is continuous across them)."""
+    s = (p - c).dot(axis)
+    ends = (c - half * axis, c + half * axis)
+    across = p - c - s * axis
+    distance = sp.Piecewise((sp.sqrt((p - ends[0]).dot(p - ends[0])), s < -half),
+                            (sp.sqrt((p - ends[1]).dot(p - ends[1])), s > half), (sp.sqrt(across.dot(across)), True))
+    nearest = sp.Matrix([sp.Piecewise((ends[0][k], s < -half), (ends[1][k], s > half), (c[k] + s * axis[k], True))
+                         for k in range(3)])
+    return distance, nearest
+
+
+def _centre(builder, text, path):
+    """(part, (world position, rotation)) of the frame ``text`` on a part (not the world)."""
     part, frame = frame_reference(builder, text, path)
     if part is None:
         builder.fail(path, "a contact's sphere sits on a part, not on the world")
-    position = part.pose(frame)[0]
-    return (part, position) if with_part else position
+    return part, part.pose(frame)
 
 
-def _radius(builder, text, path):
+def _radius(builder, text, path, what="radius"):
     radius = builder.constant(text, path)
     if builder.value(radius) < 0:
-        builder.fail(path, f"a radius is ≥ 0, got {builder.value(radius):g}")
+        builder.fail(path, f"a {what} is ≥ 0, got {builder.value(radius):g}")
     return radius
 
 

@@ -10,6 +10,7 @@
       kinetic: {energy: kinetic}            # kinetic, potential or total
       push: {contact: floor.force}          # a contact's or limit's normal force λ (0 while open)
       hits: {contact: floor.impulse}        #   and its normal impulses since the previous row
+      drag: {contact: floor.friction}       #   and its friction force (world x, y, z; 0 while open)
 
 An output with several components gives one column each, named ``tip[x]``, ``tip[y]``,
 ``tip[z]`` (``load[0]``, … for multipliers). Expressions, positions and velocities are
@@ -34,7 +35,8 @@ AXES = ("x", "y", "z")
 BUILT_IN_COLUMNS = ("t", "energy")  # a trajectory file's columns besides the coordinates and velocities
 ENERGIES = ("kinetic", "potential", "total")
 REACTION_PARTS = ("force", "torque", "multipliers")
-CONTACT_PARTS = ("force", "impulse")
+CONTACT_PARTS = ("force", "impulse", "friction")
+NO_CONTACT = (0.0, 0.0, (0.0, 0.0, 0.0))  # a gap neither held nor struck since the previous row
 
 log = logging.getLogger(__name__)
 
@@ -57,7 +59,8 @@ class Output:
     def columns(self):
         if self.size == 1 and self.kind in ("expression", "energy", "contact"):
             return [self.name]
-        labels = AXES if self.kind in ("position", "velocity") or self.part in ("force", "torque") else range(self.size)
+        labels = AXES if self.kind in ("position", "velocity", "contact") or self.part in ("force", "torque") \
+            else range(self.size)
         return [f"{self.name}[{label}]" for label in labels]
 
 
@@ -85,12 +88,14 @@ def reaction_output(name, constraint, which):
 
 
 def contact_output(name, gap, which):
-    """``which`` (force or impulse) of the unilateral gap named ``gap`` (a contact or a
-    joint's limit): its normal force λ at each row (0 while it is open), or the sum of its
-    normal impulses (impact and contact events) since the previous row."""
+    """``which`` (force, impulse or friction) of the unilateral gap named ``gap`` (a contact
+    or a joint's limit): its normal force λ at each row (0 while it is open), the sum of its
+    normal impulses (impact and contact events) since the previous row, or its friction
+    force in the world (x, y, z; 0 while open or without friction)."""
     if which not in CONTACT_PARTS:
-        raise ModelError(f"output '{name}': a contact output is '<contact>.force' or '.impulse', not '.{which}'")
-    return Output(name, "contact", constraint=gap, part=which)
+        raise ModelError(f"output '{name}': a contact output is '<contact>.force', '.impulse' or '.friction', "
+                         f"not '.{which}'")
+    return Output(name, "contact", constraint=gap, part=which, size=3 if which == "friction" else 1)
 
 
 def energy_output(name, which):
@@ -120,7 +125,7 @@ class OutputEvaluator:
     def evaluate(self, t, q, qd, motion=None, contacts=None):
         """One row: every output's columns at (t, q, q̇); ``motion`` (System.motion at that
         state) for reactions, computed when not given; ``contacts`` ({gap name: (force,
-        impulse)}, the run's; a gap not in it has neither) for contact outputs."""
+        impulse, friction)}, the run's; a gap not in it has neither) for contact outputs."""
         data, p = self.data, self.data.parameter_values
         compiled = iter(self._compiled(t, q, qd, p)[0].ravel()) if self._compiled else iter(())
         reactions = None
@@ -132,7 +137,8 @@ class OutputEvaluator:
             if output.kind == "reaction":
                 row += list(getattr(reactions[output.constraint], output.part))
             elif output.kind == "contact":
-                row.append((contacts or {}).get(output.constraint, (0.0, 0.0))[CONTACT_PARTS.index(output.part)])
+                value = (contacts or {}).get(output.constraint, NO_CONTACT)[CONTACT_PARTS.index(output.part)]
+                row += list(value) if output.size > 1 else [value]
             elif output.kind == "energy":
                 energies = data.energy(t, q, qd) if energies is None else energies
                 kinetic, potential = energies

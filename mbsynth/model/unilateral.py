@@ -1,9 +1,11 @@
 """Unilateral constraints: gaps g(q) ≥ 0 that may open, close and strike.
 
 A ``Unilateral`` is one gap with Newton's restitution coefficient e (0 ≤ e ≤ 1): a joint's
-limit (``hinge.lower``: g = angle − lo; ``hinge.upper``: g = hi − angle) or a contact (a
-point or sphere on a part's frame against a ground plane, g = n·p − h − r; two spheres,
-g = |p_B − p_A| − r_A − r_B). Its ``row`` is a holonomic Constraint with φ = g, so that its
+limit (``hinge.lower``: g = angle − lo; ``hinge.upper``: g = hi − angle; a universal
+joint's per angle; a spherical joint's ``ball.cone``: g = z_A·z_B − cos θ) or a contact (a
+point or sphere on a part's frame against a ground plane, g = n·p − h − r, a capsule's end
+spheres and a box's corners each one; two spheres, g = |p_B − p_A| − r_A − r_B; a sphere
+against a capsule, its centre's distance to the segment less both radii: io/unilateral.py). Its ``row`` is a holonomic Constraint with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
 A plane contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·v_c, the
@@ -33,7 +35,9 @@ class Unilateral:
     sympy expression of the parameters), its holonomic ``row`` (φ = g), Coulomb's
     ``friction`` μ and the nonholonomic ``slip`` rows (None without friction); a contact's
     ``point`` (where it touches, world) and ``normal`` (the unit direction its impulse
-    pushes the child, or the second sphere), sympy columns of q, for the viewer."""
+    pushes the child, or the second sphere), sympy columns of q, for the viewer; with
+    friction, its slip rows' unit ``tangents`` t1, t2 (the columns of a sympy (3, 2) of the
+    parameters)."""
 
     name: str
     kind: str
@@ -43,6 +47,7 @@ class Unilateral:
     slip: Constraint = None
     point: sp.Matrix = None
     normal: sp.Matrix = None
+    tangents: sp.Matrix = None
 
     def restitution_at(self, system, p):
         """e at the parameter values ``p`` of ``system``; ModelError unless 0 ≤ e ≤ 1."""
@@ -133,6 +138,9 @@ class Gaps:
         self.restitution = np.array([u.restitution_at(system, p) for u in self.unilaterals], dtype=float)
         self.friction = np.array([u.friction_at(system, p) if u.slip is not None else 0.0
                                   for u in self.unilaterals], dtype=float)
+        values = dict(zip(system.parameter_symbols, p))
+        self.tangents = [None if u.tangents is None else np.array(u.tangents.xreplace(values), dtype=float)
+                         for u in self.unilaterals]  # (3, 2): a contact's unit tangents t1, t2 as columns
 
     def __len__(self):
         return len(self.unilaterals)

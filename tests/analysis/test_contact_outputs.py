@@ -42,8 +42,8 @@ def test_the_ball_reads_its_impulses_at_each_bounce_and_its_weight_once_at_rest(
 
 @pytest.mark.parametrize("spec, message", [
     ("{contact: wall.force}", "outputs.push.contact: unknown contact or limit 'wall' in 'wall.force'"),
-    ("{contact: floor.torque}", "outputs.push.contact: output 'push': a contact output is '<contact>.force' or "
-                                "'.impulse', not '.torque'"),
+    ("{contact: floor.torque}", "outputs.push.contact: output 'push': a contact output is '<contact>.force', "
+                                "'.impulse' or '.friction', not '.torque'"),
 ])
 def test_a_contact_output_of_an_unknown_contact_or_part_is_refused_at_its_line(spec, message):
     with pytest.raises(ModelError) as err:
@@ -60,3 +60,22 @@ def test_a_block_sliding_down_a_slope_reads_the_normal_force_m_g_cos_alpha():
     traj = mb.simulate(system, 0.5, dt=0.05, rtol=1e-10, atol=1e-10)
     assert np.abs(traj.column("push")[1:] - 2.0 * G * np.cos(0.5)).max() < 1e-9
     assert (traj.column("hits") == 0).all()  # it came to rest in contact at t0 from rest: no impulse
+
+
+
+@pytest.mark.parametrize("alpha, mu, size", [
+    (0.5, 0.3, lambda m, a, mu: mu * m * G * np.cos(a)),  # tan α > μ: it slides, friction μ N
+    (0.2, 0.3, lambda m, a, mu: m * G * np.sin(a)),  # tan α < μ: it sticks, friction m g sin α
+])
+def test_the_friction_output_of_a_block_on_a_slope_is_mu_N_sliding_and_m_g_sin_alpha_sticking(alpha, mu, size):
+    """``{contact: floor.friction}`` (models/contact/block_on_slope.yaml, m = 2): the
+    friction force in the world, up the slope (−cos α, 0, sin α), of size μ m g cos α = μ N
+    while the block slides and m g sin α while it sticks, at every row after the first."""
+    text = (Path(__file__).resolve().parents[2] / "models" / "contact" / "block_on_slope.yaml").read_text()
+    system = mb.loads(text + "outputs:\n  drag: {contact: floor.friction}\n  push: {contact: floor.force}\n",
+                      parameters={"alpha": alpha, "mu": mu})
+    traj = mb.simulate(system, 0.5, dt=0.05, rtol=1e-10, atol=1e-10)
+    drag = np.column_stack([traj.column(f"drag[{x}]") for x in "xyz"])[1:]
+    assert np.abs(drag - size(2.0, alpha, mu) * np.array([-np.cos(alpha), 0.0, np.sin(alpha)])).max() < 1e-10
+    if alpha > np.arctan(mu):
+        assert np.abs(np.linalg.norm(drag, axis=1) - mu * traj.column("push")[1:]).max() < 1e-10

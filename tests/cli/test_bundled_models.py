@@ -26,6 +26,8 @@ MODES = {
     "contact/block_on_slope.yaml": ([], 1, "does not rest at this configuration"),  # it slides down the slope
     "contact/rimless_wheel.yaml": ([], 2, NOT_UNIQUE),  # its mass at the hub: its turn is free with no foot held
     "contact/simplest_walker.yaml": ([], 1, "does not rest at this configuration"),  # it walks
+    "contact/box_drop.yaml": ([], 1, "does not rest at this configuration"),  # dropped
+    "contact/cone_pendulum.yaml": "rests",  # hanging (it starts swinging from there)
     "flexible/cantilever.yaml": "rests",
     "flexible/slider_crank.yaml": "equilibrium",  # the crank hanging, the rod sagging
     "flexible/spin_up_beam.yaml": "rests",  # at rest at t = 0, the hub held by its servo row

@@ -59,6 +59,8 @@ HOSTS = {
     "contact_plane": (("contacts", 0), {"name": "floor", "type": "plane", "child": "point"}, {}),
     "contact_spheres": (("contacts", 0), {"name": "touch", "type": "spheres", "between": ["point", "body"],
                                           "radius": [0.1, 0.1]}, {}),
+    "cone_limit": (("joints", 0, "limits"), {"cone": 0.5},
+                   {("joints", 0): {"name": "ball", "type": "spherical", "parent": "world", "child": "body.top"}}),
     "joint_actuation": (("joints", 0, "actuation"), {},
                         {("joints", 0): {"name": "pin", "type": "cylindrical", "parent": "world", "child": "body"}}),
     "joint_spring": (("joints", 0, "spring"), {"stiffness": "k"},
