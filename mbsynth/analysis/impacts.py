@@ -122,7 +122,7 @@ class EventIntegration(ContinuousIntegration):
         data = self.phases.get(key)
         if data is None:
             names = {self.gaps.names[i] for i in active}
-            slid = {self.gaps.names[i]: (self.gaps.friction[i], d) for i, d in sliding.items()}
+            slid = {self.gaps.names[i]: (self.gaps.friction[i], d, self.atol) for i, d in sliding.items()}
             stuck = {self.gaps.names[i] for i in sticking}
             data = self.phases[key] = with_active(self.base.system, names, slid, stuck).data(self.base.path)
         if not np.array_equal(data.parameter_values, self.base.parameter_values):
@@ -346,7 +346,7 @@ class EventIntegration(ContinuousIntegration):
         names = list(self.base.system.constraint_names) + [self.gaps.names[i] for i in rows] + \
             [f"{self.gaps.names[i]}.slip" for i in sticking for _ in slips[i][1]]
         speed = np.abs(qd).max(initial=0.0)
-        per_unit = [-self.gaps.friction[i] * slips[i][0].T @ slip_direction(slips[i][0], qd, sliding[i], speed)
+        per_unit = [-self.gaps.friction[i] * slips[i][0].T @ slip_direction(slips[i][0], qd, sliding[i], speed, self.atol)
                     for i in slipping]
         at = [len(arrays.b) + rows.index(i) for i in slipping]
 
@@ -391,7 +391,7 @@ class EventIntegration(ContinuousIntegration):
         speed, found = np.abs(qd).max(initial=0.0), {}
         for i, d in self.sliding.items():
             T = self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i)
-            found[i] = T.T @ slip_direction(T, qd, d, speed)
+            found[i] = T.T @ slip_direction(T, qd, d, speed, self.atol)
         return found
 
     def _watched(self, t, q, qd, reference):
@@ -465,12 +465,11 @@ class EventIntegration(ContinuousIntegration):
         speed, sliding, trial = np.abs(qd).max(initial=0.0), {}, []
         stuck = self._sticking(self.active, self.sliding)
         for i in sorted(i for i in active if self.gaps.friction[i] > 0):
-            T = self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i)
-            moving = slip_direction(T, qd, None, speed)
+            moving = slip_direction(self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i), qd, None, speed,
+                                    self.atol)  # slower than the run resolves: at rest, its rounding no direction
             if i in self.sliding and i not in switching:
                 sliding[i] = self.sliding[i] if moving is None else moving
-            elif i not in self.active and moving is not None and np.linalg.norm(T @ qd) > self.atol:
-                # newly held and sliding faster than the run resolves (slower: at rest, its rounding no direction)
+            elif i not in self.active and moving is not None:
                 sliding[i] = moving
             else:
                 trial.append(i)
@@ -495,8 +494,8 @@ class EventIntegration(ContinuousIntegration):
 
     def _breakaway(self, t, q, qd, held, sliding, group, motion):
         """``sliding`` with those of the sticking contacts ``group`` (whose forces the rows
-        leave free, cones.py) that slide from t: the first subset, smallest first, whose
-        mode is consistent: each sliding one's slip accelerates along its direction (found
+        leave free, cones.py) that slide from t: the first subset, largest first (a load
+        that breaks the group free moves it as a whole), whose mode is consistent: each sliding one's slip accelerates along its direction (found
         as the fixed point of the slip's acceleration, from the direction against its
         minimum-norm force, which keeps a symmetric load's symmetry) with λ_n ≥ 0, and the
         ones still sticking stay in their cones. None such: a Painlevé-type EventError
@@ -506,7 +505,7 @@ class EventIntegration(ContinuousIntegration):
         least = {i: motion.shared.lam[list(motion.shared.cones[k].tangential)]  # the minimum-norm λ_t
                  for k, i in enumerate(j for j in motion.group if j in motion.tangential)}
         start = {i: -least[i] / (np.linalg.norm(least[i]) or 1.0) for i in group}
-        for chosen in _subsets(group)[1:]:
+        for chosen in _subsets(group)[:0:-1]:
             trial = {**sliding, **{i: start[i] for i in chosen}}
             for _ in range(SLIP_DIRECTION_ROUNDS):
                 found = self._held_motion(t, q, qd, held, trial)
@@ -591,7 +590,7 @@ class EventIntegration(ContinuousIntegration):
         if len(candidates) > ENUMERATED:
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
-        subsets = _subsets(candidates)[::-1]
+        subsets = _subsets(candidates)
         for chosen in [c for c in subsets if kept <= set(c)] + [c for c in subsets if not kept <= set(c)]:
             motion = self._held_motion(t, q, qd, chosen)
             others = [i for i in candidates if i not in chosen]
