@@ -33,7 +33,10 @@ rows, unilateral.with_active) while |λ_t| ≤ μ λ_n, and where μ λ_n − |�
 (an event found on the dense output) it slides from there against λ_t; sliding, C =
 −μ λ_n Tᵀû (T its slip rows, û the unit slip; λ_n found exactly, ``_held_motion``), and
 where its slip stops (an event) it sticks again, or slides on against λ_t where |λ_t| >
-μ λ_n there.
+μ λ_n there. Sticking contacts whose forces their rows leave free (a box on four corners)
+stick as a group while some split of the forces lies in every cone (cones.py: s* ≤ 0),
+break away where s* reaches zero (an event) and slide in the first consistent mode
+(``_breakaway``).
 
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
 A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
@@ -398,7 +401,8 @@ class EventIntegration(ContinuousIntegration):
         """{(kind, held gap): a value whose sign change is an event}: ("release", i) its force
         λ; ("switch", i) of a sliding contact, its slip along its ``reference`` direction
         (T q̇)·û, given on the generalized side as Tᵀû (it stops); of a sticking one, μ λ_n −
-        |λ_t| (it reaches its friction cone's edge)."""
+        |λ_t| (it reaches its friction cone's edge); of a group whose forces the rows leave
+        free (cones.py), −s* for each of its contacts."""
         held = sorted(self.active)
         motion = self._held_motion(t, q, qd, held)
         found = {("release", i): lam for i, lam in zip(held, motion.lam)}
