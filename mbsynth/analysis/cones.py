@@ -30,7 +30,10 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import linprog
 
-from ..core.tolerances import CONE_CUTS, CONE_DEPTH, CONE_ROUNDS, CONE_TOL, DEPENDENT_RTOL, LP_FEASIBILITY_TOL
+from ..core.tolerances import CONE_DEPTH, CONE_TOL, DEPENDENT_RTOL, LP_FEASIBILITY_TOL
+
+CONE_CUTS = 8  # the first polygon circumscribing each friction cone has this many sides
+CONE_ROUNDS = 100  # cutting-plane programs at most (each halves the angle of the polygon's worst corner)
 
 
 class Cone(NamedTuple):

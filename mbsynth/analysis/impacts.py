@@ -58,7 +58,7 @@ from .trajectory import Event
 from ..core.errors import EventError, ModelError, SolveError
 from ..core.solvers import kkt_acceleration
 from ..core.tolerances import (ASSEMBLED_TOL, COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP,
-                               SLIP_DIRECTION_ROUNDS, SLIP_DIRECTION_TOL,
+                               SLIP_DIRECTION_TOL,
                                SPEED_ROUNDING)
 from ..model.reactions import indeterminate, multipliers
 from ..model.unilateral import Gaps, slip_direction, with_active
@@ -66,6 +66,7 @@ from ..model.unilateral import Gaps, slip_direction, with_active
 ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once is chattering (no hang)
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
 INSTANT_EVENTS = 100  # events in a row at one instant: held contacts switch between stick and slip without end
+SLIP_DIRECTION_ROUNDS = 20  # a breakaway's slip directions are followed to their fixed point this often
 ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
 
 

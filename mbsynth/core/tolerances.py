@@ -174,10 +174,7 @@ CONE_TOL = 1e-10  # cones.py: the cutting planes stop where the true largest con
 # is within this (in units of the forces' size) of the program's value: the lower and upper bounds on s* meet
 CONE_DEPTH = 1e-3  # cones.py: a true violation below −this (in the forces' size) is well inside the cones: the
 # programs stop there (an upper bound on s*, so its sign is right; exact values are needed only near s* = 0)
-CONE_CUTS = 8  # cones.py: the first polygon circumscribing each friction cone has this many sides
-CONE_ROUNDS = 100  # cones.py: cutting-plane programs at most (each halves the angle of the polygon's worst corner)
 LP_FEASIBILITY_TOL = 1e-10  # cones.py: HiGHS's primal and dual feasibility tolerances (the least it accepts)
-SLIP_DIRECTION_ROUNDS = 20  # impacts.py: a breakaway's slip directions are followed to their fixed point this often
 SLIP_DIRECTION_TOL = 1e-8  # impacts.py: a sliding contact's unit slip direction and its slip's acceleration's agree
 # within this (a fixed point: the friction opposes the slip it starts)
 CHECK_RESIDUAL_TOL = 1e-9  # cli/check.py: an initial constraint residual beyond this (SI units) is a violation
