@@ -34,7 +34,10 @@ rows, unilateral.with_active) while |λ_t| ≤ μ λ_n, and where μ λ_n − |�
 (an event found on the dense output) it slides from there against λ_t; sliding, C =
 −μ λ_n Tᵀû (T its slip rows, û the unit slip; λ_n found exactly, ``_held_motion``), and
 where its slip stops (an event) it sticks again, or slides on against λ_t where |λ_t| >
-μ λ_n there.
+μ λ_n there. Sticking contacts whose forces their rows leave free (a box on four corners)
+stick as a group while some split of the forces lies in every cone (cones.py: s* ≤ 0),
+break away where s* reaches zero (an event) and slide in the first consistent mode
+(``_breakaway``).
 
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
 A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
@@ -48,6 +51,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from . import stepper
+from .cones import Cone, Shared, shared_rows
 from .continuous import ContinuousIntegration
 from .derivative import Crawl
 from .impulse import Rough, velocity_jump
@@ -55,13 +59,15 @@ from .trajectory import Event
 from ..core.errors import EventError, ModelError, SolveError
 from ..core.solvers import kkt_acceleration
 from ..core.tolerances import (ASSEMBLED_TOL, COMPLEMENTARITY_RTOL, DIVISION_GUARD, EVENT_TIME_RTOL, REST_HOP,
+                               SLIP_DIRECTION_TOL,
                                SPEED_ROUNDING)
-from ..model.reactions import multipliers
+from ..model.reactions import indeterminate, multipliers
 from ..model.unilateral import Gaps, slip_direction, with_active
 
 ROUNDS = 1000  # impacts at one instant: a row that strikes this often at once is chattering (no hang)
 IDLE_EVENTS = 100  # events in a row that change nothing: the gaps chatter without an impact
 INSTANT_EVENTS = 100  # events in a row at one instant: held contacts switch between stick and slip without end
+SLIP_DIRECTION_ROUNDS = 20  # a breakaway's slip directions are followed to their fixed point this often
 ENUMERATED = 12  # rows of a complementarity problem solved by enumeration (2^12 active sets at most)
 SUNK = 0.5  # a gap at rest this many atol deep (an event puts a gap sinking from rest at 1 atol) is held
 
@@ -80,7 +86,9 @@ class Pending(NamedTuple):
 class Held(NamedTuple):
     """The motion with some gaps held (``EventIntegration._held_motion``): q̈, the held gaps'
     forces λ, every gap's g̈ and the size of its terms, the size of the forces, and per
-    sticking contact its tangential force λ_t (on its slip rows)."""
+    sticking contact its tangential force λ_t (on its slip rows); where the rows leave
+    forces free (cones.py), the held gaps they reach (``group``), their ``Shared`` forces
+    and its margin s* (≤ 0: some distribution sticks), λ and λ_t then the ones chosen."""
 
     qdd: np.ndarray
     lam: np.ndarray
@@ -88,6 +96,9 @@ class Held(NamedTuple):
     scale: np.ndarray
     force: float
     tangential: dict
+    group: tuple = ()
+    shared: Shared = None
+    margin: float = None
 
 
 class EventIntegration(ContinuousIntegration):
@@ -117,7 +128,7 @@ class EventIntegration(ContinuousIntegration):
         data = self.phases.get(key)
         if data is None:
             names = {self.gaps.names[i] for i in active}
-            slid = {self.gaps.names[i]: (self.gaps.friction[i], d) for i, d in sliding.items()}
+            slid = {self.gaps.names[i]: (self.gaps.friction[i], d, self.atol) for i, d in sliding.items()}
             stuck = {self.gaps.names[i] for i in sticking}
             data = self.phases[key] = with_active(self.base.system, names, slid, stuck).data(self.base.path)
         if not np.array_equal(data.parameter_values, self.base.parameter_values):
@@ -365,7 +376,7 @@ class EventIntegration(ContinuousIntegration):
         names = list(self.base.system.constraint_names) + [self.gaps.names[i] for i in rows] + \
             [f"{self.gaps.names[i]}.slip" for i in sticking for _ in slips[i][1]]
         speed = np.abs(qd).max(initial=0.0)
-        per_unit = [-self.gaps.friction[i] * slips[i][0].T @ slip_direction(slips[i][0], qd, sliding[i], speed)
+        per_unit = [-self.gaps.friction[i] * slips[i][0].T @ slip_direction(slips[i][0], qd, sliding[i], speed, self.atol)
                     for i in slipping]
         at = [len(arrays.b) + rows.index(i) for i in slipping]
 
@@ -389,11 +400,20 @@ class EventIntegration(ContinuousIntegration):
         acceleration = max(np.abs(motion.qdd).max(initial=0.0), force / (np.abs(arrays.M).max(initial=0.0) +
                                                                            DIVISION_GUARD))
         scale = np.abs(A_gaps).sum(axis=1) * acceleration + np.abs(b_gaps)
-        tangential, start = {}, len(arrays.b) + len(rows)
+        first, start, slip_at = len(arrays.b), len(arrays.b) + len(rows), {}
         for i in sticking:
-            tangential[i], start = lam[start:start + len(slips[i][1])], start + len(slips[i][1])
-        return Held(motion.qdd, lam[len(arrays.b):len(arrays.b) + len(rows)], gdd, scale,
-                    force + np.abs(lam).max(initial=0.0), tangential)
+            slip_at[i], start = tuple(range(start, start + len(slips[i][1]))), start + len(slips[i][1])
+        W = indeterminate(A)
+        group = tuple(i for i in rows if shared_rows(W, (first + rows.index(i),) + slip_at.get(i, ())))
+        shared = margin = None
+        if group:
+            shared = Shared(lam, W, [Cone(first + rows.index(i), slip_at[i], self.gaps.friction[i])
+                                     for i in group if i in slip_at],
+                            [first + rows.index(i) for i in group if i not in slip_at], force)
+            margin, lam = shared.margin()
+        tangential = {i: lam[list(at)] for i, at in slip_at.items()}
+        return Held(motion.qdd, lam[first:first + len(rows)], gdd, scale, force + np.abs(lam).max(initial=0.0),
+                    tangential, group, shared, margin)
 
     def _slip_references(self, t, q, qd):
         """{sliding contact: the unit direction its slip's component along is watched}: the
@@ -401,14 +421,15 @@ class EventIntegration(ContinuousIntegration):
         speed, found = np.abs(qd).max(initial=0.0), {}
         for i, d in self.sliding.items():
             T = self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i)
-            found[i] = T.T @ slip_direction(T, qd, d, speed)
+            found[i] = T.T @ slip_direction(T, qd, d, speed, self.atol)
         return found
 
     def _watched(self, t, q, qd, reference):
         """{(kind, held gap): a value whose sign change is an event}: ("release", i) its force
         λ; ("switch", i) of a sliding contact, its slip along its ``reference`` direction
         (T q̇)·û, given on the generalized side as Tᵀû (it stops); of a sticking one, μ λ_n −
-        |λ_t| (it reaches its friction cone's edge)."""
+        |λ_t| (it reaches its friction cone's edge); of a group whose forces the rows leave
+        free (cones.py), −s* for each of its contacts."""
         held = sorted(self.active)
         motion = self._held_motion(t, q, qd, held)
         found = {("release", i): lam for i, lam in zip(held, motion.lam)}
@@ -416,6 +437,9 @@ class EventIntegration(ContinuousIntegration):
             found[("switch", i)] = float(direction @ qd)
         for i, lam_t in motion.tangential.items():
             found[("switch", i)] = self.gaps.friction[i] * motion.lam[held.index(i)] - float(np.linalg.norm(lam_t))
+        for i in motion.group:  # forces the rows leave free: the group holds while s* ≤ 0
+            del found[("release", i)]
+            found[("switch" if i in motion.tangential else "release", i)] = -motion.margin
         return found
 
     # ---- settling the state at an event
@@ -446,11 +470,12 @@ class EventIntegration(ContinuousIntegration):
         rest = np.sqrt(2 * np.maximum(-gdd, 0.0) * REST_HOP * self.atol)
         resting = [i for i in self._open() if g[i] <= self.atol and abs(gd[i]) <= max(rest[i], floor[i])
                    and i not in released]
-        leaving = {i for i in self.active if gd[i] > max(rest[i], floor[i])}  # an impact left it opening
+        leaving = {i for i in self.active if changed and gd[i] > max(rest[i], floor[i])}  # an impact left it opening
         # sunk to where the event of a gap sinking from rest puts it and still sinking: left open it would
         # come back here again and again
         sunk = {i for i in resting if g[i] < -SUNK * self.atol and gd[i] <= 0}
-        active = self._contact_set(t, q, qd, sorted((self.active - released - leaving) | set(resting)), sunk)
+        kept = self.active - released - leaving
+        active = self._contact_set(t, q, qd, sorted(kept | set(resting)), kept, sunk)
         if active - self.active:
             qd = self._come_to_rest(t, q, qd, active)
         for i in sorted(self.active - active):
@@ -474,7 +499,8 @@ class EventIntegration(ContinuousIntegration):
         speed, sliding, trial = np.abs(qd).max(initial=0.0), {}, []
         stuck = self._sticking(self.active, self.sliding)
         for i in sorted(i for i in active if self.gaps.friction[i] > 0):
-            moving = slip_direction(self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i), qd, None, speed)
+            moving = slip_direction(self.gaps.slip_rows(t, q, qd, self.base.parameter_values, i), qd, None, speed,
+                                    self.atol)  # slower than the run resolves: at rest, its rounding no direction
             if i in self.sliding and i not in switching:
                 sliding[i] = self.sliding[i] if moving is None else moving
             elif i not in self.active and moving is not None:
@@ -485,13 +511,62 @@ class EventIntegration(ContinuousIntegration):
             return sliding
         motion = self._held_motion(t, q, qd, sorted(active), sliding)
         held = sorted(active)
-        for i in trial:
+        for i in (i for i in trial if i not in motion.group):
             lam_t, lam_n = motion.tangential[i], motion.lam[held.index(i)]
             size = np.linalg.norm(lam_t)
             breaks = i in switching and i in stuck  # its friction cone's edge reached: it slips from here
             if breaks or size > self.gaps.friction[i] * lam_n * (1 + COMPLEMENTARITY_RTOL):
                 sliding[i] = -lam_t / size
+        group = [i for i in trial if i in motion.group]
+        if group:
+            motion = self._held_motion(t, q, qd, held, sliding)
+            breaks = bool(set(group) & set(switching) & set(stuck))  # the group's s* reached zero: it breaks
+            if breaks or motion.margin > COMPLEMENTARITY_RTOL * motion.force:
+                sliding = self._breakaway(t, q, qd, held, sliding, [i for i in group if i in motion.tangential],
+                                          motion)
         return sliding
+
+    def _breakaway(self, t, q, qd, held, sliding, group, motion):
+        """``sliding`` with those of the sticking contacts ``group`` (whose forces the rows
+        leave free, cones.py) that slide from t: the first subset, largest first (a load
+        that breaks the group free moves it as a whole), whose mode is consistent: each sliding one's slip accelerates along its direction (found
+        as the fixed point of the slip's acceleration, from the direction against its
+        minimum-norm force, which keeps a symmetric load's symmetry) with λ_n ≥ 0, and the
+        ones still sticking stay in their cones. None such: a Painlevé-type EventError
+        naming them."""
+        p = self.base.parameter_values
+        slips = {i: self.gaps.slip_arrays(t, q, qd, p, i) for i in group}
+        least = {i: motion.shared.lam[list(motion.shared.cones[k].tangential)]  # the minimum-norm λ_t
+                 for k, i in enumerate(j for j in motion.group if j in motion.tangential)}
+        start = {i: -least[i] / (np.linalg.norm(least[i]) or 1.0) for i in group}
+        for chosen in _subsets(group)[:0:-1]:
+            trial = {**sliding, **{i: start[i] for i in chosen}}
+            for _ in range(SLIP_DIRECTION_ROUNDS):
+                found = self._held_motion(t, q, qd, held, trial)
+                accelerations = {i: slips[i][0] @ found.qdd - slips[i][1] for i in chosen}
+                turned = {i: a / np.linalg.norm(a) for i, a in accelerations.items() if np.linalg.norm(a) > 0}
+                if all(np.linalg.norm(turned[i] - trial[i]) <= SLIP_DIRECTION_TOL for i in turned):
+                    break
+                trial.update(turned)
+            if self._consistent(found, held, chosen, accelerations, trial):
+                return trial
+        raise self._fail(t, group, "no consistent friction mode (Painlevé-type: no set of these sticking contacts "
+                                   "can slide with the others in their friction cones)")
+
+    def _consistent(self, motion, held, chosen, accelerations, directions):
+        """Whether the mode of ``motion`` (the contacts ``chosen`` newly sliding along
+        ``directions``, their slips' ``accelerations``) is consistent (``_breakaway``)."""
+        tol = COMPLEMENTARITY_RTOL * motion.force
+        if (motion.lam < -tol).any() and any(i not in motion.group for i, lam in zip(held, motion.lam) if lam < -tol):
+            return False
+        if motion.margin is not None and motion.margin > tol:
+            return False
+        for i, lam_t in motion.tangential.items():
+            if i not in motion.group and np.linalg.norm(lam_t) > \
+                    self.gaps.friction[i] * motion.lam[held.index(i)] * (1 + COMPLEMENTARITY_RTOL):
+                return False
+        return all(np.linalg.norm(a / np.linalg.norm(a) - directions[i]) <= SLIP_DIRECTION_TOL
+                   for i, a in accelerations.items() if np.linalg.norm(a) > 0)
 
     def _bilateral(self, t, q, qd):
         """(A, target, names) of the model's velocity-level rows at (t, q, q̇): A q̇ = target
@@ -539,20 +614,27 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
 
-    def _contact_set(self, t, q, qd, candidates, sunk=frozenset()):
+    def _contact_set(self, t, q, qd, candidates, kept=frozenset(), sunk=frozenset()):
         """The gaps among ``candidates`` (touching, at rest or held) that hold from t: the
-        first active set, smallest first, with λ ≥ 0 on its rows and g̈ ≥ 0 on the others;
-        those ``sunk`` (sinking from rest into their gap, found where it is atol deep: a body
-        tipping over an edge of its supports at a rate g̈ below the tolerance) are held in
-        every set tried."""
+        first active set, smallest first, with λ ≥ 0 on its rows (where the rows leave forces
+        free: for some distribution of them, cones.py) and g̈ ≥ 0 on the others; those that
+        keep all of ``kept`` (held, their force not fallen to zero) first: where dependent
+        rows make several sets consistent (a box on four corners holds on three, or on
+        two at a diagonal while it sticks), a held contact stays held. Those ``sunk``
+        (sinking from rest into their gap, found where it is atol deep: a body tipping over an
+        edge of its supports at a rate g̈ below the tolerance) are held in every set tried."""
         if len(candidates) > ENUMERATED:
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
-        for chosen in (x for x in _subsets(candidates) if sunk <= set(x)):
-            _, lam, gdd, scale, force, _ = self._held_motion(t, q, qd, chosen)
+        subsets = [c for c in _subsets(candidates) if sunk <= set(c)]
+        for chosen in [c for c in subsets if kept <= set(c)] + [c for c in subsets if not kept <= set(c)]:
+            motion = self._held_motion(t, q, qd, chosen)
             others = [i for i in candidates if i not in chosen]
-            if (lam >= -COMPLEMENTARITY_RTOL * force).all() and \
-                    all(gdd[i] >= -COMPLEMENTARITY_RTOL * scale[i] for i in others):
+            determined = [lam for i, lam in zip(chosen, motion.lam) if i not in motion.group]
+            pushing = motion.shared is None or motion.shared.margin(with_cones=False)[0] <= \
+                COMPLEMENTARITY_RTOL * motion.force
+            if pushing and (np.array(determined) >= -COMPLEMENTARITY_RTOL * motion.force).all() and \
+                    all(motion.gdd[i] >= -COMPLEMENTARITY_RTOL * motion.scale[i] for i in others):
                 return frozenset(chosen)
         raise self._fail(t, candidates, "no consistent contact mode (Painlevé-type: no active set of the "
                                         "complementarity problem)")

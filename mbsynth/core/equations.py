@@ -518,13 +518,16 @@ def _named(weights):
 
 
 def _check_constraints(d: _Data, Ua, sa, k, qdd):
-    """(a): b ∈ range(A), tested on the left null space of the equilibrated A."""
+    """(a): b ∈ range(A), tested on the left null space of the equilibrated A, against the
+    size of b, of q̈ and of the acceleration the forces alone give, |Q + C| / max |M| (a
+    body held at rest by dependent rows has q̈ = 0 and b of its velocity's rounding)."""
     if d.m == 0:
         return
     U0 = Ua[:, k:]
     u = U0 @ (U0.T @ d.be)  # the part of b_e that no q̈ can produce
     size = np.linalg.norm(u)
-    if size <= _tol(sa, k, d.m) * (np.linalg.norm(d.be) + np.linalg.norm(qdd) + _TINY):
+    scale = np.linalg.norm(d.be) + np.linalg.norm(qdd) + np.linalg.norm(d.F) / d.mu + _TINY
+    if size <= _tol(sa, k, d.m) * scale:
         return
     names = [d.constraints[i] for i in _named(np.abs(u))]
     raise SolveError(

@@ -170,6 +170,13 @@ SPEED_ROUNDING = 1e3 * EPS  # impacts.py: a gap's rate within this times ‖a‖
 EVENT_TIME_RTOL = 4 * EPS  # impacts.py: an event's time is found to this relative accuracy (Brent's least: rounding)
 COMPLEMENTARITY_RTOL = 1e-9  # impacts.py: an impulse or contact force above −this × the largest, and a gap's rate or
 # acceleration above −this × its terms' size, meets its sign condition (the KKT solve's rounding)
+CONE_TOL = 1e-10  # cones.py: the cutting planes stop where the true largest cone violation at the program's force
+# is within this (in units of the forces' size) of the program's value: the lower and upper bounds on s* meet
+CONE_DEPTH = 1e-3  # cones.py: a true violation below −this (in the forces' size) is well inside the cones: the
+# programs stop there (an upper bound on s*, so its sign is right; exact values are needed only near s* = 0)
+LP_FEASIBILITY_TOL = 1e-10  # cones.py: HiGHS's primal and dual feasibility tolerances (the least it accepts)
+SLIP_DIRECTION_TOL = 1e-8  # impacts.py: a sliding contact's unit slip direction and its slip's acceleration's agree
+# within this (a fixed point: the friction opposes the slip it starts)
 CHECK_RESIDUAL_TOL = 1e-9  # cli/check.py: an initial constraint residual beyond this (SI units) is a violation
 
 # ---- validation against Pinocchio (robots/)

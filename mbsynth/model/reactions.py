@@ -49,20 +49,42 @@ def multipliers(A, f):
     m = A.shape[0]
     if m == 0:
         return np.zeros(0), np.zeros(0, dtype=bool)
-    Ae, norms = equilibrate_rows(A)
-    U, s, Vt = np.linalg.svd(Ae, full_matrices=True)
-    rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+    U, s, Vt, rank, norms = _decomposed(A)
     mu = U[:, :rank] @ ((Vt[:rank] @ f) / s[:rank])  # Aeᵀ μ = f, μ = D λ
     lam = mu / norms
-    null = U[:, rank:] / norms[:, None]  # wᵀA = 0 ⇔ D w ∈ left null of Ae
-    if null.shape[1]:
-        basis, _ = np.linalg.qr(null)
+    basis = _left_null(U[:, rank:], norms)
+    if basis.shape[1]:
         lam = lam - basis @ (basis.T @ lam)  # still a solution; now of least norm
         weight = np.abs(basis).max(axis=1)
         dependent = weight > DEPENDENT_RTOL * weight.max()
     else:
         dependent = np.zeros(m, dtype=bool)
     return lam, dependent
+
+
+def indeterminate(A):
+    """An orthonormal basis W (columns) of the λ with Aᵀλ = 0: the forces Aᵀλ = f leaves free
+    (λ = λ₀ + W z), by ``multipliers``' rank rule; no columns where they are determined."""
+    A = np.asarray(A, dtype=float)
+    if A.shape[0] == 0:
+        return np.zeros((0, 0))
+    U, _, _, rank, norms = _decomposed(A)
+    return _left_null(U[:, rank:], norms)
+
+
+def _decomposed(A):
+    """(U, s, Vᵀ, rank, row norms D) of the row-equilibrated Ae = D⁻¹A (its full SVD, the rank
+    by ``equations``' rule)."""
+    Ae, norms = equilibrate_rows(A)
+    U, s, Vt = np.linalg.svd(Ae, full_matrices=True)
+    return U, s, Vt, int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0, norms
+
+
+def _left_null(U_null, norms):
+    """The orthonormal basis of the left null space of A from that of its row-equilibrated
+    form (wᵀA = 0 ⇔ D w in the left null space of Ae)."""
+    null = U_null / norms[:, None]
+    return np.linalg.qr(null)[0] if null.shape[1] else null
 
 
 def wrench(pose, idle, generalized):

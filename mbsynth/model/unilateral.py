@@ -106,26 +106,28 @@ def with_active(system, names, sliding=None, sticking=()):
 class Sliding:
     """Coulomb's friction of a held contact that slides, as friction.py's ``coulomb`` of its
     gap row: C = −μ N Tᵀû (N the gap row's force, T its slip rows, û the unit slip T q̇/|T q̇|,
-    or ``direction`` where the slip's speed is rounding: at its onset from rest)."""
+    or ``direction`` where the slip's speed is rounding or below ``floor``, the run's
+    resolution: at its onset from rest)."""
 
-    def __init__(self, unilateral, mu, direction):
+    def __init__(self, unilateral, mu, direction, floor=0.0):
         self.joint, self.slip, self.mu = unilateral.name, unilateral.slip, mu
         self.indices = unilateral.slip.indices
-        self.direction = np.asarray(direction, dtype=float)
+        self.direction, self.floor = np.asarray(direction, dtype=float), floor
         self.load_rows = np.array([0])
 
     def evaluate(self, t, q, qd, p):
         """(1, μ Tᵀû on ``indices``): friction.py's (w, direction) with w > 0."""
         T = self.slip.evaluate(t, q, qd, p)[0]
-        return 1.0, self.mu * T.T @ slip_direction(T, qd[self.indices], self.direction, np.abs(qd).max(initial=0.0))
+        return 1.0, self.mu * T.T @ slip_direction(T, qd[self.indices], self.direction, np.abs(qd).max(initial=0.0),
+                                                   self.floor)
 
 
-def slip_direction(T, qd, direction, speed):
+def slip_direction(T, qd, direction, speed, floor=0.0):
     """The unit slip T q̇/|T q̇|, or ``direction`` where |T q̇| is rounding (SPEED_ROUNDING ×
-    ‖T‖₁ × ``speed``, the largest |q̇|)."""
+    ‖T‖₁ × ``speed``, the largest |q̇|) or not above ``floor``."""
     u = T @ qd
     size = np.linalg.norm(u)
-    return u / size if size > SPEED_ROUNDING * np.abs(T).sum(axis=1).max() * speed else direction
+    return u / size if size > max(SPEED_ROUNDING * np.abs(T).sum(axis=1).max() * speed, floor) else direction
 
 
 class Gaps:
