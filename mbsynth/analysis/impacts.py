@@ -532,8 +532,8 @@ class EventIntegration(ContinuousIntegration):
         that breaks the group free moves it as a whole), whose mode is consistent: each sliding one's slip accelerates along its direction (found
         as the fixed point of the slip's acceleration, from the direction against its
         minimum-norm force, which keeps a symmetric load's symmetry) with λ_n ≥ 0, and the
-        ones still sticking stay in their cones. None such: a Painlevé-type EventError
-        naming them."""
+        ones still sticking stay in their cones. None such: an EventError naming them, which
+        says that the held set was kept (another set of held contacts is not searched)."""
         p = self.base.parameter_values
         slips = {i: self.gaps.slip_arrays(t, q, qd, p, i) for i in group}
         least = {i: motion.shared.lam[list(motion.shared.cones[k].tangential)]  # the minimum-norm λ_t
@@ -550,8 +550,9 @@ class EventIntegration(ContinuousIntegration):
                 trial.update(turned)
             if self._consistent(found, held, chosen, accelerations, trial):
                 return trial
-        raise self._fail(t, group, "no consistent friction mode (Painlevé-type: no set of these sticking contacts "
-                                   "can slide with the others in their friction cones)")
+        raise self._fail(t, group, "these sticking contacts break away, but no set of them slides with the others in "
+                                   "their friction cones while the contacts now held stay held (a slide on another "
+                                   "set of contacts is not searched: Painlevé-type or not, the run cannot go on)")
 
     def _consistent(self, motion, held, chosen, accelerations, directions):
         """Whether the mode of ``motion`` (the contacts ``chosen`` newly sliding along
