@@ -76,6 +76,8 @@ class Evaluator:
                                                                      for f in forces])
         self.effort_elements = [f for f in forces if f.efforts_only]
         self.over_rows = OverRows()
+        parts, elements, nonideal = self.working  # ``powers`` over many rows needs the compiled power functions
+        self.powers_by_row = bool(nonideal or elements or any(type(part).power is not Part.power for part, _ in parts))
         block = [np.meshgrid(r, r, indexing="ij") for r in ranges]
         self.m_rows = np.concatenate([np.zeros(0, int)] + [r.ravel() for r, _ in block])
         self.m_cols = np.concatenate([np.zeros(0, int)] + [c.ravel() for _, c in block])
@@ -132,12 +134,11 @@ class Evaluator:
         called once over all the rows where their numpy form broadcasts along them
         (``OverRows``); a part with a power of its own, an element with a potential and a
         non-ideal C are evaluated row by row."""
-        parts, elements, nonideal = self.working
-        if nonideal or elements or any(type(part).power is not Part.power for part, _ in parts):
+        if self.powers_by_row:
             return np.array([self.power(t, q_row, qd_row, p) for t, q_row, qd_row in zip(times, q, qd)])
         args = (np.asarray(times, dtype=float), q, qd, p)
         total = np.zeros(len(times))
-        for part, r in parts:
+        for part, r in self.working[0]:
             total += self.over_rows(part.power_function(), args, r, 1)[0]
         for element in self.effort_elements:
             efforts = self.over_rows(element._evaluate, args, element.indices, len(element.indices))
@@ -196,7 +197,10 @@ def _stacked(function, times, q, qd, p, count):
     given = (times, q.T, qd.T, p)
     with np.errstate(all="ignore"):  # NaN and inf are reported where the rows are used
         out = function.raw(*given, function.values(*given), function.fixed)
-    return np.array([np.broadcast_to(np.asarray(x, dtype=float), times.shape) for x in out[:count]])
+    result = np.empty((count, len(times)))
+    for row, x in zip(result, out[:count]):
+        row[...] = x  # a value per row, or one value (an output that reads no coordinate) for all
+    return result
 
 
 def _over_rows_agrees(function, times, q, qd, p, count, single):
