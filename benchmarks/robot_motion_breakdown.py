@@ -20,10 +20,10 @@ Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
   (time(K) − time(0)) / K. "the rest" is kernel.motion in a numba loop less the stages;
 - ``motion_batch`` of BATCH states, per state;
 - the same robot with each welded link (a fixed joint to its parent) merged into its nearest
-  link on a movable joint at the URDF level (``merged``: fewer bodies and coordinates, the
-  dynamics of the movable joints unchanged, as Pinocchio merges them): ``Data.motion`` and
-  kernel.motion in a numba loop, what folding the welded bodies inside the kernel could reach
-  at most. Its q̈, mapped to Pinocchio's v̇, is compared with ``aba`` on the robot as it is.
+  link on a movable joint (``from_robot(..., merge_fixed=True)``: fewer bodies and
+  coordinates, the dynamics of the movable joints unchanged, as Pinocchio merges them):
+  ``Data.motion`` and kernel.motion in a numba loop. Its q̈, mapped to Pinocchio's v̇, is
+  compared with ``aba`` on the robot as it is.
 
 The machine is shared by several processes: every figure is the minimum over ROUNDS rounds
 in which all callables of a robot take turns (a round times COUNT calls of each), so load
@@ -39,9 +39,7 @@ import os
 import platform
 import textwrap
 import time
-from dataclasses import replace
 from pathlib import Path
-from unittest import mock
 
 import numpy as np
 import pinocchio as pin
@@ -52,7 +50,6 @@ from mbsynth.analysis.velocity_form import VelocityForm
 from mbsynth.compiled import kernel
 from mbsynth.compiled.engine import EMPTY
 from mbsynth.core.equations import Motion
-from mbsynth.robots import build
 from mbsynth.robots.twin import Twin
 from mbsynth.robots.validate import sample_pinocchio_state
 
@@ -172,38 +169,11 @@ def rounds(callables, rounds, seconds):
     return best
 
 
-def merged(description):
-    """``description`` with each link hung by a fixed joint merged into its nearest ancestor
-    on a movable joint (or the root): masses added, centres of mass combined, inertias about
-    the new centre by the parallel-axis rule; the joints below re-expressed in that link's frame."""
-    links, joints = dict(description.links), []
-    host = {description.root: (description.root, np.zeros(3), np.eye(3))}  # link → (its host, pose in the host)
-    for joint in description.tree_order():
-        name, p, R = host[joint.parent]
-        p, R = p + R @ joint.position, R @ joint.rotation
-        if joint.kind != "fixed":
-            host[joint.child] = (joint.child, np.zeros(3), np.eye(3))
-            joints.append(replace(joint, parent=name, position=p, rotation=R))
-            continue
-        host[joint.child] = (name, p, R)
-        a, c = links[name], links.pop(joint.child)
-        mass, com_c = a.mass + c.mass, p + R @ c.com
-        com = (a.mass * a.com + c.mass * com_c) / mass if mass > 0 else a.com
-
-        def about(inertia, m, r):  # an inertia about a point r from the centre of mass
-            return inertia + m * (r @ r * np.eye(3) - np.outer(r, r))
-        links[name] = replace(a, mass=mass, com=com, inertia=about(a.inertia, a.mass, a.com - com)
-                              + about(R @ c.inertia @ R.T, c.mass, com_c - com))
-    return replace(description, links=links, joints=tuple(joints))
-
-
 def merged_robot(name, floating, names, q, v, a):
-    """The robot with its welded links merged (``merged``): (Data, its state at Pinocchio's
-    (q, v), the kernel's arguments, the largest difference of its v̇ from ``a`` = aba on the
-    robot as it is, whose Pinocchio joints are ``names``, its bodies, its n)."""
-    describe = build.describe
-    with mock.patch.object(build, "describe", lambda *args, **kw: merged(describe(*args, **kw))):
-        system = mb.from_robot(name, floating=floating)
+    """The robot with its welded links merged (``from_robot(..., merge_fixed=True)``): (Data,
+    its state at Pinocchio's (q, v), the kernel's arguments, the largest difference of its v̇
+    from ``a`` = aba on the robot as it is, whose Pinocchio joints are ``names``, its bodies, its n)."""
+    system = mb.from_robot(name, floating=floating, merge_fixed=True)
     twin = Twin(system)
     assert list(twin.model.names) == names, "the merged robot's Pinocchio joints differ"
     qm, qdm = twin.to_maximal(q, v)
@@ -248,7 +218,7 @@ def robot(name, floating, loops, empty, args_rounds):
     }
     layers = {k: f for k, f in layers.items() if f is not None}
     data_m, state_m, args_m, merged_error, merged_bodies, merged_n = merged_robot(name, floating, list(twin.model.names), q, v, a)
-    layers["Data.motion, welded links merged (URDF level)"] = lambda: data_m.motion(0.0, *state_m)
+    layers["Data.motion, welded links merged (merge_fixed=True)"] = lambda: data_m.motion(0.0, *state_m)
     kernel_loops = {label: (lambda f=f, a=(args if label == "whole" else checked): f(REPEAT, *a))
                     for label, f in loops.items()}
     kernel_zero = {label: (lambda f=f: f(0, *checked)) for label, f in loops.items() if label != "whole"}
@@ -300,7 +270,7 @@ def table(results, rounds_used):
     lines.append(f"| motion_batch of {BATCH} states, per state | " + " | ".join(
         f"{r['batch'] * 1e6:.2f} ({r['batch'] / r['batch_aba']:.2f}× aba {r['batch_aba'] * 1e6:.2f})"
         for r in results) + " |")
-    lines.append("| **kernel.motion in a numba loop, welded links merged (URDF level)** | " + " | ".join(
+    lines.append("| **kernel.motion in a numba loop, welded links merged (merge_fixed=True)** | " + " | ".join(
         f"**{r['merged'] * 1e6:.2f}** ({r['merged'] / r['layers']['pinocchio.aba']:.2f}×)" for r in results) + " |")
     lines += ["", "Per body: " + "; ".join(
         f"{r['label']}: the kernel {r['whole'] / r['bodies'] * 1e9:.0f} ns on each of its {r['bodies']} bodies "
@@ -313,9 +283,8 @@ def table(results, rounds_used):
               "motion_batch runs one thread per core; aba is one call on one thread. Largest |q̈| difference "
               "of the batch's first state from `data.motion(..., method=\"reference\")`: " +
               ", ".join(f"{r['label']} {r['error']:.1e}" for r in results) + ".", "",
-              "Welded links merged into their nearest link on a movable joint at the URDF level (benchmark's "
-              "``merged``; the ceiling of folding welded bodies inside the kernel, which would add the moving of "
-              "their forces and the recovery of their q̈): " + "; ".join(
+              "Welded links merged into their nearest link on a movable joint (`from_robot(..., "
+              "merge_fixed=True)`, each merged link a frame of that link's body): " + "; ".join(
                   f"{r['label']} {r['merged_bodies']} bodies, n = {r['merged_n']}, its v̇ within "
                   f"{r['merged_error']:.1e} of aba on the robot as it is" for r in results) + ".", ""]
     return "\n".join(lines)
