@@ -18,7 +18,12 @@ Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
   arrays: kernel.motion's source is rewritten so that the statement calling the stage runs
   K times in a numba loop after the statements before it ran once; the stage costs
   (time(K) − time(0)) / K. "the rest" is kernel.motion in a numba loop less the stages;
-- ``motion_batch`` of BATCH states, per state.
+- ``motion_batch`` of BATCH states, per state;
+- the same robot with each welded link (a fixed joint to its parent) merged into its nearest
+  link on a movable joint (``from_robot(..., merge_fixed=True)``: fewer bodies and
+  coordinates, the dynamics of the movable joints unchanged, as Pinocchio merges them):
+  ``Data.motion`` and kernel.motion in a numba loop. Its q̈, mapped to Pinocchio's v̇, is
+  compared with ``aba`` on the robot as it is.
 
 The machine is shared by several processes: every figure is the minimum over ROUNDS rounds
 in which all callables of a robot take turns (a round times COUNT calls of each), so load
@@ -164,6 +169,23 @@ def rounds(callables, rounds, seconds):
     return best
 
 
+def merged_robot(name, floating, names, q, v, a):
+    """The robot with its welded links merged (``from_robot(..., merge_fixed=True)``): (Data,
+    its state at Pinocchio's (q, v), the kernel's arguments, the largest difference of its v̇
+    from ``a`` = aba on the robot as it is, whose Pinocchio joints are ``names``, its bodies, its n)."""
+    system = mb.from_robot(name, floating=floating, merge_fixed=True)
+    twin = Twin(system)
+    assert list(twin.model.names) == names, "the merged robot's Pinocchio joints differ"
+    qm, qdm = twin.to_maximal(q, v)
+    data = system.data()
+    motion = data.motion(0.0, qm, qdm)
+    assert motion.method == "tree (Baraff)", motion.method
+    error = float(np.abs(twin.to_pinocchio(qm, qdm, motion.qdd)[2] - a).max())
+    engine = data.engine
+    return data, (qm, qdm), (qm, qdm, engine.gen, EMPTY, *engine.buffers, engine.mode, -1.0, engine.general), \
+        error, len(engine.L.node_kind), system.n
+
+
 def robot(name, floating, loops, empty, args_rounds):
     system = mb.from_robot(name, floating=floating)
     twin = Twin(system)
@@ -195,11 +217,13 @@ def robot(name, floating, loops, empty, args_rounds):
         "state check (System._state)": lambda: system._state(qm, qdm),
     }
     layers = {k: f for k, f in layers.items() if f is not None}
+    data_m, state_m, args_m, merged_error, merged_bodies, merged_n = merged_robot(name, floating, list(twin.model.names), q, v, a)
+    layers["Data.motion, welded links merged (merge_fixed=True)"] = lambda: data_m.motion(0.0, *state_m)
     kernel_loops = {label: (lambda f=f, a=(args if label == "whole" else checked): f(REPEAT, *a))
                     for label, f in loops.items()}
     kernel_zero = {label: (lambda f=f: f(0, *checked)) for label, f in loops.items() if label != "whole"}
     callables = {**layers, **{("K", k): f for k, f in kernel_loops.items()},
-                 **{("0", k): f for k, f in kernel_zero.items()}}
+                 **{("0", k): f for k, f in kernel_zero.items()}, "merged": lambda: loops["whole"](REPEAT, *args_m)}
     best = rounds(callables, args_rounds, SAMPLE_S)
     whole = best[("K", "whole")] / REPEAT
     stages = {label: max(0.0, (best[("K", label)] - best[("0", label)]) / REPEAT) for label in STAGES}
@@ -213,7 +237,9 @@ def robot(name, floating, loops, empty, args_rounds):
     return dict(label=f"{name}{' (floating)' if floating else ''}", bodies=len(engine.L.node_kind), n=system.n,
                 welded=int(np.sum(engine.L.node_k == FIXED_ROWS)), joints=twin.model.njoints - 1,
                 nv=twin.model.nv, layers={k: best[k] for k in layers}, whole=whole, stages=stages, per_call=per_call,
-                batch=batch["batch"] / BATCH, batch_aba=batch["aba"], error=error, a=a)
+                batch=batch["batch"] / BATCH, batch_aba=batch["aba"], error=error, a=a,
+                merged=best["merged"] / REPEAT, merged_error=merged_error, merged_bodies=merged_bodies,
+                merged_n=merged_n)
 
 
 def table(results, rounds_used):
@@ -244,6 +270,8 @@ def table(results, rounds_used):
     lines.append(f"| motion_batch of {BATCH} states, per state | " + " | ".join(
         f"{r['batch'] * 1e6:.2f} ({r['batch'] / r['batch_aba']:.2f}× aba {r['batch_aba'] * 1e6:.2f})"
         for r in results) + " |")
+    lines.append("| **kernel.motion in a numba loop, welded links merged (merge_fixed=True)** | " + " | ".join(
+        f"**{r['merged'] * 1e6:.2f}** ({r['merged'] / r['layers']['pinocchio.aba']:.2f}×)" for r in results) + " |")
     lines += ["", "Per body: " + "; ".join(
         f"{r['label']}: the kernel {r['whole'] / r['bodies'] * 1e9:.0f} ns on each of its {r['bodies']} bodies "
         f"({r['welded']} of them welded to their parent by a fixed joint, which Pinocchio merges into the parent's "
@@ -254,7 +282,11 @@ def table(results, rounds_used):
               "the rest where it does not run per call. "
               "motion_batch runs one thread per core; aba is one call on one thread. Largest |q̈| difference "
               "of the batch's first state from `data.motion(..., method=\"reference\")`: " +
-              ", ".join(f"{r['label']} {r['error']:.1e}" for r in results) + ".", ""]
+              ", ".join(f"{r['label']} {r['error']:.1e}" for r in results) + ".", "",
+              "Welded links merged into their nearest link on a movable joint (`from_robot(..., "
+              "merge_fixed=True)`, each merged link a frame of that link's body): " + "; ".join(
+                  f"{r['label']} {r['merged_bodies']} bodies, n = {r['merged_n']}, its v̇ within "
+                  f"{r['merged_error']:.1e} of aba on the robot as it is" for r in results) + ".", ""]
     return "\n".join(lines)
 
 

@@ -206,6 +206,9 @@ def _validate(commands):
     val.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     val.add_argument("--tolerance", type=float, default=VALIDATION_RTOL,
                      help=f"largest relative error that passes (default {VALIDATION_RTOL:g})")
+    val.add_argument("--merge-fixed", action="store_true",
+                     help="a robot (not a model file) with each link on a fixed joint merged into its parent "
+                          "(from_robot's merge_fixed)")
     val.add_argument("--json", action="store_true", help="print one JSON object")
     return val
 

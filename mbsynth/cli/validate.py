@@ -15,11 +15,14 @@ def run(args):
     check_flags(args, positive=("--tolerance",))
     options = {"samples": args.samples, "seed": args.seed, "tolerance": args.tolerance}
     if args.target.endswith((".yaml", ".yml")):
+        if args.merge_fixed:
+            raise ModelError("--merge-fixed is for a robot name or URDF file; in a model file give the robot "
+                             "entry 'merge_fixed: true'")
         started = time.perf_counter()
         system = load(args.target)
         results = [validate_system(system, build_s=time.perf_counter() - started, **options)]
     else:
-        results = validate_robot(args.target, **options)
+        results = validate_robot(args.target, merge_fixed=args.merge_fixed, **options)
     passed = all(r.passed for r in results)
     if args.json:
         print(json.dumps({"robot": results[0].robot, "samples": args.samples,

@@ -12,6 +12,7 @@ rest length and damping are expressions of parameters, ≥ 0. ``name`` defaults 
 
 from ..model.forces import AXES, applied_force, applied_torque, point_spring
 from .joints import frame_reference
+from .robot import welded_frame
 from .part_types import either, file_types_of
 from .parts import read_nonnegative
 from .schema import FORCE_SECTIONS
@@ -74,9 +75,10 @@ def _force(builder, name, spec, path):
 
 def _torque(builder, name, spec, path):
     part_name = spec["part"]
-    if not isinstance(part_name, str) or part_name not in builder.parts:
+    welded = welded_frame(builder, part_name, path + ("part",)) if isinstance(part_name, str) else None
+    if welded is None and (not isinstance(part_name, str) or part_name not in builder.parts):
         builder.fail(path + ("part",), f"unknown part {part_name!r}; parts: {', '.join(builder.parts)}")
-    part = builder.parts[part_name]
+    part = builder.parts[part_name] if welded is None else welded[0]  # a merged link turns with its host
     if not part.part_type.rigid:  # a torque turns a part with an orientation of its own, as one piece
         named = either(file_types_of(lambda part_type: part_type.rigid))
         builder.fail(path + ("part",), f"a torque acts on a {named} part; '{part_name}' is a {part.type_name}")

@@ -18,6 +18,7 @@ from .parts import read_frames
 from .substructures import COUNT_MAX
 from .part_types import either, file_types_of
 from .placement import place_height
+from .robot import welded_frame
 
 # ground contacts (their keys: schema.py): the orientations (model/parts/part_type.py) of the rigid parts they may sit on
 CONTACT_TYPES = {"rolling_disk": (QUATERNION, ANGLES), "knife_edge": (QUATERNION, ANGLES, PLANE)}
@@ -67,6 +68,8 @@ def frame_reference(builder, text, path):
     if text == "world" or part_name == "world":
         frame_name = "" if text == "world" else frame_name
         frames, part = builder.world_frames, None
+    elif (welded := welded_frame(builder, text, path)) is not None:
+        return welded
     elif part_name in builder.parts:
         part = builder.parts[part_name]
         frames = part.frames

@@ -69,6 +69,8 @@ class Assembly:
         self.parts = {}  # full name -> part, in the model's order
         self.owners = {}  # full part name -> (its builder, its entry name there)
         self.ports = {}  # full port name -> (part, frame)
+        self.welded = {}  # full part name a merged robot link would have -> its RobotEntry (io/robot.py)
+        self.welded_joints = {}  # full name a merged fixed joint of a robot would have -> its link
         self.documents = {}  # resolved path -> Document: a file used N times is read once
         self.q, self.qd = [], []
         self.index = {}  # coordinate symbol -> its place in q

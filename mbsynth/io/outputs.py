@@ -38,6 +38,10 @@ def read_outputs(builder, constraints, gaps=()):
         kpath = path + (kind,)
         if kind == "reaction":
             constraint, _, which = str(value).rpartition(".")
+            link = builder.assembly.welded_joints.get(builder.full_name(constraint))
+            if link is not None:
+                builder.fail(kpath, f"'{constraint}' is the fixed joint of link '{link}', merged into its parent "
+                                    "(merge_fixed: true): it carries no reaction; without merge_fixed it does")
             if constraint not in by_name:
                 builder.fail(kpath, f"unknown joint or constraint '{constraint}' in '{value}' (write "
                                     f"'<joint>.force', '.torque' or '.multipliers'); known: {', '.join(by_name)}")

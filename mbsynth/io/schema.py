@@ -218,7 +218,10 @@ SECTIONS = {section.name: section for section in (
                  "{position: [0, 0, 0.5]}", default="the world's origin"),
              Key("initial", "mapping URDF joint name → " + _EXPR, "initial position of each movable joint "
                  "[rad or m]: the links start where the URDF's kinematics puts them", "{elbow_joint: 0.5}",
-                 default="0 for every joint"), _DESCRIPTION)),
+                 default="0 for every joint"),
+             Key("merge_fixed", "boolean", "merge each link on a fixed joint into its nearest ancestor on a "
+                 "movable joint (fewer bodies, the same joint motion); ``NAME_<link>`` then names a frame of "
+                 "that ancestor's body", "true", default="false"), _DESCRIPTION)),
     Section("flexible_body", "``parts: {NAME: {type: flexible_body, ...}}``",
             "A flexible body: a finite-element model (``beam`` or ``fe``, exactly one) reduced to a few "
             "coordinates, on a floating frame. Coordinates x, y, z (the frame's origin, which is the FE "

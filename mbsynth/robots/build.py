@@ -14,6 +14,10 @@ body: its block of M is zero, and the joints decide whether its motion is determ
 Every movable joint is driven by a parameter ``tau_<joint>`` (default 0): a torque about
 a revolute axis, a force along a prismatic one (joint_forces.actuation).
 
+With ``merge_fixed`` each link on a fixed joint is merged into its nearest ancestor on a
+movable joint (urdf.Description.merged, as Pinocchio's parser does) and kept as a frame of
+that ancestor's body named after the link: fewer bodies, the same joint motion.
+
 Robots by name are those ``example-robot-data`` ships (``robot_files``); any URDF path
 works too.
 """
@@ -125,9 +129,11 @@ def identifier(text):
 class Robot:
     """A robot decomposed into parts: ``parts`` maps each URDF link to its part's name,
     ``joints`` each URDF joint to its constraint's name, ``torques`` each movable joint to
-    its torque parameter. ``base`` is the root link's world (position, rotation) when
-    fixed, its initial pose when ``floating``; ``positions`` the initial joint positions
-    ({URDF joint name: value}, 0 where not given)."""
+    its torque parameter; with the welded links merged (``Description.merged``), ``welded``
+    maps each merged link to the name its part would have and ``welded_joints`` each merged
+    fixed joint's would-be constraint name to its link. ``base`` is the root link's world
+    (position, rotation) when fixed, its initial pose when ``floating``; ``positions`` the
+    initial joint positions ({URDF joint name: value}, 0 where not given)."""
 
     description: object
     prefix: str
@@ -138,19 +144,27 @@ class Robot:
     torques: dict
     base_joint: str
     positions: dict = field(default_factory=dict)
+    welded: dict = field(default_factory=dict)  # merged link → the name of the part it would be
+    welded_joints: dict = field(default_factory=dict)  # merged fixed joint's constraint name → its link
 
     @classmethod
     def plan(cls, description, prefix="", floating=False, base=None, scope=""):
         """Names for the parts, constraints and torque parameters of ``description``, each
-        after ``scope`` (a substructure's ``left_leg.``)."""
+        after ``scope`` (a substructure's ``left_leg.``); a merged link (``welded``) keeps
+        the part name it would have, the name that finds its frame on its host."""
         base = (np.zeros(3), np.eye(3)) if base is None else tuple(np.asarray(x, dtype=float) for x in base)
-        parts = _unique({link: scope + prefix + identifier(link) for link in description.links})
-        joints = _unique({j.name: prefix + identifier(j.name) for j in description.joints}
+        links = (*description.links, *description.welded)
+        parts = _unique({link: scope + prefix + identifier(link) for link in links})
+        welded = {link: parts.pop(link) for link in description.welded}
+        joints = _unique({j: prefix + identifier(j) for j in (*(j.name for j in description.joints),
+                                                               *(w.joint for w in description.welded.values()))}
                          | {None: prefix + "fixed_base"})
         base_joint = scope + joints.pop(None)
         torques = {j.name: f"{scope}tau_{joints[j.name]}" for j in description.joints if j.kind != "fixed"}
         joints = {key: scope + name for key, name in joints.items()}
-        return cls(description, prefix, floating, base, parts, joints, torques, base_joint)
+        welded_joints = {joints.pop(w.joint): link for link, w in description.welded.items()}
+        return cls(description, prefix, floating, base, parts, joints, torques, base_joint, welded=welded,
+                   welded_joints=welded_joints)
 
     @property
     def parameters(self):
@@ -165,6 +179,13 @@ class Robot:
             on_parent, on_child = self.joint_frames(joint)
             frames[joint.parent].append(on_parent)
             frames[joint.child].append(on_child)
+        for link, weld in self.description.welded.items():
+            frame = self.welded_frame(link)
+            if any(f.name == frame.name for f in frames[weld.host]):
+                raise ModelError(f"{self.description.path}: merged link '{link}' would be frame '{frame.name}' of "
+                                 f"'{frame.part}', which has a frame of that name (a joint's): build without "
+                                 "merge_fixed")
+            frames[weld.host].append(frame)
         poses = self.description.poses(self.base, self.positions)
         bodies = []
         for link, lk in self.description.links.items():
@@ -188,6 +209,37 @@ class Robot:
         return (Frame(self.parts[joint.parent], name, exact(joint.position - parent.com), exact(joint.rotation @ A)),
                 Frame(self.parts[joint.child], name, exact(-child.com), exact(A)))
 
+    def welded_frame(self, link, origin=False):
+        """The frame on its host's body of a merged link: its link frame, named after the
+        link (``origin``: at its own centre of mass, the origin its part would have)."""
+        weld = self.description.welded[link]
+        host = self.description.links[weld.host]
+        position = weld.position + (weld.rotation @ weld.com if origin else 0.0) - host.com
+        return Frame(self.parts[weld.host], identifier(link) + ("_com" if origin else ""), exact(position),
+                     exact(weld.rotation))
+
+    def welded_reference(self, part, frame, parts):
+        """(host part, Frame) for frame ``frame`` ('' its origin) of ``part``, the part a
+        merged link would be: its link frame (``link``, or the frame of the fixed joint that
+        hung it), the frame of a joint that hung from it, or its origin (its centre of mass,
+        link axes). None when ``part`` is no merged link's; a ModelError for another frame.
+        ``parts``: the parts by name."""
+        link = next((link for link, name in self.welded.items() if name == part), None)
+        if link is None:
+            return None
+        weld = self.description.welded[link]
+        host = parts[self.parts[weld.host]]
+        below = {identifier(j): j for j in weld.children}
+        if frame in ("", LINK_FRAME, identifier(weld.joint)):
+            merged = self.welded_frame(link, origin=not frame and bool(np.any(weld.com)))
+            return host, host.frames.get(merged.name, merged)
+        if frame in below:
+            child = next((c for c, w in self.description.welded.items() if w.joint == below[frame]), None)
+            return host, host.frames[identifier(child) if child else frame]
+        known = ", ".join([LINK_FRAME, identifier(weld.joint), *below])
+        raise ModelError(f"'{part}' (link '{link}', merged into '{host.name}' by merge_fixed) has no frame "
+                         f"'{frame}'; it has: {known}")
+
     def connect(self, parts, q, qd, params):
         """(joints, torque force elements) between the bodies ``parts`` (name → part)."""
         joints = [] if self.floating else [self.weld(parts, q, qd, params)]
@@ -210,13 +262,18 @@ class Robot:
         return Joint(self.base_joint, "fixed", None, world, root, root.frames[LINK_FRAME], q, qd, params)
 
 
-def from_robot(name_or_urdf, floating=False, *, base=None, gravity=GRAVITY, prefix="", package_dirs=()):
+def from_robot(name_or_urdf, floating=False, *, base=None, gravity=GRAVITY, prefix="", package_dirs=(),
+               merge_fixed=False):
     """A System of the robot ``name_or_urdf`` (an example-robot-data name or a URDF file):
     one rigid body per link, one joint per URDF joint, one torque parameter per movable
     joint (``tau_<joint>``, set with ``System.with_parameters``). ``floating``: a free
-    root link instead of a fixed base; ``base``: the root link's (position, rotation)."""
+    root link instead of a fixed base; ``base``: the root link's (position, rotation).
+    ``merge_fixed``: each link hung by a fixed joint merged into its nearest ancestor on a
+    movable joint (``urdf.Description.merged``), kept as a frame of that ancestor's body
+    named after the link (``Robot.welded_frame``): fewer bodies, the same joint motion."""
     compiled.compile_ahead("rigid_tree")  # a robot is a rigid tree: a cold compile starts beside the derivation
     description = describe(name_or_urdf, package_dirs)
+    description = description.merged() if merge_fixed else description
     robot = Robot.plan(description, prefix, floating, base)
     params = [sp.Symbol(p) for p in robot.parameters]
     bodies = robot.bodies(sp.Matrix(gravity), params)

@@ -10,7 +10,7 @@ default); ``<dynamics>`` (damping, friction) is ignored.
 
 import os
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -49,8 +49,24 @@ class UrdfJoint:
 
 
 @dataclass(frozen=True)
+class Weld:
+    """A link merged into its nearest ancestor on a movable joint (``Description.merged``):
+    ``host`` that ancestor, ``joint`` the fixed joint that hung the link, ``position`` and
+    ``rotation`` the link frame in the host's link frame, ``com`` the link's own centre of
+    mass (its link axes), ``children`` the URDF joints that hung from it."""
+
+    host: str
+    joint: str
+    position: np.ndarray
+    rotation: np.ndarray
+    com: np.ndarray
+    children: tuple
+
+
+@dataclass(frozen=True)
 class Description:
-    """A robot: links by name, joints in file order, and its root link."""
+    """A robot: links by name, joints in file order, and its root link; ``welded``: the
+    links merged into an ancestor ({link: Weld}, empty unless ``merged``)."""
 
     name: str
     path: str
@@ -58,6 +74,7 @@ class Description:
     joints: tuple
     root: str
     package_dirs: tuple = field(default=(), compare=False)
+    welded: dict = field(default_factory=dict, compare=False)
 
     def children(self, link):
         """The joints that hang links from ``link``."""
@@ -92,6 +109,42 @@ class Description:
                 order.append(joint)
                 frontier.append(joint.child)
         return order
+
+    def merged(self):
+        """This robot with each link hung by a fixed joint merged into its nearest ancestor
+        on a movable joint (or the root), as Pinocchio's model does: masses added, centres of
+        mass combined, inertias about the new centre by the parallel-axis rule, visuals
+        carried over; the joints below re-expressed in the ancestor's link frame. The
+        dynamics of the movable joints are those of the robot as it is."""
+        links, joints, welded = dict(self.links), [], {}
+        host = {self.root: (self.root, np.zeros(3), np.eye(3))}  # link → (its host, its frame in the host's)
+        for joint in self.tree_order():
+            name, p, R = host[joint.parent]
+            p, R = p + R @ joint.position, R @ joint.rotation
+            if joint.kind != "fixed":
+                host[joint.child] = (joint.child, np.zeros(3), np.eye(3))
+                joints.append(replace(joint, parent=name, position=p, rotation=R))
+                continue
+            host[joint.child] = (name, p, R)
+            child = links.pop(joint.child)
+            below = tuple(j.name for j in self.children(child.name))
+            welded[joint.child] = Weld(name, joint.name, p, R, child.com, below)
+            links[name] = _merged_link(links[name], child, p, R)
+        return replace(self, links=links, joints=tuple(joints), welded=welded)
+
+
+def _merged_link(a, c, p, R):
+    """Link ``a`` carrying link ``c`` whose frame is at (``p``, ``R``) in ``a``'s: the mass
+    of both, about their common centre of mass (parallel-axis rule), with both visuals."""
+    mass, com_c = a.mass + c.mass, p + R @ c.com
+    com = (a.mass * a.com + c.mass * com_c) / mass if mass > 0 else a.com
+
+    def about(inertia, m, r):  # an inertia about a point r from the centre of mass
+        return inertia + m * (r @ r * np.eye(3) - np.outer(r, r))
+    inertia = about(a.inertia, a.mass, a.com - com) + about(R @ c.inertia @ R.T, c.mass, com_c - com)
+    visuals = tuple(dict(v, position=(p + R @ np.asarray(v["position"])).tolist(),
+                         rotation=(R @ np.asarray(v["rotation"])).tolist()) for v in c.visuals)
+    return replace(a, mass=mass, com=com, inertia=inertia, visuals=a.visuals + visuals)
 
 
 

@@ -79,10 +79,12 @@ class Validation:
         return asdict(self)
 
 
-def validate_robot(name_or_urdf, samples=20, seed=0, bases=("fixed", "floating"), tolerance=VALIDATION_RTOL):
-    """[Validation] of a robot for each base: built once floating, then welded for fixed."""
+def validate_robot(name_or_urdf, samples=20, seed=0, bases=("fixed", "floating"), tolerance=VALIDATION_RTOL,
+                   merge_fixed=False):
+    """[Validation] of a robot for each base: built once floating (``merge_fixed``: its
+    welded links merged, from_robot), then welded for fixed."""
     started = time.perf_counter()
-    floating = from_robot(name_or_urdf, floating=True)
+    floating = from_robot(name_or_urdf, floating=True, merge_fixed=merge_fixed)
     build_s = time.perf_counter() - started
     results = []
     for base in bases:
