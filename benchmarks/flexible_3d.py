@@ -67,6 +67,7 @@ sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE))
 from tests.helpers.prescribed_frame import tip_history, tumbling_rates, tumbling_rotation  # noqa: E402
 from tests.model.flexible.test_flexible_pendulum import ELEMENTS, SECTION  # noqa: E402
+from flexible import seconds  # noqa: E402
 
 try:
     import exudyn as exu
@@ -279,10 +280,6 @@ def lumped():
 
 
 # ----------------------------------------------------------------------------- the report
-
-def seconds(value):
-    return f"{value:.4f}" if value < 1 else f"{value:.2f}"
-
 
 def report(result, args):
     ref = result["reference"]
