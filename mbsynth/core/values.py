@@ -61,13 +61,26 @@ class Keyed:
         return key
 
     def __eq__(self, other):
-        return self is other or (type(other) is type(self) and self._key() == other._key())
+        return self is other or (type(other) is type(self) and shared_if_equal(self._key(), other, other._key(),
+                                                                               "_content_key"))
 
     def __hash__(self):
         found = self.__dict__.get("_content_hash")
         if found is None:
             found = self.__dict__["_content_hash"] = hash(self._key())
         return found
+
+
+def shared_if_equal(key, other, other_key, name):
+    """Whether the content keys ``key`` and ``other_key`` (``other``'s, kept in its __dict__
+    under ``name``) are equal; where they are, ``other`` keeps ``key`` instead, so that the
+    next comparison of the two (a cache's lookup on every call) is by identity, at once."""
+    if key is other_key:
+        return True
+    if key != other_key:
+        return False
+    other.__dict__[name] = key
+    return True
 
 
 def read_only(array):

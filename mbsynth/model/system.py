@@ -25,7 +25,7 @@ from ..compiled.background import default_path
 from .data import Data, shared
 from ..core.errors import ModelError
 from ..core.memo import MEMO
-from ..core.values import freeze, frozen_mapping, read_only
+from ..core.values import freeze, frozen_mapping, read_only, shared_if_equal
 from .joint_values import JointKinematics, value_expressions
 from .parts import LINK_FRAME, Frame
 from ..symbolic.derive import T_SYMBOL
@@ -143,13 +143,20 @@ class System:
             return True
         if type(other) is not type(self):
             return NotImplemented
-        return hash(self) == hash(other) and freeze(self._content()) == freeze(other._content())
+        return hash(self) == hash(other) and shared_if_equal(self._frozen(), other, other._frozen(), "_frozen_content")
+
+    def _frozen(self):
+        """``freeze`` of each compared field, kept as the hash is (the content is immutable)."""
+        found = self.__dict__.get("_frozen_content")
+        if found is None:
+            found = self.__dict__["_frozen_content"] = tuple(freeze(x) for x in self._content())
+        return found
 
     def __hash__(self):
         found = self.__dict__.get("_hash")  # a hash of immutable content, kept as str keeps its own
         if found is None:
-            found = hash((self.name, self.structure, self.coordinates, tuple(self.parameters.values()),
-                          self.initial_q.tobytes(), self.initial_qd.tobytes()))
+            found = hash((self.name, self.source_file, self.structure, self.coordinates,
+                          tuple(self.parameters.values()), self.initial_q.tobytes(), self.initial_qd.tobytes()))
             self.__dict__["_hash"] = found
         return found
 

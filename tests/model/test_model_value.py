@@ -30,6 +30,23 @@ def test_two_loads_of_one_file_are_equal_and_move_alike(path):
     assert first.motion(0.2, q, qd).qdd.tobytes() == second.motion(0.2, q, qd).qdd.tobytes()
 
 
+def test_a_model_compares_its_content_once_per_equal_model(monkeypatch):
+    """Equal models share their frozen content after one comparison, and a loaded model's
+    own methods find its Data without comparing it with the loader's unfinished model (its
+    file not yet set): both cost a full content comparison (milliseconds) per call."""
+    from mbsynth.core import values
+    from mbsynth.model import system as system_module
+    first, second = mb.load(FOUR_BAR), mb.load(FOUR_BAR)
+    q, qd = first.initial_state()
+    assert first == second
+    frozen = []
+    for module in (values, system_module):
+        monkeypatch.setattr(module, "freeze", lambda x: frozen.append(x) or x)
+    assert second == first and first == second and second.structure == first.structure
+    first.motion(0.0, q, qd), second.motion(0.0, q, qd), second.data()
+    assert frozen == []
+
+
 def test_a_changed_parameter_makes_another_model_and_changing_it_back_the_same():
     model = mb.load(FOUR_BAR)
     name = next(iter(model.parameters))
