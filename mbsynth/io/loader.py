@@ -685,9 +685,10 @@ class _Builder:
     def check_branches(self, system):
         """No joint may be assembled at the initial state (its rows hold) in a pose its rows
         allow but it does not mean (a fixed joint's frames turned 180°): System.branch_problems.
-        A joint whose rows do not hold yet is left to the state made consistent."""
+        A joint whose rows do not hold yet is left to the state made consistent. One state:
+        evaluated on the KKT path (numpy), which compiles nothing."""
         q, qd = system.initial_state()
-        phi, _ = system.constraint_residuals(0.0, q, qd)
+        phi, _ = system.data("kkt").constraint_residuals(0.0, q, qd)
         apart = {row.split("[")[0] for row, r in zip(system.constraint_names, phi) if abs(r) > ASSEMBLED_TOL}
         for joint, problem in system.branch_problems(q):
             if joint not in apart:
