@@ -1,4 +1,4 @@
-"""One numba function per shared structure of constraint or part expressions.
+"""The compiled evaluation of a shared structure of constraint or part expressions.
 
 ``symbolic.compile_function`` compiles the expressions of constraints (and parts) alike
 once, in placeholder form (``symbolic.canonical``); grouped.py evaluates the instances of
@@ -9,10 +9,13 @@ one structure together. ``kernel(raw)`` turns that structure into
         q[columns[j, m]] (velocities from qd), parameters from p, constants from
         values[:, m] and numbers from fixed[:, m]
 
-written into the cache under the hash of its text and compiled by numba (``cache=True``:
-a structure seen before, by any model, loads its machine code from disk). A Data on the
-compiled path (grouped.Batch with ``compiled``) builds it at its first call, waiting;
-``MBSYNTH_COMPILED=off`` never builds it (grouped.py then uses numpy).
+written as a tape (tape.py) that one function compiled for every structure reads: a new
+structure costs its tape (milliseconds), no compile. A structure holding an expression the
+tape has no operation for is written as a module of its own into the cache under the hash
+of its text and compiled by numba (``cache=True``: a structure seen before, by any model,
+loads its machine code from disk). A Data on the compiled path (grouped.Batch with
+``compiled``) builds it at its first call, waiting; ``MBSYNTH_COMPILED=off`` never builds
+it (grouped.py then uses numpy).
 """
 
 import logging
@@ -21,6 +24,7 @@ import threading
 from ..symbolic.derive import beyond_double_as_inf
 from .background import mode
 from .codegen import assignments, load
+from .tape import Unsupported, run, tape
 
 log = logging.getLogger(__name__)
 
@@ -54,13 +58,28 @@ def kernel(raw):
 
 
 def _build(raw):
+    args, forms = raw.structure()
     try:
-        evaluate = load(source(*raw.structure()), prefix="mbsynth_structure").evaluate
+        return Taped(tape(args, forms))
+    except Unsupported as err:
+        log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
+    try:
+        evaluate = load(source(args, forms), prefix="mbsynth_structure").evaluate
         evaluate.compile(SIGNATURE)  # here, not at the first call
     except Exception as err:  # noqa: BLE001 - numpy serves
         log.warning("a constraint structure stays on numpy (%s: %s)", type(err).__name__, err)
         return None
     return evaluate
+
+
+class Taped:
+    """``evaluate`` of a structure written as a tape (tape.py): ``tape.run`` on its arrays."""
+
+    def __init__(self, arrays):
+        self.arrays = arrays
+
+    def __call__(self, t, q, qd, p, columns, values, fixed, out):
+        run(t, q, qd, p, columns, values, fixed, out, *self.arrays)
 
 
 def source(args, forms):

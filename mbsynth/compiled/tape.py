@@ -1,0 +1,293 @@
+"""Every shared structure on one compiled function: its expressions as a tape.
+
+structures.py evaluates the instances of one constraint or part structure together. Rather
+than generating and compiling a numba function per structure (a second or more each: the
+cold cost of a new model, paid again for every structure it brings), ``tape(args, forms)``
+writes the structure's expressions, their common subexpressions once (sympy ``cse``), as a
+list of operations on registers, and ``run`` — one numba function, compiled once with the
+rest of the compiled path — reads that list for each instance:
+
+    run(t, q, qd, p, columns, values, fixed, out, code, operands, numbers, size)
+        for each instance m: out[:, m] = the expressions, coordinate slot j read from
+        q[columns[j, m]] (velocities from qd), parameters from p, constants from
+        values[:, m] and numbers from fixed[:, m]
+
+An operation is ``code[i]`` on ``operands[i] = (destination, a, b, c)``: registers, or an
+index into the arguments or ``numbers``. Piecewise expressions evaluate every branch and
+select (as numpy does), comparisons give 1.0 or 0.0. An expression of a kind the tape does
+not know raises ``Unsupported`` (structures.py then compiles the structure on its own).
+"""
+
+import math
+
+import numpy as np
+import sympy as sp
+from numba import njit
+
+from ..symbolic.derive import beyond_double_as_inf
+
+(T, Q, QD, P, VALUE, FIXED, NUMBER, OUT, ADD, SUB, MUL, DIV, NEG, SQUARE, POWI, POW, SQRT, SIN, COS, TAN, ASIN,
+ ACOS, ATAN, ATAN2, SINH, COSH, TANH, EXP, LOG, ABS, SIGN, FLOOR, CEIL, MAX, MIN, LT, LE, EQ, NE, AND, OR, NOT,
+ SELECT) = range(43)
+
+READS = (T, Q, QD, P, VALUE, FIXED)  # the argument each slot group of a structure is read from
+FUNCTIONS = {sp.sin: SIN, sp.cos: COS, sp.tan: TAN, sp.asin: ASIN, sp.acos: ACOS, sp.atan: ATAN, sp.sinh: SINH,
+             sp.cosh: COSH, sp.tanh: TANH, sp.exp: EXP, sp.log: LOG, sp.Abs: ABS, sp.sign: SIGN, sp.floor: FLOOR,
+             sp.ceiling: CEIL}
+RELATIONS = {sp.StrictLessThan: (LT, False), sp.LessThan: (LE, False), sp.StrictGreaterThan: (LT, True),
+             sp.GreaterThan: (LE, True), sp.Equality: (EQ, False), sp.Unequality: (NE, False)}
+
+
+class Unsupported(Exception):
+    """An expression the tape has no operation for."""
+
+
+class Tape:
+    """The operations of one structure: (code, operands, numbers, size), see the module."""
+
+    def __init__(self):
+        self.code, self.operands, self.numbers = [], [], []
+        self.size = 0
+        self.made = {}  # expression -> its register
+
+    def emit(self, op, a=0, b=0, c=0):
+        """A new register holding ``op`` of (a, b, c)."""
+        self.code.append(op)
+        self.operands.append((self.size, a, b, c))
+        self.size += 1
+        return self.size - 1
+
+    def number(self, value):
+        self.numbers.append(float(value))
+        return self.emit(NUMBER, len(self.numbers) - 1)
+
+    def arrays(self):
+        return (np.array(self.code, dtype=np.int64), np.array(self.operands, dtype=np.int64).reshape(-1, 4),
+                np.array(self.numbers + [0.0]), max(self.size, 1))
+
+
+def tape(args, forms):
+    """The Tape of ``forms`` in the slots ``args`` = (t, q slots, q̇ slots, parameter slots,
+    constant slots, number slots), as numpy arrays (code, operands, numbers, size)."""
+    t, *groups = args
+    written = Tape()
+    reads = {t: (T, 0)}
+    for op, slots in zip(READS[1:], groups):
+        reads.update({s: (op, j) for j, s in enumerate(slots)})
+    steps, results = sp.cse([beyond_double_as_inf(sp.sympify(e)) for e in forms],
+                            symbols=sp.numbered_symbols("_x"), order="none")
+    for symbol, expr in steps:
+        written.made[symbol] = _register(written, expr, reads)
+    for k, expr in enumerate(results):
+        written.emit(OUT, k, _register(written, expr, reads))
+    return written.arrays()
+
+
+def _register(written, expr, reads):
+    """The register of ``expr``, its operations written first (each subexpression once)."""
+    found = written.made.get(expr)
+    if found is None:
+        found = written.made[expr] = _write(written, expr, reads)
+    return found
+
+
+def _write(written, expr, reads):
+    arg = lambda e: _register(written, e, reads)  # noqa: E731
+    if expr in reads:
+        op, j = reads[expr]
+        return written.emit(op, j)
+    if expr is sp.true or expr is sp.false:
+        return written.number(expr is sp.true)
+    if expr.is_Number or expr.is_NumberSymbol:
+        return written.number(_float(expr))
+    if expr.is_Add:
+        return _sum(written, expr.args, arg)
+    if expr.is_Mul:
+        return _product(written, expr, arg)
+    if expr.is_Pow:
+        return _power(written, expr.base, expr.exp, arg)
+    if expr.func in FUNCTIONS and len(expr.args) == 1:
+        return written.emit(FUNCTIONS[expr.func], arg(expr.args[0]))
+    if expr.func == sp.atan2:
+        return written.emit(ATAN2, arg(expr.args[0]), arg(expr.args[1]))
+    if expr.func in (sp.Max, sp.Min):
+        return _fold(written, MAX if expr.func == sp.Max else MIN, [arg(x) for x in expr.args])
+    if type(expr) in RELATIONS:
+        op, swapped = RELATIONS[type(expr)]
+        a, b = arg(expr.lhs), arg(expr.rhs)
+        return written.emit(op, *((b, a) if swapped else (a, b)))
+    if isinstance(expr, (sp.And, sp.Or)):
+        return _fold(written, AND if isinstance(expr, sp.And) else OR, [arg(x) for x in expr.args])
+    if isinstance(expr, sp.Not):
+        return written.emit(NOT, arg(expr.args[0]))
+    if isinstance(expr, sp.Piecewise):
+        return _piecewise(written, expr, arg)
+    raise Unsupported(f"{type(expr).__name__}: {expr}")
+
+
+def _float(number):
+    """A sympy number as a float (±inf, NaN for the infinities and NaN)."""
+    if number is sp.zoo or number is sp.nan:
+        return math.nan
+    if number in (sp.oo, -sp.oo):
+        return math.inf if number is sp.oo else -math.inf
+    return float(number)
+
+
+def _fold(written, op, registers):
+    result = registers[0]
+    for r in registers[1:]:
+        result = written.emit(op, result, r)
+    return result
+
+
+def _sum(written, terms, arg):
+    """A sum: a term with a negative coefficient (after the first) subtracted."""
+    result = arg(terms[0])
+    for term in terms[1:]:
+        negative = term.as_coeff_Mul()[0] < 0
+        result = written.emit(SUB if negative else ADD, result, arg(-term if negative else term))
+    return result
+
+
+def _product(written, expr, arg):
+    """A product: −x as NEG; factors with a negative integer power as one division."""
+    coefficient, factors = expr.as_coeff_mul()
+    above = [f for f in factors if not (f.is_Pow and f.exp.is_Integer and f.exp < 0)]
+    below = [f.base ** -f.exp for f in factors if f not in above]
+    registers = [arg(f) for f in above]
+    if coefficient not in (1, -1):
+        registers.insert(0, arg(coefficient))
+    result = _fold(written, MUL, registers) if registers else written.number(1.0)
+    if below:
+        result = written.emit(DIV, result, _fold(written, MUL, [arg(f) for f in below]))
+    return written.emit(NEG, result) if coefficient == -1 else result
+
+
+def _power(written, base, exponent, arg):
+    if exponent == 2:
+        return written.emit(SQUARE, arg(base))
+    if exponent.is_Integer and exponent > 0:
+        return written.emit(POWI, arg(base), int(exponent))
+    if exponent.is_Integer:
+        return written.emit(DIV, written.number(1.0), _power(written, base, -exponent, arg))
+    if exponent == sp.Rational(1, 2):
+        return written.emit(SQRT, arg(base))
+    if exponent == -sp.Rational(1, 2):
+        return written.emit(DIV, written.number(1.0), written.emit(SQRT, arg(base)))
+    return written.emit(POW, arg(base), arg(exponent))
+
+
+def _piecewise(written, expr, arg):
+    """Every branch evaluated, the first whose condition holds selected (NaN where none)."""
+    result = written.number(math.nan)
+    for value, condition in reversed(expr.args):
+        if condition is sp.true:
+            result = arg(value)
+        elif condition is not sp.false:
+            result = written.emit(SELECT, arg(condition), arg(value), result)
+    return result
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def run(t, q, qd, p, columns, values, fixed, out, code, operands, numbers, size):
+    """``out[:, m]`` of every instance m: the tape (code, operands, numbers) read for each."""
+    r = np.empty(size)
+    for m in range(columns.shape[1]):
+        for i in range(code.shape[0]):
+            op, d, a, b = code[i], operands[i, 0], operands[i, 1], operands[i, 2]
+            if op == MUL:
+                r[d] = r[a] * r[b]
+            elif op == ADD:
+                r[d] = r[a] + r[b]
+            elif op == SUB:
+                r[d] = r[a] - r[b]
+            elif op == Q:
+                r[d] = q[columns[a, m]]
+            elif op == SQUARE:
+                r[d] = r[a] * r[a]
+            elif op == NEG:
+                r[d] = -r[a]
+            elif op == NUMBER:
+                r[d] = numbers[a]
+            elif op == P:
+                r[d] = p[a]
+            elif op == FIXED:
+                r[d] = fixed[a, m]
+            elif op == VALUE:
+                r[d] = values[a, m]
+            elif op == QD:
+                r[d] = qd[columns[a, m]]
+            elif op == OUT:
+                out[a, m] = r[b]
+            elif op == DIV:
+                r[d] = r[a] / r[b]
+            elif op == SIN:
+                r[d] = math.sin(r[a])
+            elif op == COS:
+                r[d] = math.cos(r[a])
+            else:
+                r[d] = _rare(op, r, a, b, operands[i, 3], t)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _rare(op, r, a, b, c, t):
+    """The value of the operations ``run`` does not test for first."""
+    x = r[a]
+    if op == T:
+        return t
+    if op == POWI:
+        return x ** b
+    if op == POW:
+        return x ** r[b]
+    if op == SQRT:
+        return math.sqrt(x) if x >= 0 else math.nan
+    if op == ATAN2:
+        return math.atan2(x, r[b])
+    if op == TAN:
+        return math.tan(x)
+    if op == ASIN:
+        return math.asin(x) if -1 <= x <= 1 else math.nan
+    if op == ACOS:
+        return math.acos(x) if -1 <= x <= 1 else math.nan
+    if op == ATAN:
+        return math.atan(x)
+    if op == SINH:
+        return math.sinh(x)
+    if op == COSH:
+        return math.cosh(x)
+    if op == TANH:
+        return math.tanh(x)
+    if op == EXP:
+        return math.exp(x)
+    if op == LOG:
+        return math.log(x) if x > 0 else (-math.inf if x == 0 else math.nan)
+    if op == ABS:
+        return abs(x)
+    if op == SIGN:
+        return math.nan if x != x else (1.0 if x > 0 else (-1.0 if x < 0 else 0.0))
+    if op == FLOOR:
+        return np.floor(x)
+    if op == CEIL:
+        return np.ceil(x)
+    if op == MAX:
+        return x if (x > r[b] or x != x) else r[b]
+    if op == MIN:
+        return x if (x < r[b] or x != x) else r[b]
+    if op == LT:
+        return 1.0 if x < r[b] else 0.0
+    if op == LE:
+        return 1.0 if x <= r[b] else 0.0
+    if op == EQ:
+        return 1.0 if x == r[b] else 0.0
+    if op == NE:
+        return 1.0 if x != r[b] else 0.0
+    if op == AND:
+        return 1.0 if (x != 0 and r[b] != 0) else 0.0
+    if op == OR:
+        return 1.0 if (x != 0 or r[b] != 0) else 0.0
+    if op == NOT:
+        return 1.0 if x == 0 else 0.0
+    if op == SELECT:
+        return r[b] if x != 0 else r[c]
+    return math.nan
