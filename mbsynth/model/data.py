@@ -347,7 +347,8 @@ class Data:
                                                  g[k.child_indices])
             out[con.name] = reactions.Reaction(lam[rows].copy(), bool(dependent[rows].any()), force, torque)
             row += con.size
-        return out
+        merged = {joint: link for robot in self.system.robots for joint, link in robot.welded_joints.items()}
+        return reactions.Reactions(out, merged)
 
     def _joint_force(self, joint, lam, t, q, qd):
         """The generalized force of ``joint``: its rows' Aᵀλ, its C (viscous and, at the

@@ -18,6 +18,7 @@ which moves nothing, left out: ``Part.idle_directions``). F and τ are given in 
 frame's axes: for a robot's joint, its child link frame, as Pinocchio's ``data.f``.
 """
 
+import difflib
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,24 @@ import numpy as np
 from ..core.equations import equilibrate_rows
 from ..core.tolerances import DEPENDENT_RTOL, RANK_RTOL
 
+
+
+class Reactions(dict):
+    """{constraint name: Reaction}; a name it lacks is a KeyError that says why: a robot's
+    fixed joint merged away (``merge_fixed``: its link welded to its host, no joint left to
+    carry a reaction), or the model's nearest constraint names."""
+
+    def __init__(self, entries, merged):
+        super().__init__(entries)
+        self.merged = merged  # merged fixed joint's would-be constraint name -> its link
+
+    def __missing__(self, name):
+        if name in self.merged:
+            raise KeyError(f"'{name}' is a fixed joint merged away with merge_fixed=True (its link "
+                           f"'{self.merged[name]}' welded to its parent's body): no joint carries a reaction there; "
+                           f"build the robot without merge_fixed to read it")
+        near = difflib.get_close_matches(str(name), list(self), n=3)
+        raise KeyError(f"no constraint named {name!r}" + (f"; nearest: {', '.join(near)}" if near else ""))
 
 
 @dataclass(frozen=True)

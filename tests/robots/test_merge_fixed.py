@@ -184,3 +184,19 @@ def test_a_merged_link_named_as_a_joint_frame_of_its_host_is_refused(tmp_path):
     with pytest.raises(mb.ModelError, match=r"clash\.urdf: merged link 'b' would be frame 'b' of 'a', which has a "
                                              r"frame of that name \(a joint's\): build without merge_fixed"):
         mb.from_robot(str(path), merge_fixed=True)
+
+
+def test_a_merged_joints_reaction_says_it_was_merged_away(pair):
+    """The reactions of the merged robot have no entry for a merged fixed joint; asking for
+    one says why, where the unmerged robot has it; a name no constraint has gets the
+    nearest names."""
+    whole, merged, _ = pair
+    joint = next(iter(merged.robots[0].welded_joints))
+    q, qd = merged.initial_state()
+    found = merged.reactions(0.0, q, qd)
+    with pytest.raises(KeyError, match=f"'{re.escape(joint)}' is a fixed joint merged away with merge_fixed"):
+        found[joint]
+    assert joint in whole.reactions(0.0, *whole.initial_state())
+    near = next(iter(found))
+    with pytest.raises(KeyError, match=f"no constraint named '{re.escape(near)}x'; nearest: {re.escape(near)}"):
+        found[near + "x"]
