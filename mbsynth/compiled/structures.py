@@ -24,7 +24,6 @@ import threading
 from ..symbolic.derive import beyond_double_as_inf
 from .background import mode
 from .codegen import assignments, load
-from .tape import Unsupported, run, tape
 
 log = logging.getLogger(__name__)
 
@@ -58,10 +57,11 @@ def kernel(raw):
 
 
 def _build(raw):
+    from . import tape  # numba: loaded with the first structure built, not with the package
     args, forms = raw.structure()
     try:
-        return Taped(tape(args, forms))
-    except Unsupported as err:
+        return Taped(tape.run, tape.tape(args, forms))
+    except tape.Unsupported as err:
         log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
     try:
         evaluate = load(source(args, forms), prefix="mbsynth_structure").evaluate
@@ -75,11 +75,11 @@ def _build(raw):
 class Taped:
     """``evaluate`` of a structure written as a tape (tape.py): ``tape.run`` on its arrays."""
 
-    def __init__(self, arrays):
-        self.arrays = arrays
+    def __init__(self, run, arrays):
+        self.run, self.arrays = run, arrays
 
     def __call__(self, t, q, qd, p, columns, values, fixed, out):
-        run(t, q, qd, p, columns, values, fixed, out, *self.arrays)
+        self.run(t, q, qd, p, columns, values, fixed, out, *self.arrays)
 
 
 def source(args, forms):

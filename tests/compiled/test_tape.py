@@ -93,7 +93,7 @@ def test_a_models_structures_on_the_tape_equal_them_compiled_alone(path):
         alone = structures.load(structures.source(args, forms), prefix="mbsynth_structure").evaluate
         values = group._gathered(0.0, q0, qd0, data.parameter_values) if group.picks is not None else group.values
         taped, compiled = np.empty(group.dest.shape), np.empty(group.dest.shape)
-        structures.Taped(tape.tape(args, forms))(0.0, q0, qd0, data.parameter_values, group.columns, values,
+        structures.Taped(tape.run, tape.tape(args, forms))(0.0, q0, qd0, data.parameter_values, group.columns, values,
                                                  group.fixed, taped)
         alone(0.0, q0, qd0, data.parameter_values, group.columns, values, group.fixed, compiled)
         assert np.allclose(taped, compiled, rtol=1e-13, atol=1e-13, equal_nan=True)
