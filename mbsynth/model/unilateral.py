@@ -27,6 +27,7 @@ import sympy as sp
 from .constraints.base import Constraint
 from ..core.errors import ModelError
 from ..core.tolerances import SPEED_ROUNDING
+from ..symbolic.derive import differentiate_through
 
 
 @dataclass(frozen=True)
@@ -76,9 +77,15 @@ def tangent_basis(n, value=float):
     return t1, n.cross(t1)
 
 
-def gap_row(name, gap, q, qd, params):
-    """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed)."""
-    return Constraint.holonomic(name, [gap], q, qd, params)
+def gap_row(name, gap, q, qd, params, through=None):
+    """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed);
+    ``through``: {symbol: its value, an expression of q} for the symbols ``gap`` is written
+    in, differentiated by the chain rule through them (``differentiate_through``)."""
+    if through is None:
+        return Constraint.holonomic(name, [gap], q, qd, params)
+    a, b, psi = differentiate_through(gap, through, q, qd)
+    return Constraint(name, "holonomic", a, [b], sp.SparseMatrix(len(q), 1, {}), [gap.xreplace(through)], [psi], q,
+                      qd, params)
 
 
 def with_active(system, names, sliding=None, sticking=()):
