@@ -5,7 +5,8 @@ limit (``hinge.lower``: g = angle − lo; ``hinge.upper``: g = hi − angle; a u
 joint's per angle; a spherical joint's ``ball.cone``: g = z_A·z_B − cos θ) or a contact (a
 point or sphere on a part's frame against a ground plane, g = n·p − h − r, a capsule's end
 spheres and a box's corners each one; two spheres, g = |p_B − p_A| − r_A − r_B; a sphere
-against a capsule, its centre's distance to the segment less both radii: io/unilateral.py). Its ``row`` is a holonomic Constraint with φ = g, so that its
+against a capsule, its centre's distance to the segment less both radii; two capsules, the
+distance between their segments less both radii: io/unilateral.py, segments.py). Its ``row`` is a holonomic Constraint with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
 A plane contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·v_c, the

@@ -344,32 +344,26 @@ def differentiate_through(phi, values, q, qd, t=T_SYMBOL):
     value in q, never φ(x(q)) twice through q (a closed-form distance between two bodies'
     points and axes). With ẍ_k = a_k q̈ − b_k (each value's own row): ψ = Σ ∂φ/∂x_k ẋ_k,
     a = Σ ∂φ/∂x_k a_k, b = Σ ∂φ/∂x_k b_k − Σ ∂²φ/∂x_j∂x_k ẋ_j ẋ_k. (a as a sparse row, b, ψ)
-    in q, q̇, t. A Piecewise φ is differentiated branch by branch, its conditions put in once."""
+    in q, q̇, t. A Piecewise φ is differentiated branch by branch: each ∂φ/∂x_k and the sum
+    of second derivatives is one Piecewise of its conditions."""
     x = tuple(values)
     rows = [differentiate(sp.sympify(values[s]), q, qd, t) for s in x]
     put = dict(values)
     put.update({_RATE[k]: row[2] for k, row in enumerate(rows)})
     conditions, branches = _chain_forms(sp.piecewise_fold(sp.sympify(phi)), x)
-    found = []
-    for gradient, quadratic in branches:
-        entries = {}
-        for g, row in zip(gradient, rows):
-            for (_, j), entry in sp.SparseMatrix(row[0]).todok().items():
-                entries[j] = entries.get(j, sp.S.Zero) + g * entry
-        b = sum((g * row[1] for g, row in zip(gradient, rows)), sp.S.Zero) - quadratic
-        psi = sum((g * _RATE[k] for k, g in enumerate(gradient)), sp.S.Zero)
-        found.append(({j: e.xreplace(put) for j, e in entries.items()}, b.xreplace(put), psi.xreplace(put)))
-    if conditions is None:
-        entries, b, psi = found[0]
-        return sp.SparseMatrix(1, len(q), {(0, j): e for j, e in entries.items()}), b, psi
-    conditions = [c.xreplace(put) for c in conditions]
+    conditions = None if conditions is None else [c.xreplace(put) for c in conditions]
 
     def pick(parts):
-        return sp.Piecewise(*zip(parts, conditions), evaluate=False)
-    columns = sorted(set().union(*(entries for entries, _, _ in found)))
-    a = sp.SparseMatrix(1, len(q), {(0, j): pick([entries.get(j, sp.S.Zero) for entries, _, _ in found])
-                                    for j in columns})
-    return a, pick([b for _, b, _ in found]), pick([psi for _, _, psi in found])
+        parts = [part.xreplace(put) for part in parts]
+        return parts[0] if conditions is None else sp.Piecewise(*zip(parts, conditions), evaluate=False)
+    gradient = [pick([g[k] for g, _ in branches]) for k in range(len(x))]
+    entries = {}
+    for g, row in zip(gradient, rows):
+        for (_, j), entry in sp.SparseMatrix(row[0]).todok().items():
+            entries[0, j] = entries.get((0, j), sp.S.Zero) + g * entry
+    b = sum((g * row[1] for g, row in zip(gradient, rows)), sp.S.Zero) - pick([quadratic for _, quadratic in branches])
+    psi = sum((g * row[2] for g, row in zip(gradient, rows)), sp.S.Zero)
+    return sp.SparseMatrix(1, len(q), entries), b, psi
 
 
 @MEMO.function(256)

@@ -387,33 +387,18 @@ def test_two_capsules_gap_is_coals_distance_and_its_rates_are_coals_derivatives(
     assert len(kinds) == 5
 
 
-CROSSED = """
-name: crossed_capsules
-parameters: {m1: 1.5, m2: 0.8, r1: 0.04, r2: 0.03, L1: 0.8, L2: 0.6, v: 1.5, e: 0.5, ox: 0, oy: 0}
-parts:
-  bar:
-    type: rigid_body
-    mass: m1
-    inertia: [m1*L1**2/12, m1*L1**2/12, m1*r1**2/2]
-    initial: {rpy: [0, pi/2, 0]}
-  rod:
-    type: rigid_body
-    mass: m2
-    inertia: [m2*L2**2/12, m2*L2**2/12, m2*r2**2/2]
-    initial: {position: [ox, -oy, 0.3], rpy: [-pi/2, 0, 0], velocity: [0, 0, -v]}
-contacts:
-  - {name: hit, type: spheres, between: [bar, rod], radius: [r1, r2], length: [L1, L2], restitution: e}
-"""
+CROSSED = (Path(__file__).resolve().parents[2] / "models" / "contact" / "crossed_capsules.yaml").read_text()
 
 
 @pytest.mark.parametrize("ox, oy", [(0.0, 0.0), (0.25, -0.1)])
 @pytest.mark.parametrize("e", [0.5, 1.0])
 def test_two_capsules_crossing_at_right_angles_take_the_two_body_impulse(e, ox, oy):
-    """A bar (m1, along x, at rest) and a rod (m2, along y, falling at v along −z) cross at
-    right angles, touching at ox along the bar and oy along the rod: the normal is z, the arms
-    across it ox and oy, and P = (1 + e) v / (1/m1 + 1/m2 + ox²/I1 + oy²/I2) (I = m L²/12):
-    after it the bar moves at −P/m1 and turns at P ox/I1 about y, the rod at −v + P/m2 and
-    P oy/I2 about x; their contact points part at e v."""
+    """models/contact/crossed_capsules.yaml: a bar (m1, along x, at rest) and a rod (m2, along
+    y, falling at v along −z) cross at right angles, touching at ox along the bar and oy
+    along the rod: the normal is z, the arms across it ox and oy, and P = (1 + e) v / (1/m1 +
+    1/m2 + ox²/I1 + oy²/I2) (I = m L²/12): after it the bar moves at −P/m1 and turns at
+    P ox/I1 about y, the rod at −v + P/m2 and P oy/I2 about x; their contact points part
+    at e v."""
     m1, m2, r1, r2, l1, l2, v = 1.5, 0.8, 0.04, 0.03, 0.8, 0.6, 1.5
     i1, i2 = m1 * l1**2 / 12, m2 * l2**2 / 12
     traj = mb.simulate(mb.loads(CROSSED, parameters={"e": e, "ox": ox, "oy": oy}), 0.2, dt=0.01, rtol=1e-12, atol=1e-12)
