@@ -318,23 +318,27 @@ def _poses(rng):
     """[(kind, q)] of the two capsules: crossed, skew, parallel (and antiparallel) side by side
     overlapping or not, end to end along one line, an end against a side."""
     found = []
-    unit = lambda v: v / np.linalg.norm(v)  # noqa: E731
     for _ in range(6):
-        u = unit(rng.normal(size=3))
-        w = unit(np.cross(u, rng.normal(size=3)))
+        u = _unit(rng.normal(size=3))
+        w = _unit(np.cross(u, rng.normal(size=3)))
         v = np.cross(u, w)
         s, t = rng.uniform(-L1 / 2, L1 / 2), rng.uniform(-L2 / 2, L2 / 2)
         c1 = rng.normal(size=3)
         gap = rng.uniform(0.01, 0.3)
         found.append(("crossed", c1, u, c1 + s * u + (R1 + R2 + gap) * w - t * v, v))
-        found.append(("skew", c1, u, c1 + rng.normal(size=3), unit(rng.normal(size=3))))
+        found.append(("skew", c1, u, c1 + rng.normal(size=3), _unit(rng.normal(size=3))))
         sign = rng.choice([-1.0, 1.0])
         found.append(("parallel", c1, u, c1 + rng.uniform(-1.2, 1.2) * u + (R1 + R2 + gap) * w, sign * u))
-        found.append(("end to end", c1, u, c1 + sign * ((L1 + L2) / 2 + R1 + R2 + gap) * u, rng.choice([-1.0, 1.0]) * u))
-        tilt = unit(u + rng.uniform(-0.3, 0.3) * w)
+        found.append(("end to end", c1, u, c1 + sign * ((L1 + L2) / 2 + R1 + R2 + gap) * u,
+                      rng.choice([-1.0, 1.0]) * u))
+        tilt = _unit(u + rng.uniform(-0.3, 0.3) * w)
         found.append(("end to side", c1, w, c1 + s * u + (R1 + R2 + gap + L1 / 2) * w + L2 / 2 * tilt, tilt))
     return [(kind, np.concatenate([c1, _quaternion(u1, rng.uniform(0, 6)), c2, _quaternion(u2, rng.uniform(0, 6))]))
             for kind, c1, u1, c2, u2 in found]
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
 
 
 def _coal_distance(q):
