@@ -391,6 +391,20 @@ def test_two_capsules_gap_is_coals_distance_and_its_rates_are_coals_derivatives(
     assert len(kinds) == 5
 
 
+@pytest.mark.parametrize("angle", [0.0, 3e-10, 1e-7, 1e-5])
+@pytest.mark.parametrize("across", [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+def test_nearly_parallel_capsules_gap_is_coals_distance(capsules, angle, across):
+    """Two capsules side by side along z, the second's axis turned by ``angle`` towards the
+    offset (x) or across it (y): within PARALLEL_SIN2 (sin² < 1e-16) and beyond it the gap
+    is coal's distance to 1e-9, with no division by the angle (finite a and b)."""
+    hit, p = capsules.unilaterals[0], capsules.parameter_values
+    axis = np.cos(angle) * np.array([0.0, 0.0, 1.0]) + np.sin(angle) * np.array(across)
+    q = np.concatenate([[0.0, 0.0, 0.0], _quaternion([0, 0, 1], 0.0), [0.2, 0.0, 0.1], _quaternion(axis, 0.0)])
+    assert hit.row.residuals(0.0, q, np.zeros(14), p)[0][0] == pytest.approx(_coal_distance(q), abs=1e-9)
+    a, b, _ = hit.row.evaluate(0.0, q, np.full(14, 0.1), p)
+    assert np.isfinite(a).all() and np.isfinite(b).all()
+
+
 CROSSED = (Path(__file__).resolve().parents[2] / "models" / "contact" / "crossed_capsules.yaml").read_text()
 
 
