@@ -77,6 +77,8 @@ GRAM_ZERO_RTOL = 1e-14  # parts/flexible_body.py: invariant entries below this f
 # written as zero
 BEAM_UP_PARALLEL_RTOL = 1e-9  # flexible/beam.py: a section's up vector whose part across the axis is below this
 # (relative to |up|, at least 1) is parallel to the axis
+PARALLEL_SIN2 = 1e-16  # segments.py: two capsules' axes with sin² of their angle below this are parallel (no division
+# by it): there the gap is off by at most sin × their overlap (1e-8 L); above it the lines' pair rounds by ~ε/sin
 
 # ---- finite-element models (model/flexible/)
 FE_SYMMETRY_RTOL = 1e-8  # matrices.py: largest |A − Aᵀ| accepted, relative to max |A| (exports round to ~8 digits)

@@ -427,15 +427,17 @@ SECTIONS = {section.name: section for section in (
                  "moves with its spin): tangential impulses at impacts, stick or slip; sliding", "0.5", default="0"),
              _DESCRIPTION)),
     Section("contact_spheres", "an entry of ``contacts:`` with ``type: spheres``",
-            "Two spheres on two parts: the gap |p_B − p_A| − r_A − r_B stays ≥ 0. With a ``length``, one of "
-            "them is a capsule (its segment along its frame's z, centred on it): the gap is the distance "
-            "from the sphere's centre to the segment less both radii.",
+            "Two spheres on two parts: the gap |p_B − p_A| − r_A − r_B stays ≥ 0. With a ``length``, one or "
+            "both of them is a capsule (its segment along its frame's z, centred on it): the gap is the "
+            "distance from the sphere's centre to the segment, or between the two segments, less both radii "
+            "(parallel capsules overlapping along their length: one row, at the first's point nearest the "
+            "second's centre).",
             (_required("name", "plain name", "the contact's name", "c12"),
              _required("type", "string", "``spheres``", "spheres"),
              _required("between", "list of 2 frames", "the spheres' centres, on two parts", "[ball1, ball2]"),
              _required("radius", "list of 2 " + _EXPRS + ", ≥ 0", "their radii", "[r, r]"),
-             Key("length", "list of 2 " + _EXPRS + ", ≥ 0, one of them 0", "their segments' lengths (0: a "
-                 "sphere; > 0: a capsule along its frame's z)", "[0, 0.5]", default="[0, 0]"),
+             Key("length", "list of 2 " + _EXPRS + ", ≥ 0", "their segments' lengths (0: a sphere; > 0: a "
+                 "capsule along its frame's z)", "[0, 0.5]", default="[0, 0]"),
              Key("restitution", _EXPR + ", 0 ≤ e ≤ 1", "Newton's coefficient of restitution", "1", default="0"),
              _DESCRIPTION)),
     Section("rolling_disk", "an entry of ``joints:`` with ``type: rolling_disk``",

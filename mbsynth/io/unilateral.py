@@ -11,7 +11,9 @@ from ..core.tolerances import ASSEMBLED_TOL
 from ..model.constraints.base import Constraint
 from ..model.joint_templates import pose
 from ..model.parts.base import frame_velocity
+from ..model.segments import between_segments, to_segment
 from ..model.unilateral import Unilateral, gap_row, tangent_basis
+from ..symbolic.cache import placeholder
 from .joints import frame_reference
 
 CONTACT_KINDS = {"plane": "contact_plane", "spheres": "contact_spheres"}  # contact type -> schema section
@@ -94,9 +96,9 @@ def read_contacts(builder):
         names.add(name)
         e = _restitution(builder, spec, path)
         if kind == "spheres":
-            gap, point, normal = _spheres_gap(builder, spec, path)
-            found.append((Unilateral(builder.full_name(name), "contact", e, _row(builder, name, gap), point=point,
-                                     normal=normal), path))
+            gap, point, normal, through = _spheres_gap(builder, spec, path)
+            found.append((Unilateral(builder.full_name(name), "contact", e, _row(builder, name, gap, through),
+                                     point=point, normal=normal), path))
             continue
         unit = _normal(builder, spec, path)
         mu = _friction(builder, spec, path)
@@ -110,8 +112,8 @@ def read_contacts(builder):
     return found
 
 
-def _row(builder, name, gap):
-    return gap_row(builder.full_name(name), gap, builder.q, builder.qd, builder.parameter_symbols)
+def _row(builder, name, gap, through=None):
+    return gap_row(builder.full_name(name), gap, builder.q, builder.qd, builder.parameter_symbols, through)
 
 
 def _friction(builder, spec, path):
@@ -185,12 +187,15 @@ def _normal(builder, spec, path):
 
 
 def _spheres_gap(builder, spec, path):
-    """(gap, contact point, unit normal u) of a sphere against a sphere or a capsule on
-    another part: two spheres, |p_B − p_A| − r_A − r_B; a sphere of centre p against a
-    capsule (``length: [L_A, L_B]``, one of them > 0: its segment c ± (L/2) z along its
-    frame's z), the distance from p to the segment (to its nearest point s, closed form)
-    less both radii. u points from the first's nearest point to the second's; the contact
-    point is the first's surface there."""
+    """(gap, contact point, unit normal u) of a sphere or a capsule against a sphere or a
+    capsule on another part: two spheres, |p_B − p_A| − r_A − r_B; a sphere of centre p
+    against a capsule (``length: [L_A, L_B]``, > 0 for a capsule: its segment c ± (L/2) z
+    along its frame's z), the distance from p to the segment (to its nearest point s,
+    closed form) less both radii; two capsules, the distance between their segments (their
+    nearest pair, model/segments.py) less both radii, written in symbols standing for their
+    centres and axes (``through``: {symbol: value}, None for the others; gap_row). u
+    points from the first's nearest point to the second's; the contact point is the first's
+    surface there."""
     between = builder.sized_list(spec["between"], path + ("between",), 2)
     radii = builder.sized_list(spec["radius"], path + ("radius",), 2)
     lengths = builder.sized_list(spec.get("length", [0, 0]), path + ("length",), 2)
@@ -200,33 +205,28 @@ def _spheres_gap(builder, spec, path):
         builder.fail(path + ("between",), "the two spheres must be on two parts")
     r_a, r_b = (_radius(builder, r, path + ("radius", k)) for k, r in enumerate(radii))
     l_a, l_b = (_radius(builder, x, path + ("length", k), "length") for k, x in enumerate(lengths))
+    p_a, p_b, through = pose_a[0], pose_b[0], {}
+    z_a, z_b = sp.Matrix(pose_a[1])[:, 2], sp.Matrix(pose_b[1])[:, 2]
     if builder.value(l_a) > 0 and builder.value(l_b) > 0:
-        builder.fail(path + ("length",), "a contact between two capsules is not available (one of the two "
-                                         "lengths must be 0: a sphere against a capsule)")
-    p_a, p_b = pose_a[0], pose_b[0]
-    if builder.value(l_a) > 0:
-        distance, p_a = _to_segment(p_b, p_a, sp.Matrix(pose_a[1])[:, 2], l_a / 2)
+        # differentiated in the segments' centres and axes, then through them (gap_row)
+        c_a, z_a, c_b, z_b = (_standing_for(x, through) for x in (p_a, z_a, p_b, z_b))
+        distance, p_a, p_b = between_segments(c_a, z_a, l_a / 2, c_b, z_b, l_b / 2)
+    elif builder.value(l_a) > 0:
+        distance, p_a = to_segment(p_b, p_a, z_a, l_a / 2)
     elif builder.value(l_b) > 0:
-        distance, p_b = _to_segment(p_a, p_b, sp.Matrix(pose_b[1])[:, 2], l_b / 2)
+        distance, p_b = to_segment(p_a, p_b, z_b, l_b / 2)
     else:
         distance = sp.sqrt((p_b - p_a).dot(p_b - p_a))
     unit = (p_b - p_a) / sp.sqrt((p_b - p_a).dot(p_b - p_a))
-    return distance - r_a - r_b, p_a + r_a * unit, unit
+    return distance - r_a - r_b, (p_a + r_a * unit).xreplace(through), unit.xreplace(through), through or None
 
 
-def _to_segment(p, c, axis, half):
-    """(the distance from p to the segment c + s·axis, |s| ≤ ``half`` (axis a unit column),
-    its point nearest to p): with s = (p − c)·axis, |p − c ∓ half·axis| beyond an end, else
-    |p − c − s·axis| (one Piecewise of three smooth branches, each differentiated on its
-    own; the distance's gradient is continuous across them)."""
-    s = (p - c).dot(axis)
-    ends = (c - half * axis, c + half * axis)
-    across = p - c - s * axis
-    distance = sp.Piecewise((sp.sqrt((p - ends[0]).dot(p - ends[0])), s < -half),
-                            (sp.sqrt((p - ends[1]).dot(p - ends[1])), s > half), (sp.sqrt(across.dot(across)), True))
-    nearest = sp.Matrix([sp.Piecewise((ends[0][k], s < -half), (ends[1][k], s > half), (c[k] + s * axis[k], True))
-                         for k in range(3)])
-    return distance, nearest
+def _standing_for(column, through):
+    """A column of symbols standing for the entries of ``column``, recorded in ``through``
+    (the same symbols in every contact: a gap alike is differentiated once, gap_row)."""
+    symbols = sp.Matrix([placeholder(f"segments{len(through) + k}") for k in range(len(column))])
+    through.update(zip(symbols, column))
+    return symbols
 
 
 def _centre(builder, text, path):

@@ -5,7 +5,8 @@ limit (``hinge.lower``: g = angle − lo; ``hinge.upper``: g = hi − angle; a u
 joint's per angle; a spherical joint's ``ball.cone``: g = z_A·z_B − cos θ) or a contact (a
 point or sphere on a part's frame against a ground plane, g = n·p − h − r, a capsule's end
 spheres and a box's corners each one; two spheres, g = |p_B − p_A| − r_A − r_B; a sphere
-against a capsule, its centre's distance to the segment less both radii: io/unilateral.py). Its ``row`` is a holonomic Constraint with φ = g, so that its
+against a capsule, its centre's distance to the segment less both radii; two capsules, the
+distance between their segments less both radii: io/unilateral.py, segments.py). Its ``row`` is a holonomic Constraint with φ = g, so that its
 row a = ∂g/∂q, its b (a q̈ = b while it holds), its φ = g and its φ̇ = ġ come from the same
 machinery as every bilateral row; λ > 0 on it pushes the gap open (Qc = Aᵀλ, reactions.py).
 A plane contact with Coulomb's ``friction`` μ also has its ``slip`` rows ψ = t_k·v_c, the
@@ -27,6 +28,7 @@ import sympy as sp
 from .constraints.base import Constraint
 from ..core.errors import ModelError
 from ..core.tolerances import SPEED_ROUNDING
+from ..symbolic.derive import differentiate_through
 
 
 @dataclass(frozen=True)
@@ -76,9 +78,15 @@ def tangent_basis(n, value=float):
     return t1, n.cross(t1)
 
 
-def gap_row(name, gap, q, qd, params):
-    """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed)."""
-    return Constraint.holonomic(name, [gap], q, qd, params)
+def gap_row(name, gap, q, qd, params, through=None):
+    """The holonomic Constraint of the gap expression ``gap`` (sympy; joint values allowed);
+    ``through``: {symbol: its value, an expression of q} for the symbols ``gap`` is written
+    in, differentiated by the chain rule through them (``differentiate_through``)."""
+    if through is None:
+        return Constraint.holonomic(name, [gap], q, qd, params)
+    a, b, psi = differentiate_through(gap, through, q, qd)
+    return Constraint(name, "holonomic", a, [b], sp.SparseMatrix(len(q), 1, {}), [gap.xreplace(through)], [psi], q,
+                      qd, params)
 
 
 def with_active(system, names, sliding=None, sticking=()):

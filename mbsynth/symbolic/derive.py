@@ -4,7 +4,8 @@
   of a part given by its kinetic energy T, potential energy V and generalized
   forces F, from Lagrange's equations.
 - ``differentiate(phi, q, qd, t)``: a constraint ``phi = 0`` differentiated to
-  the row ``A q̈ = b`` (2.4), once if phi contains velocities, twice if not.
+  the row ``A q̈ = b`` (2.4), once if phi contains velocities, twice if not;
+  ``differentiate_through`` the same through symbols standing for expressions of q.
 - ``generalized_force(V, efforts, q, qd)``: Q of a potential and (effort, rate) pairs.
 - ``compile_function(args, exprs)``: one fast numpy function for many expressions.
 
@@ -335,6 +336,52 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     chain = sum((sp.diff(psi, s) * s.rate for s in joint_values_in(psi)), sp.S.Zero)  # JointValue symbols
     b = -(jacobian([psi], q) * sp.Matrix(qd))[0] - sp.diff(psi, t) - chain
     return a, b, psi
+
+
+def differentiate_through(phi, values, q, qd, t=T_SYMBOL):
+    """``differentiate`` of a position-level φ(x) written in symbols x that stand for
+    ``values`` ({x_k: x_k(q, t)}), by the chain rule: φ differentiated in the few x, each
+    value in q, never φ(x(q)) twice through q (a closed-form distance between two bodies'
+    points and axes). With ẍ_k = a_k q̈ − b_k (each value's own row): ψ = Σ ∂φ/∂x_k ẋ_k,
+    a = Σ ∂φ/∂x_k a_k, b = Σ ∂φ/∂x_k b_k − Σ ∂²φ/∂x_j∂x_k ẋ_j ẋ_k. (a as a sparse row, b, ψ)
+    in q, q̇, t. A Piecewise φ is differentiated branch by branch: each ∂φ/∂x_k and the sum
+    of second derivatives is one Piecewise of its conditions."""
+    x = tuple(values)
+    rows = [differentiate(sp.sympify(values[s]), q, qd, t) for s in x]
+    put = dict(values)
+    put.update({_RATE[k]: row[2] for k, row in enumerate(rows)})
+    conditions, branches = _chain_forms(sp.piecewise_fold(sp.sympify(phi)), x)
+    conditions = None if conditions is None else [c.xreplace(put) for c in conditions]
+
+    def pick(parts):
+        parts = [part.xreplace(put) for part in parts]
+        return parts[0] if conditions is None else sp.Piecewise(*zip(parts, conditions), evaluate=False)
+    gradient = [pick([g[k] for g, _ in branches]) for k in range(len(x))]
+    entries = {}
+    for g, row in zip(gradient, rows):
+        for (_, j), entry in sp.SparseMatrix(row[0]).todok().items():
+            entries[0, j] = entries.get((0, j), sp.S.Zero) + g * entry
+    b = sum((g * row[1] for g, row in zip(gradient, rows)), sp.S.Zero) - pick([quadratic for _, quadratic in branches])
+    psi = sum((g * row[2] for g, row in zip(gradient, rows)), sp.S.Zero)
+    return sp.SparseMatrix(1, len(q), entries), b, psi
+
+
+@MEMO.function(256)
+def _chain_forms(phi, x):
+    """(the conditions of φ's branches, or None for one smooth φ; per branch (∂φ/∂x_k, and
+    Σ_jk ∂²φ/∂x_j∂x_k r_j r_k in the rate slots r = _RATE)), once per φ in a process."""
+    pieces = phi.args if isinstance(phi, sp.Piecewise) else ((phi, sp.true),)
+    branches = []
+    for expr, _ in pieces:
+        gradient = [sp.diff(expr, s) for s in x]
+        free = expr.free_symbols
+        quadratic = sp.S.Zero
+        for k, g in enumerate(gradient):
+            for j in range(k + 1):
+                if x[j] in free and g != 0:
+                    quadratic += (1 if j == k else 2) * sp.diff(g, x[j]) * _RATE[j] * _RATE[k]
+        branches.append((gradient, quadratic))
+    return (tuple(c for _, c in pieces) if isinstance(phi, sp.Piecewise) else None), tuple(branches)
 
 
 def symbols_in(exprs):

@@ -1,5 +1,6 @@
 """Contact shapes beyond a sphere (io/unilateral.py): a box's corners and a capsule's end
-spheres against the ground, a sphere against a capsule, against the classical rigid-body
+spheres against the ground, a sphere against a capsule, two capsules (their gap against
+coal's distance), against the classical rigid-body
 impact formulas (Newton's law on the normal rate, the impulse P along the unit normal n at
 a point r from the centre of mass: P = (1 + e) v_n / (1/m + (r × n)ᵀ I⁻¹ (r × n)))."""
 
@@ -7,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import coal
 import numpy as np
 import pytest
 
@@ -240,8 +242,12 @@ contacts:
     ("{name: floor, type: plane, child: block, radius: 0.1, box: [1, 1, 1]}",
      "contacts[0].box: a contact has one of radius, capsule, box, got radius and box"),
     ("{name: floor, type: plane, child: lid, box: [1, 1, 1]}", "contacts[0].child"),
-    ("{name: hit, type: spheres, between: [ball, block], radius: [0.1, 0.1], length: [0.2, 0.3]}",
-     "contacts[0].length: a contact between two capsules is not available"),
+    ("{name: hit, type: spheres, between: [ball, block], radius: [0.1, -0.1], length: [0.2, 0.3]}",
+     "contacts[0].radius[1]: a radius is ≥ 0, got -0.1"),
+    ("{name: hit, type: spheres, between: [ball, block], radius: [0.1, 0.1], length: [0.2, -0.3]}",
+     "contacts[0].length[1]: a length is ≥ 0, got -0.3"),
+    ("{name: hit, type: spheres, between: [block, block], radius: [0.1, 0.1], length: [0.2, 0.3]}",
+     "contacts[0].between: the two spheres must be on two parts"),
     ("{name: hit, type: spheres, between: [ball, block], radius: [0.1, 0.1], length: [0, -1]}",
      "contacts[0].length[1]: a length is ≥ 0, got -1"),
 ])
@@ -274,3 +280,157 @@ def test_the_command_line_refuses_a_box_with_a_negative_size_with_one_line(tmp_p
     assert done.returncode == 2
     assert done.stderr.strip().count("\n") == 0
     assert "bad.yaml:6: at contacts[0].box[1]: a contact's dimensions are > 0, got -0.2" in done.stderr
+
+
+R1, R2, L1, L2 = 0.05, 0.08, 0.6, 0.9  # the two capsules' radii and segment lengths
+
+
+@pytest.fixture(scope="module")
+def capsules():
+    return mb.loads(f"""
+name: two_capsules
+parts:
+  one: {{type: rigid_body, mass: 1, inertia: [1, 1, 1]}}
+  two: {{type: rigid_body, mass: 1, inertia: [1, 1, 1], initial: {{position: [0, 0, 1]}}}}
+contacts:
+  - {{name: hit, type: spheres, between: [one, two], radius: [{R1}, {R2}], length: [{L1}, {L2}]}}
+""")
+
+
+def _quaternion(axis, spin):
+    """The unit quaternion (w, x, y, z) that turns by ``spin`` about z, then z onto ``axis``."""
+    axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    across = np.cross([0.0, 0.0, 1.0], axis)
+    angle = np.arctan2(np.linalg.norm(across), axis[2])
+    across = across / np.linalg.norm(across) if np.linalg.norm(across) > 0 else np.array([1.0, 0.0, 0.0])
+    turn = np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * across])
+    return _product(turn, [np.cos(spin / 2), 0.0, 0.0, np.sin(spin / 2)])
+
+
+def _product(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _poses(rng):
+    """[(kind, q)] of the two capsules: crossed, skew, parallel (and antiparallel) side by side
+    overlapping or not, end to end along one line, an end against a side."""
+    found = []
+    for _ in range(6):
+        u = _unit(rng.normal(size=3))
+        w = _unit(np.cross(u, rng.normal(size=3)))
+        v = np.cross(u, w)
+        s, t = rng.uniform(-L1 / 2, L1 / 2), rng.uniform(-L2 / 2, L2 / 2)
+        c1 = rng.normal(size=3)
+        gap = rng.uniform(0.01, 0.3)
+        found.append(("crossed", c1, u, c1 + s * u + (R1 + R2 + gap) * w - t * v, v))
+        found.append(("skew", c1, u, c1 + rng.normal(size=3), _unit(rng.normal(size=3))))
+        sign = rng.choice([-1.0, 1.0])
+        found.append(("parallel", c1, u, c1 + rng.uniform(-1.2, 1.2) * u + (R1 + R2 + gap) * w, sign * u))
+        found.append(("end to end", c1, u, c1 + sign * ((L1 + L2) / 2 + R1 + R2 + gap) * u,
+                      rng.choice([-1.0, 1.0]) * u))
+        tilt = _unit(u + rng.uniform(-0.3, 0.3) * w)
+        found.append(("end to side", c1, w, c1 + s * u + (R1 + R2 + gap + L1 / 2) * w + L2 / 2 * tilt, tilt))
+    return [(kind, np.concatenate([c1, _quaternion(u1, rng.uniform(0, 6)), c2, _quaternion(u2, rng.uniform(0, 6))]))
+            for kind, c1, u1, c2, u2 in found]
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
+
+
+def _coal_distance(q):
+    """coal's distance between the capsules at q (its Capsule(radius, length) along z, centred)."""
+    shapes = [coal.Capsule(R1, L1), coal.Capsule(R2, L2)]
+    frames = [coal.Transform3s(_quaternion_matrix(q[k + 3:k + 7]), q[k:k + 3]) for k in (0, 7)]
+    return coal.distance(shapes[0], frames[0], shapes[1], frames[1], coal.DistanceRequest(), coal.DistanceResult())
+
+
+def _moved(q, twist, h):
+    """q after moving both bodies for h along ``twist`` (per body: velocity, world angular velocity)."""
+    q = q.copy()
+    for k, (v, w) in zip((0, 7), twist):
+        q[k:k + 3] += h * v
+        angle = np.linalg.norm(w) * h
+        turn = np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * w / np.linalg.norm(w)])
+        q[k + 3:k + 7] = _product(turn, q[k + 3:k + 7])
+    return q
+
+
+def test_two_capsules_gap_is_coals_distance_and_its_rates_are_coals_derivatives(capsules):
+    """At seeded poses of each kind the gap is coal's capsule distance to 1e-9; along a rigid
+    motion of both (velocities v, world angular velocities ω, the quaternions' q̇ = ½ ω q and
+    q̈ = −¼|ω|² q) the row's rate a q̇ and g̈ = a q̈ − b are coal's distance differentiated
+    by central differences (parallel capsules turned alike)."""
+    hit, p = capsules.unilaterals[0], capsules.parameter_values
+    rng = np.random.default_rng(7)
+    kinds = set()
+    for kind, q in _poses(rng):
+        distance = _coal_distance(q)
+        assert distance > 0.005, kind
+        g = hit.row.residuals(0.0, q, np.zeros(14), p)[0][0]
+        assert g == pytest.approx(distance, abs=1e-9), kind
+        twist = [(rng.normal(size=3), rng.normal(size=3)) for _ in range(2)]
+        if kind == "parallel":  # turned alike, they stay parallel: turned apart, the nearest pair jumps to an
+            twist[1] = (twist[1][0], twist[0][1])  # end of the overlap, where the distance has a kink
+        qd, qdd = np.zeros(14), np.zeros(14)
+        for k, (v, w) in zip((0, 7), twist):
+            qd[k:k + 3] = v
+            qd[k + 3:k + 7] = 0.5 * _product(np.concatenate([[0.0], w]), q[k + 3:k + 7])
+            qdd[k + 3:k + 7] = -0.25 * w @ w * q[k + 3:k + 7]
+        a, b, _ = hit.row.evaluate(0.0, q, qd, p)
+        h = 1e-5
+        rate = (_coal_distance(_moved(q, twist, h)) - _coal_distance(_moved(q, twist, -h))) / (2 * h)
+        assert a[0] @ qd[hit.row.indices] == pytest.approx(rate, abs=1e-6), kind
+        h = 1e-4
+        second = (_coal_distance(_moved(q, twist, h)) - 2 * distance + _coal_distance(_moved(q, twist, -h))) / h**2
+        assert a[0] @ qdd[hit.row.indices] - b[0] == pytest.approx(second, abs=1e-4 * max(1.0, abs(second))), kind
+        kinds.add(kind)
+    assert len(kinds) == 5
+
+
+@pytest.mark.parametrize("angle", [0.0, 3e-10, 1e-7, 1e-5])
+@pytest.mark.parametrize("across", [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+def test_nearly_parallel_capsules_gap_is_coals_distance(capsules, angle, across):
+    """Two capsules side by side along z, the second's axis turned by ``angle`` towards the
+    offset (x) or across it (y): within PARALLEL_SIN2 (sin² < 1e-16) and beyond it the gap
+    is coal's distance to 1e-9, with no division by the angle (finite a and b)."""
+    hit, p = capsules.unilaterals[0], capsules.parameter_values
+    axis = np.cos(angle) * np.array([0.0, 0.0, 1.0]) + np.sin(angle) * np.array(across)
+    q = np.concatenate([[0.0, 0.0, 0.0], _quaternion([0, 0, 1], 0.0), [0.2, 0.0, 0.1], _quaternion(axis, 0.0)])
+    assert hit.row.residuals(0.0, q, np.zeros(14), p)[0][0] == pytest.approx(_coal_distance(q), abs=1e-9)
+    a, b, _ = hit.row.evaluate(0.0, q, np.full(14, 0.1), p)
+    assert np.isfinite(a).all() and np.isfinite(b).all()
+
+
+CROSSED = (Path(__file__).resolve().parents[2] / "models" / "contact" / "crossed_capsules.yaml").read_text()
+
+
+@pytest.mark.parametrize("ox, oy", [(0.0, 0.0), (0.25, -0.1)])
+@pytest.mark.parametrize("e", [0.5, 1.0])
+def test_two_capsules_crossing_at_right_angles_take_the_two_body_impulse(e, ox, oy):
+    """models/contact/crossed_capsules.yaml: a bar (m1, along x, at rest) and a rod (m2, along
+    y, falling at v along −z) cross at right angles, touching at ox along the bar and oy
+    along the rod: the normal is z, the arms across it ox and oy, and P = (1 + e) v / (1/m1 +
+    1/m2 + ox²/I1 + oy²/I2) (I = m L²/12): after it the bar moves at −P/m1 and turns at
+    P ox/I1 about y, the rod at −v + P/m2 and P oy/I2 about x; their contact points part
+    at e v."""
+    m1, m2, r1, r2, l1, l2, v = 1.5, 0.8, 0.04, 0.03, 0.8, 0.6, 1.5
+    i1, i2 = m1 * l1**2 / 12, m2 * l2**2 / 12
+    traj = mb.simulate(mb.loads(CROSSED, parameters={"e": e, "ox": ox, "oy": oy}), 0.2, dt=0.01, rtol=1e-12, atol=1e-12)
+    impact = traj.events[0]
+    assert (impact.name, impact.kind) == ("hit", "impact")
+    assert impact.t == pytest.approx((0.3 - r1 - r2) / v, rel=1e-10)
+    assert len([ev for ev in traj.events if ev.kind == "impact"]) == 1
+    P = (1 + e) * v / (1 / m1 + 1 / m2 + ox**2 / i1 + oy**2 / i2)
+    assert impact.impulse == pytest.approx(P, rel=1e-10)
+    q, qd = traj.q[-1], traj.qd[-1]
+    assert qd[:3] == pytest.approx([0.0, 0.0, -P / m1], abs=1e-10)
+    assert qd[7:10] == pytest.approx([0.0, 0.0, -v + P / m2], abs=1e-10)
+    w1, w2 = _omega(q[3:7], qd[3:7]), _omega(q[10:14], qd[10:14])
+    assert w1 == pytest.approx([0.0, P * ox / i1, 0.0], abs=1e-10)
+    assert w2 == pytest.approx([P * oy / i2, 0.0, 0.0], abs=1e-10)
+    parting = (qd[9] + w2[0] * oy) - (qd[2] - w1[1] * ox)  # the contact points' normal velocities just after
+    assert parting == pytest.approx(e * v, abs=1e-10)

@@ -29,6 +29,7 @@ MODES = {
     "contact/box_drop.yaml": ([], 1, "does not rest at this configuration"),  # dropped
     "contact/cone_pendulum.yaml": "rests",  # hanging (it starts swinging from there)
     "contact/box_on_four_corners.yaml": ([], 1, "does not rest at this configuration"),  # its weight on its corners
+    "contact/crossed_capsules.yaml": "rests",  # no gravity: two free bodies, at rest anywhere (modes at q̇ = 0)
     "flexible/cantilever.yaml": "rests",
     "flexible/slider_crank.yaml": "equilibrium",  # the crank hanging, the rod sagging
     "flexible/spin_up_beam.yaml": "rests",  # at rest at t = 0, the hub held by its servo row
@@ -85,10 +86,10 @@ MODES = {
 
 
 # the models whose three commands take longest (robots, legs, a governor's equilibrium
-# search, flexible bodies): run by `make test-slow` and CI
-SLOW = {"flexible/slider_crank.yaml", "flexible/spin_up_beam.yaml", "legged/leg.yaml", "legged/quadruped.yaml",
-        "mechanisms/flyball_governor.yaml", "robots/two_arms_bar.yaml", "robots/ur5_holding_bar.yaml",
-        "robots/ur5_payload.yaml"}
+# search, flexible bodies, two capsules' gap derived and compiled): run by `make test-slow` and CI
+SLOW = {"contact/crossed_capsules.yaml", "flexible/slider_crank.yaml", "flexible/spin_up_beam.yaml", "legged/leg.yaml",
+        "legged/quadruped.yaml", "mechanisms/flyball_governor.yaml", "robots/two_arms_bar.yaml",
+        "robots/ur5_holding_bar.yaml", "robots/ur5_payload.yaml"}
 
 
 def test_every_model_file_is_listed():
