@@ -359,6 +359,7 @@ def _moved(q, twist, h):
     return q
 
 
+@pytest.mark.slow  # two capsules' rows take a minute to derive with a cold cache (make test-slow)
 def test_two_capsules_gap_is_coals_distance_and_its_rates_are_coals_derivatives(capsules):
     """At seeded poses of each kind the gap is coal's capsule distance to 1e-9; along a rigid
     motion of both (velocities v, world angular velocities ω, the quaternions' q̇ = ½ ω q and
@@ -391,6 +392,7 @@ def test_two_capsules_gap_is_coals_distance_and_its_rates_are_coals_derivatives(
     assert len(kinds) == 5
 
 
+@pytest.mark.slow  # two capsules' rows take a minute to derive with a cold cache (make test-slow)
 @pytest.mark.parametrize("angle", [0.0, 3e-10, 1e-7, 1e-5])
 @pytest.mark.parametrize("across", [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 def test_nearly_parallel_capsules_gap_is_coals_distance(capsules, angle, across):
@@ -408,6 +410,7 @@ def test_nearly_parallel_capsules_gap_is_coals_distance(capsules, angle, across)
 CROSSED = (Path(__file__).resolve().parents[2] / "models" / "contact" / "crossed_capsules.yaml").read_text()
 
 
+@pytest.mark.slow  # two capsules' rows take a minute to derive with a cold cache (make test-slow)
 @pytest.mark.parametrize("ox, oy", [(0.0, 0.0), (0.25, -0.1)])
 @pytest.mark.parametrize("e", [0.5, 1.0])
 def test_two_capsules_crossing_at_right_angles_take_the_two_body_impulse(e, ox, oy):
