@@ -42,7 +42,8 @@ from tests.helpers.literal import literal_2_14
 from tests.helpers.states import random_state
 
 MODELS = sorted((Path(__file__).resolve().parents[2] / "models").glob("**/*.yaml"))
-SLOW_MODELS = ("quadruped.yaml",)  # the longest case (the largest model): run by make test-slow and CI
+# the longest cases, run by make test-slow and CI: the largest model, and two capsules' rows (a minute to derive cold)
+SLOW_MODELS = ("quadruped.yaml", "crossed_capsules.yaml")
 TREE = "tree (Baraff)"
 
 # Every joint kind (core/joint_kinds.py) once, between bodies, a particle and the world, with

@@ -10,6 +10,7 @@ import mbsynth as mb
 from mbsynth.core.equations import term_scales
 
 MODELS = sorted(str(p) for p in Path(__file__).parents[2].joinpath("models").rglob("*.yaml"))
+SLOW_MODEL = "crossed_capsules.yaml"  # two capsules' rows take a minute to derive cold: make test-slow and CI
 RNG = np.random.default_rng(7)
 
 
@@ -47,7 +48,8 @@ def close(x, y, terms=1.0):
     return x.shape == y.shape and np.allclose(x, y, rtol=1e-12, atol=1e-12 * scale, equal_nan=True)
 
 
-@pytest.mark.parametrize("path", MODELS, ids=lambda p: Path(p).stem)
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.endswith(SLOW_MODEL) else p
+                                  for p in MODELS], ids=lambda p: Path(p).stem)
 def test_batched_arrays_equal_the_loop_over_constraints(path):
     system = mb.load(path)
     q0, qd0 = system.initial_state()
