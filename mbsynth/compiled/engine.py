@@ -110,7 +110,7 @@ class Engine:
         self.lock = threading.Lock()
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
-        self.projections = []  # the Projection, once made (a list: ``at``'s copies share it)
+        self.projections = []  # the Projection, once made (``at``'s copies get it on their parameter values)
         # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with extra rows
         self.rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
         self.generated_phi = slice(self.outputs - template.phi_outputs, self.outputs)  # φ of the extra rows in gen
@@ -121,6 +121,7 @@ class Engine:
         allocates nothing."""
         other = copy.copy(self)
         other.p = p
+        other.projections = [made and made.at(other) for made in self.projections]
         return other
 
     def at_rest(self):

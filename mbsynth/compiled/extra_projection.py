@@ -24,6 +24,7 @@ gives where the model is small. Its energies are left to the Data (``energies`` 
 run's singular watch goes on through its states (``watched``).
 """
 
+import copy
 import threading
 
 import numpy as np
@@ -71,6 +72,13 @@ class ExtraProjection:
         if template.phi_outputs != L.xrow_row.size or template.rows_depend_on_time:
             return None
         return cls(engine)
+
+    def at(self, engine):
+        """This projection on ``engine``, a copy of its Engine at other parameter values
+        (``Engine.at``): the same buffers and lock, the rows at ``engine``'s values."""
+        other = copy.copy(self)
+        other.engine = engine
+        return other
 
     def _evaluate(self, q, qd):
         """The generated outputs at (q, q̇) (t = 0: they do not depend on it)."""

@@ -235,6 +235,11 @@ class Projection:
         work = (*rows_work, np.zeros(rows_work[0].shape), np.zeros(n), np.zeros(n))
         return (*self.rows.packed, self.at_rest.packed[1], *packed_work, self.gen, self.at_rest.general, work)
 
+    def at(self, engine):
+        """This projection for ``engine``, a copy of its Engine at other parameter values
+        (``Engine.at``): itself, its numbers being the Layout's, which the copy shares."""
+        return self
+
     @classmethod
     def build(cls, engine):
         """The Projection on ``engine``'s Layout, or None where its kernel does not cover the System."""

@@ -22,12 +22,11 @@ from benchmarks import iftomm_reference as ref
 from benchmarks.flexible_startup import model_text
 
 
-@pytest.mark.xfail(strict=True, reason="known defect: the one cache keeps what a run of an equal structure at "
-                                       "another scale decided, and the later run's answer changes with it")
 def test_a_cached_scaled_four_bar_changes_no_later_run():
     """A cached value changes how fast an answer comes, never the answer (core/memo.py): the
-    parallelogram run after a kilometre-scale four-bar run (the same structure) gives the
-    end state it gives from an empty cache. It does not yet (1e-8 apart, three spans relaxed)."""
+    parallelogram run after a kilometre-scale four-bar run (the same structure, whose Engine
+    it gets at its own parameter values, projection included) gives the end state it gives
+    from an empty cache."""
     def parallelogram():
         traj = mb.simulate(mb.loads(ref.n_four_bar_yaml(1, g=0.0), name="parallelogram"), 10.0)
         return traj.q[-1], len(traj.stats["relaxed_spans"])
@@ -47,10 +46,7 @@ def test_a_parallelogram_turns_through_its_change_points_at_constant_rate():
     are collinear (rank A drops by one, the anti-parallelogram branch meets this one); the
     motion must stay on its branch: 10 s cross the change points three times (at t = π/2,
     3π/2, 5π/2), at the requested tolerance (no span relaxed), and the run lists each of
-    them at its time, though no stage need come near one (analysis/singular_watch.py).
-    From an empty cache: what a scaled four-bar run before it leaves there changes this run
-    (test_a_cached_scaled_four_bar_changes_no_later_run, a known defect)."""
-    MEMO.clear()
+    them at its time, though no stage need come near one (analysis/singular_watch.py)."""
     system = mb.loads(ref.n_four_bar_yaml(1, g=0.0), name="parallelogram")
     traj = mb.simulate(system, 10.0)
     assert traj.status == "completed" and not traj.stats["relaxed_spans"]

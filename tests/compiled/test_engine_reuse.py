@@ -27,6 +27,7 @@ from mbsynth.model.system import System
 from mbsynth.compiled.layout import build as build_layout
 
 from tests.helpers.compare import rel
+from benchmarks import iftomm_reference as ref
 
 # Parameters in a mass, an inertia, frame offsets, a rod's length, gravity and a force.
 MODEL = """
@@ -239,6 +240,25 @@ def test_equal_systems_behave_the_same(model):
     heavier = engine_for(replace(model, parameters={**model.parameters, "m": 5.0}))
     assert heavier.template is engine.template
     assert heavier.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
+
+
+def test_a_parameter_only_the_rows_read_moves_the_projection_too():
+    """Two four-bars of one structure, bars of 1 m and 2 m: the Layout has no numbers (the
+    rows are all generated), so the second model's Engine is the first's at other parameter
+    values (``Engine.at``). The first model's projection made first, the second's projects on
+    its own constraints: φ after it is zero to rounding, as the symbolic rows (the KKT
+    path's) evaluate it."""
+    longer = mb.loads(ref.n_four_bar_yaml(1, L=2.0, g=0.0), name="n_four_bar_1")
+    model = mb.loads(ref.n_four_bar_yaml(1, g=0.0), name="n_four_bar_1")
+    assert engine_for(longer).projection() is not None
+    projection = engine_for(model).projection()
+    q, qd = model.initial_state()
+    moved = q + 1e-4 * np.sin(np.arange(q.size) + 1.0)
+    assert np.abs(model.data(path="kkt").constraint_residuals(0.0, moved, qd)[0]).max() > 1e-6
+    projected = projection(moved, qd)
+    assert projected is not None  # the first model's rows: the steps do not converge
+    phi, psi = model.data(path="kkt").constraint_residuals(0.0, projected.q, projected.qd)
+    assert np.abs(phi).max() < 1e-12 and np.abs(psi).max() < 1e-12
 
 
 def test_a_data_takes_the_path_it_was_made_with(monkeypatch):
