@@ -18,6 +18,7 @@ loads its machine code from disk). A Data on the compiled path (grouped.Batch wi
 it (grouped.py then uses numpy).
 """
 
+import functools
 import logging
 import threading
 
@@ -60,7 +61,7 @@ def _build(raw):
     from . import tape  # numba: loaded with the first structure built, not with the package
     args, forms = raw.structure()
     try:
-        return Taped(tape.run, tape.tape(args, forms))
+        return functools.partial(tape.run, *tape.tape(args, forms))  # evaluate's arguments after the tape's
     except tape.Unsupported as err:
         log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
     try:
@@ -70,16 +71,6 @@ def _build(raw):
         log.warning("a constraint structure stays on numpy (%s: %s)", type(err).__name__, err)
         return None
     return evaluate
-
-
-class Taped:
-    """``evaluate`` of a structure written as a tape (tape.py): ``tape.run`` on its arrays."""
-
-    def __init__(self, run, arrays):
-        self.run, self.arrays = run, arrays
-
-    def __call__(self, t, q, qd, p, columns, values, fixed, out):
-        self.run(t, q, qd, p, columns, values, fixed, out, *self.arrays)
 
 
 def source(args, forms):

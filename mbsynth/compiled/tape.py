@@ -7,15 +7,20 @@ writes the structure's expressions, their common subexpressions once (sympy ``cs
 list of operations on registers, and ``run`` — one numba function, compiled once with the
 rest of the compiled path — reads that list for each instance:
 
-    run(t, q, qd, p, columns, values, fixed, out, code, operands, numbers, size)
+    run(batches, operands, numbers, size, t, q, qd, p, columns, values, fixed, out)
         for each instance m: out[:, m] = the expressions, coordinate slot j read from
         q[columns[j, m]] (velocities from qd), parameters from p, constants from
         values[:, m] and numbers from fixed[:, m]
 
-An operation is ``code[i]`` on ``operands[i] = (destination, a, b, c)``: registers, or an
-index into the arguments or ``numbers``. Piecewise expressions evaluate every branch and
-select (as numpy does), comparisons give 1.0 or 0.0. An expression of a kind the tape does
-not know raises ``Unsupported`` (structures.py then compiles the structure on its own).
+An operation writes ``operands[:, i] = (destination, a, b, c)``: registers, or an index into
+the arguments or ``numbers``. Each register is written once, so the operations whose operands
+are all ready may run in any order: the tape groups them by level (the longest chain of
+operations before them) and, within a level, by kind, and ``run`` reads each group
+``batches[k] = (kind, first, stop)`` as one loop of that one operation: a dispatch per
+group, not per operation, and the same values in the same registers as the operations one by
+one. Piecewise expressions evaluate every branch and select (as numpy does), comparisons give
+1.0 or 0.0. An expression of a kind the tape does not know raises ``Unsupported``
+(structures.py then compiles the structure on its own).
 """
 
 import math
@@ -31,6 +36,8 @@ from ..symbolic.derive import beyond_double_as_inf
  SELECT) = range(43)
 
 READS = (T, Q, QD, P, VALUE, FIXED)  # the argument each slot group of a structure is read from
+ARITY = {**dict.fromkeys(range(SELECT + 1), 1), ADD: 2, SUB: 2, MUL: 2, DIV: 2, POW: 2, ATAN2: 2, MAX: 2, MIN: 2,
+         LT: 2, LE: 2, EQ: 2, NE: 2, AND: 2, OR: 2, SELECT: 3}  # the registers an operation reads (from a)
 FUNCTIONS = {sp.sin: SIN, sp.cos: COS, sp.tan: TAN, sp.asin: ASIN, sp.acos: ACOS, sp.atan: ATAN, sp.sinh: SINH,
              sp.cosh: COSH, sp.tanh: TANH, sp.exp: EXP, sp.log: LOG, sp.Abs: ABS, sp.sign: SIGN, sp.floor: FLOOR,
              sp.ceiling: CEIL}
@@ -62,8 +69,27 @@ class Tape:
         return self.emit(NUMBER, len(self.numbers) - 1)
 
     def arrays(self):
-        return (np.array(self.code, dtype=np.int64), np.array(self.operands, dtype=np.int64).reshape(-1, 4),
+        """(batches, operands, numbers, size): the operations grouped by (level, kind), their
+        operands a row each of destinations, a, b and c (unsigned: no index wraps around)."""
+        level = np.zeros(self.size, dtype=np.int64)  # each register's: 0 for the reads, else 1 + its inputs' highest
+        for op, (d, a, b, c) in zip(self.code, self.operands):
+            inputs = () if op in READS or op == NUMBER else (b,) if op == OUT else (a, b, c)[:ARITY[op]]
+            level[d] = 1 + max((level[r] for r in inputs), default=-1)
+        order = sorted(range(len(self.code)), key=lambda i: (_level(self, level, i), self.code[i]))
+        batches = []
+        for n, i in enumerate(order):
+            key = (_level(self, level, i), self.code[i])
+            if not batches or batches[-1][0] != key:
+                batches.append([key, n, n])
+            batches[-1][2] = n + 1
+        return (np.array([(op, first, stop) for (_, op), first, stop in batches], dtype=np.int64).reshape(-1, 3),
+                np.ascontiguousarray(np.array([self.operands[i] for i in order], dtype=np.uint64).reshape(-1, 4).T),
                 np.array(self.numbers + [0.0]), max(self.size, 1))
+
+
+def _level(written, level, i):
+    """The level operation i runs at: that of its register; the outputs after all the others."""
+    return np.iinfo(np.int64).max if written.code[i] == OUT else int(level[written.operands[i][0]])
 
 
 def tape(args, forms):
@@ -190,44 +216,61 @@ def _piecewise(written, expr, arg):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run(t, q, qd, p, columns, values, fixed, out, code, operands, numbers, size):
-    """``out[:, m]`` of every instance m: the tape (code, operands, numbers) read for each."""
+def run(batches, operands, numbers, size, t, q, qd, p, columns, values, fixed, out):
+    """``out[:, m]`` of every instance m: the tape's groups (batches, operands, numbers) read for each."""
     r = np.empty(size)
+    d, a, b, c = operands[0], operands[1], operands[2], operands[3]
     for m in range(columns.shape[1]):
-        for i in range(code.shape[0]):
-            op, d, a, b = code[i], operands[i, 0], operands[i, 1], operands[i, 2]
+        for k in range(batches.shape[0]):
+            op, first, stop = batches[k, 0], batches[k, 1], batches[k, 2]
             if op == MUL:
-                r[d] = r[a] * r[b]
+                for i in range(first, stop):
+                    r[d[i]] = r[a[i]] * r[b[i]]
             elif op == ADD:
-                r[d] = r[a] + r[b]
+                for i in range(first, stop):
+                    r[d[i]] = r[a[i]] + r[b[i]]
             elif op == SUB:
-                r[d] = r[a] - r[b]
-            elif op == Q:
-                r[d] = q[columns[a, m]]
-            elif op == SQUARE:
-                r[d] = r[a] * r[a]
-            elif op == NEG:
-                r[d] = -r[a]
-            elif op == NUMBER:
-                r[d] = numbers[a]
-            elif op == P:
-                r[d] = p[a]
-            elif op == FIXED:
-                r[d] = fixed[a, m]
-            elif op == VALUE:
-                r[d] = values[a, m]
-            elif op == QD:
-                r[d] = qd[columns[a, m]]
+                for i in range(first, stop):
+                    r[d[i]] = r[a[i]] - r[b[i]]
             elif op == OUT:
-                out[a, m] = r[b]
+                for i in range(first, stop):
+                    out[a[i], m] = r[b[i]]
+            elif op == NEG:
+                for i in range(first, stop):
+                    r[d[i]] = -r[a[i]]
+            elif op == SQUARE:
+                for i in range(first, stop):
+                    r[d[i]] = r[a[i]] * r[a[i]]
+            elif op == Q:
+                for i in range(first, stop):
+                    r[d[i]] = q[columns[a[i], m]]
+            elif op == QD:
+                for i in range(first, stop):
+                    r[d[i]] = qd[columns[a[i], m]]
+            elif op == NUMBER:
+                for i in range(first, stop):
+                    r[d[i]] = numbers[a[i]]
+            elif op == P:
+                for i in range(first, stop):
+                    r[d[i]] = p[a[i]]
+            elif op == FIXED:
+                for i in range(first, stop):
+                    r[d[i]] = fixed[a[i], m]
+            elif op == VALUE:
+                for i in range(first, stop):
+                    r[d[i]] = values[a[i], m]
             elif op == DIV:
-                r[d] = r[a] / r[b]
+                for i in range(first, stop):
+                    r[d[i]] = r[a[i]] / r[b[i]]
             elif op == SIN:
-                r[d] = math.sin(r[a])
+                for i in range(first, stop):
+                    r[d[i]] = math.sin(r[a[i]])
             elif op == COS:
-                r[d] = math.cos(r[a])
+                for i in range(first, stop):
+                    r[d[i]] = math.cos(r[a[i]])
             else:
-                r[d] = _rare(op, r, a, b, operands[i, 3], t)
+                for i in range(first, stop):
+                    r[d[i]] = _rare(op, r, np.int64(a[i]), np.int64(b[i]), np.int64(c[i]), t)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
