@@ -108,9 +108,11 @@ def test_a_pose_where_the_rows_do_not_hold_yet_is_checked_once_consistent():
 
 
 @pytest.mark.parametrize("model", ["rigid/double_pendulum_spatial.yaml", "mechanisms/four_bar.yaml",
-                                   "mechanisms/bricard.yaml", "mechanisms/slider_crank.yaml", "robots/ur5_payload.yaml"])
+                                   "mechanisms/bricard.yaml", "mechanisms/slider_crank.yaml", "robots/ur5_payload.yaml",
+                                   "rolling/bicycle.yaml"])
 def test_frame_rotations_of_the_branch_check_equal_the_poses_sympy_gives(model):
-    """The branch check's numeric rotations (R(u) R_frame, R_z(θ) R_frame, R_frame) against
+    """The branch check's numeric rotations (R(u) R_frame, R_z(θ) R_frame, R_frame, and the
+    Euler-angle bodies' R(angles) R_frame of the bicycle) against
     substitution into each part's sympy pose, at a random state off the manifold."""
     system = mb.load(Path(__file__).resolve().parents[2] / "models" / model)
     q = system.initial_state()[0] + 0.3 * np.random.default_rng(5).normal(size=system.n)

@@ -166,7 +166,8 @@ def _rotation_at(part, frame, values):
     R_z(θ) R_frame, R_frame — not by substitution into the pose's sympy matrices, which grows
     with the model (a robot of many links); other parts by substitution."""
     if part is not None and not part.part_type.shared_pose:
-        return _numeric(pose(part, frame)[1], values)
+        numeric = getattr(part, "rotation_at", None)  # a part that computes it from its coordinates' values
+        return _numeric(pose(part, frame)[1], values) if numeric is None else numeric(frame, values)
     own = frame.constant_rotation
     own = _numeric(frame.rotation, values) if own is None else own
     if own is None or part is None or part.part_type.orientation == POINT:
