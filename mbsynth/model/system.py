@@ -529,14 +529,16 @@ def _coordinate_groups(parts):
     return np.array(labels)
 
 
+@MEMO.function(4096)
 def _time_in_part(part):
     """Whether the part's T or V holds t (parts shared from a template hold neither)."""
     own = part.__dict__.get("_symbolic")
-    return bool(own) and any(T_SYMBOL in x.free_symbols for x in own[2:])
+    return bool(own) and any(x.has(T_SYMBOL) for x in own[2:])
 
 
+@MEMO.function(4096)
 def _time_in_rows(con):
     """Whether the constraint's b or velocity residual ψ holds t: a prescribed motion
     (placed joint rows hold neither)."""
     own = con.__dict__.get("_symbolic")
-    return bool(own) and any(T_SYMBOL in x.free_symbols for x in (*own[1], *(own[4] if own[4] is not None else ())))
+    return bool(own) and any(x.has(T_SYMBOL) for x in (*own[1], *(own[4] if own[4] is not None else ())))
