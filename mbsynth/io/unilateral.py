@@ -97,7 +97,7 @@ def read_contacts(builder):
         e = _restitution(builder, spec, path)
         if kind == "spheres":
             gap, point, normal, through = _spheres_gap(builder, spec, path)
-            found.append((Unilateral(builder.full_name(name), "contact", e, _row(builder, name, gap, through),
+            found.append((Unilateral(builder.full_name(name), "contact", e, _row(builder, path, name, gap, through),
                                      point=point, normal=normal), path))
             continue
         unit = _normal(builder, spec, path)
@@ -106,13 +106,19 @@ def read_contacts(builder):
         for suffix, centre, radius, omega in _plane_spheres(builder, spec, path):
             full = builder.full_name(name + suffix)
             slip, tangents = (None, None) if mu is None else _slip(builder, full, centre, radius, omega, unit)
-            row = _row(builder, name + suffix, unit.dot(centre) - ground - radius)
+            row = _row(builder, path, name + suffix, unit.dot(centre) - ground - radius)
             found.append((Unilateral(full, "contact", e, row, sp.S.Zero if mu is None else mu, slip,
                                      centre - radius * unit, unit, tangents), path))
     return found
 
 
-def _row(builder, name, gap, through=None):
+def _row(builder, path, name, gap, through=None):
+    """The gap's row (model/unilateral.gap_row); the contact at ``path`` is refused where its
+    gap changes with no coordinate (it could never touch or leave)."""
+    in_coordinates = gap if through is None else gap.xreplace(through)
+    if not in_coordinates.free_symbols & set(builder.q):
+        builder.fail(path, f"contact '{name}': its gap {in_coordinates} changes with no coordinate, so it can never "
+                           "touch or leave (a normal across its part's plane of motion?)")
     return gap_row(builder.full_name(name), gap, builder.q, builder.qd, builder.parameter_symbols, through)
 
 

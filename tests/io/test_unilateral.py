@@ -74,6 +74,9 @@ BAD = [
      "the two spheres must be on two parts"),
     (BALL.format(z=0.5, contact="{name: c, type: spheres, between: [ball, other], radius: [r, 0.6]}"), 7,
      "the initial state penetrates 'c' by 0.2"),
+    ("name: disc\nparts:\n  disc: {type: planar_body, mass: 1.0, inertia: 0.1, initial: {position: [0, 1]}}\n"
+     "contacts:\n  - {name: floor, type: plane, child: disc}\n", 5,  # the normal z, across the disc's x-y plane
+     "contact 'floor': its gap 0 changes with no coordinate"),
 ]
 
 
