@@ -500,7 +500,7 @@ def test_mutations_of_every_model(text, data):
 
 @pytest.mark.slow
 @pytest.mark.timeout(1800)
-@settings(max_examples=8, deadline=None, database=None, suppress_health_check=list(HealthCheck), print_blob=True)
+@settings(max_examples=4, deadline=None, database=None, suppress_health_check=list(HealthCheck), print_blob=True)
 @given(text=st.sampled_from([path.read_text() for path in MODELS if path.name in SLOW_TO_DERIVE]), data=st.data())
 def test_mutations_of_the_models_slow_to_derive(text, data):
     """As above, for the models of SLOW_TO_DERIVE (the suite's case count leaves them out)."""
