@@ -50,7 +50,7 @@ class Unsupported(Exception):
 
 
 class Tape:
-    """The operations of one structure: (code, operands, numbers, size), see the module."""
+    """The operations of one structure, in the order written (``arrays``: as ``run`` reads them)."""
 
     def __init__(self):
         self.code, self.operands, self.numbers = [], [], []
@@ -69,32 +69,29 @@ class Tape:
         return self.emit(NUMBER, len(self.numbers) - 1)
 
     def arrays(self):
-        """(batches, operands, numbers, size): the operations grouped by (level, kind), their
-        operands a row each of destinations, a, b and c (unsigned: no index wraps around)."""
+        """(batches, operands, numbers, size): the operations grouped by (level, kind), the
+        outputs last; their operands a row each of destinations, a, b and c (unsigned: no
+        index wraps around)."""
         level = np.zeros(self.size, dtype=np.int64)  # each register's: 0 for the reads, else 1 + its inputs' highest
         for op, (d, a, b, c) in zip(self.code, self.operands):
             inputs = () if op in READS or op == NUMBER else (b,) if op == OUT else (a, b, c)[:ARITY[op]]
             level[d] = 1 + max((level[r] for r in inputs), default=-1)
-        order = sorted(range(len(self.code)), key=lambda i: (_level(self, level, i), self.code[i]))
-        batches = []
+        last = int(level.max(initial=0)) + 1
+        keys = [(last if op == OUT else int(level[d]), op) for op, (d, *_) in zip(self.code, self.operands)]
+        order = sorted(range(len(keys)), key=keys.__getitem__)
+        batches = []  # [kind, first, stop] of each run of equal keys in ``order``
         for n, i in enumerate(order):
-            key = (_level(self, level, i), self.code[i])
-            if not batches or batches[-1][0] != key:
-                batches.append([key, n, n])
+            if n == 0 or keys[i] != keys[order[n - 1]]:
+                batches.append([keys[i][1], n, n])
             batches[-1][2] = n + 1
-        return (np.array([(op, first, stop) for (_, op), first, stop in batches], dtype=np.int64).reshape(-1, 3),
+        return (np.array(batches, dtype=np.int64).reshape(-1, 3),
                 np.ascontiguousarray(np.array([self.operands[i] for i in order], dtype=np.uint64).reshape(-1, 4).T),
                 np.array(self.numbers + [0.0]), max(self.size, 1))
 
 
-def _level(written, level, i):
-    """The level operation i runs at: that of its register; the outputs after all the others."""
-    return np.iinfo(np.int64).max if written.code[i] == OUT else int(level[written.operands[i][0]])
-
-
 def tape(args, forms):
     """The Tape of ``forms`` in the slots ``args`` = (t, q slots, q̇ slots, parameter slots,
-    constant slots, number slots), as numpy arrays (code, operands, numbers, size)."""
+    constant slots, number slots), as numpy arrays (batches, operands, numbers, size)."""
     t, *groups = args
     written = Tape()
     reads = {t: (T, 0)}

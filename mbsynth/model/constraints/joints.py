@@ -31,10 +31,10 @@ import sympy as sp
 
 from .base import Constraint
 from ...core.joint_kinds import ALIGNED_AXIS, JOINT_KINDS, KINDS, OPERATIONS, ORIENTATION_LOCK
-from ...core.kinematics import quaternion_rotation
+from ...core.kinematics import euler_rotation, quaternion_rotation
 from ..joint_templates import Templates, joint_coordinates, pose, shared
 from ..joint_values import MOTION_NAMES, free_motions
-from ..parts.part_type import PLANE, POINT, QUATERNION
+from ..parts.part_type import ANGLES, PLANE, POINT, QUATERNION
 from ...symbolic.cache import placeholder
 from ...symbolic.derive import compile_function, differentiate, differentiated, jacobian, placed_values, positions
 
@@ -164,10 +164,11 @@ def _rotation_at(part, frame, values):
     or None where that is no real number. The shared part kinds are computed from their
     coordinates' values — R(u) R_frame in R(u)'s homogeneous form (kinematics.quaternion_rotation),
     R_z(θ) R_frame, R_frame — not by substitution into the pose's sympy matrices, which grows
-    with the model (a robot of many links); other parts by substitution."""
-    if part is not None and not part.part_type.shared_pose:
-        numeric = getattr(part, "rotation_at", None)  # a part that computes it from its coordinates' values
-        return _numeric(pose(part, frame)[1], values) if numeric is None else numeric(frame, values)
+    with the model (a robot of many links); so are rigid parts turned by three angles
+    (R(angles) R_frame); other parts by substitution."""
+    by_angles = part is not None and part.part_type.orientation == ANGLES and part.part_type.rigid
+    if part is not None and not part.part_type.shared_pose and not by_angles:
+        return _numeric(pose(part, frame)[1], values)
     own = frame.constant_rotation
     own = _numeric(frame.rotation, values) if own is None else own
     if own is None or part is None or part.part_type.orientation == POINT:
@@ -180,6 +181,8 @@ def _rotation_at(part, frame, values):
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ own
     if part.part_type.orientation == QUATERNION:
         return quaternion_rotation([float(values[x]) for x in part.q[part.part_type.quaternion]]) @ own
+    if by_angles:
+        return np.array(euler_rotation(part.sequence, [sp.Float(values[x]) for x in part.q[3:6]]), dtype=float) @ own
     raise ValueError(f"a {part.type_name} part shares its poses but turns by {part.part_type.orientation}: no rotation "
                      "from its coordinates here")
 

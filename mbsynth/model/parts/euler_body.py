@@ -55,18 +55,6 @@ class EulerBody(Part):
         R = euler_rotation(self.sequence, self.q[3:])
         return sp.Matrix(self.q[:3]) + R * frame.position, R * frame.rotation
 
-    def rotation_at(self, frame, values):
-        """``pose``'s rotation at ``values`` ({symbol: number}) as floats, or None where an
-        angle is not given or not real: R(angles) R_frame from the angles' values, not by
-        substitution into the symbolic pose (a run's branch check reads it)."""
-        own = frame.constant_rotation
-        try:
-            angles = [sp.Float(values[a]) for a in self.q[3:]]
-            own = np.array(sp.Matrix(frame.rotation).xreplace(values), dtype=float) if own is None else own
-        except (KeyError, TypeError):
-            return None
-        return np.array(euler_rotation(self.sequence, angles), dtype=float) @ own
-
     def angular_velocity(self):
         return euler_rotation(self.sequence, self.q[3:]) * euler_rate_matrix(self.sequence, self.q[3:]) \
             * sp.Matrix(self.qd[3:])
