@@ -3,9 +3,10 @@
 Constraints and parts built from one template (``Constraint._place``, a robot's links)
 share the raw numpy function of ``symbolic.compile_function`` and differ only in the
 coordinates they read and in their numbers. ``Batch`` stacks those arguments (one column
-per instance) and calls the shared function once, numpy broadcasting every operation,
-instead of once per instance in a Python loop. Functions that are not ``Compiled``, or
-whose raw function does not broadcast, are called one by one.
+per instance) and evaluates every instance of every shared structure in one compiled call
+(the tape, compiled/tape.py), or calls each shared function once, numpy broadcasting every
+operation, instead of once per instance in a Python loop. Functions that are not
+``Compiled``, or whose raw function does not broadcast, are called one by one.
 """
 
 import operator
@@ -25,8 +26,10 @@ class Batch:
     returns a tuple of arrays (one per *slot*: a, b, C, φ, ψ of a constraint; M, Q or T, V
     of a part). A call returns, per slot, the raveled outputs of all functions
     concatenated in order (``slots`` of them). The layout is fixed at the first call.
-    ``compiled``: each group of a shared structure is evaluated by its numba kernel, built
-    at its first call (compiled/structures.py), else by numpy throughout."""
+    ``compiled``: the groups of shared structures are evaluated compiled
+    (compiled/structures.py, built at the first call): those on the tape all in one
+    ``tape.Program`` call, any other by its own kernel; else by numpy throughout. Which way
+    a group goes depends on its structure alone, never on the values of a state."""
 
     def __init__(self, functions, indices, slots, compiled):
         self.functions, self.slots = list(functions), slots
@@ -38,18 +41,27 @@ class Batch:
         t = np.float64(t)
         if self.layout is None:
             return self._first(t, q, qd, p)
-        total, groups, singles, slots = self.layout
+        total, on_tape, groups, singles, slots = self.layout
         out = np.empty(total)
-        with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
-            for group in groups:
-                out[group.dest] = group(t, q, qd, p)
+        if on_tape is not None:
+            on_tape(t, q, qd, p, out)
+        if groups:
+            with np.errstate(all="ignore"):  # NaN and inf are reported by the checks of M, Q, A, b
+                for group in groups:
+                    out[group.dest] = group(t, q, qd, p)
         for f, idx, dest in singles:
             out[dest] = np.concatenate([np.ravel(x) for x in f(t, q[idx], qd[idx], p)])
         return [out[a:b] for a, b in slots]
 
+    def groups(self):
+        """(the groups of shared structures, the functions called one by one), once laid out."""
+        _, on_tape, groups, singles, _ = self.layout
+        return (on_tape.groups if on_tape is not None else []) + groups, singles
+
     def _first(self, t, q, qd, p):
         """Call each function alone, lay the outputs out, group the functions that share a
-        raw function and keep the groups whose stacked call reproduces the single calls."""
+        raw function: those whose structure compiles are evaluated compiled from now on,
+        the others stacked on numpy where that reproduces the single calls."""
         outputs = [[np.ravel(x) for x in f(t, q[idx], qd[idx], p)] for f, idx in zip(self.functions, self.indices)]
         count = self.slots
         sizes = np.array([[x.size for x in o] for o in outputs], dtype=int).reshape(len(outputs), count)
@@ -60,20 +72,26 @@ class Batch:
         dests = [np.concatenate([slot_start[j] + before[i, j] + np.arange(sizes[i, j]) for j in range(count)])
                  .astype(int) for i in range(len(outputs))]
         expected = np.concatenate([np.zeros(0)] + [o[j] for j in range(count) for o in outputs])  # slot by slot
-        groups, singles = [], []
+        taped, groups, singles = [], [], []
         for members in _shared(self.functions, self.indices):
             group = None
             if isinstance(self.functions[members[0]], Compiled):
                 group = _Group([self.functions[i] for i in members], np.array([self.indices[i] for i in members]),
-                               np.array([dests[i] for i in members]).T, self.compiled)
-                if not group.reproduces(t, q, qd, p, expected):
+                               np.array([dests[i] for i in members]).T)
+                found = structures.kernel(group.raw) if self.compiled else None
+                if found is not None and not callable(found):  # a tape.Taped
+                    taped.append((group, found))
+                    continue
+                group.kernel = found if found is not None and group.runs(t, q, qd, p) else None
+                if group.kernel is None and not group.reproduces(t, q, qd, p, expected):
                     group = None
             if group is None:
                 singles.extend((self.functions[i], self.indices[i], dests[i]) for i in members)
             else:
                 groups.append(group)
-        self.layout = (int(slot_start[-1]), groups, singles, list(zip(slot_start[:-1], slot_start[1:])))
-        return [expected[a:b] for a, b in self.layout[3]]
+        on_tape = _OnTape(taped, t, q, qd, p) if taped else None
+        self.layout = (int(slot_start[-1]), on_tape, groups, singles, list(zip(slot_start[:-1], slot_start[1:])))
+        return [expected[a:b] for a, b in self.layout[4]]
 
 
 def _shared(functions, indices):
@@ -91,13 +109,44 @@ def _values_key(values):
     return ("gathered", len(values.fixed), tuple((k, a, i is None) for k, a, i in values.picks))
 
 
-class _Group:
-    """Functions sharing one raw function: evaluated by its numba kernel
-    (compiled/structures.py, built at the first call) where ``compiled``, else by one
-    stacked numpy call when there are at least STACK_MIN of them, else one by one. ``dest``
-    (outputs × members): where each output of each member goes in the flat result."""
+class _OnTape:
+    """The groups whose structures are on the tape (``taped``: (group, its tape.Taped)),
+    evaluated by one ``tape.Program`` call. Their stacked constants are kept for the next
+    call when they read the parameters alone and the parameters are ``frozen`` (a Data's)."""
 
-    def __init__(self, functions, indices, dest, compiled):
+    def __init__(self, taped, t, q, qd, p):
+        from . import tape  # numba: loaded with the first structure compiled, not with the package
+
+        self.groups = [group for group, _ in taped]
+        rows = [len(group.stacked_values(t, q, qd, p)) for group in self.groups]
+        self.program = tape.Program([(found, group.columns, count, group.fixed, group.dest)
+                                     for (group, found), count in zip(taped, rows)])
+        self.constant = all(group.reads <= {PARAMETERS} for group in self.groups)
+        self.kept = (None, None)  # (the frozen parameter array, the values read with it)
+
+    def __call__(self, t, q, qd, p, out):
+        self.program.call(t, q, qd, p, self._values(t, q, qd, p), out)  # the Program's call, no frame of its own
+
+    def _values(self, t, q, qd, p):
+        kept, values = self.kept
+        if self.constant and p is kept:
+            return values
+        values = np.empty(self.program.values_size)
+        for group, where in zip(self.groups, self.program.value_slices):
+            values[where] = group.stacked_values(t, q, qd, p).ravel()
+        if self.constant and frozen(p):
+            self.kept = (p, values)
+        return values
+
+
+class _Group:
+    """Functions sharing one raw function: evaluated by its own compiled ``kernel`` where
+    Batch gives one (compiled/structures.py), else by one stacked numpy call when there are
+    at least STACK_MIN of them, else one by one. ``dest`` (outputs × members): where each
+    output of each member goes in the flat result. ``reads``: the arguments (positions in
+    t, q, q̇, p) the members' constants read."""
+
+    def __init__(self, functions, indices, dest):
         first = functions[0]
         self.raw, self.dest = first.raw, dest
         self.columns = np.ascontiguousarray(indices.T)  # coordinates × members: lambdify unpacks the rows
@@ -108,28 +157,30 @@ class _Group:
         # parameters once per read-only parameter array (_with_parameters), the others per call
         self.picks = None
         self.values = first.values
+        self.reads = set(getattr(first.values, "reads", range(PARAMETERS + 1)))
         if hasattr(first.values, "picks"):
             self.values = np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
             picks = _picks(first.values.picks, [f.values.picks for f in functions], self.columns)
             self.picks = [pick for pick in picks if pick[0] != PARAMETERS]
             self.parameter_picks = [pick for pick in picks if pick[0] == PARAMETERS]
             self.gathered_at = (None, self.values)  # (the read-only parameter array, the values with it put in)
+            self.reads = {a for a, _, _ in picks}
         self.pick = None  # (itemgetter of the outputs that are arrays, their rows, the others' and theirs)
-        self.kernel = None  # the numba kernel once it is ready and checked
-        self.refused = not compiled  # numpy for good (also when the kernel disagreed with numpy)
+        self.kernel = None  # the structure's own compiled function, set by Batch
 
     def __call__(self, t, q, qd, p):
-        if self.picks is None:
-            values = _stacked(self.values(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
-        else:
-            values = self._gathered(t, q, qd, p)
-        if self.kernel is None and not self.refused:
-            self._take_kernel(t, q, qd, p, values)
+        values = self.stacked_values(t, q, qd, p)
         if self.kernel is not None:
             result = np.empty(self.dest.shape)
             self.kernel(t, q, qd, p, self.columns, values, self.fixed, result)
             return result
         return self._numpy(t, q, qd, p, values)
+
+    def stacked_values(self, t, q, qd, p):
+        """The members' constants at (t, q, q̇, p): rows × members."""
+        if self.picks is None:
+            return _stacked(self.values(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
+        return self._gathered(t, q, qd, p)
 
     def _gathered(self, t, q, qd, p):
         """The stacked constants with each member's arguments put in."""
@@ -153,23 +204,6 @@ class _Group:
             self.gathered_at = (p, values)
         return values
 
-    def _take_kernel(self, t, q, qd, p, values):
-        """Use the kernel from now on (built now if need be) if it agrees with numpy at this state."""
-        found = structures.kernel(self.raw)
-        if found is None:
-            self.refused = True  # none: numpy for good
-            return
-        result = np.empty(self.dest.shape)
-        try:
-            found(t, q, qd, p, self.columns, values, self.fixed, result)
-        except Exception:  # noqa: BLE001 - arguments the kernel was not compiled for: numpy serves
-            self.refused = True
-            return
-        if stacked_agrees(result, self._numpy(t, q, qd, p, values)):
-            self.kernel = found
-        else:
-            self.refused = True
-
     def _numpy(self, t, q, qd, p, values):
         members = self.dest.shape[1]
         if members < STACK_MIN:
@@ -192,7 +226,18 @@ class _Group:
             result[others] = np.array(get_others(out), dtype=float)[:, None]
         return result
 
+    def runs(self, t, q, qd, p):
+        """Whether this group's call returns (its own kernel: compiled for other arguments raises)."""
+        try:
+            with np.errstate(all="ignore"):
+                self(t, q, qd, p)
+        except Exception:  # noqa: BLE001 - numpy serves
+            return False
+        return True
+
     def reproduces(self, t, q, qd, p, expected):
+        """Whether this group's call gives the single calls' outputs ``expected`` (its
+        places in them): a raw function that does not broadcast does not."""
         try:
             with np.errstate(all="ignore"):
                 got = self(t, q, qd, p)

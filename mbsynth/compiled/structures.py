@@ -2,23 +2,23 @@
 
 ``symbolic.compile_function`` compiles the expressions of constraints (and parts) alike
 once, in placeholder form (``symbolic.canonical``); grouped.py evaluates the instances of
-one structure together. ``kernel(raw)`` turns that structure into
+one structure together. ``kernel(raw)`` turns that structure into its tape (a
+``tape.Taped``), which the one function compiled for every structure reads (grouped.Batch
+runs the tapes of all its structures in one ``tape.Program`` call): a new structure costs
+its tape (milliseconds), no compile. A structure holding an expression the tape has no
+operation for is written as a module of its own into the cache under the hash of its text
+and compiled by numba (``cache=True``: a structure seen before, by any model, loads its
+machine code from disk) as
 
     evaluate(t, q, qd, p, columns, values, fixed, out)
         for each instance m: out[:, m] = the expressions with coordinate slot j read from
         q[columns[j, m]] (velocities from qd), parameters from p, constants from
         values[:, m] and numbers from fixed[:, m]
 
-written as a tape (tape.py) that one function compiled for every structure reads: a new
-structure costs its tape (milliseconds), no compile. A structure holding an expression the
-tape has no operation for is written as a module of its own into the cache under the hash
-of its text and compiled by numba (``cache=True``: a structure seen before, by any model,
-loads its machine code from disk). A Data on the compiled path (grouped.Batch with
-``compiled``) builds it at its first call, waiting; ``MBSYNTH_COMPILED=off`` never builds
-it (grouped.py then uses numpy).
+A Data on the compiled path (grouped.Batch with ``compiled``) builds it at its first call,
+waiting; ``MBSYNTH_COMPILED=off`` never builds it (grouped.py then uses numpy).
 """
 
-import functools
 import logging
 import threading
 
@@ -46,9 +46,10 @@ UNSET = "unset"  # a raw function's ``kernel`` before its build
 
 
 def kernel(raw):
-    """The compiled ``evaluate`` of the structure of ``raw`` (a function made by
-    symbolic.derive._lambdified), built now if it is not yet, or None: MBSYNTH_COMPILED=off,
-    or not compilable. Kept on ``raw`` itself (its attribute ``kernel``)."""
+    """The structure of ``raw`` (a function made by symbolic.derive._lambdified) compiled:
+    its ``tape.Taped``, else (an expression the tape does not know) its own compiled
+    ``evaluate``, built now if it is not yet; or None: MBSYNTH_COMPILED=off, or not
+    compilable. Kept on ``raw`` itself (its attribute ``kernel``)."""
     if mode() == "off" or not hasattr(raw, "structure"):
         return None
     with _lock:  # one build per structure; another thread asking meanwhile waits for it
@@ -61,7 +62,7 @@ def _build(raw):
     from . import tape  # numba: loaded with the first structure built, not with the package
     args, forms = raw.structure()
     try:
-        return functools.partial(tape.run, *tape.tape(args, forms))  # evaluate's arguments after the tape's
+        return tape.tape(args, forms)
     except tape.Unsupported as err:
         log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
     try:

@@ -4,13 +4,16 @@ structures.py evaluates the instances of one constraint or part structure togeth
 than generating and compiling a numba function per structure (a second or more each: the
 cold cost of a new model, paid again for every structure it brings), ``tape(args, forms)``
 writes the structure's expressions, their common subexpressions once (sympy ``cse``), as a
-list of operations on registers, and ``run`` — one numba function, compiled once with the
-rest of the compiled path — reads that list for each instance:
+list of operations on registers (a ``Taped``), and ``run`` — one numba function, compiled
+once with the rest of the compiled path — reads those lists. A ``Program`` holds the tapes
+of several structures, each with its instances, and evaluates them all in one call
+(grouped.Batch: every shared structure of a model's constraints or parts):
 
-    run(batches, operands, numbers, size, t, q, qd, p, columns, values, fixed, out)
-        for each instance m: out[:, m] = the expressions, coordinate slot j read from
-        q[columns[j, m]] (velocities from qd), parameters from p, constants from
-        values[:, m] and numbers from fixed[:, m]
+    program(t, q, qd, p, values, out)
+        for each structure g, for each of its instances m: out[dest of output k at m] = its
+        expression k, coordinate slot j read from q[columns[j, m]] (velocities from qd),
+        parameters from p, constant j from values (its rows × members, flat), number j from
+        fixed[j, m]
 
 An operation writes ``operands[:, i] = (destination, a, b, c)``: registers, or an index into
 the arguments or ``numbers``. Each register is written once, so the operations whose operands
@@ -23,7 +26,9 @@ one. Piecewise expressions evaluate every branch and select (as numpy does), com
 (structures.py then compiles the structure on its own).
 """
 
+import functools
 import math
+from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
@@ -49,6 +54,60 @@ class Unsupported(Exception):
     """An expression the tape has no operation for."""
 
 
+class Taped(NamedTuple):
+    """A structure's tape as ``run`` reads it: its operation groups (kind, first, stop), their
+    operands (rows: destination, a, b, c), its numbers and its count of registers."""
+
+    batches: np.ndarray
+    operands: np.ndarray
+    numbers: np.ndarray
+    size: int
+
+
+class Program:
+    """The tapes of several structures, each over its own instances, evaluated by one call.
+
+    ``groups``: per structure (its Taped, columns (coordinate slots × members), its count of
+    constant rows, fixed (number slots × members), dest (outputs × members): where in ``out``
+    each output of each member goes). ``program(t, q, qd, p, values, out)``: ``values`` the
+    constants of every structure in turn, each (rows × members) flattened row by row
+    (``value_slices`` says where each lies)."""
+
+    def __init__(self, groups):
+        plan, batches, operands, numbers, columns, fixed, dest = [], [], [], [], [], [], []
+        at = dict.fromkeys(("batch", "operand", "number", "column", "value", "fixed", "dest"), 0)
+        self.value_slices = []
+        for taped, cols, rows, fix, where in groups:
+            members = where.shape[1]
+            plan.append((at["batch"], at["batch"] + len(taped.batches), members, at["column"], at["value"],
+                         at["fixed"], at["number"], at["dest"]))
+            shifted = taped.batches.copy()
+            shifted[:, 1:] += at["operand"]
+            batches.append(shifted)
+            operands.append(taped.operands)
+            numbers.append(taped.numbers)
+            columns.append(np.ravel(cols))
+            fixed.append(np.ravel(fix))
+            dest.append(np.ravel(where))
+            self.value_slices.append(slice(at["value"], at["value"] + rows * members))
+            for name, size in (("batch", len(taped.batches)), ("operand", taped.operands.shape[1]),
+                               ("number", len(taped.numbers)), ("column", np.size(cols)), ("value", rows * members),
+                               ("fixed", np.size(fix)), ("dest", np.size(where))):
+                at[name] += size
+        self.values_size = at["value"]
+
+        def joined(arrays, dtype):
+            return np.ascontiguousarray(np.concatenate([np.zeros(0, dtype)] + arrays), dtype)
+        self.call = functools.partial(
+            run, np.array(plan, dtype=np.uint64).reshape(-1, 8), np.concatenate([np.zeros((0, 3), np.int64)] + batches),
+            np.ascontiguousarray(np.concatenate([np.zeros((4, 0), np.uint64)] + operands, axis=1)),
+            joined(numbers, float), max([taped.size for taped, *_ in groups], default=1),
+            joined(columns, np.uint64), joined(fixed, float), joined(dest, np.uint64))
+
+    def __call__(self, t, q, qd, p, values, out):
+        self.call(t, q, qd, p, values, out)
+
+
 class Tape:
     """The operations of one structure, in the order written (``arrays``: as ``run`` reads them)."""
 
@@ -69,9 +128,9 @@ class Tape:
         return self.emit(NUMBER, len(self.numbers) - 1)
 
     def arrays(self):
-        """(batches, operands, numbers, size): the operations grouped by (level, kind), the
-        outputs last; their operands a row each of destinations, a, b and c (unsigned: no
-        index wraps around)."""
+        """(batches, operands, numbers, size) of a Taped: the operations grouped by (level,
+        kind), the outputs last; their operands a row each of destinations, a, b and c
+        (unsigned: no index wraps around)."""
         level = np.zeros(self.size, dtype=np.int64)  # each register's: 0 for the reads, else 1 + its inputs' highest
         for op, (d, a, b, c) in zip(self.code, self.operands):
             inputs = () if op in READS or op == NUMBER else (b,) if op == OUT else (a, b, c)[:ARITY[op]]
@@ -90,8 +149,8 @@ class Tape:
 
 
 def tape(args, forms):
-    """The Tape of ``forms`` in the slots ``args`` = (t, q slots, q̇ slots, parameter slots,
-    constant slots, number slots), as numpy arrays (batches, operands, numbers, size)."""
+    """The Taped of ``forms`` in the slots ``args`` = (t, q slots, q̇ slots, parameter slots,
+    constant slots, number slots)."""
     t, *groups = args
     written = Tape()
     reads = {t: (T, 0)}
@@ -103,7 +162,7 @@ def tape(args, forms):
         written.made[symbol] = _register(written, expr, reads)
     for k, expr in enumerate(results):
         written.emit(OUT, k, _register(written, expr, reads))
-    return written.arrays()
+    return Taped(*written.arrays())
 
 
 def _register(written, expr, reads):
@@ -213,61 +272,66 @@ def _piecewise(written, expr, arg):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run(batches, operands, numbers, size, t, q, qd, p, columns, values, fixed, out):
-    """``out[:, m]`` of every instance m: the tape's groups (batches, operands, numbers) read for each."""
+def run(plan, batches, operands, numbers, size, columns, fixed, dest, t, q, qd, p, values, out):
+    """``Program``'s call: for each structure g (``plan[g]`` = its first and stop batch, its
+    count of members and where its columns, values, fixed, numbers and dest start), its
+    tape read for each of its members."""
     r = np.empty(size)
     d, a, b, c = operands[0], operands[1], operands[2], operands[3]
-    for m in range(columns.shape[1]):
-        for k in range(batches.shape[0]):
-            op, first, stop = batches[k, 0], batches[k, 1], batches[k, 2]
-            if op == MUL:
-                for i in range(first, stop):
-                    r[d[i]] = r[a[i]] * r[b[i]]
-            elif op == ADD:
-                for i in range(first, stop):
-                    r[d[i]] = r[a[i]] + r[b[i]]
-            elif op == SUB:
-                for i in range(first, stop):
-                    r[d[i]] = r[a[i]] - r[b[i]]
-            elif op == OUT:
-                for i in range(first, stop):
-                    out[a[i], m] = r[b[i]]
-            elif op == NEG:
-                for i in range(first, stop):
-                    r[d[i]] = -r[a[i]]
-            elif op == SQUARE:
-                for i in range(first, stop):
-                    r[d[i]] = r[a[i]] * r[a[i]]
-            elif op == Q:
-                for i in range(first, stop):
-                    r[d[i]] = q[columns[a[i], m]]
-            elif op == QD:
-                for i in range(first, stop):
-                    r[d[i]] = qd[columns[a[i], m]]
-            elif op == NUMBER:
-                for i in range(first, stop):
-                    r[d[i]] = numbers[a[i]]
-            elif op == P:
-                for i in range(first, stop):
-                    r[d[i]] = p[a[i]]
-            elif op == FIXED:
-                for i in range(first, stop):
-                    r[d[i]] = fixed[a[i], m]
-            elif op == VALUE:
-                for i in range(first, stop):
-                    r[d[i]] = values[a[i], m]
-            elif op == DIV:
-                for i in range(first, stop):
-                    r[d[i]] = r[a[i]] / r[b[i]]
-            elif op == SIN:
-                for i in range(first, stop):
-                    r[d[i]] = math.sin(r[a[i]])
-            elif op == COS:
-                for i in range(first, stop):
-                    r[d[i]] = math.cos(r[a[i]])
-            else:
-                for i in range(first, stop):
-                    r[d[i]] = _rare(op, r, np.int64(a[i]), np.int64(b[i]), np.int64(c[i]), t)
+    for g in range(plan.shape[0]):
+        k0, k1, n, col, val, fix, num, at = (plan[g, 0], plan[g, 1], plan[g, 2], plan[g, 3], plan[g, 4], plan[g, 5],
+                                             plan[g, 6], plan[g, 7])
+        for m in range(n):
+            for k in range(k0, k1):
+                op, first, stop = batches[k, 0], batches[k, 1], batches[k, 2]
+                if op == MUL:
+                    for i in range(first, stop):
+                        r[d[i]] = r[a[i]] * r[b[i]]
+                elif op == ADD:
+                    for i in range(first, stop):
+                        r[d[i]] = r[a[i]] + r[b[i]]
+                elif op == SUB:
+                    for i in range(first, stop):
+                        r[d[i]] = r[a[i]] - r[b[i]]
+                elif op == OUT:
+                    for i in range(first, stop):
+                        out[dest[at + a[i] * n + m]] = r[b[i]]
+                elif op == NEG:
+                    for i in range(first, stop):
+                        r[d[i]] = -r[a[i]]
+                elif op == SQUARE:
+                    for i in range(first, stop):
+                        r[d[i]] = r[a[i]] * r[a[i]]
+                elif op == Q:
+                    for i in range(first, stop):
+                        r[d[i]] = q[columns[col + a[i] * n + m]]
+                elif op == QD:
+                    for i in range(first, stop):
+                        r[d[i]] = qd[columns[col + a[i] * n + m]]
+                elif op == NUMBER:
+                    for i in range(first, stop):
+                        r[d[i]] = numbers[num + a[i]]
+                elif op == P:
+                    for i in range(first, stop):
+                        r[d[i]] = p[a[i]]
+                elif op == FIXED:
+                    for i in range(first, stop):
+                        r[d[i]] = fixed[fix + a[i] * n + m]
+                elif op == VALUE:
+                    for i in range(first, stop):
+                        r[d[i]] = values[val + a[i] * n + m]
+                elif op == DIV:
+                    for i in range(first, stop):
+                        r[d[i]] = r[a[i]] / r[b[i]]
+                elif op == SIN:
+                    for i in range(first, stop):
+                        r[d[i]] = math.sin(r[a[i]])
+                elif op == COS:
+                    for i in range(first, stop):
+                        r[d[i]] = math.cos(r[a[i]])
+                else:
+                    for i in range(first, stop):
+                        r[d[i]] = _rare(op, r, np.int64(a[i]), np.int64(b[i]), np.int64(c[i]), t)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)

@@ -563,7 +563,9 @@ def _positions_in(args, picks=()):
 def _values(args, values, picks=()):
     """A function of ``args`` giving the array of ``values``: gathered from numbers and picks
     (k, argument a, position i or None) of the arguments (``picks``: where symbols read from
-    an argument given whole stand) where that is all they are, else lambdified."""
+    an argument given whole stand) where that is all they are, else lambdified (its
+    ``reads``: the positions of the arguments the values read; grouped.py keeps values that
+    read the parameters alone)."""
     where = _positions_in(args, picks)
     if all(v.is_Number or v in where for v in values):  # numbers, and arguments (a joint's effort τ)
         fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
@@ -594,7 +596,11 @@ def _values(args, values, picks=()):
         return sp.lambdify(named, [beyond_double_as_inf(v) for v in forms], modules=[_FLOAT64, "numpy"])
 
     raw = remembered_function("values", (args, values), derive)
-    return lambda *given: np.asarray(raw(*given), dtype=float)
+
+    def evaluated(*given):
+        return np.asarray(raw(*given), dtype=float)
+    evaluated.reads = {where[s][0] for v in values for s in v.free_symbols if s in where}
+    return evaluated
 
 
 def _by_argument(picks):

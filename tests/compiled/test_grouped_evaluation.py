@@ -78,7 +78,7 @@ def test_a_robots_joints_share_one_call():
     rows = data.constraint_arrays(0.0, q, qd)
     assert close(rows.A.toarray(), A) and close(rows.phi, phi) and close(rows.psi, psi)
     batch = data.evaluator.rows
-    groups, singles = batch.layout[1], batch.layout[2]
+    groups, singles = batch.groups()
     assert len(groups) + len(singles) < len(system.constraints) / 2
 
 
@@ -102,7 +102,7 @@ def test_a_robots_joint_torques_share_one_call_and_equal_their_sympy_force():
         stacked = np.bincount(forces.f_cols, weights=forces.forces(0.0, q, qd, system.parameter_values)[0],
                               minlength=system.n)
         assert np.abs(stacked - Q).max() <= 1e-12 * np.abs(Q).max()
-    groups, singles = forces.forces.layout[1], forces.forces.layout[2]
+    groups, singles = forces.forces.groups()
     assert len(torques) == len(system.forces) == 32 and len(groups) + len(singles) <= 3
 
 

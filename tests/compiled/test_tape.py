@@ -51,10 +51,16 @@ def on_tape(forms, time, Q, QD, P, C, K):
     columns = np.array([[m * len(q) + j for m in range(members)] for j in range(len(q))], dtype=np.int64)
     rates = np.zeros((len(q), members))  # q̇ slot j is the rate of coordinate slot j: read through its column
     rates[:len(qd)] = QD
-    out = np.empty((len(forms), members))
-    tape.run(*tape.tape(ARGS, forms), time, Q.T.ravel(), rates.T.ravel(), P, columns, np.ascontiguousarray(C),
-             np.ascontiguousarray(K), out)
-    return out
+    return evaluate_one(tape.tape(ARGS, forms), len(forms), time, Q.T.ravel(), rates.T.ravel(), P, columns, C, K)
+
+
+def evaluate_one(taped, outputs, time, q, qd, p, columns, values, fixed):
+    """A structure's tape over its instances (columns, values and fixed: rows × members) as
+    a Program of one structure: its outputs × members."""
+    dest = np.arange(outputs * columns.shape[1]).reshape(outputs, -1)
+    out = np.full(dest.size, np.nan)
+    tape.Program([(taped, columns, len(values), fixed, dest)])(time, q, qd, p, np.ravel(values), out)
+    return out.reshape(dest.shape)
 
 
 @pytest.mark.parametrize("form", range(len(FORMS)))
@@ -87,14 +93,14 @@ def test_a_models_structures_on_the_tape_equal_them_compiled_alone(path):
     q0, qd0 = model.initial_state()
     data = model.data("compiled")
     data.constraint_arrays(0.0, q0, qd0)
-    groups = data.evaluator.rows.layout[1]
+    groups, _ = data.evaluator.rows.groups()
     assert groups
     for group in groups:
         args, forms = group.raw.structure()
         alone = structures.load(structures.source(args, forms), prefix="mbsynth_structure").evaluate
-        values = group._gathered(0.0, q0, qd0, data.parameter_values) if group.picks is not None else group.values
-        taped, compiled = np.empty(group.dest.shape), np.empty(group.dest.shape)
-        tape.run(*tape.tape(args, forms), 0.0, q0, qd0, data.parameter_values, group.columns, values, group.fixed,
-                 taped)
+        values = group.stacked_values(0.0, q0, qd0, data.parameter_values)
+        compiled = np.empty(group.dest.shape)
+        taped = evaluate_one(tape.tape(args, forms), len(forms), 0.0, q0, qd0, data.parameter_values,
+                             group.columns, values, group.fixed)
         alone(0.0, q0, qd0, data.parameter_values, group.columns, values, group.fixed, compiled)
         assert np.allclose(taped, compiled, rtol=1e-13, atol=1e-13, equal_nan=True)
