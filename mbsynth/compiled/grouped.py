@@ -157,7 +157,7 @@ class _Group:
         # parameters once per read-only parameter array (_with_parameters), the others per call
         self.picks = None
         self.values = first.values
-        self.reads = set(getattr(first.values, "reads", range(PARAMETERS + 1)))
+        self.reads = getattr(first.values, "reads", None)  # lambdified (derive._values); gathered: below
         if hasattr(first.values, "picks"):
             self.values = np.ascontiguousarray(np.array([f.values.fixed for f in functions], dtype=float).T)
             picks = _picks(first.values.picks, [f.values.picks for f in functions], self.columns)
@@ -179,7 +179,7 @@ class _Group:
     def stacked_values(self, t, q, qd, p):
         """The members' constants at (t, q, q̇, p): rows × members."""
         if self.picks is None:
-            return _stacked(self.values(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
+            return _stacked(self.values.listed(t, q[self.columns], qd[self.columns], p), self.dest.shape[1])
         return self._gathered(t, q, qd, p)
 
     def _gathered(self, t, q, qd, p):

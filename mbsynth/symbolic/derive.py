@@ -565,7 +565,7 @@ def _values(args, values, picks=()):
     (k, argument a, position i or None) of the arguments (``picks``: where symbols read from
     an argument given whole stand) where that is all they are, else lambdified (its
     ``reads``: the positions of the arguments the values read; grouped.py keeps values that
-    read the parameters alone)."""
+    read the parameters alone; ``listed``: the values as a list)."""
     where = _positions_in(args, picks)
     if all(v.is_Number or v in where for v in values):  # numbers, and arguments (a joint's effort τ)
         fixed = np.array([_as_double(v) if v.is_Number else 0.0 for v in values], dtype=float)
@@ -600,6 +600,7 @@ def _values(args, values, picks=()):
     def evaluated(*given):
         return np.asarray(raw(*given), dtype=float)
     evaluated.reads = {where[s][0] for v in values for s in v.free_symbols if s in where}
+    evaluated.listed = raw  # each value alone, a number or an array: grouped.py stacks them
     return evaluated
 
 

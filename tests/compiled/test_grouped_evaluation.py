@@ -142,3 +142,31 @@ def test_each_parameter_array_is_read_for_itself_by_the_shared_groups():
         Q = expected(writeable)
         assert np.abs(stacked(writeable) - Q).max() <= 1e-12 * np.abs(Q).max()
     assert not np.allclose(expected(first.parameter_values), expected(second.parameter_values))
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_constants_that_read_the_state_are_put_in_at_every_call(compiled):
+    """Eight functions of one structure whose constants read t, a coordinate and a parameter
+    (one read-only parameter array, kept between calls where only it is read): the Batch's
+    outputs at three states equal each function called alone, on the tape and on numpy."""
+    import sympy as sp
+    from mbsynth.compiled.grouped import Batch
+    from mbsynth.core.values import read_only
+    from mbsynth.symbolic.cache import placeholder
+    from mbsynth.symbolic.derive import compile_function
+    t, k = sp.symbols("t k")
+    x, y, xd, yd = sp.symbols("x y xd yd")
+    c0, c1 = placeholder("c0"), placeholder("c1")
+    args = (t, [x, y], [xd, yd], [k])
+    form = [sp.Matrix([c0 * x + c1 * yd, c0 * c1])]
+    functions = [compile_function(args, form, constants=[(c0, sp.sin(t) + x ** 2), (c1, 3 * k)]) for _ in range(8)]
+    indices = [np.array([i, (i + 3) % 8]) for i in range(8)]
+    batch = Batch(functions, indices, 1, compiled)
+    p = read_only(np.array([0.7]))
+    for t0 in (0.0, 0.4, 1.3):
+        q, qd = RNG.normal(size=8), RNG.normal(size=8)
+        (got,) = batch(t0, q, qd, p)
+        want = np.concatenate([np.ravel(f(t0, q[i], qd[i], p)[0]) for f, i in zip(functions, indices)])
+        assert np.allclose(got, want, rtol=1e-14, atol=1e-14)
+    groups, singles = batch.groups()
+    assert len(groups) == 1 and not singles
