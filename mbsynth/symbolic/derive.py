@@ -19,6 +19,7 @@ import numpy as np
 import sympy as sp
 
 from .cache import Unstable, fingerprint, placeholder, remembered, remembered_function
+from .dag import Replacing, atoms_of, replaced
 from ..core.memo import MEMO
 from ..core.values import frozen
 
@@ -125,7 +126,7 @@ def jacobian(exprs, symbols):
     exprs, symbols = [sp.sympify(e) for e in exprs], list(symbols)
     out = sp.zeros(len(exprs), len(symbols))
     for i, e in enumerate(exprs):
-        free = e.free_symbols
+        free = symbols_in([e])
         for j, s in enumerate(symbols):
             if s in free:
                 out[i, j] = e.diff(s)
@@ -148,13 +149,13 @@ class JointValue(sp.Dummy):
 
 def joint_values_in(expr):
     """The JointValue symbols of ``expr``."""
-    return [s for s in sp.sympify(expr).free_symbols if isinstance(s, JointValue)]
+    return [s for s in symbols_in([expr]) if isinstance(s, JointValue)]
 
 
 def expand_joint_values(expr):
     """``expr`` with its JointValue symbols replaced by their values."""
     found = joint_values_in(expr)
-    return sp.sympify(expr).xreplace({s: s.value for s in found}) if found else expr
+    return replaced([sp.sympify(expr)], {s: s.value for s in found})[0] if found else expr
 
 
 def turn_residual(phi):
@@ -216,16 +217,21 @@ _PLAIN = sp.Symbol("x").assumptions0
 _PICKED = Slots("p")  # the parameters a compiled function reads from its whole parameter argument
 
 
-def _numbers(expr, found):
+def _numbers(expr, found, seen=None):
     """The non-integer numbers of ``expr`` into the dict ``found``, in preorder, numeric
-    exponents left alone (x**2, sqrt)."""
+    exponents left alone (x**2, sqrt); ``seen``: the subexpressions walked already (each
+    walked once, in the order of its first occurrence)."""
+    seen = set() if seen is None else seen
+    if id(expr) in seen:
+        return
+    seen.add(id(expr))
     if expr.is_Number:
         if expr.is_Float or (expr.is_Rational and not expr.is_Integer):  # not nan, oo
             found.setdefault(expr, None)
         return
     args = expr.args[:1] if expr.is_Pow and expr.exp.is_Number else expr.args
     for arg in args:
-        _numbers(arg, found)
+        _numbers(arg, found, seen)
 
 
 def canonical(exprs, symbols):
@@ -233,12 +239,12 @@ def canonical(exprs, symbols):
     positional placeholders and each distinct non-integer number a placeholder ``k_i``.
     Two expressions with equal placeholder forms have the same structure, whatever the
     names of their symbols and the values of their numbers."""
-    found = {}
+    found, seen = {}, set()
     for e in exprs:
-        _numbers(e, found)
+        _numbers(e, found, seen)
     forward = {s: _ARGUMENT[i] for i, s in enumerate(symbols)}
     forward.update({x: _NUMBER[i] for i, x in enumerate(found)})
-    return tuple(e.xreplace(forward) for e in exprs), tuple(found)
+    return tuple(replaced(exprs, forward)), tuple(found)
 
 
 def differentiated(exprs, q, qd, t=T_SYMBOL):
@@ -255,13 +261,12 @@ def differentiated(exprs, q, qd, t=T_SYMBOL):
     back = dict(constants)
     back.update(zip(slots[0], (q[i] for i in involved)))
     back.update(zip(slots[1], (qd[i] for i in involved)))
-    entries = {}
+    entries, put = {}, Replacing(back)
     for r, row in enumerate(a):
         for j, entry in enumerate(row):
             if entry != 0:
-                entries[r, involved[j]] = entry.xreplace(back)
-    return (sp.SparseMatrix(len(exprs), len(q), entries), [x.xreplace(back) for x in b],
-            [x.xreplace(back) for x in psi])
+                entries[r, involved[j]] = put(entry)
+    return sp.SparseMatrix(len(exprs), len(q), entries), [put(x) for x in b], [put(x) for x in psi]
 
 
 def differentiated_template(exprs, q, qd, t=T_SYMBOL):
@@ -271,7 +276,7 @@ def differentiated_template(exprs, q, qd, t=T_SYMBOL):
     involved, the parameters (constants: (slot, symbol)) and the numbers (constants:
     (slot, number)). Constraints alike but for their symbols and numbers share it."""
     where = positions(q, qd)
-    free = set().union(*(e.free_symbols for e in exprs))
+    free = symbols_in(exprs)
     involved = sorted({where[s] for s in free if s in where})
     others = sorted((s for s in free if s not in where and s != t and _plain(s)), key=str)  # parameters
     count = len(involved)
@@ -330,7 +335,7 @@ def differentiate(phi, q, qd, t=T_SYMBOL):
     a = ∂ψ/∂q̇ and b = −(∂ψ/∂q) q̇ − ∂ψ/∂t (plus the chain rule through JointValue
     symbols, whose rates are exact on the manifold).
     """
-    velocity_level = bool(set(qd) & phi.free_symbols)
+    velocity_level = bool(set(qd) & symbols_in([phi]))
     psi = phi if velocity_level else time_derivative(phi, q, qd, t)
     a = jacobian([psi], qd)
     chain = sum((sp.diff(psi, s) * s.rate for s in joint_values_in(psi)), sp.S.Zero)  # JointValue symbols
@@ -351,10 +356,11 @@ def differentiate_through(phi, values, q, qd, t=T_SYMBOL):
     put = dict(values)
     put.update({_RATE[k]: row[2] for k, row in enumerate(rows)})
     conditions, branches = _chain_forms(sp.piecewise_fold(sp.sympify(phi)), x)
-    conditions = None if conditions is None else [c.xreplace(put) for c in conditions]
+    put = Replacing(put)  # one walk of the subexpressions the branches share
+    conditions = None if conditions is None else [put(c) for c in conditions]
 
     def pick(parts):
-        parts = [part.xreplace(put) for part in parts]
+        parts = [put(part) for part in parts]
         return parts[0] if conditions is None else sp.Piecewise(*zip(parts, conditions), evaluate=False)
     gradient = [pick([g[k] for g, _ in branches]) for k in range(len(x))]
     entries = {}
@@ -374,7 +380,7 @@ def _chain_forms(phi, x):
     branches = []
     for expr, _ in pieces:
         gradient = [sp.diff(expr, s) for s in x]
-        free = expr.free_symbols
+        free = symbols_in([expr])
         quadratic = sp.S.Zero
         for k, g in enumerate(gradient):
             for j in range(k + 1):
@@ -448,7 +454,7 @@ def _picking(args, position, flat, constants):
     forward = {s: _PICKED[i] for i, s in enumerate(used)}
     constants = tuple(constants) + tuple((slot, s) for s, slot in forward.items())
     return (tuple(args[:position]) + (_WHOLE,) + tuple(args[position + 1:]),
-            [x.xreplace(forward) for x in flat] if forward else flat, constants,
+            replaced(flat, forward) if forward else flat, constants,
             tuple((v, (position, index[v])) for _, v in constants if v in index))
 
 
@@ -629,7 +635,7 @@ def _positional(args, forms):
         return x
 
     named = rename(tuple(args), ())
-    return named, [sp.sympify(f).xreplace(names) for f in forms]
+    return named, replaced([sp.sympify(f) for f in forms], names)
 
 
 def _frozen(args):
@@ -656,5 +662,6 @@ def beyond_double_as_inf(expr):
     """``expr`` with exact numbers beyond the double range (a mass of 1e308 times g = 1e308)
     replaced by ±inf, as float arithmetic would give, instead of an OverflowError when
     evaluated; the non-finite result is then reported by the checks of M, Q, A, b."""
-    huge = {x: sp.sign(x) * sp.oo for x in sp.sympify(expr).atoms(sp.Rational) if abs(x) > _LARGEST}
-    return sp.sympify(expr).xreplace(huge) if huge else expr
+    expr = sp.sympify(expr)
+    huge = {x: sp.sign(x) * sp.oo for x in atoms_of([expr], sp.Rational) if abs(x) > _LARGEST}
+    return replaced([expr], huge)[0] if huge else expr
