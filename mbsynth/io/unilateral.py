@@ -14,6 +14,7 @@ from ..model.parts.base import frame_velocity
 from ..model.segments import between_segments, to_segment
 from ..model.unilateral import Unilateral, gap_row, tangent_basis
 from ..symbolic.cache import placeholder
+from ..symbolic.dag import Replacing
 from .joints import frame_reference
 
 CONTACT_KINDS = {"plane": "contact_plane", "spheres": "contact_spheres"}  # contact type -> schema section
@@ -224,7 +225,8 @@ def _spheres_gap(builder, spec, path):
     else:
         distance = sp.sqrt((p_b - p_a).dot(p_b - p_a))
     unit = (p_b - p_a) / sp.sqrt((p_b - p_a).dot(p_b - p_a))
-    return distance - r_a - r_b, (p_a + r_a * unit).xreplace(through), unit.xreplace(through), through or None
+    put = Replacing(through)  # the nearest points share their subexpressions
+    return distance - r_a - r_b, (p_a + r_a * unit).applyfunc(put), unit.applyfunc(put), through or None
 
 
 def _standing_for(column, through):

@@ -531,7 +531,8 @@ def _lambdified(digest, structure):
     workers, a file checked then simulated) reuse it."""
     def derive():
         args, forms = _positional(*structure())
-        return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True)
+        return sp.lambdify(args, [beyond_double_as_inf(x) for x in forms], modules=[_FLOAT64, "numpy"], cse=True,
+                           use_imps=False)  # no implemented_function here: its search walks the whole tree
 
     def make():
         raw = derive() if digest is None else remembered_function("lambdified", digest, derive)
@@ -599,7 +600,7 @@ def _values(args, values, picks=()):
 
     def derive():
         named, forms = _positional(args, values)
-        return sp.lambdify(named, [beyond_double_as_inf(v) for v in forms], modules=[_FLOAT64, "numpy"])
+        return sp.lambdify(named, [beyond_double_as_inf(v) for v in forms], modules=[_FLOAT64, "numpy"], use_imps=False)
 
     raw = remembered_function("values", (args, values), derive)
 
