@@ -286,6 +286,7 @@ class Data:
         system = self.system
         # no copy of states already in float64 rows (a copy of a large batch costs page faults, serially)
         q, qd = (np.atleast_2d(np.ascontiguousarray(x, dtype=float)) for x in (q_batch, qd_batch))
+        q, qd = (x if x.flags.writeable else x.copy() for x in (q, qd))  # the kernels' arrays are writeable
         if q.ndim != 2 or q.shape != qd.shape or q.shape[1] != system.n:
             raise ValueError(f"model '{system.name}' has {system.n} coordinates: q_batch and qd_batch must both "
                              f"have shape (B, {system.n}), got {q.shape} and {qd.shape}")

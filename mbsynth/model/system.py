@@ -362,12 +362,15 @@ class System:
                        appended_balances=self.appended_balances + tuple(balances))
 
     def _state(self, q, qd):
-        """(q, q̇) as 1-d contiguous float arrays of n entries (the arrays given, where they
-        are such: no copy), or ValueError naming the shapes."""
+        """(q, q̇) as 1-d contiguous, writeable float arrays of n entries (the arrays given,
+        where they are such: no copy), or ValueError naming the shapes. A read-only array (a
+        model's ``initial_q``) is copied: the compiled kernels are compiled for writeable
+        arrays, and numba would compile them again, for a minute, for read-only ones."""
         if (type(q) is np.ndarray and type(qd) is np.ndarray and q.dtype is FLOAT and qd.dtype is FLOAT
-                and q.shape == qd.shape == (self.n,) and q.flags.c_contiguous and qd.flags.c_contiguous):
+                and q.shape == qd.shape == (self.n,) and q.flags.c_contiguous and qd.flags.c_contiguous
+                and q.flags.writeable and qd.flags.writeable):
             return q, qd  # an integrator's or a controller's own arrays, every call
-        q, qd = np.asarray(q, dtype=float).ravel(), np.asarray(qd, dtype=float).ravel()
+        q, qd = np.array(q, dtype=float).ravel(), np.array(qd, dtype=float).ravel()
         if q.shape != (self.n,) or qd.shape != (self.n,):
             raise ValueError(f"model '{self.name}' has {self.n} coordinates; got q of shape "
                              f"{q.shape} and qd of shape {qd.shape}")

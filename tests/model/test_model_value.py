@@ -111,6 +111,28 @@ def test_a_state_is_taken_as_given_or_as_an_array_of_n():
         model.motion(0.1, q[1:], qd)
 
 
+
+def test_a_read_only_state_is_copied_and_compiles_nothing_more():
+    """A model's own ``initial_q`` is read-only (the model is a value): given as the state
+    of motion() and motion_batch(), the compiled kernels see a writeable copy, so numba
+    compiles no second, read-only specialization of them (a minute on a new machine), and
+    the motion equals that of a writeable copy."""
+    import numba
+    from mbsynth.compiled import kernel
+    model = mb.from_robot("ur5")
+    q, qd = model.initial_q, np.zeros(model.n)
+    qd.flags.writeable = False
+    assert not q.flags.writeable
+    expected = model.motion(0.0, q.copy(), qd.copy()).qdd
+    np.testing.assert_array_equal(model.motion(0.0, q, qd).qdd, expected)
+    np.testing.assert_array_equal(model.motion_batch(0.0, np.array([q]), np.array([qd]))[0][0], expected)
+    q_batch = np.array([q])
+    q_batch.flags.writeable = False
+    np.testing.assert_array_equal(model.motion_batch(0.0, q_batch, np.array([qd]))[0][0], expected)
+    for dispatcher in (kernel.motion, kernel.motion_rows):
+        assert all(argument.mutable for signature in dispatcher.signatures for argument in signature
+                   if isinstance(argument, numba.types.Array))
+
 def test_the_one_cache_can_be_emptied_without_changing_an_answer():
     model = mb.load(FOUR_BAR)
     q, qd = model.initial_state()
