@@ -39,8 +39,6 @@ def evaluate(t, q, qd, p, columns, values, fixed, out):
     for m in range(columns.shape[1]):
 '''
 
-SIGNATURE = ("(float64, float64[::1], float64[::1], float64[::1], int64[:, ::1], float64[:, ::1], "
-             "float64[:, ::1], float64[:, ::1])")
 _lock = threading.Lock()
 UNSET = "unset"  # a raw function's ``kernel`` before its build
 
@@ -67,7 +65,7 @@ def _build(raw):
         log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
     try:
         evaluate = load(source(args, forms), prefix="mbsynth_structure").evaluate
-        evaluate.compile(SIGNATURE)  # here, not at the first call
+        evaluate.compile(_signature())  # here, not at the first call
     except Exception as err:  # noqa: BLE001 - numpy serves
         log.warning("a constraint structure stays on numpy (%s: %s)", type(err).__name__, err)
         return None
@@ -86,3 +84,12 @@ def source(args, forms):
     reads.update({s: f"fixed[{j}, m]" for j, s in enumerate(numbers)})
     body = assignments([beyond_double_as_inf(e) for e in forms], reads, "out[{}, m]", "        ")
     return HEADER.format(count=len(forms)) + body + "\n"
+
+
+def _signature():
+    """``evaluate``'s argument types as a Data calls it: its parameter values read-only
+    (data.py), the rest writeable (numba compiles a function again for each)."""
+    from numba import types
+    column, table = types.float64[::1], types.float64[:, ::1]
+    return (types.float64, column, column, types.Array(types.float64, 1, "C", readonly=True), types.int64[:, ::1],
+            table, table, table)

@@ -104,3 +104,28 @@ def test_a_models_structures_on_the_tape_equal_them_compiled_alone(path):
                              group.columns, values, group.fixed)
         alone(0.0, q0, qd0, data.parameter_values, group.columns, values, group.fixed, compiled)
         assert np.allclose(taped, compiled, rtol=1e-13, atol=1e-13, equal_nan=True)
+
+
+def test_a_structure_the_tape_does_not_know_is_compiled_on_its_own_once():
+    """Three functions of a structure holding Γ (no tape operation): grouped on the
+    structure's own compiled function, their values those of math.gamma, and that
+    function compiled once, for the read-only parameter array a Data passes (numba
+    compiles a function again for each kind of array)."""
+    import math
+    from mbsynth.compiled.grouped import Batch
+    from mbsynth.core.values import read_only
+    from mbsynth.symbolic.derive import compile_function
+    t, k = sp.Symbol("t"), sp.Symbol("k")
+    x, y, xd, yd = sp.symbols("x y xd yd")
+    functions = [compile_function((t, [x, y], [xd, yd], [k]), [sp.Matrix([sp.gamma(x ** 2 + 1) * k + yd])])
+                 for _ in range(3)]
+    indices = [np.array([i, i + 3]) for i in range(3)]
+    batch = Batch(functions, indices, 1, True)
+    p = read_only(np.array([0.7]))
+    q, qd = np.linspace(0.1, 0.9, 6), np.linspace(-1.0, 1.0, 6)
+    for _ in range(2):  # the first call lays the groups out, the second runs them
+        (got,) = batch(0.2, q, qd, p)
+    want = [math.gamma(q[i] ** 2 + 1) * 0.7 + qd[i + 3] for i in range(3)]
+    assert np.allclose(got, want, rtol=1e-14, atol=0)
+    (group,), singles = batch.groups()
+    assert not singles and callable(group.kernel) and len(group.kernel.signatures) == 1
