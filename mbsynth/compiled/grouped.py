@@ -82,7 +82,9 @@ class Batch:
                 if found is not None and not callable(found):  # a tape.Taped
                     taped.append((group, found))
                     continue
-                group.kernel = found if found is not None and group.runs(t, q, qd, p) else None
+                group.kernel = found
+                if found is not None and group.attempt(t, q, qd, p) is None:
+                    group.kernel = None  # it raises: numpy serves
                 if group.kernel is None and not group.reproduces(t, q, qd, p, expected):
                     group = None
             if group is None:
@@ -226,24 +228,20 @@ class _Group:
             result[others] = np.array(get_others(out), dtype=float)[:, None]
         return result
 
-    def runs(self, t, q, qd, p):
-        """Whether this group's call returns (its own kernel: compiled for other arguments raises)."""
+    def attempt(self, t, q, qd, p):
+        """This group's call, or None where it raises (its own kernel compiled for other
+        arguments, a raw function that does not broadcast)."""
         try:
             with np.errstate(all="ignore"):
-                self(t, q, qd, p)
-        except Exception:  # noqa: BLE001 - numpy serves
-            return False
-        return True
+                return self(t, q, qd, p)
+        except Exception:  # noqa: BLE001 - the functions are then called one by one
+            return None
 
     def reproduces(self, t, q, qd, p, expected):
         """Whether this group's call gives the single calls' outputs ``expected`` (its
-        places in them): a raw function that does not broadcast does not."""
-        try:
-            with np.errstate(all="ignore"):
-                got = self(t, q, qd, p)
-        except Exception:  # noqa: BLE001 - a raw function that does not broadcast is called singly
-            return False
-        return stacked_agrees(got, expected[self.dest])
+        places in them)."""
+        got = self.attempt(t, q, qd, p)
+        return got is not None and stacked_agrees(got, expected[self.dest])
 
 
 def _picks(first, every, columns):

@@ -74,35 +74,28 @@ class Program:
     (``value_slices`` says where each lies)."""
 
     def __init__(self, groups):
-        plan, batches, operands, numbers, columns, fixed, dest = [], [], [], [], [], [], []
-        at = dict.fromkeys(("batch", "operand", "number", "column", "value", "fixed", "dest"), 0)
-        self.value_slices = []
-        for taped, cols, rows, fix, where in groups:
-            members = where.shape[1]
-            plan.append((at["batch"], at["batch"] + len(taped.batches), members, at["column"], at["value"],
-                         at["fixed"], at["number"], at["dest"]))
-            shifted = taped.batches.copy()
-            shifted[:, 1:] += at["operand"]
-            batches.append(shifted)
-            operands.append(taped.operands)
-            numbers.append(taped.numbers)
-            columns.append(np.ravel(cols))
-            fixed.append(np.ravel(fix))
-            dest.append(np.ravel(where))
-            self.value_slices.append(slice(at["value"], at["value"] + rows * members))
-            for name, size in (("batch", len(taped.batches)), ("operand", taped.operands.shape[1]),
-                               ("number", len(taped.numbers)), ("column", np.size(cols)), ("value", rows * members),
-                               ("fixed", np.size(fix)), ("dest", np.size(where))):
-                at[name] += size
-        self.values_size = at["value"]
+        tapes = [taped for taped, *_ in groups]
+        members = [where.shape[1] for *_, where in groups]
+        # per structure, how much of each flat array it takes; where it starts is the sum of those before
+        sizes = np.array([(len(taped.batches), taped.operands.shape[1], len(taped.numbers), np.size(cols),
+                           rows * n, np.size(fix), np.size(where))
+                          for (taped, cols, rows, fix, where), n in zip(groups, members)], dtype=np.int64).reshape(-1, 7)
+        starts = np.cumsum(sizes, axis=0) - sizes
+        batch, operand, number, column, value, fix_at, dest_at = starts.T
+        plan = np.column_stack([batch, batch + sizes[:, 0], members, column, value, fix_at, number, dest_at])
+        self.value_slices = [slice(a, a + size) for a, size in zip(value.tolist(), sizes[:, 4].tolist())]
+        self.values_size = int(sizes[:, 4].sum())
+        shifted = [taped.batches + np.array([0, k, k]) for taped, k in zip(tapes, operand.tolist())]
 
         def joined(arrays, dtype):
-            return np.ascontiguousarray(np.concatenate([np.zeros(0, dtype)] + arrays), dtype)
+            return np.ascontiguousarray(np.concatenate([np.zeros(0, dtype)] + [np.ravel(x) for x in arrays]), dtype)
         self.call = functools.partial(
-            run, np.array(plan, dtype=np.uint64).reshape(-1, 8), np.concatenate([np.zeros((0, 3), np.int64)] + batches),
-            np.ascontiguousarray(np.concatenate([np.zeros((4, 0), np.uint64)] + operands, axis=1)),
-            joined(numbers, float), max([taped.size for taped, *_ in groups], default=1),
-            joined(columns, np.uint64), joined(fixed, float), joined(dest, np.uint64))
+            run, np.ascontiguousarray(plan, dtype=np.uint64).reshape(-1, 8),
+            np.concatenate([np.zeros((0, 3), np.int64)] + shifted),
+            np.ascontiguousarray(np.concatenate([np.zeros((4, 0), np.uint64)] + [t.operands for t in tapes], axis=1)),
+            joined([t.numbers for t in tapes], float), max([t.size for t in tapes], default=1),
+            joined([cols for _, cols, *_ in groups], np.uint64), joined([fix for *_, fix, _ in groups], float),
+            joined([where for *_, where in groups], np.uint64))
 
     def __call__(self, t, q, qd, p, values, out):
         self.call(t, q, qd, p, values, out)

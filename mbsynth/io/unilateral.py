@@ -14,7 +14,7 @@ from ..model.parts.base import frame_velocity
 from ..model.segments import between_segments, to_segment
 from ..model.unilateral import Unilateral, gap_row, tangent_basis
 from ..symbolic.cache import placeholder
-from ..symbolic.dag import Replacing
+from ..symbolic.dag import Replacing, replaced, symbols_in
 from .joints import frame_reference
 
 CONTACT_KINDS = {"plane": "contact_plane", "spheres": "contact_spheres"}  # contact type -> schema section
@@ -116,8 +116,8 @@ def read_contacts(builder):
 def _row(builder, path, name, gap, through=None):
     """The gap's row (model/unilateral.gap_row); the contact at ``path`` is refused where its
     gap changes with no coordinate (it could never touch or leave)."""
-    in_coordinates = gap if through is None else gap.xreplace(through)
-    if not in_coordinates.free_symbols & set(builder.q):
+    in_coordinates = gap if through is None else replaced([gap], through)[0]
+    if not symbols_in([in_coordinates]) & set(builder.q):
         builder.fail(path, f"contact '{name}': its gap {in_coordinates} changes with no coordinate, so it can never "
                            "touch or leave (a normal across its part's plane of motion?)")
     return gap_row(builder.full_name(name), gap, builder.q, builder.qd, builder.parameter_symbols, through)

@@ -365,7 +365,7 @@ class System:
         """(q, q̇) as 1-d contiguous, writeable float arrays of n entries (the arrays given,
         where they are such: no copy), or ValueError naming the shapes. A read-only array (a
         model's ``initial_q``) is copied: the compiled kernels are compiled for writeable
-        arrays, and numba would compile them again, for a minute, for read-only ones."""
+        arrays, and numba would compile them all again for read-only ones."""
         if (type(q) is np.ndarray and type(qd) is np.ndarray and q.dtype is FLOAT and qd.dtype is FLOAT
                 and q.shape == qd.shape == (self.n,) and q.flags.c_contiguous and qd.flags.c_contiguous
                 and q.flags.writeable and qd.flags.writeable):

@@ -8,7 +8,7 @@ proportional to the tree, not to what is stored. These give the same results, vi
 each distinct subexpression once.
 """
 
-from sympy import Basic, Piecewise
+from sympy import Basic, Piecewise, Symbol, sympify
 
 
 class Replacing:
@@ -45,14 +45,20 @@ def replaced(exprs, mapping):
 
 def atoms_of(exprs, kind):
     """The subexpressions of ``exprs`` that are instances of ``kind`` (``atoms``), each
-    distinct subexpression visited once."""
+    stored subexpression visited once."""
     seen, found, stack = set(), set(), [e for e in exprs if isinstance(e, Basic)]
     while stack:
         expr = stack.pop()
-        if expr in seen:
+        if id(expr) in seen:
             continue
-        seen.add(expr)
+        seen.add(id(expr))
         if isinstance(expr, kind):
             found.add(expr)
         stack.extend(a for a in expr.args if isinstance(a, Basic))
     return found
+
+
+def symbols_in(exprs):
+    """The symbols in ``exprs``, as ``free_symbols`` gives them for expressions without
+    bound variables (derivatives, which share subexpressions)."""
+    return atoms_of([sympify(e) for e in exprs], Symbol)

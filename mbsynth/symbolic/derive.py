@@ -19,7 +19,7 @@ import numpy as np
 import sympy as sp
 
 from .cache import Unstable, fingerprint, placeholder, remembered, remembered_function
-from .dag import Replacing, atoms_of, replaced
+from .dag import Replacing, atoms_of, replaced, symbols_in
 from ..core.memo import MEMO
 from ..core.values import frozen
 
@@ -388,22 +388,6 @@ def _chain_forms(phi, x):
                     quadratic += (1 if j == k else 2) * sp.diff(g, x[j]) * _RATE[j] * _RATE[k]
         branches.append((gradient, quadratic))
     return (tuple(c for _, c in pieces) if isinstance(phi, sp.Piecewise) else None), tuple(branches)
-
-
-def symbols_in(exprs):
-    """The symbols in ``exprs``, as ``free_symbols`` gives them for expressions without
-    bound variables (derivatives, which share subexpressions): each object visited once,
-    where free_symbols walks a shared subexpression at every use (a joint's rows share many)."""
-    seen, found, stack = set(), set(), [sp.sympify(e) for e in exprs]
-    while stack:
-        expr = stack.pop()
-        if id(expr) not in seen:
-            seen.add(id(expr))
-            if expr.is_Symbol:
-                found.add(expr)
-            else:
-                stack.extend(expr.args)
-    return found
 
 
 def compile_function(args, exprs, constants=(), dtype=float, picked=None):

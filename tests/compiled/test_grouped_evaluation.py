@@ -148,7 +148,8 @@ def test_each_parameter_array_is_read_for_itself_by_the_shared_groups():
 def test_constants_that_read_the_state_are_put_in_at_every_call(compiled):
     """Eight functions of one structure whose constants read t, a coordinate and a parameter
     (one read-only parameter array, kept between calls where only it is read): the Batch's
-    outputs at three states equal each function called alone, on the tape and on numpy."""
+    outputs at three states equal their closed form and each function called alone, on the
+    tape and on numpy."""
     import sympy as sp
     from mbsynth.compiled.grouped import Batch
     from mbsynth.core.values import read_only
@@ -166,7 +167,10 @@ def test_constants_that_read_the_state_are_put_in_at_every_call(compiled):
     for t0 in (0.0, 0.4, 1.3):
         q, qd = RNG.normal(size=8), RNG.normal(size=8)
         (got,) = batch(t0, q, qd, p)
-        want = np.concatenate([np.ravel(f(t0, q[i], qd[i], p)[0]) for f, i in zip(functions, indices)])
+        c0, c1 = np.sin(t0) + q[:8] ** 2, 3 * 0.7  # each member's constants, its x the coordinate i
+        want = np.ravel([[a * q[i] + c1 * qd[(i + 3) % 8], a * c1] for i, a in enumerate(c0)])
         assert np.allclose(got, want, rtol=1e-14, atol=1e-14)
+        alone = np.concatenate([np.ravel(f(t0, q[i], qd[i], p)[0]) for f, i in zip(functions, indices)])
+        assert np.allclose(got, alone, rtol=1e-14, atol=1e-14)
     groups, singles = batch.groups()
     assert len(groups) == 1 and not singles
