@@ -79,9 +79,9 @@ def best(f, count):
             f()
         rounds.append((time.perf_counter() - started) / count * 1e6)
     return min(rounds)
-assert engine.derivative(0.0, y) is not None
+assert engine.stages().rates(0.0, y) is not None
 print(best(lambda: flexible.equations(q[:n], qd[:n], g, *arrays, M, Q, Mnu, nu), 20000),
-      best(lambda: engine.motion(0.0, q, qd), 5000), best(lambda: engine.derivative(0.0, y), 5000))
+      best(lambda: engine.motion(0.0, q, qd), 5000), best(lambda: engine.stages().rates(0.0, y), 5000))
 """
 
 
@@ -181,7 +181,7 @@ def main():
                                                       capture_output=True, text=True).stdout.split())
     lines += ["", "Per call on benchmarks/flexible.py's pinned pendulum (8 modes, 15 coordinates), best of 7 rounds: "
               f"the part's kernel (compiled/flexible.py `equations`, M and Q) {kernel:.1f} µs; `Engine.motion` "
-              f"(the compiled path's motion(), the part's kernel included) {motion:.1f} µs; `Engine.derivative` "
+              f"(the compiled path's motion(), the part's kernel included) {motion:.1f} µs; `Stages.rates` "
               f"(an integrator's stage, off the manifold) {stage:.1f} µs."]
     text = "\n".join(lines) + "\n"
     print(text)

@@ -8,8 +8,8 @@ Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
 - the layers from Python: ``System.motion`` (finds the model's default Data), ``Data.motion``
   (checks the state, picks the path), ``Engine.motion`` (compiled/engine.py: the generated
   function, the kernel, the ``Motion``), the Engine's lean entry for an integrator's stage
-  (``Engine.derivative`` as ``simulate``'s stages call it: ẏ in the integrator's form,
-  analysis/velocity_form.py), and ``kernel.motion`` called alone from Python;
+  (``Stages.rates`` of compiled/staged.py as ``simulate``'s stages call it: ẏ in the
+  integrator's form, analysis/velocity_form.py), and ``kernel.motion`` called alone from Python;
 - the Python → numba call alone: an empty njit function with kernel.motion's argument count,
   called with the same arguments, and the generated function's own call (codegen.py);
 - the ``Motion`` made from the kernel's results (core/equations.py) and the per-call check
@@ -198,7 +198,8 @@ def robot(name, floating, loops, empty, args_rounds):
     assert motion.method == "tree (Baraff)", motion.method
     engine = data.engine
     a = pin.aba(twin.model, twin.data, q, v, tau)
-    state, starts = np.concatenate([qm, qdm]), VelocityForm(system).starts  # a stage as simulate hands it over
+    form = VelocityForm(system)
+    y, stages = form.to_integrator(qm, qdm), engine.stages(form.starts)  # a stage as simulate hands it over
     args = (qm, qdm, engine.gen, EMPTY, *engine.buffers, engine.mode, -1.0, engine.general)  # as motion() calls it
     checked = (*args[:-3], kernel.CHECKED, *args[-2:])  # the stages: the residual check runs too
     W = engine.W
@@ -208,7 +209,7 @@ def robot(name, floating, loops, empty, args_rounds):
         "System.motion": lambda: system.motion(0.0, qm, qdm),
         "Data.motion": lambda: data.motion(0.0, qm, qdm),
         "Engine.motion": lambda: engine.motion(0.0, qm, qdm),
-        "Engine.derivative (the integrator's stage)": lambda: engine.derivative(0.0, state, starts),
+        "Stages.rates (the integrator's stage)": lambda: stages.rates(0.0, y),
         "kernel.motion from Python": lambda: kernel.motion(*args),
         f"empty njit call, {len(args)} arguments": lambda: empty(*args),
         "generated function (codegen)": (lambda: engine.module.evaluate(*gen_args)) if engine.module else None,

@@ -69,10 +69,10 @@ class StateDerivative:
     def use(self, engine):
         """Its motion from the Data's parameter values as they are now (new at a control
         sample), ``engine`` the compiled Engine serving the stages (Data.engine) or None."""
-        # the compiled engine's ẏ (Engine.derivative) where stage_motion would call it anyway: no Motion per stage
-        self.fast = None if engine is None or self.baumgarte is not None else engine.derivative
+        # the compiled engine's ẏ (compiled/staged.py) where stage_motion would call it anyway: no Motion per stage
+        self.staged = None if engine is None or self.baumgarte is not None else engine.stages(self.form.starts)
         # a stage the engine declined goes to the KKT path at once
-        self.stage_motion = self.data.stage_motion(self.baumgarte, drift=True, compiled=self.fast is None)
+        self.stage_motion = self.data.stage_motion(self.baumgarte, drift=True, compiled=self.staged is None)
 
     def begin(self, t, t_next, relaxed=False, may_crawl=True):
         """Count the evaluations from here: an interval from t to t_next; ``relaxed``: it is
@@ -86,29 +86,63 @@ class StateDerivative:
 
     def __call__(self, t, y):
         self.t_failed = t
-        self.calls += 1
-        self.evaluations += 1
         if self.on_manifold is not None:  # a step across a singular position (crossing.py)
             y = self._on_manifold(y)
-        if self.calls % COLLAPSE_CALLS == 0:
-            if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, STEP_RESOLUTION * abs(t)):
-                raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
-            self.t_mark = t
+        self._count(1, t, y)
         if self.angles and self.angles.nearest(y) < ANGLES_NEAR:
             self.angle_calls += 1
             if self.angle_calls > ANGLES_CRAWL_CALLS:
                 raise self._angles_crawl(t, y)
         rates = self._rates(t, y, True)
+        self._crawled(t, y)
+        return rates
+
+    def step(self, solver):
+        """One step of the DOP853 ``solver`` in compiled code (staged.Stages.step: its
+        ``_step_impl``'s result), its stages counted as ``__call__`` counts them; None where
+        the step is the Python path's: no compiled stages, a step across a singular position
+        (``on_manifold``), parts turned by angles (watched per stage), a stage the kernel
+        declined."""
+        if self.staged is None or self.on_manifold is not None or self.angles:
+            return None
+        self.t_failed = solver.t
+        taken, evaluations = self.staged.step(solver)
+        self._count(evaluations, solver.t, solver.y)
+        self._crawled(solver.t, solver.y)
+        return taken
+
+    def extra(self, solver):
+        """DOP853's extra stages of the solver's last step in compiled code, as far as the
+        kernel takes them (``step``'s conditions); returns how many."""
+        if self.staged is None or self.on_manifold is not None or self.angles:
+            return 0
+        done = self.staged.extra(solver, solver.K_extended, solver.n_stages + 1)
+        self._count(done, solver.t, solver.y)
+        return done
+
+    def _count(self, count, t, y):
+        """``count`` evaluations more, the last at (t, y); raise the step-size collapse's
+        SolveError where COLLAPSE_CALLS more of them moved t too little (module docstring)."""
+        before = self.calls
+        self.calls += count
+        self.evaluations += count
+        if self.calls // COLLAPSE_CALLS > before // COLLAPSE_CALLS:
+            if abs(t - self.t_mark) < max(COLLAPSE_SPAN * self.span, STEP_RESOLUTION * abs(t)):
+                raise self.collapse(t, y, f"{COLLAPSE_CALLS} evaluations moved t by {abs(t - self.t_mark):.3g}")
+            self.t_mark = t
+
+    def _crawled(self, t, y):
+        """Raise Crawl (or the stuck SolveError) where the interval's evaluations since its
+        first stage near a singular position exceed its allowance (module docstring)."""
         if self.singular_call is not None and self.calls - self.singular_call > self.crawl_calls:
             raise Crawl if self.may_crawl else self._stuck(t, y)
-        return rates
 
     def _rates(self, t, y, noted=False):
         """ẏ at the stage (t, y): the compiled engine's (in the integrator's form) where it
         covers the state (unique, far from singular), else the stage motion's, whose
         non-unique and singular stages are noted where ``noted``; NaN where y is beyond
         MAX_STATE."""
-        found = None if self.fast is None else self.fast(t, self.form.stage_state(y), self.form.starts)
+        found = None if self.staged is None else self.staged.rates(t, y)
         if found is not None:
             return found
         if not np.abs(y).max(initial=0.0) <= MAX_STATE:  # a stage of a trial step gone wild (NaN included):

@@ -334,10 +334,12 @@ class EventIntegration(ContinuousIntegration):
         falls to zero from above; from a touching start (g0 ≤ atol) moving apart, where g
         returns to g0 ((g − g0)/(t − t0), ġ0 at t0, changes sign); from a touching start at
         rest or closing, where it sinks atol below (there settle finds it). None where
-        the gap ends above where it started touching."""
+        the gap ends above where it started touching. A touching start counts as moving apart
+        where ġ0 would lift it by atol within the step: below that (the rounding of a state
+        at rest, ġ0 ~ 1e-24) it is at rest."""
         if g0 > self.atol:
             return _root(lambda t: self._gap_at(dense, i, t), t0, t1, g0, g1)
-        if gd0 > floor:
+        if gd0 > max(floor, self.atol / (t1 - t0)):
             if not g1 < min(g0, 0.0):
                 return None
             return _root(lambda t: (self._gap_at(dense, i, t) - g0) / (t - t0), t0, t1, gd0, (g1 - g0) / (t1 - t0))

@@ -94,8 +94,8 @@ class Integration:
         else:
             y = self.form.to_integrator(q, qd)
             jacobian = dict(jac=self.f.jacobian) if issubclass(self.method, stepper.IMPLICIT) else {}
-            solver = self.solver = self.method(self.f, t, y, t_bound, rtol=rtol, atol=atol, first_step=first,
-                                               **jacobian)
+            solver = self.solver = stepper.start(self.method, self.f, t, y, t_bound, rtol=rtol, atol=atol,
+                                                 first_step=first, **jacobian)
             self.solver_tolerances = (rtol, atol)
         self.forces_jumped = False
         return solver

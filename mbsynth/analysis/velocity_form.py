@@ -29,7 +29,7 @@ then views and copies, no per-body work.
 import numpy as np
 from numba import njit
 
-from ..compiled.bodies import velocities as _velocities
+from ..compiled.bodies import state_of as _state_of, velocities as _velocities
 
 
 class VelocityForm:
@@ -126,32 +126,10 @@ def _rates_into(y, state_rates, starts):
 def _state_into(y, starts, out):
     """(q, q̇) of y into ``out`` (2n)."""
     n = out.size // 2
-    _split_into(y, starts, out[:n], out[n:])
-
-
-@njit(cache=True)
-def _split_into(y, starts, q, qd):
-    """q and q̇ of y into ``q``, ``qd``: u̇ = E(u)ᵀ h per body, the other entries copied."""
-    n = q.size
-    q[:] = y[:n]
-    i, j = n, 0  # where y's v is read and q̇ written
-    for s in starts:
-        while j < s:
-            qd[j] = y[i]
-            i, j = i + 1, j + 1
-        w, x, yy, z = y[s], y[s + 1], y[s + 2], y[s + 3]
-        a, b, c = y[i], y[i + 1], y[i + 2]
-        qd[s] = -x * a - yy * b - z * c
-        qd[s + 1] = w * a - z * b + yy * c
-        qd[s + 2] = z * a + w * b - x * c
-        qd[s + 3] = -yy * a + x * b + w * c
-        i, j = i + 3, s + 4
-    while j < n:
-        qd[j] = y[i]
-        i, j = i + 1, j + 1
+    _state_of(y, starts, out[:n], out[n:])
 
 
 @njit(cache=True)
 def _states_into(rows, starts, q, qd):
     for r in range(rows.shape[0]):
-        _split_into(rows[r], starts, q[r], qd[r])
+        _state_of(rows[r], starts, q[r], qd[r])

@@ -36,7 +36,7 @@ def warm(texts):
         engine = background.build(system)
         q, qd = system.initial_state()
         engine.motion_batch(np.zeros(2), np.array([q, q]), np.array([qd, qd]))
-        engine.derivative(0.0, np.concatenate([q, qd]))  # simulate's stages (kernel.motion_rates)
+        engine.stages().rates(0.0, np.concatenate([q, qd]))  # simulate's stages (staged.py)
         system.data("compiled").constraint_arrays(0.0, q, qd)  # the shared structures' tape (tape.run)
         projection = engine.projection()
         if projection is not None:  # simulate's rows and projections, one by one and fitted (row_fit.py)

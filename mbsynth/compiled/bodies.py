@@ -180,3 +180,26 @@ def velocities(q, rates, starts, v):
     while j < rates.size:
         v[i] = rates[j]
         i, j = i + 1, j + 1
+
+
+@njit(**OPTIONS)
+def state_of(y, starts, q, qd):
+    """q and q̇ of y, a state in the integrator's form (``velocities``), into ``q``, ``qd``:
+    u̇ = E(u)ᵀ h per body (its h = ω/2 read at its quaternion's place in v), the other entries copied."""
+    n = q.size
+    q[:] = y[:n]
+    i, j = n, 0  # where y's v is read and q̇ written
+    for s in starts:
+        while j < s:
+            qd[j] = y[i]
+            i, j = i + 1, j + 1
+        w, x, yy, z = y[s], y[s + 1], y[s + 2], y[s + 3]
+        a, b, c = y[i], y[i + 1], y[i + 2]
+        qd[s] = -x * a - yy * b - z * c
+        qd[s + 1] = w * a - z * b + yy * c
+        qd[s + 2] = z * a + w * b - x * c
+        qd[s + 3] = -yy * a + x * b + w * c
+        i, j = i + 3, s + 4
+    while j < n:
+        qd[j] = y[i]
+        i, j = i + 1, j + 1

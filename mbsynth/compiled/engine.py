@@ -11,10 +11,11 @@ Engines share one set of buffers, ``Engine.at``). ``Template.engine(p)`` makes t
 at parameter values p: its numbers and work buffers. An Engine holds no reference to a System.
 
 ``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
-send the problem to the exact treatment (kernel.py's status); ``derivative`` is the same
-call for an integrator's stage, without the Motion; ``motion_batch`` evaluates many states
-in parallel. Each is one call into the kernel, which leaves q̈ and Qc in the Engine's own
-buffers (its Work); a Motion holds copies of them, so that the next call leaves it as it is.
+send the problem to the exact treatment (kernel.py's status); ``stages`` gives the same
+evaluation for an integrator's stages and steps, without the Motion (staged.py);
+``motion_batch`` evaluates many states in parallel. Each is one call into the kernel, which
+leaves q̈ and Qc in the Engine's own buffers (its Work); a Motion holds copies of them, so
+that the next call leaves it as it is.
 
 The kernel's residual check (kernel.CHECKED) runs per call where it can fail: loops, extra
 coordinates, particles. On a rigid tree (``Template.mode``) the kernel eliminates by the
@@ -34,7 +35,7 @@ import sympy as sp
 
 from ..core.equations import Motion
 from ..symbolic.derive import T_SYMBOL
-from . import ahead, codegen, flexible, kernel, layout
+from . import ahead, codegen, flexible, kernel, layout, staged
 from .assembly import Work, make_work
 from .projection import Projection
 from .extra_projection import ExtraProjection
@@ -43,7 +44,7 @@ from .packing import pack, views
 from .threads import THREADS, pool
 
 EMPTY = np.zeros(0)
-NO_BODIES = np.zeros(0, dtype=np.int64)  # ``derivative``'s ``starts`` of a state in (q, q̇) itself
+NO_BODIES = np.zeros(0, dtype=np.int64)  # ``stages``' ``starts`` of a state in (q, q̇) itself
 CHUNK = 16  # fewest rows a thread takes at a time
 
 
@@ -111,6 +112,7 @@ class Engine:
         self.batch_lock = threading.Lock()
         self.batch_works = []  # one packed Work per thread of motion_batch, made on first use
         self.projections = []  # the Projection, once made (``at``'s copies get it on their parameter values)
+        self.staged = {}  # the compiled stages (staged.Stages) per integrator form, once made
         # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with extra rows
         self.rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
         self.generated_phi = slice(self.outputs - template.phi_outputs, self.outputs)  # φ of the extra rows in gen
@@ -121,6 +123,7 @@ class Engine:
         allocates nothing."""
         other = copy.copy(self)
         other.p = p
+        other.staged = {}
         other.projections = [made and made.at(other) for made in self.projections]
         return other
 
@@ -134,6 +137,14 @@ class Engine:
         if not self.projections:
             self.projections.append(Projection.build(self) or ExtraProjection.build(self))
         return self.projections[0]
+
+    def stages(self, starts=NO_BODIES):
+        """The compiled stages of an integrator on this Engine (staged.Stages) for states in its
+        form with rigid bodies' quaternions at ``starts`` (velocity_form.py; none: (q, q̇))."""
+        key = starts.tobytes()
+        if key not in self.staged:
+            self.staged[key] = staged.Stages(self, starts)
+        return self.staged[key]
 
     def new_work(self):
         """(packed buffers, Work of views into them)."""
@@ -171,21 +182,6 @@ class Engine:
         """The kernel's relative residual (kernel.motion, CHECKED) of the motion at (t, q, q̇)."""
         with self.lock:
             return self._solved(t, q, qd, bshift, drift, kernel.CHECKED)[1]
-
-    def derivative(self, t, state, starts=NO_BODIES):
-        """ẏ at an integrator's stage, the state (q, q̇) stacked in ``state`` (off the manifold:
-        ``motion``'s drift): a new array (q̇, v̇), v̇ being q̈ with the quaternion accelerations
-        of the rigid bodies whose quaternions start at ``starts`` in the integrator's form
-        (analysis/velocity_form.py; none: (q̇, q̈)), or None for the exact path. ``motion``
-        without a Motion: the generated function, then one call into the kernel."""
-        state = np.ascontiguousarray(state, dtype=float)
-        q, qd = state[:self.n], state[self.n:]
-        out = np.empty(state.size - starts.size)  # a body's four quaternion rates are three there
-        with self.lock:
-            delta = self._generated(t, q, qd, True)
-            status = kernel.motion_rates(q, qd, self.gen, EMPTY, *self.buffers, self.mode, delta, self.general,
-                                         starts, out)
-        return out if status == kernel.OK else None
 
     def _solved(self, t, q, qd, bshift, drift, mode):
         """kernel.motion's (status, residual) at (t, q, q̇) in ``mode``, its q̈ and Qc left

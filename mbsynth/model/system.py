@@ -477,14 +477,7 @@ class System:
         not zero there (friction) or an explicit t (a prescribed motion), limits and contacts whose impacts
         lose energy (restitution below 1). Empty: the energy is conserved, and its change
         along a run is drift."""
-        values = {symbol: sp.Float(v) for symbol, v in zip(self.parameter_symbols,
-                                                           self.parameter_values if p is None else p)}
-        found = [e.name for e in self.forces
-                 if not (e.conservative or e.idle_at(values)) or T_SYMBOL in e.V.free_symbols]
-        found += [part.name for part in self.parts if part.working or _time_in_part(part)]
-        found += [con.name for con in self.constraints if getattr(con, "coulomb", None)
-                  or any(not sp.sympify(x).xreplace(values).is_zero for x in con.C.values()) or _time_in_rows(con)]
-        return found + self._inelastic(p)
+        return list(_working_forces(self, tuple(float(v) for v in (self.parameter_values if p is None else p))))
 
     def unaccounted_work(self):
         """The names among ``working_forces`` whose work a run does not integrate
@@ -530,6 +523,19 @@ def _coordinate_groups(parts):
         labels += [group.get(c, start + len(part.groups) + i) for i, c in enumerate(part.coordinates)]
         start += len(part.groups) + len(part.coordinates)
     return np.array(labels)
+
+
+@MEMO.function(256)
+def _working_forces(system, p):
+    """System.working_forces at the parameter values p (a tuple): asked by every run, and
+    sympy's zero tests cost milliseconds on a robot's actuators."""
+    values = {symbol: sp.Float(v) for symbol, v in zip(system.parameter_symbols, p)}
+    found = [e.name for e in system.forces
+             if not (e.conservative or e.idle_at(values)) or T_SYMBOL in e.V.free_symbols]
+    found += [part.name for part in system.parts if part.working or _time_in_part(part)]
+    found += [con.name for con in system.constraints if getattr(con, "coulomb", None)
+              or any(not sp.sympify(x).xreplace(values).is_zero for x in con.C.values()) or _time_in_rows(con)]
+    return tuple(found + system._inelastic(np.array(p)))
 
 
 @MEMO.function(4096)

@@ -529,31 +529,34 @@ def test_batch_equals_single_states(all_joints):
 
 
 def test_an_integrators_stage_equals_the_motion(all_joints):
-    """Engine.derivative, what simulate's stages call, gives (q̇, q̈) with q̈ that of
-    System.motion bit for bit, and (2.14)'s to 1e-10, also on a state in a strided array;
-    None where the kernel hands the problem back (a NaN)."""
-    engine = engine_for(all_joints)
+    """The compiled stage (staged.Stages.rates), what simulate's stages call, gives (q̇, q̈) with
+    q̈ that of System.motion bit for bit, and (2.14)'s to 1e-10, also from a state in a
+    strided array; None where the kernel hands the problem back (a NaN)."""
+    stages = engine_for(all_joints).stages()  # y = (q, q̇) itself
     q, qd = random_state(all_joints, np.random.default_rng(11))
     y = np.concatenate([q, qd])
-    found = engine.derivative(0.7, y)
+    found = stages.rates(0.7, y)
     assert np.array_equal(found[:q.size], qd)
     assert np.array_equal(found[q.size:], all_joints.motion(0.7, q, qd).qdd)
     assert rel(found[q.size:], all_joints.motion(0.7, q, qd, method="reference").qdd) < 1e-10
     strided = np.zeros(2 * y.size)
     strided[::2] = y
-    assert np.array_equal(engine.derivative(0.7, strided[::2]), found)
+    assert np.array_equal(stages.rates(0.7, strided[::2]), found)
     y[3] = np.nan
-    assert engine.derivative(0.7, y) is None
+    assert stages.rates(0.7, y) is None
 
 
 def test_an_integrators_stage_in_its_own_form(all_joints):
-    """Engine.derivative with the integrator's form's ``starts`` (analysis/velocity_form.py)
-    gives ẏ = (q̇, v̇) in one call: q̇ as it is, each rigid body's v̇ = E(u) ü / |u|² from
-    System.motion's ü (E by hand, tests/helpers/rotations.py), the other entries q̈."""
+    """The compiled stage in the integrator's form (analysis/velocity_form.py: y with each
+    rigid body's angular velocity) gives ẏ = (q̇, v̇) in one call: q̇ of the state y stands
+    for, each rigid body's v̇ = E(u) ü / |u|² from System.motion's ü there (E by hand,
+    tests/helpers/rotations.py), the other entries q̈."""
     engine, form = engine_for(all_joints), VelocityForm(all_joints)
     q, qd = random_state(all_joints, np.random.default_rng(12))
+    y = form.to_integrator(q, qd)
+    q, qd = form.to_state(y)
     qdd = all_joints.motion(0.3, q, qd).qdd
-    found = engine.derivative(0.3, np.concatenate([q, qd]), form.starts)
+    found = engine.stages(form.starts).rates(0.3, y)
     n, bodies = all_joints.n, list(form.starts)
     assert bodies and found.shape == (form.size,)
     assert np.array_equal(found[:n], qd)
