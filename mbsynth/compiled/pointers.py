@@ -14,10 +14,14 @@ from numba.core import cgutils
 from numba.experimental.function_type import _get_jit_address, _get_wrapper_address
 from numba.extending import intrinsic
 
+from ..core.memo import MEMO
 
+
+@MEMO.function(1024)
 def address(dispatcher, signature):
     """(C wrapper address, jit address) of ``dispatcher`` compiled for ``signature`` (a full
-    numba signature, its return type included, which must be the one numba infers)."""
+    numba signature, its return type included, which must be the one numba infers); kept,
+    with the dispatcher, for the next Engine that asks (every run makes one)."""
     dispatcher.compile(signature.args)
     found = dispatcher.overloads[signature.args].signature.return_type
     if found != signature.return_type:

@@ -14,7 +14,8 @@ call with DECLINED and the caller takes that step or stage again on the Python p
 (analysis/derivative.py), which serves every stage: these functions are a faster way to
 evaluate the same stages, not another integrator. The model's generated function and the
 kernel are called through function pointers (pointers.py), so they compile once for every
-model; ``Stages`` holds the arrays and the addresses of one Engine.
+model; the flexible parts' kernel and the rows' residuals too, which keeps these small to
+compile. ``Stages`` holds the arrays and the addresses of one Engine.
 """
 
 import math
@@ -33,8 +34,11 @@ ACCEPTED, TOO_SMALL, DECLINED = range(3)  # ``step``'s outcome
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 PART_ARRAYS = 6  # a flexible part's kernel arrays (axes, W, s0, K, D, S: flexible_body.PartArrays)
 
-F1, I1, I2 = types.float64[::1], types.int64[::1], types.int64[:, ::1]
+F1, F2, F4 = types.float64[::1], types.float64[:, ::1], types.float64[:, :, :, ::1]
+I1, I2 = types.int64[::1], types.int64[:, ::1]
 GENERATED = types.none(types.float64, F1, F1, F1, F1)  # codegen's evaluate(t, q, qd, p, out)
+FILL = types.none(F1, F1, F1, types.int64, types.int64, types.int64, types.int64, I1, F2, F1, F2, F2, F4)  # flexible.fill
+RESIDUALS = types.UniTuple(types.float64, 6)(F1, F1, I1, F1, I2, F1, F1, F4, types.boolean)  # rows.residuals_energy
 KERNEL_ARGUMENTS = (F1, F1, F1, F1, I1, F1, I2, I1, F1, I2, types.int64, types.float64)  # up to ``general``
 
 
@@ -43,27 +47,30 @@ def rates_signature(general):
     return types.int64(*KERNEL_ARGUMENTS, general, I1, F1)
 
 
-_generated, _kernel_rates = caster(lambda _: GENERATED), caster(rates_signature)
+_generated, _fill, _residuals = caster(lambda _: GENERATED), caster(lambda _: FILL), caster(lambda _: RESIDUALS)
+_kernel_rates = caster(rates_signature)
 
 
 @njit(**OPTIONS)
 def rates(t, y, out, bundle, general):
     """ẏ at (t, y) into ``out`` (the integrator's form); returns kernel.py's status (out is
     left as it was unless OK). ``bundle``: Stages.bundle; ``general``: the kernel's variant."""
-    (generated_c, generated_jit, kernel_c, kernel_jit, p, gen, q, qd, starts, own_meta, own_ints, own_floats,
-     own_index, closes, phi_from, phi_to, phi, psi, Rs, LI, LF, LX, WI, WF, WX, mode) = bundle
+    (generated_c, generated_jit, fill_c, fill_jit, residuals_c, residuals_jit, kernel_c, kernel_jit, p, gen, q, qd,
+     starts, own_meta, own_ints, own_floats, own_index, closes, phi_from, phi_to, phi, psi, Rs, LI, LF, LX, WI, WF, WX,
+     mode) = bundle
     state_of(y, starts, q, qd)
     if generated_c != 0:
         _generated(generated_c, generated_jit, None)(t, q, qd, p, gen)
     for part in range(own_meta.shape[0]):
         k = PART_ARRAYS * part
-        flexible.fill(q, qd, gen, own_meta[part, 0], own_meta[part, 1], own_meta[part, 2], own_meta[part, 3],
-                      view1(own_ints, own_index, k), view2(own_floats, own_index, k + 1),
-                      view1(own_floats, own_index, k + 2), view2(own_floats, own_index, k + 3),
-                      view2(own_floats, own_index, k + 4), view4(own_floats, own_index, k + 5))
+        _fill(fill_c, fill_jit, None)(q, qd, gen, own_meta[part, 0], own_meta[part, 1], own_meta[part, 2],
+                                      own_meta[part, 3], view1(own_ints, own_index, k),
+                                      view2(own_floats, own_index, k + 1), view1(own_floats, own_index, k + 2),
+                                      view2(own_floats, own_index, k + 3), view2(own_floats, own_index, k + 4),
+                                      view4(own_floats, own_index, k + 5))
     drift = -1.0
     if closes:
-        largest = residuals_energy(q, qd, LI, LF, LX, phi, psi, Rs, False)[2]
+        largest = _residuals(residuals_c, residuals_jit, None)(q, qd, LI, LF, LX, phi, psi, Rs, False)[2]
         for k in range(phi_from, phi_to):
             largest = max(largest, abs(gen[k]))
         drift = largest / max(np.abs(q).max(), 1.0)
@@ -154,15 +161,17 @@ class Stages:
         p = np.array(engine.p, dtype=float)
         generated_c, generated_jit = (0, 0) if generated is None else address(generated.evaluate, GENERATED)
         kernel_c, kernel_jit = address(kernel.motion_rates, rates_signature(typeof(engine.general)))
+        fill_c, fill_jit = address(flexible.fill, FILL) if own else (0, 0)
         own_meta = np.array([(o.start, o.m0, o.q0, o.g0) for o in own], dtype=np.int64).reshape(-1, 4)
         own_ints, own_floats, own_index = pack([np.asarray(a) for o in own for a in o.arrays])
         closes = engine.rows is not None
+        residuals_c, residuals_jit = address(residuals_energy, RESIDUALS) if closes else (0, 0)
         phi, psi, Rs = (engine.rows.phi, engine.rows.psi, *engine.rows.work) if closes else \
             (np.zeros(0), np.zeros(0), np.zeros((1, 2, 3, 3)))
-        self.bundle = (generated_c, generated_jit, kernel_c, kernel_jit, p, engine.gen, np.zeros(self.n),
-                       np.zeros(self.n), starts, own_meta, own_ints, own_floats, own_index, closes,
-                       engine.generated_phi.start, engine.generated_phi.stop, phi, psi, Rs, *engine.buffers,
-                       engine.mode)
+        self.bundle = (generated_c, generated_jit, fill_c, fill_jit, residuals_c, residuals_jit, kernel_c, kernel_jit,
+                       p, engine.gen, np.zeros(self.n), np.zeros(self.n), starts, own_meta, own_ints, own_floats,
+                       own_index, closes, engine.generated_phi.start, engine.generated_phi.stop, phi, psi, Rs,
+                       *engine.buffers, engine.mode)
         self.keep = (generated, module)  # the code the addresses point into
         self.stage = np.empty(self.size)
 
