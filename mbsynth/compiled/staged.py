@@ -30,7 +30,7 @@ from .pointers import address, caster
 from .rows import residuals_energy
 
 ACCEPTED, TOO_SMALL, DECLINED = range(3)  # ``step``'s outcome
-# scipy's step-size control (scipy.integrate._ivp.rk): its constants, read from it where it has them
+# scipy's step-size control, the constants of scipy.integrate._ivp.rk (the test of this module compares them)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 PART_ARRAYS = 6  # a flexible part's kernel arrays (axes, W, s0, K, D, S: flexible_body.PartArrays)
 

@@ -8,6 +8,7 @@ import copy
 import numpy as np
 import pytest
 import scipy.integrate
+from scipy.integrate._ivp import rk
 
 import mbsynth as mb
 from mbsynth.analysis.velocity_form import VelocityForm
@@ -63,6 +64,7 @@ def test_a_step_is_scipys(model):
         assert mine.h_previous == pytest.approx(theirs.h_previous, rel=1e-10) and np.array_equal(mine.y_old, solver.y)
         solver.step()
     assert rejected >= 1
+    assert (staged.SAFETY, staged.MIN_FACTOR, staged.MAX_FACTOR) == (rk.SAFETY, rk.MIN_FACTOR, rk.MAX_FACTOR)
 
 
 def test_a_step_below_the_smallest_fails_as_scipys(model):
