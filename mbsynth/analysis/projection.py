@@ -191,11 +191,13 @@ def project_velocities(data, t, q, qd, fixed=None, tolerance=PROJECTION_RTOL, ar
     if not (np.abs(psi[rows]) > tolerance * term_scales(arrays.A, qd)[rows]).any():
         return qd
     A = arrays.A[rows]
-    before = np.abs(qd)
+    before, largest = np.abs(qd), np.abs(psi[rows]).max()
     qd[free] -= _least_change(A[:, free], psi[rows], data.model.coordinate_groups[free])  # ψ is affine in q̇, slope A
     _, psi = data.constraint_residuals(t, q, qd)
-    # the step's rounding is that of the rates it subtracted from, not of what is left (at rest: rounding alone)
-    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * term_scales(A, np.maximum(before, np.abs(qd)))
+    # the step's rounding is that of the rates it subtracted from, not of what is left (at rest: rounding alone),
+    # and, in a row whose own terms are smaller, that of the other rows' corrections: the least-squares step over
+    # dependent rows (a box's corners) leaves each row about ε κ of the largest ψ it removed
+    unmet = np.abs(psi[rows]) > VELOCITY_ACCEPT * np.maximum(term_scales(A, np.maximum(before, np.abs(qd))), largest)
     if unmet.any():
         raise SolveError(_unmet(data, psi, "velocities", free),
                          constraints=[n for n, u in zip(np.array(data.model.constraint_names)[rows], unmet) if u])

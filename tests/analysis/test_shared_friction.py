@@ -5,6 +5,7 @@ exact Coulomb cone, against the closed forms of a box on four corners."""
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import mbsynth as mb
 from mbsynth.analysis.cones import Cone, Shared
@@ -20,6 +21,20 @@ def test_a_box_on_four_corners_below_tan_alpha_mu_stays_at_rest():
     corner outside its cone, another split holds them all, so the box stays where it is."""
     system = mb.load(MODEL, parameters={"alpha": 0.3, "mu": 0.5})
     traj = mb.simulate(system, 20.0, rtol=1e-10, atol=1e-10)
+    assert {ev.kind for ev in traj.events} == {"contact", "stick"}
+    assert np.abs(traj.q - traj.q[0]).max() < 1e-10
+    assert np.abs(traj.qd).max() < 1e-10
+
+
+@pytest.mark.parametrize("moved", [1e-16, 3e-15, 1e-14])
+def test_the_box_at_rest_stays_there_from_states_moved_by_rounding(moved):
+    """The same box from its initial q moved by rounding: a run at rest has velocities of
+    rounding (1e-24 to 1e-12), which neither lift a touching corner nor make its dependent
+    rows (three corners' nine, on seven velocities) look unmet after the velocity step; the
+    box stays where it is, its corners stuck."""
+    system = mb.load(MODEL, parameters={"alpha": 0.3, "mu": 0.5})
+    q0, qd0 = system.initial_state()
+    traj = mb.simulate(system, 20.0, rtol=1e-10, atol=1e-10, q0=q0 + moved * np.cos(1.7 * np.arange(q0.size)), qd0=qd0)
     assert {ev.kind for ev in traj.events} == {"contact", "stick"}
     assert np.abs(traj.q - traj.q[0]).max() < 1e-10
     assert np.abs(traj.qd).max() < 1e-10
