@@ -69,7 +69,7 @@ part = system.parts[0]
 n = len(part.q)
 M, Q, Mnu, nu = np.zeros((n, n)), np.zeros(n), np.zeros((n - 1, n - 1)), np.zeros(n - 1)
 g = part.gravity_at(0.0, system.parameter_values)
-arrays = part.kernel_arrays[:5]
+arrays = part.kernel_arrays[:6]  # (axes, W, s0, K, D, S): what equations reads
 def best(f, count):
     f()
     rounds = []
