@@ -103,7 +103,7 @@ class StateDerivative:
         the step is the Python path's: no compiled stages, a step across a singular position
         (``on_manifold``), parts turned by angles (watched per stage), a stage the kernel
         declined."""
-        if self.staged is None or self.on_manifold is not None or self.angles:
+        if not self._compiled_steps:
             return None
         self.t_failed = solver.t
         taken, evaluations = self.staged.step(solver)
@@ -114,11 +114,17 @@ class StateDerivative:
     def extra(self, solver):
         """DOP853's extra stages of the solver's last step in compiled code, as far as the
         kernel takes them (``step``'s conditions); returns how many."""
-        if self.staged is None or self.on_manifold is not None or self.angles:
+        if not self._compiled_steps:
             return 0
         done = self.staged.extra(solver, solver.K_extended, solver.n_stages + 1)
         self._count(done, solver.t, solver.y)
         return done
+
+    @property
+    def _compiled_steps(self):
+        """Whether whole steps may be taken in compiled code: compiled stages, no step across a
+        singular position (``on_manifold``), no parts turned by angles (watched per stage)."""
+        return self.staged is not None and self.on_manifold is None and not self.angles
 
     def _count(self, count, t, y):
         """``count`` evaluations more, the last at (t, y); raise the step-size collapse's

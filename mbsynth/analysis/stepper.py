@@ -38,15 +38,14 @@ IMPLICIT = (scipy.integrate.Radau, scipy.integrate.BDF, scipy.integrate.LSODA)
 
 class CompiledDOP853(scipy.integrate.DOP853):
     """scipy's DOP853 whose steps and extra stages are taken in compiled code where the run's
-    right-hand side can (compiled/staged.py, through derivative.StateDerivative's ``step``
-    and ``extra``, given as ``stages``), else by scipy's own Python (a stage the kernel
-    declines, a run outside the compiled engine): the same method, tableau and step-size
-    control either way."""
+    right-hand side can (compiled/staged.py, through ``derivative``'s ``step`` and ``extra``),
+    else by scipy's own Python (a stage the kernel declines, a run outside the compiled
+    engine): the same method, tableau and step-size control either way."""
 
-    stages = None  # the run's StateDerivative
+    derivative = None  # the run's StateDerivative (analysis/derivative.py)
 
     def _step_impl(self):
-        taken = None if self.stages is None else self.stages.step(self)
+        taken = None if self.derivative is None else self.derivative.step(self)
         return super()._step_impl() if taken is None else taken
 
 
@@ -56,7 +55,7 @@ def start(method, f, t, y, t_bound, **options):
     if method is not scipy.integrate.DOP853 or not DOP853_INTERNALS:
         return method(f, t, y, t_bound, **options)
     solver = CompiledDOP853(f, t, y, t_bound, **options)
-    solver.stages = f
+    solver.derivative = f
     return solver
 
 
@@ -129,14 +128,15 @@ def cap(solver, max_step):
 def interpolate(solver, times, out):
     """The states (a row per time) at ``times`` within the solver's last step, from its
     interpolant, into ``out``. DOP853's as scipy's ``dense_output`` makes it — three extra
-    stages (compiled with the steps where CompiledDOP853 can), then y_old + x (F₀ + (1 − x)(F₁ +
-    x (F₂ + (1 − x)(…)))) with x the step's fraction — with the arithmetic compiled (scipy's costs more than the stages' motion
-    on a small model). Other interpolants through scipy."""
+    stages (compiled, as the steps, where CompiledDOP853's derivative can), then
+    y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…)))) with x the step's fraction — with the
+    arithmetic compiled (scipy's costs more than the stages' motion on a small model). Other
+    interpolants through scipy."""
     if not (DOP853_INTERNALS and isinstance(solver, scipy.integrate.DOP853) and solver.t != solver.t_old):
         out[:] = solver.dense_output()(times).T
         return
     K, h, t_old, y_old = solver.K_extended, solver.h_previous, solver.t_old, solver.y_old
-    done = solver.stages.extra(solver) if getattr(solver, "stages", None) is not None else 0
+    done = solver.derivative.extra(solver) if getattr(solver, "derivative", None) is not None else 0
     for s, (a, c) in enumerate(zip(solver.A_EXTRA[done:], solver.C_EXTRA[done:]), start=solver.n_stages + 1 + done):
         K[s] = solver.fun(t_old + c * h, _stage_state(K, a, s, h, y_old))
     F = np.empty((solver.D.shape[0] + 3, y_old.size))

@@ -39,7 +39,7 @@ from . import ahead, codegen, flexible, kernel, layout, staged
 from .assembly import Work, make_work
 from .projection import Projection
 from .extra_projection import ExtraProjection
-from .rows import Rows
+from .rows import Rows, relative_drift
 from .packing import pack, views
 from .threads import THREADS, pool
 
@@ -198,12 +198,10 @@ class Engine:
         return self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
 
     def relative_drift(self, q, qd):
-        """The state's largest |φ| (the kernel's rows and the extra rows, from ``gen`` as the
-        generated function left it at this state) over its largest coordinate, at least 1."""
-        delta = self.rows.relative_drift(q, qd)
-        if self.generated_phi.start < self.outputs:
-            delta = max(delta, np.abs(self.gen[self.generated_phi]).max() / max(np.abs(q).max(), 1.0))
-        return delta
+        """The state's relative drift (rows.relative_drift), the extra rows' φ read from ``gen``
+        as the generated function left it at this state."""
+        return relative_drift(self.rows.largest_phi(q, qd), self.gen, self.generated_phi.start,
+                              self.generated_phi.stop, q)
 
     def motion_batch(self, t, q, qd):
         """(q̈ per row, status per row) for states q, q̇ (B × n) at times t (B,): one thread

@@ -157,8 +157,17 @@ class Rows:
         object's, overwritten by the next call."""
         return (self.phi, self.psi, *residuals_energy(q, qd, *self.packed, self.phi, self.psi, *self.work))
 
-    def relative_drift(self, q, qd):
-        """The largest |φ| over the largest coordinate (at least 1: a quaternion's unit),
-        φ alone (kernel.motion's ``drift``)."""
-        _, _, phi_max, _, q_max, _ = residuals_energy(q, qd, *self.packed, self.phi, self.psi, *self.work, False)
-        return phi_max / max(q_max, 1.0)
+    def largest_phi(self, q, qd):
+        """The largest |φ| of the kernel's rows at q (φ alone: ``relative_drift``'s phi_max)."""
+        return residuals_energy(q, qd, *self.packed, self.phi, self.psi, *self.work, False)[2]
+
+
+@njit(**OPTIONS)
+def relative_drift(phi_max, gen, phi_from, phi_to, q):
+    """A state's relative drift, kernel.motion's ``drift``: its largest |φ| — phi_max of the
+    kernel's rows (``Rows.largest_phi``), gen[phi_from:phi_to] of the extra rows (the generated
+    function's outputs there) — over its largest coordinate, at least 1 (a quaternion's unit)."""
+    largest = phi_max
+    for k in range(phi_from, phi_to):
+        largest = max(largest, abs(gen[k]))
+    return largest / max(np.abs(q).max(), 1.0)

@@ -3,10 +3,10 @@
 
 ``rates`` evaluates ẏ at y as the compiled engine's motion does: (q, q̇) of y, the model's
 generated function, the flexible parts' M and Q (flexible.fill), the state's relative drift
-where the model closes loops (Engine.relative_drift), kernel.motion_rates. ``step`` is scipy's DOP853
-step — its tableau, error norm and step-size control (``RungeKutta._step_impl``), rejected
-trials included — with every stage through ``rates``; ``extra`` evaluates the three extra
-stages of its dense output. The Python path costs scipy's array arithmetic and a few
+where the model closes loops (rows.relative_drift), kernel.motion_rates. ``step`` is
+scipy's DOP853 step — its tableau, error norm and step-size control
+(``RungeKutta._step_impl``), rejected trials included — with every stage through ``rates``;
+``extra`` evaluates the three extra stages of its dense output. The Python path costs scipy's array arithmetic and a few
 wrappers per stage, more than the kernel itself on a small model.
 
 A stage the kernel declines (kernel.py's status: the exact treatment's to serve) ends the
@@ -27,7 +27,7 @@ from . import flexible, kernel
 from .bodies import OPTIONS, state_of
 from .packing import pack, view1, view2, view4
 from .pointers import address, caster
-from .rows import residuals_energy
+from .rows import relative_drift, residuals_energy
 
 ACCEPTED, TOO_SMALL, DECLINED = range(3)  # ``step``'s outcome
 # scipy's step-size control, the constants of scipy.integrate._ivp.rk (the test of this module compares them)
@@ -70,10 +70,8 @@ def rates(t, y, out, bundle, general):
                                       view4(own_floats, own_index, k + 5))
     drift = -1.0
     if closes:
-        largest = _residuals(residuals_c, residuals_jit, None)(q, qd, LI, LF, LX, phi, psi, Rs, False)[2]
-        for k in range(phi_from, phi_to):
-            largest = max(largest, abs(gen[k]))
-        drift = largest / max(np.abs(q).max(), 1.0)
+        phi_max = _residuals(residuals_c, residuals_jit, None)(q, qd, LI, LF, LX, phi, psi, Rs, False)[2]
+        drift = relative_drift(phi_max, gen, phi_from, phi_to, q)
     empty = np.zeros(0)
     return _kernel_rates(kernel_c, kernel_jit, general)(q, qd, gen, empty, LI, LF, LX, WI, WF, WX, mode, drift,
                                                          general, starts, out)
@@ -97,7 +95,9 @@ def step(t, y, f, h_abs, t_bound, max_step, rtol, atol, direction, A, B, C, E3, 
     takes it: its stages into K, the solution and its ẏ into y_new, f_new. Returns
     (outcome, t_new, h, the next step's h_abs, evaluations): ACCEPTED; TOO_SMALL (the step
     size fell below ten units of t's rounding, as scipy's message); DECLINED (a stage the
-    kernel declined: nothing is decided, the caller takes the step again)."""
+    kernel declined: nothing is decided, the caller takes the step again). Each retry cuts
+    the step by at least SAFETY (by MIN_FACTOR where the error norm is not finite), so the
+    loop ends at TOO_SMALL at the latest."""
     n, stages = y.shape[0], A.shape[0]
     min_step = 10.0 * abs(np.nextafter(t, direction * np.inf) - t)
     h_abs = max_step if h_abs > max_step else max(h_abs, min_step)
