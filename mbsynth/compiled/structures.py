@@ -22,6 +22,7 @@ waiting; ``MBSYNTH_COMPILED=off`` never builds it (grouped.py then uses numpy).
 import logging
 import threading
 
+from ..symbolic.cache import remembered
 from ..symbolic.derive import beyond_double_as_inf
 from .background import mode
 from .codegen import assignments, load
@@ -58,11 +59,10 @@ def kernel(raw):
 
 def _build(raw):
     from . import tape  # numba: loaded with the first structure built, not with the package
+    taped = _taped(raw, tape)
+    if taped is not None:
+        return taped
     args, forms = raw.structure()
-    try:
-        return tape.tape(args, forms)
-    except tape.Unsupported as err:
-        log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
     try:
         evaluate = load(source(args, forms), prefix="mbsynth_structure").evaluate
         evaluate.compile(_signature())  # here, not at the first call
@@ -70,6 +70,22 @@ def _build(raw):
         log.warning("a constraint structure stays on numpy (%s: %s)", type(err).__name__, err)
         return None
     return evaluate
+
+
+def _taped(raw, tape):
+    """The structure's ``tape.Taped``, or None where the tape has no operation for one of its
+    expressions. Kept on disk under the structure's digest (symbolic/cache.py), so that a
+    structure taped before, in any process, skips its canonical form and sympy's cse."""
+    def derive():
+        try:
+            return tape.tape(*raw.structure())
+        except tape.Unsupported as err:
+            log.info("a constraint structure is compiled on its own (the tape has no %s)", err)
+            return None
+    if raw.digest is None:
+        return derive()
+    return remembered("tape", raw.digest, derive, store=lambda taped: taped if taped is None else tuple(taped),
+                      load=lambda stored: stored if stored is None else tape.Taped(*stored))
 
 
 def source(args, forms):

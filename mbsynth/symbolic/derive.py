@@ -521,6 +521,7 @@ def _lambdified(digest, structure):
     def make():
         raw = derive() if digest is None else remembered_function("lambdified", digest, derive)
         raw.structure = _kernel_view(structure)  # for compiled/structures.py, which compiles it with numba
+        raw.digest = digest  # where compiled/structures.py keeps its tape on disk (None: not kept)
         return raw
     return make() if digest is None else _LAMBDIFIED.get(digest, make)
 

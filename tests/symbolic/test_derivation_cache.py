@@ -119,3 +119,41 @@ def test_lambdified_code_does_not_depend_on_the_dummies_made_before():
 
     power = 10 ** (len(str(sp.Dummy._count + 10)))
     assert code_after(power - 2) == code_after(power + 100)  # names crossing a digit, then not
+
+
+# the Andrews squeezer's constraint rows on the compiled path in a fresh process: their
+# values at a state off the initial one, and how many tapes it wrote (sympy cse each)
+ROWS = textwrap.dedent("""
+    import json
+    import numpy as np
+    from mbsynth.compiled import tape
+    written, write = [0], tape.tape
+    def counting(*args):
+        written[0] += 1
+        return write(*args)
+    tape.tape = counting
+    import mbsynth as mb
+    model = mb.load("models/mechanisms/andrews.yaml")
+    q, qd = model.initial_state()
+    rng = np.random.default_rng(5)
+    arrays = model.data("compiled").constraint_arrays(0.3, q + 0.01 * rng.normal(size=q.size), qd, sparse=False)
+    print(json.dumps(dict(tapes=written[0], values=[float(x).hex() for x in np.concatenate([np.ravel(arrays.A), arrays.b])])))
+""")
+
+
+def test_a_structure_taped_before_reads_its_tape_and_gets_the_same_numbers(tmp_path):
+    """A constraint structure's tape (compiled/structures.py) is kept with the derivations:
+    a model loaded again in a fresh process writes none, and its rows are the same to the bit
+    as those of a process that writes them all."""
+    def rows(cache, **settings):
+        env = {**os.environ, "MBSYNTH_CACHE_DIR": str(cache), **settings}
+        out = subprocess.run([sys.executable, "-c", ROWS], env=env, cwd=ROOT, capture_output=True, text=True,
+                             check=True, timeout=600)
+        return json.loads(out.stdout.splitlines()[-1])
+    first = rows(tmp_path)
+    assert first["tapes"] > 0 and any(p.name.startswith("tape-") for p in entries(tmp_path))
+    again = rows(tmp_path)
+    assert again["tapes"] == 0
+    derived = rows(tmp_path / "other", MBSYNTH_DERIVATION_CACHE="off")
+    assert derived["tapes"] == first["tapes"]
+    assert again["values"] == first["values"] == derived["values"]
