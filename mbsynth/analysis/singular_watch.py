@@ -16,6 +16,7 @@ to decompose at every step (WATCH_ENTRIES).
 """
 
 import numpy as np
+from numba import njit
 
 from ..core.equations import equilibrate_rows
 from ..core.tolerances import DIP_FLOOR, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
@@ -76,8 +77,8 @@ class SingularWatch:
 
     def _measure(self, t, q, qd, A=None):
         """σ_r/σ₁ of the equilibrated A at (t, q, q̇) (``A``: the rows there, if at hand)."""
-        s = np.linalg.svd(self._equilibrated(t, q, qd, A), compute_uv=False)
-        return s[self.rank - 1] / s[0] if s[0] > 0 else 0.0
+        A = self.data.constraint_arrays(t, q, qd, sparse=False).A if A is None else A
+        return _ratio(np.array(A.toarray() if hasattr(A, "toarray") else A, dtype=float, order="C"), self.rank)
 
     def _bottom(self):
         """The time of the smallest ratio between the first and the last end (golden section)."""
@@ -105,3 +106,22 @@ class SingularWatch:
         q = h00 * q0 + h10 * h * v0 + h01 * q1 + h11 * h * v1
         qd = (d00 * q0 + d01 * q1) / h + d10 * v0 + d11 * v1
         return q, qd
+
+
+@njit(cache=True)
+def _ratio(A, rank):
+    """σ_rank/σ₁ of A (overwritten) with its rows and then its columns scaled to unit norm
+    (``SingularWatch._equilibrated``); 0 where σ₁ is."""
+    _unit_rows(A)
+    _unit_rows(A.T)
+    s = np.linalg.svd(A, full_matrices=False)[1]
+    return s[rank - 1] / s[0] if s[0] > 0 else 0.0
+
+
+@njit(cache=True)
+def _unit_rows(X):
+    """Each row of X divided by its 2-norm, in place (zero rows stay zero)."""
+    for i in range(X.shape[0]):
+        norm = np.sqrt(np.sum(X[i] * X[i]))
+        if norm != 0.0:
+            X[i] /= norm

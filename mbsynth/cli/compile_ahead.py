@@ -115,10 +115,16 @@ joints:
   - {name: hinge, type: revolute, parent: world.pivot, child: upper.top}
   - {name: weld, type: fixed, parent: upper.low, child: lower.top}
 """
+WARM_PLANAR = """name: warm_planar
+parts:
+  rod: {type: planar_body, mass: 1.0, inertia: 0.1, frames: {end: {position: [-0.5, 0, 0]}}, initial: {position: [0.5, 0]}}
+joints:
+  - {name: pin, type: revolute, parent: world, child: rod.end}
+"""  # extra coordinates alone: compiled/extra_projection.py and the run's singular watch
 WARM_MODELS = [WARM_TREE + """  - {name: again, type: spherical, parent: world, child: link.top}
 forces:
   - {name: push, type: force, at: bob, value: ["sin(t)", 0, 0]}
-""", WARM_TREE]  # kernel.GENERAL
+""", WARM_TREE, WARM_PLANAR]  # kernel.GENERAL
 
 if __name__ == "__main__":
     main()

@@ -22,18 +22,36 @@ exact one; analysis/projection.py: 2e-8): a run steps across such positions with
 away from them (analysis/crossing.py), from the rows' ``measure``, which its singular watch
 gives where the model is small. Its energies are left to the Data (``energies`` False); the
 run's singular watch goes on through its states (``watched``).
+
+A projection and a drift are each one compiled call (``project``, ``drift``), with the
+model's generated function and the kernel called through their addresses (pointers.py), as
+staged.py's stages call them.
 """
 
 import copy
 import threading
 
 import numpy as np
+from numba import njit, typeof, types
 
 from . import kernel
-from .projection import MAX_STEPS, TINY, Projected, ProjectedRows
-from ..core.equations import entry_term_scales
-from ..core.tolerances import MASS_PROJECTION_RATE_RTOL, MASS_PROJECTION_RTOL, MASS_PROJECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
+from .bodies import OPTIONS
+from .kernel import OK, UNCHECKED, WORK
 from .least_direction import LeastDirection
+from .packing import view1
+from .pointers import address, caster
+from .projection import DONE, MAX_STEPS, PHI_MAX, PSI_MAX, TINY, ProjectedRows
+from .rows import largest
+from .staged import KERNEL_ARGUMENTS, evaluate, evaluation_of
+from ..core.tolerances import MASS_PROJECTION_RATE_RTOL, MASS_PROJECTION_RTOL, MASS_PROJECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
+
+
+def motion_signature(general):
+    """kernel.motion's signature in the variant whose ``general`` has the numba type given."""
+    return types.Tuple((types.int64, types.float64))(*KERNEL_ARGUMENTS, general)
+
+
+_motion = caster(motion_signature)
 
 
 class ExtraProjection:
@@ -44,22 +62,30 @@ class ExtraProjection:
 
     def __init__(self, engine):
         L = engine.L
-        self.engine, self.n = engine, engine.n
+        self.n = engine.n
         counts = [L.gen_q.size, L.gen_c.size, L.gen_mi.size, L.gen_arow.size, L.gen_brow.size]
         starts = np.cumsum([0] + counts)
-        self.forces = slice(0, int(starts[2]))  # Q additions and C
-        self.entries = slice(int(starts[3]), int(starts[4]))  # the rows' entries
-        self.rights = slice(int(starts[4]), int(starts[5]))  # their b
-        self.phi = slice(engine.outputs - engine.template.phi_outputs, engine.outputs)
         self.rows, self.columns = L.gen_arow, L.x_coord[L.gen_acol]
         self.xrow_row, self.m = L.xrow_row, int(L.sizes[1])
+        self.entries = slice(int(starts[3]), int(starts[4]))  # the rows' entries in gen
         self.gen = np.zeros(engine.outputs)
-        self.shift = np.zeros(self.m)
-        self.rest = np.zeros(self.n)
-        packed_work, self.W = engine.new_work()
-        self.buffers = (*engine.packed, *packed_work)
+        packed_work, _ = engine.new_work()
+        kernel_c, kernel_jit = address(kernel.motion, motion_signature(typeof(engine.general)))
+        count = self.xrow_row.size
+        # rows, columns, their entries, Q and C to zero, b to zero, φ in gen, the System's rows of the extra rows
+        self.layout = (self.rows, self.columns, int(starts[3]), int(starts[2]), int(starts[4]), int(starts[5]),
+                       engine.outputs - engine.template.phi_outputs, self.xrow_row, kernel_c, kernel_jit,
+                       *engine.packed, *packed_work)
+        # the right side's shift per System row, q̇ = 0, then per extra row: φ, φ̇, φ̇ before the step, term sizes
+        self.work = (np.zeros(self.m), np.zeros(self.n), *(np.zeros(count) for _ in range(4)))
         self.lock = threading.Lock()
         self.least = None  # the rows' LeastDirection, made at the first ``measure``
+        self._use(engine)
+
+    def _use(self, engine):
+        """Evaluate the generated function of ``engine`` (its parameter values)."""
+        self.engine, self.general = engine, engine.general
+        self.evaluation, self.keep = evaluation_of(engine, self.gen)
 
     @classmethod
     def build(cls, engine):
@@ -77,68 +103,22 @@ class ExtraProjection:
         """This projection on ``engine``, a copy of its Engine at other parameter values
         (``Engine.at``): the same buffers and lock, the rows at ``engine``'s values."""
         other = copy.copy(self)
-        other.engine = engine
+        other._use(engine)
         return other
-
-    def _evaluate(self, q, qd):
-        """The generated outputs at (q, q̇) (t = 0: they do not depend on it)."""
-        self.engine.module.evaluate(0.0, q, qd, self.engine.p, self.gen)
-
-    def _rates(self, qd):
-        """φ̇ = A q̇ per extra row, from the rows' entries as evaluated last."""
-        return np.bincount(self.rows, weights=self.gen[self.entries] * qd[self.columns], minlength=self.xrow_row.size)
-
-    def _terms(self, x, floor):
-        """The size of each row's terms at x (core/equations.term_scales), from the rows'
-        entries as evaluated last: residuals are judged against them, alike at every scale."""
-        scales = entry_term_scales(self.rows, self.columns, self.gen[self.entries], self.xrow_row.size, x, floor)
-        return np.maximum(scales, TINY)
-
-    def _step(self, q, residual):
-        """The least-M-norm Δ with A Δ = −residual (rows as evaluated last at q), or None
-        where the kernel declines it."""
-        gen = self.gen
-        gen[self.forces] = 0.0
-        gen[self.rights] = 0.0
-        self.shift[self.xrow_row] = -residual
-        status = kernel.motion(q, self.rest, gen, self.shift, *self.buffers, kernel.UNCHECKED, -1.0,
-                               self.engine.general)[0]
-        return self.W.qdd.copy() if status == kernel.OK else None
 
     def __call__(self, q, qd):
         """``Projected`` (q, q̇) on the constraints (new arrays; kinetic and potential energy
         NaN), or None (module docstring)."""
-        with self.lock:
-            q, qd = np.array(q, dtype=float), np.array(qd, dtype=float)
-            self._evaluate(q, qd)
-            phi = self.gen[self.phi].copy()
-            for step in range(MAX_STEPS + 1):
-                if np.all(np.abs(phi) <= MASS_PROJECTION_RTOL * self._terms(q, TERM_FLOOR)):
-                    break
-                delta = None if step == MAX_STEPS else self._step(q, phi)
-                if delta is None:
-                    return None
-                q += delta
-                self._evaluate(q, qd)
-                phi = self.gen[self.phi].copy()
-            psi = self._rates(qd)
-            before = np.abs(psi)
-            delta = self._step(q, psi)
-            if delta is None:
-                return None
-            qd += delta
-            self._evaluate(q, qd)
-            psi = self._rates(qd)
-            if not np.all(np.abs(psi) <= np.maximum(MASS_PROJECTION_SHRINK * before,
-                                                    MASS_PROJECTION_RATE_RTOL * self._terms(qd, TERM_FLOOR))):
-                return None
-            return Projected(q, qd, np.nan, np.nan, float(np.abs(self.gen[self.phi]).max(initial=0.0)),
-                             float(np.abs(psi).max(initial=0.0)))
+        return self.block(np.asarray(q, dtype=float)[None, :], np.asarray(qd, dtype=float)[None, :]).row(0)
 
     def block(self, Q, QD, fractions=None):
-        """``__call__`` of each state (row of Q, Q̇), as ProjectedRows (``fractions``, the
-        states' fractions of a step, are not used: each state is projected on its own)."""
-        return ProjectedRows.of([self(q, qd) for q, qd in zip(Q, QD)], self.n)
+        """Each state (row of Q, Q̇) projected, as ProjectedRows (``fractions``, the states'
+        fractions of a step, are not used: each state is projected on its own)."""
+        Q_on, QD_on = np.array(Q, dtype=float, order="C"), np.array(QD, dtype=float, order="C")
+        found = np.full((Q_on.shape[0], DONE + 1), np.nan)
+        with self.lock:
+            project(Q_on, QD_on, found, self.evaluation, self.layout, self.work, self.general)
+        return ProjectedRows(Q_on, QD_on, found)
 
     def measure(self, q, qd):
         """σ_min/σ₁ of the rows' A at (q, q̇), each row scaled to unit norm
@@ -154,7 +134,6 @@ class ExtraProjection:
 
     def _least(self, q, qd):
         """(σ_min/σ₁, the rows' weights in the least direction) at (q, q̇)."""
-        q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
         with self.lock:
             self._evaluate(q, qd)
             values = self.gen[self.entries].copy()
@@ -162,17 +141,147 @@ class ExtraProjection:
             self.least = LeastDirection(self.rows, self.columns, self.xrow_row.size)
         return self.least(values)
 
+    def _evaluate(self, q, qd):
+        """The generated outputs at (q, q̇) into gen (t = 0: they do not depend on it)."""
+        evaluate(0.0, np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float), self.evaluation)
+
     def residuals_energy(self, q, qd):
         """(φ, φ̇ of the extra rows, NaN, NaN): the energies are the Data's."""
+        qd = np.ascontiguousarray(qd, dtype=float)
         with self.lock:
-            self._evaluate(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
-            return self.gen[self.phi].copy(), self._rates(np.asarray(qd, dtype=float)), np.nan, np.nan
+            self._evaluate(q, qd)
+            psi = np.zeros(self.xrow_row.size)
+            _rates(qd, self.gen, self.layout, psi)
+            return self.gen[self.layout[6]:].copy(), psi, np.nan, np.nan
 
     def drift(self, q, qd):
         """The largest |φ| or |φ̇| relative to its row's terms (``_terms`` with DRIFT_FLOOR,
         as analysis/projection.relative_drift)."""
-        q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
         with self.lock:
-            self._evaluate(q, qd)
-            return max(float((np.abs(self.gen[self.phi]) / self._terms(q, DRIFT_FLOOR)).max(initial=0.0)),
-                       float((np.abs(self._rates(qd)) / self._terms(qd, DRIFT_FLOOR)).max(initial=0.0)))
+            return drift(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float),
+                         self.evaluation, self.layout, self.work)
+
+
+@njit(**OPTIONS)
+def _terms(x, floor, gen, layout, out):
+    """The size of each row's terms at x (core/equations.entry_term_scales, at least TINY) into
+    ``out``, from the rows' entries as evaluated last: residuals are judged against them,
+    alike at every scale."""
+    rows, columns, entries = layout[0], layout[1], layout[2]
+    norms = np.zeros(out.shape[0])
+    out[:] = 0.0
+    for e in range(rows.shape[0]):
+        weight = abs(gen[entries + e])
+        out[rows[e]] += weight * abs(x[columns[e]])
+        norms[rows[e]] += weight
+    size = largest(x)
+    for r in range(out.shape[0]):
+        out[r] = max(out[r] + floor * norms[r] * size, TINY)
+
+
+@njit(**OPTIONS)
+def _rates(qd, gen, layout, out):
+    """φ̇ = A q̇ per extra row into ``out``, from the rows' entries as evaluated last."""
+    rows, columns, entries = layout[0], layout[1], layout[2]
+    out[:] = 0.0
+    for e in range(rows.shape[0]):
+        out[rows[e]] += gen[entries + e] * qd[columns[e]]
+
+
+@njit(**OPTIONS)
+def _phi(gen, layout, out):
+    """φ of the extra rows, as evaluated last, into ``out``."""
+    for r in range(out.shape[0]):
+        out[r] = gen[layout[6] + r]
+
+
+@njit(**OPTIONS)
+def _step(q, residual, gen, layout, work, general):
+    """The least-M-norm Δ with A Δ = −residual (rows as evaluated last at q) into the Work's
+    q̈: (2.14) with the generated forces, C and b zero and q̇ = 0; whether the kernel gave it."""
+    (_, _, _, forces_to, rights_from, rights_to, _, xrow_row, kernel_c, kernel_jit, LI, LF, LX, WI, WF, WX) = layout
+    shift, rest = work[0], work[1]
+    for k in range(forces_to):
+        gen[k] = 0.0
+    for k in range(rights_from, rights_to):
+        gen[k] = 0.0
+    for x in range(xrow_row.shape[0]):
+        shift[xrow_row[x]] = -residual[x]
+    return _motion(kernel_c, kernel_jit, general)(q, rest, gen, shift, LI, LF, LX, WI, WF, WX, UNCHECKED, -1.0,
+                                                  general)[0] == OK
+
+
+@njit(**OPTIONS)
+def project(Q, QD, found, evaluation, layout, work, general):
+    """Each state (row of Q, Q̇) put on the constraints in place (module docstring), found's
+    row (NaN energies, PHI_MAX, PSI_MAX, DONE = 1), or DONE = 0 and the row zero where the
+    kernel declines a step or the steps miss their goals. Positions: Gauss–Newton steps while
+    a row's |φ| exceeds MASS_PROJECTION_RTOL of its terms, at most MAX_STEPS; then one
+    velocity step, which must cut each row's φ̇ by MASS_PROJECTION_SHRINK or leave it below
+    MASS_PROJECTION_RATE_RTOL of its terms."""
+    gen = evaluation[5]
+    qdd = view1(layout[14], layout[15], WORK.qdd)
+    phi, psi, before, terms = work[2], work[3], work[4], work[5]
+    for b in range(Q.shape[0]):
+        q, qd = Q[b], QD[b]
+        found[b, DONE] = 0.0
+        done = _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work, general)
+        if not done:
+            q[:] = 0.0
+            qd[:] = 0.0
+            continue
+        found[b, PHI_MAX], found[b, PSI_MAX], found[b, DONE] = largest(phi), largest(psi), 1.0
+
+
+@njit(**OPTIONS)
+def _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work, general):
+    """``project`` of one state; whether it is on the constraints (φ and φ̇ there in phi, psi)."""
+    evaluate(0.0, q, qd, evaluation)
+    _phi(gen, layout, phi)
+    for step in range(MAX_STEPS + 1):
+        _terms(q, TERM_FLOOR, gen, layout, terms)
+        met = True
+        for r in range(phi.shape[0]):
+            met = met and abs(phi[r]) <= MASS_PROJECTION_RTOL * terms[r]
+        if met:
+            break
+        if step == MAX_STEPS or not _step(q, phi, gen, layout, work, general):
+            return False
+        for c in range(q.shape[0]):
+            q[c] += qdd[c]
+        evaluate(0.0, q, qd, evaluation)
+        _phi(gen, layout, phi)
+    _rates(qd, gen, layout, psi)
+    for r in range(psi.shape[0]):
+        before[r] = abs(psi[r])
+    if not _step(q, psi, gen, layout, work, general):
+        return False
+    for c in range(qd.shape[0]):
+        qd[c] += qdd[c]
+    evaluate(0.0, q, qd, evaluation)
+    _phi(gen, layout, phi)
+    _rates(qd, gen, layout, psi)
+    _terms(qd, TERM_FLOOR, gen, layout, terms)
+    for r in range(psi.shape[0]):
+        if not abs(psi[r]) <= max(MASS_PROJECTION_SHRINK * before[r], MASS_PROJECTION_RATE_RTOL * terms[r]):
+            return False
+    return True
+
+
+@njit(**OPTIONS)
+def drift(q, qd, evaluation, layout, work):
+    """The largest |φ| or |φ̇| at (q, q̇) relative to its row's terms (DRIFT_FLOOR; NaN if
+    any is)."""
+    gen = evaluation[5]
+    phi, psi, terms = work[2], work[3], work[5]
+    evaluate(0.0, q, qd, evaluation)
+    _phi(gen, layout, phi)
+    _rates(qd, gen, layout, psi)
+    _terms(q, DRIFT_FLOOR, gen, layout, terms)
+    for r in range(phi.shape[0]):
+        phi[r] /= terms[r]
+    _terms(qd, DRIFT_FLOOR, gen, layout, terms)
+    for r in range(psi.shape[0]):
+        psi[r] /= terms[r]
+    position, velocity = largest(phi), largest(psi)
+    return position if position > velocity or position != position else velocity

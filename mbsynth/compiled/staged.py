@@ -52,13 +52,10 @@ _kernel_rates = caster(rates_signature)
 
 
 @njit(**OPTIONS)
-def rates(t, y, out, bundle, general):
-    """ẏ at (t, y) into ``out`` (the integrator's form); returns kernel.py's status (out is
-    left as it was unless OK). ``bundle``: Stages.bundle; ``general``: the kernel's variant."""
-    (generated_c, generated_jit, fill_c, fill_jit, residuals_c, residuals_jit, kernel_c, kernel_jit, p, gen, q, qd,
-     starts, own_meta, own_ints, own_floats, own_index, closes, phi_from, phi_to, phi, psi, Rs, LI, LF, LX, WI, WF, WX,
-     mode) = bundle
-    state_of(y, starts, q, qd)
+def evaluate(t, q, qd, evaluation):
+    """The generated function's outputs at (t, q, q̇) into gen, the flexible parts' M and Q
+    among them (flexible.fill). ``evaluation``: ``evaluation_of``'s first item."""
+    generated_c, generated_jit, fill_c, fill_jit, p, gen, own_meta, own_ints, own_floats, own_index = evaluation
     if generated_c != 0:
         _generated(generated_c, generated_jit, None)(t, q, qd, p, gen)
     for part in range(own_meta.shape[0]):
@@ -68,6 +65,32 @@ def rates(t, y, out, bundle, general):
                                       view2(own_floats, own_index, k + 1), view1(own_floats, own_index, k + 2),
                                       view2(own_floats, own_index, k + 3), view2(own_floats, own_index, k + 4),
                                       view4(own_floats, own_index, k + 5))
+
+
+def evaluation_of(engine, gen):
+    """(``evaluate``'s tuple for ``engine``'s generated function and flexible parts, writing
+    into ``gen``; the code its addresses point into, to be kept while it is used)."""
+    module = engine.module
+    own = getattr(module, "own", ())
+    generated = getattr(module, "generated", module)
+    p = np.array(engine.p, dtype=float)  # writeable and C-contiguous: the pointer's signature
+    generated_c, generated_jit = (0, 0) if generated is None else address(generated.evaluate, GENERATED)
+    fill_c, fill_jit = address(flexible.fill, FILL) if own else (0, 0)
+    own_meta = np.array([(o.start, o.m0, o.q0, o.g0) for o in own], dtype=np.int64).reshape(-1, 4)
+    own_ints, own_floats, own_index = pack([np.asarray(a) for o in own for a in o.arrays])
+    return (generated_c, generated_jit, fill_c, fill_jit, p, gen, own_meta, own_ints, own_floats, own_index), \
+        (generated, module)
+
+
+@njit(**OPTIONS)
+def rates(t, y, out, bundle, general):
+    """ẏ at (t, y) into ``out`` (the integrator's form); returns kernel.py's status (out is
+    left as it was unless OK). ``bundle``: Stages.bundle; ``general``: the kernel's variant."""
+    (evaluation, residuals_c, residuals_jit, kernel_c, kernel_jit, q, qd, starts, closes, phi_from, phi_to, phi, psi,
+     Rs, LI, LF, LX, WI, WF, WX, mode) = bundle
+    state_of(y, starts, q, qd)
+    evaluate(t, q, qd, evaluation)
+    gen = evaluation[5]
     drift = -1.0
     if closes:
         phi_max = _residuals(residuals_c, residuals_jit, None)(q, qd, LI, LF, LX, phi, psi, Rs, False)[2]
@@ -154,25 +177,15 @@ class Stages:
     def __init__(self, engine, starts):
         self.engine, self.general, self.n = engine, engine.general, engine.n
         self.size = 2 * engine.n - starts.size
-        module = engine.module
-        own = getattr(module, "own", ())
-        generated = getattr(module, "generated", module)
-        # the generated function's parameter array, writeable and C-contiguous (its pointer's signature)
-        p = np.array(engine.p, dtype=float)
-        generated_c, generated_jit = (0, 0) if generated is None else address(generated.evaluate, GENERATED)
+        evaluation, self.keep = evaluation_of(engine, engine.gen)
         kernel_c, kernel_jit = address(kernel.motion_rates, rates_signature(typeof(engine.general)))
-        fill_c, fill_jit = address(flexible.fill, FILL) if own else (0, 0)
-        own_meta = np.array([(o.start, o.m0, o.q0, o.g0) for o in own], dtype=np.int64).reshape(-1, 4)
-        own_ints, own_floats, own_index = pack([np.asarray(a) for o in own for a in o.arrays])
         closes = engine.rows is not None
         residuals_c, residuals_jit = address(residuals_energy, RESIDUALS) if closes else (0, 0)
         phi, psi, Rs = (engine.rows.phi, engine.rows.psi, *engine.rows.work) if closes else \
             (np.zeros(0), np.zeros(0), np.zeros((1, 2, 3, 3)))
-        self.bundle = (generated_c, generated_jit, fill_c, fill_jit, residuals_c, residuals_jit, kernel_c, kernel_jit,
-                       p, engine.gen, np.zeros(self.n), np.zeros(self.n), starts, own_meta, own_ints, own_floats,
-                       own_index, closes, engine.generated_phi.start, engine.generated_phi.stop, phi, psi, Rs,
-                       *engine.buffers, engine.mode)
-        self.keep = (generated, module)  # the code the addresses point into
+        self.bundle = (evaluation, residuals_c, residuals_jit, kernel_c, kernel_jit, np.zeros(self.n),
+                       np.zeros(self.n), starts, closes, engine.generated_phi.start, engine.generated_phi.stop, phi,
+                       psi, Rs, *engine.buffers, engine.mode)
         self.stage = np.empty(self.size)
 
     def rates(self, t, y):

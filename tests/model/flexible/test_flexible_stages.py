@@ -12,7 +12,8 @@ import pytest
 
 import mbsynth as mb
 from benchmarks.flexible_startup import model_text
-from mbsynth.compiled import kernel
+from mbsynth.compiled import extra_projection, staged
+from mbsynth.compiled.projection import DONE
 
 ROOT = Path(__file__).resolve().parents[3]
 SLIDER_CRANK = ROOT / "models" / "flexible" / "slider_crank.yaml"
@@ -48,24 +49,34 @@ def test_stages_off_the_manifold_are_the_kernels_with_the_drift_rules_motion(mod
 
 @pytest.mark.parametrize("name", ["strip", "slider_crank"])
 def test_a_run_takes_every_stage_on_the_compiled_path(models, name, monkeypatch):
-    """0.05 s of the model: every kernel call returns OK (none hands a stage to the exact
-    path), and the exact path's solver is never called."""
+    """0.05 s of the model: every step is taken in compiled code (staged.py: no stage
+    declined), every state the extra coordinates' projection meets is put on the constraints
+    there (extra_projection.py), and the exact path's solver is never called (a stage or
+    motion the kernel declines goes there)."""
     system = models[name]
-    statuses = []
-    original = kernel.motion
+    steps, projected = [], []
+    step, project = staged.Stages.step, extra_projection.project
 
-    def counted(*args):
-        found = original(*args)
-        statuses.append(int(found[0]))
+    def stepped(self, solver):
+        found = step(self, solver)
+        steps.append(found[0] is not None)
         return found
+
+    def projecting(Q, QD, found, *args):
+        project(Q, QD, found, *args)
+        projected.extend(found[:, DONE] == 1.0)
 
     def refused(*args, **kwargs):
         raise AssertionError("a stage went to the KKT path")
-    monkeypatch.setattr(kernel, "motion", counted)
+    monkeypatch.setattr(staged.Stages, "step", stepped)
+    monkeypatch.setattr(extra_projection, "project", projecting)
     monkeypatch.setattr(system.data().__class__, "_kkt_motion", refused)
     run = mb.simulate(system, 0.05)
     assert run.status == "completed"
-    assert statuses and set(statuses) == {kernel.OK}
+    assert steps and all(steps)
+    assert all(projected)
+    if isinstance(system.data().engine.projection(), extra_projection.ExtraProjection):
+        assert projected
 
 
 def test_the_spin_up_beams_indefinite_mass_stages_are_the_kernels_with_the_drift_rules_motion(monkeypatch):
