@@ -161,8 +161,8 @@ class ContinuousIntegration(CutIntegration):
         with self._stages_on_manifold(True):  # the interpolant's extra stages, as the step's
             stepper.interpolate(solver, [t_star], y)
         q, qd = self.form.to_state(y[0])
-        on = self.projection(q, qd)
-        rows = self.projection.least_rows(*((q, qd) if on is None else on[:2]), NAMED_SHARE)
+        on = self.projection(t_star, q, qd)
+        rows = self.projection.least_rows(t_star, *((q, qd) if on is None else on[:2]), NAMED_SHARE)
         names = self.data.system.constraint_names
         self.f.add_singular(t_star, tuple(names[r] for r in rows), solver.t - t_start)
 
@@ -170,7 +170,7 @@ class ContinuousIntegration(CutIntegration):
     def _stages_on_manifold(self, across):
         """Within: where ``across`` (a step across a singular position), each stage is put on
         the constraints by the kernel's projection before its motion is evaluated."""
-        self.f.on_manifold = self.projection if across else None
+        self.f.on_manifold = self.projection if across else None  # called with (t, q, q̇)
         try:
             yield
         finally:
@@ -208,7 +208,7 @@ class ContinuousIntegration(CutIntegration):
         states[-1] = solver.y
         times.append(solver.t)
         projected = None if self.projection is None else \
-            self.projection.block(*self.form.states(states), (np.array(times) - start[0]) / taken)
+            self.projection.block(times, *self.form.states(states), (np.array(times) - start[0]) / taken)
         bounded = _bounded(states)
         self.passed = Passed(times, states, projected, bounded)
         q_on, qd_on = self._on_constraints(solver.t, q, qd, None if projected is None else projected.row(-1), arrays)
@@ -252,7 +252,7 @@ class ContinuousIntegration(CutIntegration):
             if self.watch is not None:
                 m = self.watch.measure
             else:
-                m = self.projection.measure(q, qd)
+                m = self.projection.measure(t, q, qd)
             self.crossing.passed(t, m)
 
     def _drift(self, t, q, qd, span):
@@ -260,7 +260,7 @@ class ContinuousIntegration(CutIntegration):
         reached, its ConstraintArrays or None):
         the kernel's rows where it projects the model, else projection.py's."""
         if self.projection is not None:
-            return self.projection.drift(q, qd), None
+            return self.projection.drift(t, q, qd), None
         if not self.has_rows:
             return 0.0, None
         arrays = self.data.constraint_arrays(t, q, qd, sparse=None)

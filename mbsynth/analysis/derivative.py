@@ -61,7 +61,7 @@ class StateDerivative:
         self.non_unique = False
         self.singular = []  # (t, rows) of the interval's stages near a singular position
         self.singular_positions = []  # per interval with such stages: {t_from, t_to, rows}
-        self.on_manifold = None  # (q, q̇) -> the state on the constraints or None: a step across a singular position
+        self.on_manifold = None  # (t, q, q̇) -> the state on the constraints or None: a step across a singular position
         self.angles = AngleParts(data.model)  # the parts that turn by angles, watched for their singular position
         self.use(None)
         self.begin(0.0, 0.0)
@@ -87,7 +87,7 @@ class StateDerivative:
     def __call__(self, t, y):
         self.t_failed = t
         if self.on_manifold is not None:  # a step across a singular position (crossing.py)
-            y = self._on_manifold(y)
+            y = self._on_manifold(t, y)
         self._count(1, t, y)
         if self.angles and self.angles.nearest(y) < ANGLES_NEAR:
             self.angle_calls += 1
@@ -188,11 +188,11 @@ class StateDerivative:
                              f"method (DOP853)", coordinates=culprits)
         return J
 
-    def _on_manifold(self, y):
-        """The stage y put on the constraints by ``on_manifold`` (as it is where that declines)."""
+    def _on_manifold(self, t, y):
+        """The stage (t, y) put on the constraints by ``on_manifold`` (as it is where that declines)."""
         if not np.abs(y).max(initial=0.0) <= MAX_STATE:
             return y
-        projected = self.on_manifold(*self.form.to_state(y))
+        projected = self.on_manifold(t, *self.form.to_state(y))
         return y if projected is None else self.form.to_integrator(projected.q, projected.qd)
 
     def add_singular(self, t, rows, within):

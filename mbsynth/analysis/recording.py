@@ -57,7 +57,7 @@ class Recorder:
         data = self.data
         if projected is None:
             if projection is not None:
-                phi, psi, kinetic, potential = projection.residuals_energy(q, qd)
+                phi, psi, kinetic, potential = projection.residuals_energy(t, q, qd)
             else:
                 phi, psi = data.constraint_residuals(t, q, qd) if arrays is None else (arrays.phi, arrays.psi)
             residuals = _max_abs(phi), _max_abs(psi)

@@ -40,9 +40,10 @@ def warm(texts):
         system.data("compiled").constraint_arrays(0.0, q, qd)  # the shared structures' tape (tape.run)
         projection = engine.projection()
         if projection is not None:  # simulate's rows and projections, one by one and fitted (row_fit.py)
-            projection(q, qd)
+            projection(0.0, q, qd)
             count = row_fit.MIN_ROWS
-            projection.block(np.tile(q, (count, 1)), np.tile(qd, (count, 1)), np.arange(1, count + 1) / count)
+            projection.block(np.zeros(count), np.tile(q, (count, 1)), np.tile(qd, (count, 1)),
+                             np.arange(1, count + 1) / count)
         simulate(system, WARM_RUN)
 
 

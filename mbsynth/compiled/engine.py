@@ -31,10 +31,8 @@ import functools
 import threading
 
 import numpy as np
-import sympy as sp
 
 from ..core.equations import Motion
-from ..symbolic.derive import T_SYMBOL
 from . import ahead, codegen, flexible, kernel, layout, staged
 from .assembly import Work, make_work
 from .projection import Projection
@@ -52,9 +50,10 @@ class Template:
     """What the Systems with one structure share: the Layout (with the numbers of the System
     it was built from, at parameter values ``p``) and the compiled generated function."""
 
-    def __init__(self, system, L, exprs, phi_outputs, own):
+    def __init__(self, system, L, exprs, phi_outputs, phi_rates, own):
         self.L, self.n, self.p = L, system.n, system.parameter_values
         self.phi_outputs = phi_outputs  # the generated function's last outputs: φ of the extra rows
+        self.phi_rates = phi_rates  # 0, or φ_outputs: ∂φ/∂t of those rows just before them (a row reads t)
         self.names = tuple(system.parameters)
         self.sources = layout.sources(L, system)  # the parts and joints its numbers are read from
         self.outputs = len(exprs)
@@ -63,9 +62,6 @@ class Template:
         # the flexible parts' M and Q written after the generated function (layout.Own, flexible.py)
         self.module = flexible.Filled(generated, own) if own else generated
         self.closes_loops = L.xrow_row.size > 0  # extra rows: loop joints or other constraints
-        # the generated masses, rows and φ (all but the Q additions and C) depend on t: no projection without t
-        self.rows_depend_on_time = any(T_SYMBOL in sp.sympify(expr).free_symbols
-                                       for expr in exprs[L.gen_q.size + L.gen_c.size:] if expr is not None)
         self.general = kernel.RIGID_TREE if layout.rigid_tree(L) else kernel.GENERAL  # kernel.motion's last argument
         # the kernel's mode per call: the residual checked where it can fail (module docstring)
         self.mode = kernel.UNCHECKED if self.general is kernel.RIGID_TREE else kernel.CHECKED

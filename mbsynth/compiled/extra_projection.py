@@ -7,14 +7,15 @@ zero and q̇ = 0, the kernel's q̈ for a right side shifted by −r is the least
 A Δ = −r ((2.14) with Q = 0). Positions: Gauss–Newton steps with r = φ, the generated φ of
 the extra rows, while a row's |φ| exceeds MASS_PROJECTION_RTOL of its terms (Σ_j |A_ij q_j|, as
 core/equations.term_scales: alike at every scale), at most MAX_STEPS of them; then
-velocities, one step with r = φ̇ = A q̇ (linear). A velocity step must cut each row's φ̇ by
+velocities, one step with r = φ̇ = A q̇ + ∂φ/∂t (linear). A velocity step must cut each row's φ̇ by
 MASS_PROJECTION_SHRINK at least, or leave it below MASS_PROJECTION_RATE_RTOL of its terms. A state the
 kernel declines (its dense Schur step finds the rows contradict) or whose steps do not meet these goals goes
 to analysis/projection.py (None), as with compiled/projection.py.
 
 Only for Systems whose every coordinate is an extra coordinate, every extra row has a φ
-(holonomic rows: a velocity-level row has no position to project), whose masses and rows
-do not depend on time (a projection is called without t). The banded Schur step of a larger
+(holonomic rows: a velocity-level row has no position to project). Masses and rows
+that depend on time (a servo's prescribed angle) are evaluated at each state's t, their
+∂φ/∂t among the generated outputs (engine.Template.phi_rates). The banded Schur step of a larger
 model (kernel.py; layout.DENSE_SCHUR_MAX) declines states near a singular position, and
 there the mass metric moves the velocity far more than analysis/projection.py's (a velocity 1e-10 off
 the N = 40 four-bar's manifold 1e-4 rad from a horizontal position is put 1e-6 from the
@@ -69,13 +70,15 @@ class ExtraProjection:
         self.xrow_row, self.m = L.xrow_row, int(L.sizes[1])
         self.entries = slice(int(starts[3]), int(starts[4]))  # the rows' entries in gen
         self.gen = np.zeros(engine.outputs)
+        phi_from = engine.outputs - engine.template.phi_outputs
+        rates_from = phi_from - engine.template.phi_rates if engine.template.phi_rates else -1
         packed_work, _ = engine.new_work()
         kernel_c, kernel_jit = address(kernel.motion, motion_signature(typeof(engine.general)))
         count = self.xrow_row.size
-        # rows, columns, their entries, Q and C to zero, b to zero, φ in gen, the System's rows of the extra rows
+        # rows, columns, their entries, Q and C to zero, b to zero, φ and ∂φ/∂t (or −1: none) in gen, the
+        # System's rows of the extra rows
         self.layout = (self.rows, self.columns, int(starts[3]), int(starts[2]), int(starts[4]), int(starts[5]),
-                       engine.outputs - engine.template.phi_outputs, self.xrow_row, kernel_c, kernel_jit,
-                       *engine.packed, *packed_work)
+                       phi_from, rates_from, self.xrow_row, kernel_c, kernel_jit, *engine.packed, *packed_work)
         # the right side's shift per System row, q̇ = 0, then per extra row: φ, φ̇, φ̇ before the step, term sizes
         self.work = (np.zeros(self.m), np.zeros(self.n), *(np.zeros(count) for _ in range(4)))
         self.lock = threading.Lock()
@@ -90,12 +93,11 @@ class ExtraProjection:
     @classmethod
     def build(cls, engine):
         """The ExtraProjection of ``engine``, or None where its model is not of extra
-        coordinates alone, has no row or a row without φ, or rows or masses that depend on t
-        (Template.rows_depend_on_time)."""
-        L, template = engine.L, engine.template
+        coordinates alone, or has no row or a row without φ."""
+        L = engine.L
         if L.node_kind.size or L.x_coord.size != engine.n or not L.xrow_row.size:
             return None
-        if template.phi_outputs != L.xrow_row.size or template.rows_depend_on_time:
+        if engine.template.phi_outputs != L.xrow_row.size:
             return None
         return cls(engine)
 
@@ -106,59 +108,63 @@ class ExtraProjection:
         other._use(engine)
         return other
 
-    def __call__(self, q, qd):
-        """``Projected`` (q, q̇) on the constraints (new arrays; kinetic and potential energy
-        NaN), or None (module docstring)."""
-        return self.block(np.asarray(q, dtype=float)[None, :], np.asarray(qd, dtype=float)[None, :]).row(0)
+    def __call__(self, t, q, qd):
+        """``Projected`` (q, q̇) at t on the constraints (new arrays; kinetic and potential
+        energy NaN), or None (module docstring)."""
+        return self.block([t], np.asarray(q, dtype=float)[None, :], np.asarray(qd, dtype=float)[None, :]).row(0)
 
-    def block(self, Q, QD, fractions=None):
-        """Each state (row of Q, Q̇) projected, as ProjectedRows (``fractions``, the states'
-        fractions of a step, are not used: each state is projected on its own)."""
+    def block(self, times, Q, QD, fractions=None):
+        """Each state (row of Q, Q̇, at its entry of ``times``) projected, as ProjectedRows
+        (``fractions``, the states' fractions of a step, are not used: each state is projected
+        on its own)."""
         Q_on, QD_on = np.array(Q, dtype=float, order="C"), np.array(QD, dtype=float, order="C")
         found = np.full((Q_on.shape[0], DONE + 1), np.nan)
         with self.lock:
-            project(Q_on, QD_on, found, self.evaluation, self.layout, self.work, self.general)
+            project(np.asarray(times, dtype=float), Q_on, QD_on, found, self.evaluation, self.layout, self.work,
+                    self.general)
         return ProjectedRows(Q_on, QD_on, found)
 
-    def measure(self, q, qd):
+    def measure(self, t, q, qd):
         """σ_min/σ₁ of the rows' A at (q, q̇), each row scaled to unit norm
         (least_direction.py): what a run's step plan near singular positions reads
         (analysis/crossing.py) where its singular watch does not."""
-        return self._least(q, qd)[0]
+        return self._least(t, q, qd)[0]
 
-    def least_rows(self, q, qd, share):
-        """The System's rows that take part in the least direction of the rows' A at (q, q̇):
+    def least_rows(self, t, q, qd, share):
+        """The System's rows that take part in the least direction of the rows' A at (t, q, q̇):
         those of weight above ``share`` of the largest."""
-        weights = self._least(q, qd)[1]
+        weights = self._least(t, q, qd)[1]
         return tuple(int(r) for r in self.xrow_row[weights > share * weights.max(initial=0.0)])
 
-    def _least(self, q, qd):
-        """(σ_min/σ₁, the rows' weights in the least direction) at (q, q̇)."""
+    def _least(self, t, q, qd):
+        """(σ_min/σ₁, the rows' weights in the least direction) at (t, q, q̇)."""
         with self.lock:
-            self._evaluate(q, qd)
+            self._evaluate(t, q, qd)
             values = self.gen[self.entries].copy()
         if self.least is None:
             self.least = LeastDirection(self.rows, self.columns, self.xrow_row.size)
         return self.least(values)
 
-    def _evaluate(self, q, qd):
-        """The generated outputs at (q, q̇) into gen (t = 0: they do not depend on it)."""
-        evaluate(0.0, np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float), self.evaluation)
+    def _evaluate(self, t, q, qd):
+        """The generated outputs at (t, q, q̇) into gen."""
+        evaluate(float(t), np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float),
+                 self.evaluation)
 
-    def residuals_energy(self, q, qd):
-        """(φ, φ̇ of the extra rows, NaN, NaN): the energies are the Data's."""
+    def residuals_energy(self, t, q, qd):
+        """(φ, φ̇ of the extra rows at (t, q, q̇), NaN, NaN): the energies are the Data's."""
         qd = np.ascontiguousarray(qd, dtype=float)
         with self.lock:
-            self._evaluate(q, qd)
-            psi = np.zeros(self.xrow_row.size)
+            self._evaluate(t, q, qd)
+            phi, psi = np.zeros(self.xrow_row.size), np.zeros(self.xrow_row.size)
+            _phi(self.gen, self.layout, phi)
             _rates(qd, self.gen, self.layout, psi)
-            return self.gen[self.layout[6]:].copy(), psi, np.nan, np.nan
+            return phi, psi, np.nan, np.nan
 
-    def drift(self, q, qd):
-        """The largest |φ| or |φ̇| relative to its row's terms (``_terms`` with DRIFT_FLOOR,
-        as analysis/projection.relative_drift)."""
+    def drift(self, t, q, qd):
+        """The largest |φ| or |φ̇| at (t, q, q̇) relative to its row's terms (``_terms`` with
+        DRIFT_FLOOR, as analysis/projection.relative_drift)."""
         with self.lock:
-            return drift(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float),
+            return drift(float(t), np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float),
                          self.evaluation, self.layout, self.work)
 
 
@@ -181,9 +187,11 @@ def _terms(x, floor, gen, layout, out):
 
 @njit(**OPTIONS)
 def _rates(qd, gen, layout, out):
-    """φ̇ = A q̇ per extra row into ``out``, from the rows' entries as evaluated last."""
-    rows, columns, entries = layout[0], layout[1], layout[2]
-    out[:] = 0.0
+    """φ̇ = A q̇ + ∂φ/∂t per extra row into ``out``, from the rows' entries (and ∂φ/∂t, where
+    the rows have it) as evaluated last."""
+    rows, columns, entries, rates_from = layout[0], layout[1], layout[2], layout[7]
+    for r in range(out.shape[0]):
+        out[r] = gen[rates_from + r] if rates_from >= 0 else 0.0
     for e in range(rows.shape[0]):
         out[rows[e]] += gen[entries + e] * qd[columns[e]]
 
@@ -199,7 +207,7 @@ def _phi(gen, layout, out):
 def _step(q, residual, gen, layout, work, general):
     """The least-M-norm Δ with A Δ = −residual (rows as evaluated last at q) into the Work's
     q̈: (2.14) with the generated forces, C and b zero and q̇ = 0; whether the kernel gave it."""
-    (_, _, _, forces_to, rights_from, rights_to, _, xrow_row, kernel_c, kernel_jit, LI, LF, LX, WI, WF, WX) = layout
+    (_, _, _, forces_to, rights_from, rights_to, _, _, xrow_row, kernel_c, kernel_jit, LI, LF, LX, WI, WF, WX) = layout
     shift, rest = work[0], work[1]
     for k in range(forces_to):
         gen[k] = 0.0
@@ -212,20 +220,21 @@ def _step(q, residual, gen, layout, work, general):
 
 
 @njit(**OPTIONS)
-def project(Q, QD, found, evaluation, layout, work, general):
-    """Each state (row of Q, Q̇) put on the constraints in place (module docstring), found's
+def project(times, Q, QD, found, evaluation, layout, work, general):
+    """Each state (row of Q, Q̇, at its entry of ``times``) put on the constraints in place
+    (module docstring), found's
     row (NaN energies, PHI_MAX, PSI_MAX, DONE = 1), or DONE = 0 and the row zero where the
     kernel declines a step or the steps miss their goals. Positions: Gauss–Newton steps while
     a row's |φ| exceeds MASS_PROJECTION_RTOL of its terms, at most MAX_STEPS; then one
     velocity step, which must cut each row's φ̇ by MASS_PROJECTION_SHRINK or leave it below
     MASS_PROJECTION_RATE_RTOL of its terms."""
     gen = evaluation[5]
-    qdd = view1(layout[14], layout[15], WORK.qdd)
+    qdd = view1(layout[15], layout[16], WORK.qdd)
     phi, psi, before, terms = work[2], work[3], work[4], work[5]
     for b in range(Q.shape[0]):
         q, qd = Q[b], QD[b]
         found[b, DONE] = 0.0
-        done = _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work, general)
+        done = _project(times[b], q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work, general)
         if not done:
             q[:] = 0.0
             qd[:] = 0.0
@@ -234,9 +243,9 @@ def project(Q, QD, found, evaluation, layout, work, general):
 
 
 @njit(**OPTIONS)
-def _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work, general):
-    """``project`` of one state; whether it is on the constraints (φ and φ̇ there in phi, psi)."""
-    evaluate(0.0, q, qd, evaluation)
+def _project(t, q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work, general):
+    """``project`` of one state at t; whether it is on the constraints (φ and φ̇ there in phi, psi)."""
+    evaluate(t, q, qd, evaluation)
     _phi(gen, layout, phi)
     for step in range(MAX_STEPS + 1):
         _terms(q, TERM_FLOOR, gen, layout, terms)
@@ -249,7 +258,7 @@ def _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work,
             return False
         for c in range(q.shape[0]):
             q[c] += qdd[c]
-        evaluate(0.0, q, qd, evaluation)
+        evaluate(t, q, qd, evaluation)
         _phi(gen, layout, phi)
     _rates(qd, gen, layout, psi)
     for r in range(psi.shape[0]):
@@ -258,7 +267,7 @@ def _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work,
         return False
     for c in range(qd.shape[0]):
         qd[c] += qdd[c]
-    evaluate(0.0, q, qd, evaluation)
+    evaluate(t, q, qd, evaluation)
     _phi(gen, layout, phi)
     _rates(qd, gen, layout, psi)
     _terms(qd, TERM_FLOOR, gen, layout, terms)
@@ -269,12 +278,12 @@ def _project(q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, work,
 
 
 @njit(**OPTIONS)
-def drift(q, qd, evaluation, layout, work):
-    """The largest |φ| or |φ̇| at (q, q̇) relative to its row's terms (DRIFT_FLOOR; NaN if
+def drift(t, q, qd, evaluation, layout, work):
+    """The largest |φ| or |φ̇| at (t, q, q̇) relative to its row's terms (DRIFT_FLOOR; NaN if
     any is)."""
     gen = evaluation[5]
     phi, psi, terms = work[2], work[3], work[5]
-    evaluate(0.0, q, qd, evaluation)
+    evaluate(t, q, qd, evaluation)
     _phi(gen, layout, phi)
     _rates(qd, gen, layout, psi)
     _terms(q, DRIFT_FLOOR, gen, layout, terms)

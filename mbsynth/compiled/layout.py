@@ -333,7 +333,7 @@ class _Builder:
             for r in range(con.size):
                 xrow_row.append(row + r)
                 segs.append(ends)
-        exprs, gen, phi_outputs, own = self._generated(xrow_row, segs)
+        exprs, gen, phi_outputs, phi_rates, own = self._generated(xrow_row, segs)
         seg_ptr = np.cumsum([0] + [len(s) for s in segs])
         patterns = _patterns(gen, len(xrow_row), len(self.x_coord))
         band = dict(band_pos=_ints([]), band_width=_ints([]))
@@ -361,7 +361,7 @@ class _Builder:
             quat_row=_ints([self.quat[f"{part.name}.unit_quaternion"] if r else -1
                             for (part, _), r in zip(nodes, rigid)]),
             sizes=_ints(sizes), **numbers, **gen, **patterns, **band)
-        return layout, exprs, phi_outputs, own
+        return layout, exprs, phi_outputs, phi_rates, own
 
     def _end_of(self, i, j):
         if j < 0:
@@ -397,7 +397,9 @@ class _Builder:
         return kinds, starts, program
 
     def _generated(self, xrow_row, segs):
-        """Expressions of the generated function, and where each output goes."""
+        """Expressions of the generated function, where each output goes, and the counts of its
+        last outputs: φ of the extra rows (with a φ), and before them their ∂φ/∂t where a row
+        reads t (else none)."""
         system, node_at, x_index = self.system, self.node_at, self.x_index
         Q, C = {}, {}
         for element in system.forces:
@@ -425,7 +427,8 @@ class _Builder:
                 for b in range(len(part.coordinates)):
                     if part.M[a, b] != 0:
                         M.append((x_index[int(start) + a], x_index[int(start) + b], part.M[a, b]))
-        rows, b, phi, placed = [], [], [], sum(len(s) for s in segs)
+        rows, b, phi, rates, placed = [], [], [], [], sum(len(s) for s in segs)
+        at_rest = {s: 0 for s in system.qd_symbols}  # φ̇ = A q̇ + ∂φ/∂t: ∂φ/∂t is φ̇ at q̇ = 0
         for con, row in self.others:
             for r in range(con.size):
                 if con.b[r] == 0 and all(con.a[r, int(i)] == 0 for i in con.indices):
@@ -449,9 +452,11 @@ class _Builder:
                     b.append((xr, con.b[r]))
                 if con.phi is not None and con.phi[r] != 0 and con.phi[r] is not sp.nan:
                     phi.append(con.phi[r])
+                    rates.append(sp.S.Zero if con.psi is None else sp.sympify(con.psi[r]).xreplace(at_rest))
         inputs = [g for part, *_ in own for g in part.kernel_arrays.gravity]
+        rates = rates if any(r != 0 for r in rates) else []  # ∂φ/∂t only where a row's φ reads t
         exprs = (list(Q.values()) + [None] * len(own_q) + list(C.values()) + [e for *_, e in M]
-                 + [e for *_, e in rows] + [e for _, e in b] + inputs + phi)
+                 + [e for *_, e in rows] + [e for _, e in b] + inputs + rates + phi)
         m_start = len(Q) + len(own_q) + len(C)
         g_start = m_start + len(M) + len(rows) + len(b)
         own = [Own(start, m_start + m0, len(Q) + q0, g_start + 3 * k, tuple(part.kernel_arrays[:6]))
@@ -460,4 +465,4 @@ class _Builder:
                    gen_mj=_ints([x[1] for x in M]), gen_arow=_ints([x[0] for x in rows]),
                    gen_aseg=_ints([x[1] for x in rows]), gen_acol=_ints([x[2] for x in rows]),
                    gen_brow=_ints([x[0] for x in b]))
-        return exprs, gen, len(phi), own
+        return exprs, gen, len(phi), len(rates), own

@@ -246,13 +246,14 @@ class Projection:
         rows = Rows(engine.L, engine.packed, int(engine.L.sizes[1]))
         return cls(rows, engine.at_rest()) if rows.covers else None
 
-    def __call__(self, q, qd):
+    def __call__(self, t, q, qd):
         """``Projected`` (q, q̇) on the constraints (new arrays) with their rows, or None where
         the kernel declines the state, MAX_STEPS position steps leave φ above MASS_PROJECTION_RTOL, or
-        the velocity step leaves φ̇ above MASS_PROJECTION_SHRINK of what it was (and above rounding)."""
-        return self.block(q[None, :], qd[None, :]).row(0)
+        the velocity step leaves φ̇ above MASS_PROJECTION_SHRINK of what it was (and above rounding).
+        The kernel's rows do not read the time t (nor ``times`` below: the API of extra_projection.py)."""
+        return self.block([t], q[None, :], qd[None, :]).row(0)
 
-    def block(self, Q, QD, fractions=None):
+    def block(self, times, Q, QD, fractions=None):
         """``__call__`` of each state (row of Q, Q̇), as ProjectedRows. ``fractions``: where
         the states are the rows a step passed, each one's fraction θ of the step (the last
         1, its end): where they are at least row_fit.MIN_ROWS, a few of them are projected
@@ -313,13 +314,13 @@ class Projection:
                 other.result()
         return ProjectedRows(Q_on, QD_on, found)
 
-    def residuals_energy(self, q, qd):
+    def residuals_energy(self, t, q, qd):
         """(φ, φ̇, T, V) at (q, q̇): the System's residuals and its parts' energies."""
         with self.lock:
             phi, psi, kinetic, potential = self.rows(q, qd)[:4]
             return phi.copy(), psi.copy(), kinetic, potential
 
-    def drift(self, q, qd):
+    def drift(self, t, q, qd):
         """The largest |φ| relative to the largest coordinate (at least 1: a quaternion's
         unit), or |φ̇| relative to the largest rate."""
         with self.lock:

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from mbsynth.cli import compile_ahead
 from mbsynth.compiled import background
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -29,7 +30,7 @@ def test_compiling_ahead_says_what_and_how_far():
     else:
         assert lines[0].startswith("mbsynth: the compiled path's kernels are compiled already (")
     stages = [tuple(map(int, m.groups())) for m in map(STAGE.match, lines[1:]) if m]
-    count = 5 if cold else 4
+    count = len(compile_ahead.WARM_MODELS) + 2 + cold  # each warm-up model, the rigid tree, the flexible parts
     assert stages == [(k, count) for k in range(1, count + 1)] and len(lines) == count + 1
     assert lines[-1].startswith(f"mbsynth: [{count}/{count}] the flexible parts' kernel")
     assert done.stdout.startswith("mbsynth: the compiled path's kernels compiled into ")

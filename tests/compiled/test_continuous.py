@@ -51,7 +51,7 @@ def test_compiled_rows_equal_the_systems_residuals_and_energies(model):
     system = mb.load(ROOT / "models" / model)
     rng = np.random.default_rng(3)
     q, qd = drifted_state(system, rng)
-    phi, psi, kinetic, potential = projection_of(system).residuals_energy(q, qd)
+    phi, psi, kinetic, potential = projection_of(system).residuals_energy(0.0, q, qd)
     phi_ref, psi_ref = system.constraint_residuals(0.0, q, qd)
     np.testing.assert_allclose(phi, phi_ref, rtol=1e-10, atol=1e-15)
     np.testing.assert_allclose(psi, psi_ref, rtol=1e-10, atol=1e-13)
@@ -71,7 +71,7 @@ def test_a_projection_is_the_least_mass_norm_step_onto_the_constraints(model, dr
     identity's tolerance). After them, φ and φ̇ vanish to rounding."""
     system = mb.load(ROOT / "models" / model)
     q, qd = drifted_state(system, np.random.default_rng(4), *drift)
-    q_on, qd_on = projection_of(system)(q, qd)[:2]
+    q_on, qd_on = projection_of(system)(0.0, q, qd)[:2]
     phi, psi = system.constraint_residuals(0.0, q_on, qd_on)
     assert np.abs(phi).max() < 1e-14 * max(np.abs(q).max(), 1) and np.abs(psi).max() < 1e-12 * np.abs(qd).max()
     for at, start, end in ((q, q, q_on), (q_on, qd, qd_on)):
@@ -130,10 +130,10 @@ def test_a_block_of_states_is_projected_as_each_state_alone():
     Q, QD = q + 1e-9 * rng.standard_normal((count, q.size)), qd + 1e-9 * rng.standard_normal((count, q.size))
     Q[7] = np.nan
     projection = projection_of(system)
-    block = projection.block(Q, QD)
+    block = projection.block(np.zeros(count), Q, QD)
     assert len(block.q) == count and block.row(7) is None
     for i, (q, qd) in enumerate(zip(Q, QD)):
-        together, alone = block.row(i), projection(q, qd)
+        together, alone = block.row(i), projection(0.0, q, qd)
         if alone is None:
             assert together is None
             continue
@@ -189,3 +189,22 @@ def test_a_ur5_falls_as_pinocchio_integrates_it_with_as_many_evaluations():
     assert traj.stats["evaluations"] < 1.3 * reference.nfev
     assert traj.max_residual < 1e-12
     assert np.ptp(traj.energy) < 1e-8
+
+
+def test_rows_that_read_the_time_are_projected_at_the_states_time():
+    """The spin-up beam's servo row (hub angle = θ(t)): a state of its run at 7 s (θ̇ = 2.8
+    rad/s), pushed off the constraints, is put on them at 7 s — φ and φ̇ by the System's own
+    rows at 7 s (φ̇ with its ∂φ/∂t) vanish to rounding — and not at another time: projected
+    as if 1 ms earlier, its rows at 7 s are off by about θ's change (2.8 mrad)."""
+    system = mb.load(ROOT / "models" / "flexible" / "spin_up_beam.yaml")
+    run = mb.simulate(system, 7.0, dt=7.0)
+    q, qd = run.q[-1], run.qd[-1]
+    rng = np.random.default_rng(9)
+    q, qd = q + 1e-7 * rng.standard_normal(q.size), qd + 1e-7 * rng.standard_normal(q.size)
+    projection = projection_of(system)
+    on = projection(7.0, q, qd)
+    phi, psi = system.constraint_residuals(7.0, on.q, on.qd)
+    assert np.abs(phi).max() < 1e-13 and np.abs(psi).max() < 1e-11 * np.abs(qd).max()
+    elsewhere = projection(7.0 - 1e-3, q, qd)
+    phi, psi = system.constraint_residuals(7.0, elsewhere.q, elsewhere.qd)
+    assert 2e-3 < np.abs(phi).max() < 4e-3 and np.abs(psi).max() > 1e-4

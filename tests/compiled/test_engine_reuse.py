@@ -255,7 +255,7 @@ def test_a_parameter_only_the_rows_read_moves_the_projection_too():
     q, qd = model.initial_state()
     moved = q + 1e-4 * np.sin(np.arange(q.size) + 1.0)
     assert np.abs(model.data(path="kkt").constraint_residuals(0.0, moved, qd)[0]).max() > 1e-6
-    projected = projection(moved, qd)
+    projected = projection(0.0, moved, qd)
     assert projected is not None  # the first model's rows: the steps do not converge
     phi, psi = model.data(path="kkt").constraint_residuals(0.0, projected.q, projected.qd)
     assert np.abs(phi).max() < 1e-12 and np.abs(psi).max() < 1e-12

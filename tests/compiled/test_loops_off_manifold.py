@@ -253,7 +253,7 @@ def test_a_large_planar_loop_is_served_by_the_banded_schur_step(tmp_path):
     projection = engine.projection()  # extra_projection.py, through the banded step
     q, qd = ref.n_four_bar_state(system.coordinates, N, 0.5, 2.0)
     rng = np.random.default_rng(4)
-    on = projection(q + 1e-9 * rng.standard_normal(q.size), qd + 1e-9 * rng.standard_normal(q.size))
+    on = projection(0.0, q + 1e-9 * rng.standard_normal(q.size), qd + 1e-9 * rng.standard_normal(q.size))
     phi, psi = system.constraint_residuals(0.0, on.q, on.qd)
     assert np.abs(phi).max() < 1e-14 and np.abs(psi).max() < 1e-13
     J, K = ref.n_four_bar_constants(N)

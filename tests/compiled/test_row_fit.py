@@ -59,9 +59,9 @@ def test_fitted_rows_are_the_exact_projections_and_meet_the_systems_constraints(
     fit through NODES rows fails and the span is halved until it holds."""
     Q, QD, fractions = drifted_rows(bricard, span, 120, seed=1)
     projection = bricard.data().engine.projection()
-    exact = projection.block(Q, QD)
+    exact = projection.block(np.zeros(len(Q)), Q, QD)
     count = counting(projection)
-    fitted = projection.block(Q, QD, fractions)
+    fitted = projection.block(np.zeros(len(Q)), Q, QD, fractions)
     assert fitted.done.all() and exact.done.all()
     assert count[0] < (len(Q) if span > 1 else 2 * row_fit.NODES)
     np.testing.assert_allclose(fitted.q, exact.q, rtol=0, atol=1e-12)
@@ -79,7 +79,8 @@ def test_a_row_the_fit_misses_is_projected_exactly(bricard):
     Q, QD, fractions = drifted_rows(bricard, 0.1, 120, seed=2)
     Q[50] += 1e-7
     projection = bricard.data().engine.projection()
-    fitted, exact = projection.block(Q, QD, fractions), projection.block(Q, QD)
+    times = np.zeros(len(Q))
+    fitted, exact = projection.block(times, Q, QD, fractions), projection.block(times, Q, QD)
     np.testing.assert_array_equal(fitted.q[50], exact.q[50])
     np.testing.assert_allclose(fitted.q, exact.q, rtol=0, atol=1e-12)
 

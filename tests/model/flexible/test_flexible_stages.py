@@ -62,8 +62,8 @@ def test_a_run_takes_every_stage_on_the_compiled_path(models, name, monkeypatch)
         steps.append(found[0] is not None)
         return found
 
-    def projecting(Q, QD, found, *args):
-        project(Q, QD, found, *args)
+    def projecting(times, Q, QD, found, *args):
+        project(times, Q, QD, found, *args)
         projected.extend(found[:, DONE] == 1.0)
 
     def refused(*args, **kwargs):
