@@ -8,9 +8,12 @@ A Δ = −r ((2.14) with Q = 0). Positions: Gauss–Newton steps with r = φ, th
 the extra rows, while a row's |φ| exceeds MASS_PROJECTION_RTOL of its terms (Σ_j |A_ij q_j|, as
 core/equations.term_scales: alike at every scale), at most MAX_STEPS of them; then
 velocities, one step with r = φ̇ = A q̇ + ∂φ/∂t (linear). A velocity step must cut each row's φ̇ by
-MASS_PROJECTION_SHRINK at least, or leave it below MASS_PROJECTION_RATE_RTOL of its terms. A state the
-kernel declines (its dense Schur step finds the rows contradict) or whose steps do not meet these goals goes
-to analysis/projection.py (None), as with compiled/projection.py.
+MASS_PROJECTION_SHRINK at least, or leave it below MASS_PROJECTION_RATE_RTOL of its terms. The
+kernel is called at the state's relative drift, as compiled/projection.py calls it: it takes a
+step only where the rows are certainly independent (certify.py; a mass that is not definite,
+the spin-up beam's, through the mass augmented by the rows). A state the kernel declines (rows
+nearly dependent, or contradicting) or whose steps do not meet these goals goes to
+analysis/projection.py (None), as with compiled/projection.py.
 
 Only for Systems whose every coordinate is an extra coordinate, every extra row has a φ
 (holonomic rows: a velocity-level row has no position to project). Masses and rows
@@ -42,7 +45,7 @@ from .least_direction import LeastDirection
 from .packing import view1
 from .pointers import address, caster
 from .projection import DONE, MAX_STEPS, PHI_MAX, PSI_MAX, TINY, ProjectedRows
-from .rows import largest
+from .rows import largest, relative_drift
 from .staged import KERNEL_ARGUMENTS, evaluate, evaluation_of
 from ..core.tolerances import MASS_PROJECTION_RATE_RTOL, MASS_PROJECTION_RTOL, MASS_PROJECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
 
@@ -206,16 +209,20 @@ def _phi(gen, layout, out):
 @njit(**OPTIONS)
 def _step(q, residual, gen, layout, work, general):
     """The least-M-norm Δ with A Δ = −residual (rows as evaluated last at q) into the Work's
-    q̈: (2.14) with the generated forces, C and b zero and q̇ = 0; whether the kernel gave it."""
-    (_, _, _, forces_to, rights_from, rights_to, _, _, xrow_row, kernel_c, kernel_jit, LI, LF, LX, WI, WF, WX) = layout
+    q̈: (2.14) with the generated forces, C and b zero and q̇ = 0, at q's relative drift (as
+    compiled/projection.py calls the kernel: the rows certified, else declined); whether the
+    kernel gave it."""
+    (_, _, _, forces_to, rights_from, rights_to, phi_from, _, xrow_row, kernel_c, kernel_jit, LI, LF, LX, WI, WF,
+     WX) = layout
     shift, rest = work[0], work[1]
+    drift = relative_drift(0.0, gen, phi_from, phi_from + xrow_row.shape[0], q)
     for k in range(forces_to):
         gen[k] = 0.0
     for k in range(rights_from, rights_to):
         gen[k] = 0.0
     for x in range(xrow_row.shape[0]):
         shift[xrow_row[x]] = -residual[x]
-    return _motion(kernel_c, kernel_jit, general)(q, rest, gen, shift, LI, LF, LX, WI, WF, WX, UNCHECKED, -1.0,
+    return _motion(kernel_c, kernel_jit, general)(q, rest, gen, shift, LI, LF, LX, WI, WF, WX, UNCHECKED, drift,
                                                   general)[0] == OK
 
 
