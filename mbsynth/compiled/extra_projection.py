@@ -261,26 +261,31 @@ def _project(t, q, qd, gen, qdd, phi, psi, before, terms, evaluation, layout, wo
             met = met and abs(phi[r]) <= MASS_PROJECTION_RTOL * terms[r]
         if met:
             break
-        if step == MAX_STEPS or not _step(q, phi, gen, layout, work, general):
+        if step == MAX_STEPS or not _moved(t, q, q, qd, phi, gen, qdd, phi, evaluation, layout, work, general):
             return False
-        for c in range(q.shape[0]):
-            q[c] += qdd[c]
-        evaluate(t, q, qd, evaluation)
-        _phi(gen, layout, phi)
     _rates(qd, gen, layout, psi)
     for r in range(psi.shape[0]):
         before[r] = abs(psi[r])
-    if not _step(q, psi, gen, layout, work, general):
+    if not _moved(t, qd, q, qd, psi, gen, qdd, phi, evaluation, layout, work, general):
         return False
-    for c in range(qd.shape[0]):
-        qd[c] += qdd[c]
-    evaluate(t, q, qd, evaluation)
-    _phi(gen, layout, phi)
     _rates(qd, gen, layout, psi)
     _terms(qd, TERM_FLOOR, gen, layout, terms)
     for r in range(psi.shape[0]):
         if not abs(psi[r]) <= max(MASS_PROJECTION_SHRINK * before[r], MASS_PROJECTION_RATE_RTOL * terms[r]):
             return False
+    return True
+
+
+@njit(**OPTIONS)
+def _moved(t, x, q, qd, residual, gen, qdd, phi, evaluation, layout, work, general):
+    """x (q or q̇) moved by ``_step``'s Δ for ``residual``, the generated outputs and φ then
+    evaluated at (t, q, q̇) into gen and phi; whether the kernel gave Δ."""
+    if not _step(q, residual, gen, layout, work, general):
+        return False
+    for c in range(x.shape[0]):
+        x[c] += qdd[c]
+    evaluate(t, q, qd, evaluation)
+    _phi(gen, layout, phi)
     return True
 
 
