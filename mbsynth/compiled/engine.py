@@ -53,7 +53,7 @@ class Template:
     def __init__(self, system, L, exprs, phi_outputs, phi_rates, own):
         self.L, self.n, self.p = L, system.n, system.parameter_values
         self.phi_outputs = phi_outputs  # the generated function's last outputs: φ of the extra rows
-        self.phi_rates = phi_rates  # 0, or φ_outputs: ∂φ/∂t of those rows just before them (a row reads t)
+        self.phi_rates = phi_rates  # 0, or phi_outputs: ∂φ/∂t of those rows just before them (layout._generated)
         self.names = tuple(system.parameters)
         self.sources = layout.sources(L, system)  # the parts and joints its numbers are read from
         self.outputs = len(exprs)

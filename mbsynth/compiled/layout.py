@@ -399,7 +399,7 @@ class _Builder:
     def _generated(self, xrow_row, segs):
         """Expressions of the generated function, where each output goes, and the counts of its
         last outputs: φ of the extra rows (with a φ), and before them their ∂φ/∂t where a row
-        reads t (else none)."""
+        reads t in a model of extra coordinates alone (compiled/extra_projection.py; else none)."""
         system, node_at, x_index = self.system, self.node_at, self.x_index
         Q, C = {}, {}
         for element in system.forces:
@@ -454,7 +454,8 @@ class _Builder:
                     phi.append(con.phi[r])
                     rates.append(sp.S.Zero if con.psi is None else sp.sympify(con.psi[r]).xreplace(at_rest))
         inputs = [g for part, *_ in own for g in part.kernel_arrays.gravity]
-        rates = rates if any(r != 0 for r in rates) else []  # ∂φ/∂t only where a row's φ reads t
+        # ∂φ/∂t only where a row's φ reads t, for the projection of a model of extra coordinates alone
+        rates = rates if not node_at and any(r != 0 for r in rates) else []
         exprs = (list(Q.values()) + [None] * len(own_q) + list(C.values()) + [e for *_, e in M]
                  + [e for *_, e in rows] + [e for _, e in b] + inputs + rates + phi)
         m_start = len(Q) + len(own_q) + len(C)
