@@ -18,7 +18,6 @@ to decompose at every step (WATCH_ENTRIES).
 import numpy as np
 from numba import njit
 
-from ..core.equations import equilibrate_rows
 from ..core.tolerances import DIP_FLOOR, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
 
 WATCH_ENTRIES = 4096  # the largest A (rows × coordinates) watched: an SVD per step costs little beside the step
@@ -70,15 +69,17 @@ class SingularWatch:
         return t_star, rows, self.ends[2][0] - self.ends[0][0]
 
     def _equilibrated(self, t, q, qd, A=None):
-        """A at (t, q, q̇) (``A``, if given), its rows and then its columns scaled to unit norm."""
+        """A at (t, q, q̇) (``A``, if given), its rows and then its columns scaled to unit norm
+        (a new array)."""
         A = self.data.constraint_arrays(t, q, qd, sparse=False).A if A is None else A
-        A = equilibrate_rows(np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float))[0]
-        return equilibrate_rows(A.T)[0].T
+        A = np.array(A.toarray() if hasattr(A, "toarray") else A, dtype=float, order="C")
+        _unit_rows(A)
+        _unit_rows(A.T)
+        return A
 
     def _measure(self, t, q, qd, A=None):
         """σ_r/σ₁ of the equilibrated A at (t, q, q̇) (``A``: the rows there, if at hand)."""
-        A = self.data.constraint_arrays(t, q, qd, sparse=False).A if A is None else A
-        return _ratio(np.array(A.toarray() if hasattr(A, "toarray") else A, dtype=float, order="C"), self.rank)
+        return _ratio(self._equilibrated(t, q, qd, A), self.rank)
 
     def _bottom(self):
         """The time of the smallest ratio between the first and the last end (golden section)."""
@@ -110,10 +111,7 @@ class SingularWatch:
 
 @njit(cache=True)
 def _ratio(A, rank):
-    """σ_rank/σ₁ of A (overwritten) with its rows and then its columns scaled to unit norm
-    (``SingularWatch._equilibrated``); 0 where σ₁ is."""
-    _unit_rows(A)
-    _unit_rows(A.T)
+    """σ_rank/σ₁ of A; 0 where σ₁ is."""
     s = np.linalg.svd(A, full_matrices=False)[1]
     return s[rank - 1] / s[0] if s[0] > 0 else 0.0
 

@@ -229,9 +229,8 @@ def _step(q, residual, gen, layout, work, general):
 @njit(**OPTIONS)
 def project(times, Q, QD, found, evaluation, layout, work, general):
     """Each state (row of Q, Q̇, at its entry of ``times``) put on the constraints in place
-    (module docstring), found's
-    row (NaN energies, PHI_MAX, PSI_MAX, DONE = 1), or DONE = 0 and the row zero where the
-    kernel declines a step or the steps miss their goals. Positions: Gauss–Newton steps while
+    (module docstring), found's row (NaN energies, PHI_MAX, PSI_MAX, DONE = 1), or DONE = 0
+    and the row zero where the kernel declines a step or the steps miss their goals. Positions: Gauss–Newton steps while
     a row's |φ| exceeds MASS_PROJECTION_RTOL of its terms, at most MAX_STEPS; then one
     velocity step, which must cut each row's φ̇ by MASS_PROJECTION_SHRINK or leave it below
     MASS_PROJECTION_RATE_RTOL of its terms."""

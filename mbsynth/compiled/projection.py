@@ -84,15 +84,6 @@ class ProjectedRows(NamedTuple):
         info = self.found[i]
         return Projected(self.q[i], self.qd[i], *info[:DONE]) if info[DONE] else None
 
-    @classmethod
-    def of(cls, projected, n):
-        """The rows of a list of Projected or None (a state of n coordinates each)."""
-        q, qd, found = np.zeros((len(projected), n)), np.zeros((len(projected), n)), np.zeros((len(projected), DONE + 1))
-        for i, c in enumerate(projected):
-            if c is not None:
-                q[i], qd[i], found[i, :DONE], found[i, DONE] = c.q, c.qd, c[2:], 1.0
-        return cls(q, qd, found)
-
 
 @njit(nogil=True, **OPTIONS)
 def project(Q, QD, Q_on, QD_on, found, LI, LF, LX, LF_rest, WI, WF, WX, gen, general, work):
