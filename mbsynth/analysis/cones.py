@@ -65,7 +65,7 @@ class Shared:
 
     def margin(self, with_cones=True):
         """(s*, the forces λ chosen): ``with_cones`` False: with the gaps' signs only (the
-        contact set, impacts.py's ``_contact_set``). s* ≤ 0: some distribution holds."""
+        contact set, impacts.py's ``_contact_sets``). s* ≤ 0: some distribution holds."""
         if self.violation(self.lam, with_cones) <= 0:
             return self._optimum(with_cones)[0], self.lam
         return self._optimum(with_cones)

@@ -358,19 +358,19 @@ class EventIntegration(ContinuousIntegration):
 
     # ---- the motion with some gaps held
 
-    def _held_motion(self, t, q, qd, rows, sliding=None):
+    def _held_motion(self, t, q, qd, rows, sliding=None, free=()):
         """The ``Held`` motion of (2.14) with the gaps ``rows`` held beside the model's rows
-        (its KKT form, solvers.py): of those with friction, the ones in ``sliding`` (default:
-        the run's) slide, C = −μ λ_n Tᵀû (λ_n affine in the C assumed: found exactly by one
-        solve more per sliding contact), the others stick, their slip rows held. The sizes
-        judge signs: a gap's acceleration is measured against its row times the larger of q̈
-        and the forces over the largest mass (a state at rest has q̈ = 0 to rounding), a
-        multiplier against the largest |Q + C| and |λ|."""
+        (its KKT form, solvers.py): of those with friction, the ones ``free`` slip without
+        it, the ones in ``sliding`` (default: the run's) slide, C = −μ λ_n Tᵀû (λ_n affine
+        in the C assumed: found exactly by one solve more per sliding contact), the others
+        stick, their slip rows held. The sizes judge signs: a gap's acceleration is measured
+        against its row times the larger of q̈ and the forces over the largest mass (a state
+        at rest has q̈ = 0 to rounding), a multiplier against the largest |Q + C| and |λ|."""
         sliding = self.sliding if sliding is None else sliding
         arrays, p = self.base.evaluate(t, q, qd), self.base.parameter_values
         A_gaps, b_gaps = self.gaps.rows(t, q, qd, p)
         rows = list(rows)
-        rough = [i for i in rows if self.gaps.friction[i] > 0]
+        rough = [i for i in rows if self.gaps.friction[i] > 0 and i not in free]
         sticking, slipping = [i for i in rough if i not in sliding], [i for i in rough if i in sliding]
         slips = {i: self.gaps.slip_arrays(t, q, qd, p, i) for i in rough}
         A = np.vstack([arrays.A, A_gaps[rows], *(slips[i][0] for i in sticking)])
@@ -477,12 +477,9 @@ class EventIntegration(ContinuousIntegration):
         # come back here again and again
         sunk = {i for i in resting if g[i] < -SUNK * self.atol and gd[i] <= 0}
         kept = self.active - released - leaving
-        active = self._contact_set(t, q, qd, sorted(kept | set(resting)), kept, sunk)
-        if active - self.active:
-            qd = self._come_to_rest(t, q, qd, active)
+        active, qd, sliding = self._contact_mode(t, q, qd, sorted(kept | set(resting)), kept, sunk, switching)
         for i in sorted(self.active - active):
             self.events.append(Event(float(t), self.gaps.names[i], "release", 0.0))
-        sliding = self._modes(t, q, qd, active, switching)
         sticking = self._sticking(active, sliding)
         for i in sorted(set(sliding) - set(self.sliding)):
             self.events.append(Event(float(t), self.gaps.names[i], "slip", 0.0))
@@ -492,12 +489,35 @@ class EventIntegration(ContinuousIntegration):
         self._switch(active, sliding)
         return q, qd, changed
 
-    def _modes(self, t, q, qd, active, switching):
+    def _contact_mode(self, t, q, qd, candidates, kept, sunk, switching):
+        """(the held gaps, q̇ with the newly held ones at rest, the sliding contacts) from t:
+        the first contact set (``_contact_sets``) whose friction modes are consistent
+        (``_modes``): a group breaking away may slide only on another set of contacts (a
+        box stuck on two diagonal corners tips onto a third as it slides). Records the
+        newly held gaps' contact events."""
+        group = None
+        for active in self._contact_sets(t, q, qd, candidates, kept, sunk):
+            held_qd, contacts = self._come_to_rest(t, q, qd, active) if active - self.active else (qd, [])
+            sliding = self._modes(t, q, held_qd, active, switching, [i for i in candidates if i not in active])
+            if sliding is not None:
+                self.events += contacts
+                return active, held_qd, sliding
+            group = group or active
+        if group is None:
+            raise self._fail(t, candidates, "no consistent contact mode (Painlevé-type: no active set of the "
+                                            "complementarity problem)")
+        raise self._fail(t, sorted(group), "these contacts break away, but no slide of theirs was found on any set of "
+                                           "the touching contacts (slip directions that their accelerations follow, "
+                                           "with the other contacts in their friction cones and none sinking)")
+
+    def _modes(self, t, q, qd, active, switching, others=()):
         """{held contact that slides from t: its slip's direction} among the held contacts
         with friction ``active``: one sliding goes on sliding unless it is ``switching``
         (its slip stopped) here; a newly held one slides where it moves; a sticking one
         ``switching`` (at its friction cone's edge) slides against λ_t. The others stick
-        where |λ_t| ≤ μ λ_n with their slip rows held, and otherwise slide against λ_t."""
+        where |λ_t| ≤ μ λ_n with their slip rows held, and otherwise slide against λ_t; a
+        group whose forces the rows leave free breaks away as ``_breakaway`` finds (the
+        touching gaps not held, ``others``, kept open), None where it finds no slide."""
         speed, sliding, trial = np.abs(qd).max(initial=0.0), {}, []
         stuck = self._sticking(self.active, self.sliding)
         for i in sorted(i for i in active if self.gaps.friction[i] > 0):
@@ -524,52 +544,63 @@ class EventIntegration(ContinuousIntegration):
             motion = self._held_motion(t, q, qd, held, sliding)
             breaks = bool(set(group) & set(switching) & set(stuck))  # the group's s* reached zero: it breaks
             if breaks or motion.margin > COMPLEMENTARITY_RTOL * motion.force:
-                sliding = self._breakaway(t, q, qd, held, sliding, [i for i in group if i in motion.tangential],
-                                          motion)
+                return self._breakaway(t, q, qd, held, sliding, [i for i in group if i in motion.tangential],
+                                       motion, others)
         return sliding
 
-    def _breakaway(self, t, q, qd, held, sliding, group, motion):
+    def _breakaway(self, t, q, qd, held, sliding, group, motion, others):
         """``sliding`` with those of the sticking contacts ``group`` (whose forces the rows
-        leave free, cones.py) that slide from t: the first subset, largest first (a load
-        that breaks the group free moves it as a whole), whose mode is consistent: each sliding one's slip accelerates along its direction (found
-        as the fixed point of the slip's acceleration, from the direction against its
-        minimum-norm force, which keeps a symmetric load's symmetry) with λ_n ≥ 0, and the
-        ones still sticking stay in their cones. None such: an EventError naming them, which
-        says that the held set was kept (another set of held contacts is not searched)."""
+        leave free, cones.py) that slide from t, or None: the first subset, largest first (a
+        load that breaks the group free moves it as a whole), whose mode is consistent
+        (``_consistent``). Each sliding one's slip accelerates along its direction: the
+        fixed point of the slip's acceleration, followed from the slip the load would give
+        the subset without its friction (a box pushed or on a slope starts to slide as it
+        is pushed; a group breaking away at s* = 0 has no acceleration yet, and takes that
+        direction), or against its minimum-norm force where that slip is negligible."""
         p = self.base.parameter_values
         slips = {i: self.gaps.slip_arrays(t, q, qd, p, i) for i in group}
         least = {i: motion.shared.lam[list(motion.shared.cones[k].tangential)]  # the minimum-norm λ_t
                  for k, i in enumerate(j for j in motion.group if j in motion.tangential)}
-        start = {i: -least[i] / (np.linalg.norm(least[i]) or 1.0) for i in group}
+
+        def accelerations_of(found, chosen):
+            return {i: slips[i][0] @ found.qdd - slips[i][1] for i in chosen}
+
         for chosen in _subsets(group)[:0:-1]:
-            trial = {**sliding, **{i: start[i] for i in chosen}}
+            pushed = accelerations_of(self._held_motion(t, q, qd, held, sliding, free=chosen), chosen)
+            negligible = COMPLEMENTARITY_RTOL * max(np.linalg.norm(a) for a in pushed.values())
+            trial = {**sliding, **{i: _unit(pushed[i], negligible, -least[i]) for i in chosen}}
             for _ in range(SLIP_DIRECTION_ROUNDS):
                 found = self._held_motion(t, q, qd, held, trial)
-                accelerations = {i: slips[i][0] @ found.qdd - slips[i][1] for i in chosen}
-                turned = {i: a / np.linalg.norm(a) for i, a in accelerations.items() if np.linalg.norm(a) > 0}
+                accelerations = accelerations_of(found, chosen)
+                turned = {i: a / np.linalg.norm(a) for i, a in accelerations.items() if np.linalg.norm(a) > negligible}
                 if all(np.linalg.norm(turned[i] - trial[i]) <= SLIP_DIRECTION_TOL for i in turned):
                     break
                 trial.update(turned)
-            if self._consistent(found, held, chosen, accelerations, trial):
+            else:  # no fixed point reached: no slide of this subset is known to be consistent
+                continue
+            if self._consistent(found, held, accelerations, trial, negligible, others):
                 return trial
-        raise self._fail(t, group, "these sticking contacts break away, but no set of them slides with the others in "
-                                   "their friction cones while the contacts now held stay held (a slide on another "
-                                   "set of contacts is not searched: Painlevé-type or not, the run cannot go on)")
+        return None
 
-    def _consistent(self, motion, held, chosen, accelerations, directions):
-        """Whether the mode of ``motion`` (the contacts ``chosen`` newly sliding along
-        ``directions``, their slips' ``accelerations``) is consistent (``_breakaway``)."""
+    def _consistent(self, motion, held, accelerations, directions, negligible, others):
+        """Whether the mode of ``motion`` (contacts newly sliding along ``directions``, their
+        slips' ``accelerations``) is consistent: the held gaps' determined forces λ_n ≥ 0, a
+        group's margin s* ≤ 0, the other sticking contacts in their cones, each slip that is
+        not ``negligible`` accelerating along its direction, and the touching gaps not held
+        (``others``) not sinking (g̈ ≥ 0)."""
         tol = COMPLEMENTARITY_RTOL * motion.force
         if (motion.lam < -tol).any() and any(i not in motion.group for i, lam in zip(held, motion.lam) if lam < -tol):
             return False
         if motion.margin is not None and motion.margin > tol:
+            return False
+        if any(motion.gdd[i] < -COMPLEMENTARITY_RTOL * motion.scale[i] for i in others):
             return False
         for i, lam_t in motion.tangential.items():
             if i not in motion.group and np.linalg.norm(lam_t) > \
                     self.gaps.friction[i] * motion.lam[held.index(i)] * (1 + COMPLEMENTARITY_RTOL):
                 return False
         return all(np.linalg.norm(a / np.linalg.norm(a) - directions[i]) <= SLIP_DIRECTION_TOL
-                   for i, a in accelerations.items() if np.linalg.norm(a) > 0)
+                   for i, a in accelerations.items() if np.linalg.norm(a) > negligible)
 
     def _bilateral(self, t, q, qd):
         """(A, target, names) of the model's velocity-level rows at (t, q, q̇): A q̇ = target
@@ -617,15 +648,16 @@ class EventIntegration(ContinuousIntegration):
             raise self._fail(t, rows, str(failed), failed.coordinates)
         raise self._fail(t, rows, "no consistent impact (no active set of the complementarity problem)")
 
-    def _contact_set(self, t, q, qd, candidates, kept=frozenset(), sunk=frozenset()):
-        """The gaps among ``candidates`` (touching, at rest or held) that hold from t: the
-        first active set, smallest first, with λ ≥ 0 on its rows (where the rows leave forces
-        free: for some distribution of them, cones.py) and g̈ ≥ 0 on the others; those that
-        keep all of ``kept`` (held, their force not fallen to zero) first: where dependent
-        rows make several sets consistent (a box on four corners holds on three, or on
-        two at a diagonal while it sticks), a held contact stays held. Those ``sunk``
-        (sinking from rest into their gap, found where it is atol deep: a body tipping over an
-        edge of its supports at a rate g̈ below the tolerance) are held in every set tried."""
+    def _contact_sets(self, t, q, qd, candidates, kept=frozenset(), sunk=frozenset()):
+        """The sets of gaps among ``candidates`` (touching, at rest or held) that may hold
+        from t, in the order tried: active sets, smallest first, with λ ≥ 0 on their rows
+        (where the rows leave forces free: for some distribution of them, cones.py) and
+        g̈ ≥ 0 on the others with their contacts sticking; those that keep all of ``kept``
+        (held, their force not fallen to zero) first: where dependent rows make several sets
+        consistent (a box on four corners holds on three, or on two at a diagonal while it
+        sticks), a held contact stays held. Those ``sunk`` (sinking from rest into their gap,
+        found where it is atol deep: a body tipping over an edge of its supports at a rate
+        g̈ below the tolerance) are held in every set tried."""
         if len(candidates) > ENUMERATED:
             raise self._fail(t, candidates, f"{len(candidates)} gaps rest at once (at most {ENUMERATED} are solved "
                                             f"exactly)")
@@ -638,23 +670,19 @@ class EventIntegration(ContinuousIntegration):
                 COMPLEMENTARITY_RTOL * motion.force
             if pushing and (np.array(determined) >= -COMPLEMENTARITY_RTOL * motion.force).all() and \
                     all(motion.gdd[i] >= -COMPLEMENTARITY_RTOL * motion.scale[i] for i in others):
-                return frozenset(chosen)
-        raise self._fail(t, candidates, "no consistent contact mode (Painlevé-type: no active set of the "
-                                        "complementarity problem)")
+                yield frozenset(chosen)
 
     def _come_to_rest(self, t, q, qd, active):
-        """q̇⁺ with the newly held gaps of ``active`` brought to rest (an e = 0 jump, every
-        held row at zero rate), their events recorded."""
+        """(q̇⁺ with the newly held gaps of ``active`` brought to rest (an e = 0 jump, every
+        held row at zero rate), their contact events)."""
         A_b, v_b, names_b = self._bilateral(t, q, qd)
         A_gaps = self.gaps.rows(t, q, qd, self.base.parameter_values)[0]
         rows = sorted(active)
         jump = self._jump(t, rows, self.base.evaluate(t, q, qd).M, qd, np.vstack([A_b, A_gaps[rows]]),
                           np.concatenate([v_b, np.zeros(len(rows))]), coordinates=self.base.system.coordinates,
                           constraints=names_b + [self.gaps.names[i] for i in rows])
-        for i, impulse in zip(rows, jump.impulses[len(v_b):]):
-            if i not in self.active:
-                self.events.append(Event(float(t), self.gaps.names[i], "contact", float(impulse)))
-        return jump.qd
+        return jump.qd, [Event(float(t), self.gaps.names[i], "contact", float(impulse))
+                         for i, impulse in zip(rows, jump.impulses[len(v_b):]) if i not in self.active]
 
     def _fail(self, t, rows, why, coordinates=()):
         """The EventError at t of the gaps ``rows``."""
@@ -676,6 +704,14 @@ def _subsets(rows):
     row that needs no force or impulse is not held)."""
     rows = list(rows)
     return [chosen for size in range(len(rows) + 1) for chosen in itertools.combinations(rows, size)]
+
+
+def _unit(a, negligible, otherwise):
+    """a's direction, or ``otherwise``'s where |a| is ``negligible`` (zero where both are)."""
+    size = np.linalg.norm(a)
+    if size > negligible:
+        return a / size
+    return otherwise / (np.linalg.norm(otherwise) or 1.0)
 
 
 def _root(f, t0, t1, f0, f1):

@@ -40,6 +40,44 @@ def test_the_box_at_rest_stays_there_from_states_moved_by_rounding(moved):
     assert np.abs(traj.qd).max() < 1e-10
 
 
+def test_a_box_on_four_corners_above_tan_alpha_mu_slides_down_as_a_whole():
+    """tan α > μ: the group breaks away at t = 0 and slides without turning, its centre as
+    a block's, x = ½ g (sin α − μ cos α) t²: the corners' friction adds up to μ m g cos α
+    whatever the split of the normal forces. Its slips start along the load's push (from
+    the minimum-norm forces they would turn the box)."""
+    alpha, mu = 0.5, 0.3
+    system = mb.load(MODEL, parameters={"alpha": alpha, "mu": mu})
+    traj = mb.simulate(system, 1.0, rtol=1e-10, atol=1e-10)
+    assert {ev.kind for ev in traj.events} == {"contact", "slip"}
+    assert {ev.t for ev in traj.events} == {0.0}
+    a = G * (np.sin(alpha) - mu * np.cos(alpha))
+    assert np.abs(traj.q[:, 0] - 0.5 * a * traj.t**2).max() < 1e-9
+    assert np.abs(traj.qd[:, 0] - a * traj.t).max() < 1e-9
+    assert np.abs(traj.q[:, 1:3] - traj.q[0, 1:3]).max() < 1e-10
+    assert np.abs(traj.q[:, 4:]).max() < 1e-10  # the quaternion's vector part: no turning
+
+
+@pytest.mark.slow  # about 4 minutes: the slip's first microseconds take 12,000 steps (docstring)
+def test_a_pushed_box_sticks_up_to_mu_m_g_then_slides_as_a_block():
+    """A push k t along x on level ground: the corners stick until k t = μ m g (s* reaches
+    zero with no acceleration yet: the slide starts along the push), then the box moves as
+    a block, x = k (t − t_b)³ / 6m. (Held at first on a diagonal pair, the least set, it
+    tips onto a third corner as the push begins: a contact of 2e-7 N s at 0.6 ms.) Within
+    the first milliseconds of the slide the slip is slow and its direction stiff (a yaw
+    perturbation's rate grows as μ g / |slip|): explicit steps crawl there, and the closed
+    form holds to 1e-8 in x and ẋ."""
+    m, mu, k = 2.0, 0.3, 10.0
+    system = mb.load(MODEL, parameters={"alpha": 0.0, "mu": mu, "k": k})
+    traj = mb.simulate(system, 1.0, rtol=1e-10, atol=1e-10)
+    t_b = mu * m * G / k
+    first_slip = min(ev.t for ev in traj.events if ev.kind == "slip" and ev.t > 0.1 * t_b)
+    assert abs(first_slip - t_b) < 1e-9
+    after = np.maximum(traj.t - t_b, 0.0)
+    assert np.abs(traj.q[:, 0] - k * after**3 / (6 * m)).max() < 1e-8
+    assert np.abs(traj.qd[:, 0] - k * after**2 / (2 * m)).max() < 1e-8
+    assert np.abs(traj.q[:, 4:]).max() < 1e-10
+
+
 def _table(push, mu, m=2.0, a=0.2, b=0.1, h=0.05):
     """Shared forces of a table (legs at (±a/2, ±b/2), centre of mass h above the floor)
     pushed along x at its centre of mass: its rows are each foot's normal and two tangents
