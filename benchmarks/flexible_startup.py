@@ -93,6 +93,14 @@ def model_text(modes):
     return text.replace("amplitude_rates: [0.05, 0, 0, 0]", f"amplitude_rates: [{rates}]")
 
 
+def child_environment(**variables):
+    """The environment of a timed process: this one's with ``variables``, without
+    PYTHONDONTWRITEBYTECODE (set in some sandboxes: every process would compile the sources
+    whose bytecode is stale, where a user's installation keeps it)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    return dict(env, PYTHONPATH=str(ROOT), **variables)
+
+
 def installed_kernels():
     """The folder of numba's cache holding the compiled kernels of this checkout (compiled by
     ``python -m mbsynth.cli.compile_ahead`` first where it holds none)."""
@@ -108,7 +116,7 @@ def installed_kernels():
 
 def command(arguments, cache, numba):
     """(process wall, its CPU time [s]) of ``python -m mbsynth <arguments>`` in a new process."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
+    env = child_environment(MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     subprocess.run([sys.executable, "-m", "mbsynth", *arguments], env=env, cwd=ROOT, check=True,
@@ -121,7 +129,7 @@ def command(arguments, cache, numba):
 def timed(path, cache, numba):
     """(process wall, its CPU time (user + system, its helpers included), load, simulate [s],
     output rows) of one new process."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
+    env = child_environment(MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", CHILD, str(path)], env=env, cwd=ROOT, check=True,

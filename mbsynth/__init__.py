@@ -14,6 +14,9 @@ import importlib
 
 from .core.equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
 from .core.errors import ControlError, ModelError, NoEquilibrium, SimulationError, SolveError
+from .core import leaving as _leaving
+
+_leaving.skip_final_collections()
 
 __version__ = "0.1.0"
 

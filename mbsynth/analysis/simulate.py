@@ -43,7 +43,6 @@ from ..model.data import Data
 from . import stepper
 from .continuous import ContinuousIntegration
 from .cut import CutIntegration
-from .impacts import EventIntegration
 from .projection import consistent_initial_state
 from .recording import Recorder
 from .schedule import Schedule
@@ -104,7 +103,7 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
         SampledControl(controller, times[1] - times[0] if control_dt is None else control_dt)
     schedule = Schedule(times, None if control is None else control.dt)
     run = _strategy(data.model, method, stabilization)(data, method, rtol, atol, stabilization, baumgarte, schedule)
-    if isinstance(run, EventIntegration):
+    if data.model.unilaterals:  # an EventIntegration (``_strategy``)
         run.events = recorder.events
         recorder.contact_forces = run.contact_forces
     recorder.open()
@@ -172,6 +171,7 @@ def _strategy(system, method, stabilization):
             raise ValueError(f"model '{system.name}' has limits or contacts: its run needs an explicit "
                              f"Runge–Kutta method ({', '.join(k.__name__ for k in stepper.RESUMABLE)}) and "
                              f"stabilization='projection'")
+        from .impacts import EventIntegration  # loaded only by a model with limits or contacts (start-up)
         return EventIntegration
     return ContinuousIntegration if continuous else CutIntegration
 

@@ -34,7 +34,6 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-import scipy.interpolate
 
 from ..core.errors import ModelError
 from ..core.files import file_format, unwritable, write_atomically
@@ -92,6 +91,7 @@ class Trajectory:
             return np.zeros(self.t.size)
         if not np.all(np.isfinite(self.power)):
             return np.full(self.t.size, np.nan)
+        import scipy.interpolate  # loaded only by the runs that ask for their work (start-up)
         return scipy.interpolate.CubicSpline(self.t, self.power).antiderivative()(self.t)
 
     @property
