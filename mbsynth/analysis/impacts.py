@@ -37,7 +37,7 @@ where its slip stops (an event) it sticks again, or slides on against λ_t where
 μ λ_n there. Sticking contacts whose forces their rows leave free (a box on four corners)
 stick as a group while some split of the forces lies in every cone (cones.py: s* ≤ 0),
 break away where s* reaches zero (an event) and slide in the first consistent mode
-(``_breakaway``).
+(``_breakaway``), on the first set of the touching contacts that has one (``_contact_mode``).
 
 Every impact, contact and release is an ``Event`` in the run's trajectory (and its .npz).
 A state with no consistent contact mode (Painlevé-type) or a jump that is not unique raises
