@@ -495,18 +495,18 @@ class EventIntegration(ContinuousIntegration):
         (``_modes``): a group breaking away may slide only on another set of contacts (a
         box stuck on two diagonal corners tips onto a third as it slides). Records the
         newly held gaps' contact events."""
-        group = None
+        first = None  # the first set tried, named where none slides
         for active in self._contact_sets(t, q, qd, candidates, kept, sunk):
             held_qd, contacts = self._come_to_rest(t, q, qd, active) if active - self.active else (qd, [])
             sliding = self._modes(t, q, held_qd, active, switching, [i for i in candidates if i not in active])
             if sliding is not None:
                 self.events += contacts
                 return active, held_qd, sliding
-            group = group or active
-        if group is None:
+            first = first or active
+        if first is None:
             raise self._fail(t, candidates, "no consistent contact mode (Painlevé-type: no active set of the "
                                             "complementarity problem)")
-        raise self._fail(t, sorted(group), "these contacts break away, but no slide of theirs was found on any set of "
+        raise self._fail(t, sorted(first), "these contacts break away, but no slide of theirs was found on any set of "
                                            "the touching contacts (slip directions that their accelerations follow, "
                                            "with the other contacts in their friction cones and none sinking)")
 
