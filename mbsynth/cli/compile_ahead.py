@@ -3,8 +3,8 @@ kernels (mbsynth.compiled) into the cache ahead of use, on warm-up models read a
 (hence here, on the floor that may read them).
 
 On two cores: first the kernel's largest parts for both variants of ``kernel.motion`` in
-helper processes (ahead.py); then the rigid tree's entry points (motion, motion_rows,
-motion_rates of an integrator's stage, the projection) in a helper (``python -m
+helper processes (ahead.py); then the rigid tree's entry points (motion_rates, the kernel's
+one entry from outside compiled code; motion_rows; the projection) in a helper (``python -m
 mbsynth.cli.compile_ahead rigid``) while this process compiles the general ones; then each
 warm-up model here, loading what is missing from the cache (all of it, unless a helper
 failed); then the flexible parts' kernel (ahead.PARTS). Each stage says on stderr what it

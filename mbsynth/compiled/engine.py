@@ -181,9 +181,10 @@ class Engine:
 
     def _solved(self, t, q, qd, bshift, drift, mode):
         """kernel.motion's (status, residual) at (t, q, q̇) in ``mode``, its q̈ and Qc left
-        in this Engine's Work (the caller holds the lock)."""
+        in this Engine's Work (the caller holds the lock), through the kernel's one entry
+        (kernel.motion_rates, no rates)."""
         delta = self._generated(t, q, qd, drift)
-        return kernel.motion(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general)
+        return kernel.motion_rates(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general, NO_BODIES, EMPTY)
 
     def _generated(self, t, q, qd, drift):
         """The generated function's outputs at (t, q, q̇) into ``gen`` (the caller holds the

@@ -36,7 +36,7 @@ import copy
 import threading
 
 import numpy as np
-from numba import njit, typeof, types
+from numba import njit, typeof
 
 from . import kernel
 from .bodies import OPTIONS
@@ -46,16 +46,11 @@ from .packing import view1
 from .pointers import address, caster
 from .projection import DONE, MAX_STEPS, PHI_MAX, PSI_MAX, TINY, ProjectedRows
 from .rows import largest, relative_drift
-from .staged import KERNEL_ARGUMENTS, evaluate, evaluation_of
+from .staged import evaluate, evaluation_of, rates_signature
 from ..core.tolerances import MASS_PROJECTION_RATE_RTOL, MASS_PROJECTION_RTOL, MASS_PROJECTION_SHRINK, DRIFT_FLOOR, TERM_FLOOR
 
 
-def motion_signature(general):
-    """kernel.motion's signature in the variant whose ``general`` has the numba type given."""
-    return types.Tuple((types.int64, types.float64))(*KERNEL_ARGUMENTS, general)
-
-
-_motion = caster(motion_signature)
+_motion = caster(rates_signature)  # the kernel's one entry (kernel.motion_rates), asked for no rates
 
 
 class ExtraProjection:
@@ -76,7 +71,7 @@ class ExtraProjection:
         phi_from = engine.outputs - engine.template.phi_outputs
         rates_from = phi_from - engine.template.phi_rates if engine.template.phi_rates else -1
         packed_work, _ = engine.new_work()
-        kernel_c, kernel_jit = address(kernel.motion, motion_signature(typeof(engine.general)))
+        kernel_c, kernel_jit = address(kernel.motion_rates, rates_signature(typeof(engine.general)))
         count = self.xrow_row.size
         # rows, columns, their entries, Q and C to zero, b to zero, φ and ∂φ/∂t (or −1: none) in gen, the
         # System's rows of the extra rows
@@ -223,7 +218,7 @@ def _step(q, residual, gen, layout, work, general):
     for x in range(xrow_row.shape[0]):
         shift[xrow_row[x]] = -residual[x]
     return _motion(kernel_c, kernel_jit, general)(q, rest, gen, shift, LI, LF, LX, WI, WF, WX, UNCHECKED, drift,
-                                                  general)[0] == OK
+                                                  general, np.zeros(0, np.int64), np.zeros(0))[0] == OK
 
 
 @njit(**OPTIONS)

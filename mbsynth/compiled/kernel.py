@@ -698,15 +698,17 @@ def motion_rows(q, qd, gen, LI, LF, LX, WI, WF, WX, general, mode, qdd, status):
 
 @njit(**OPTIONS)
 def motion_rates(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general, starts, out):
-    """``motion`` at an integrator's stage, its rates written for the integrator: on OK, out
-    (2n less one entry per entry of ``starts``) ← (q̇, v̇), v̇ being q̈ with the four quaternion
-    accelerations of each rigid body whose quaternion starts at an entry of ``starts``
-    replaced by the integrator's three (bodies.velocities; none: v̇ = q̈); else out is left
-    as it was. Returns the status."""
-    status = motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general)[0]
-    if status == OK:
+    """``motion``'s (status, residual), and on OK with ``out`` not empty an integrator's rates:
+    out (2n less one entry per entry of ``starts``) ← (q̇, v̇), v̇ being q̈ with the four
+    quaternion accelerations of each rigid body whose quaternion starts at an entry of
+    ``starts`` replaced by the integrator's three (bodies.velocities; none: v̇ = q̈); else out
+    is left as it was. The kernel's one entry from outside compiled code (Engine.motion from
+    Python; an integrator's stage and the extra projection through function pointers): each
+    entry's cached library holds the whole kernel, and a process loads it once."""
+    status, residual = motion(q, qd, gen, bshift, LI, LF, LX, WI, WF, WX, mode, drift, general)
+    if status == OK and out.shape[0]:
         n = q.shape[0]
         for c in range(n):
             out[c] = qd[c]
         velocities(q, view1(WF, WX, WORK.qdd), starts, out[n:])
-    return status
+    return status, residual

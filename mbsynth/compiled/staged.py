@@ -44,7 +44,7 @@ KERNEL_ARGUMENTS = (F1, F1, F1, F1, I1, F1, I2, I1, F1, I2, types.int64, types.f
 
 def rates_signature(general):
     """kernel.motion_rates's signature in the variant whose ``general`` has the numba type given."""
-    return types.int64(*KERNEL_ARGUMENTS, general, I1, F1)
+    return types.Tuple((types.int64, types.float64))(*KERNEL_ARGUMENTS, general, I1, F1)
 
 
 _generated, _fill, _residuals = caster(lambda _: GENERATED), caster(lambda _: FILL), caster(lambda _: RESIDUALS)
@@ -97,7 +97,7 @@ def rates(t, y, out, bundle, general):
         drift = relative_drift(phi_max, gen, phi_from, phi_to, q)
     empty = np.zeros(0)
     return _kernel_rates(kernel_c, kernel_jit, general)(q, qd, gen, empty, LI, LF, LX, WI, WF, WX, mode, drift,
-                                                         general, starts, out)
+                                                         general, starts, out)[0]
 
 
 @njit(**OPTIONS)

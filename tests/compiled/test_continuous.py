@@ -93,6 +93,7 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     shifted too it makes the full call itself. (A massless link at rest, with no gravity,
     is a singular tree block: the kernel declines it.)"""
     from mbsynth.compiled import kernel
+    from mbsynth.compiled.engine import EMPTY, NO_BODIES
     system = mb.load(ROOT / "models" / model)
     rng = np.random.default_rng(8)
     q = drifted_state(system, rng, 1e-6)[0]
@@ -101,7 +102,7 @@ def test_a_reusing_call_at_rest_solves_as_a_full_call(model):
     gen, qd = np.zeros(rest.outputs), np.zeros(q.size)
 
     def call(shift, mode):
-        status = kernel.motion(q, qd, gen, shift, *rest.buffers, mode, -1.0, rest.general)[0]
+        status = kernel.motion_rates(q, qd, gen, shift, *rest.buffers, mode, -1.0, rest.general, NO_BODIES, EMPTY)[0]
         assert status == kernel.OK
         return rest.W.qdd.copy()
 

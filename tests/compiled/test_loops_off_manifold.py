@@ -14,6 +14,7 @@ import pytest
 
 import mbsynth as mb
 from mbsynth.compiled import kernel, layout, staged
+from mbsynth.compiled.engine import Engine
 
 ROOT = Path(__file__).resolve().parents[2]
 from benchmarks import iftomm_reference as ref
@@ -140,12 +141,12 @@ def test_the_rigid_n_four_bar_passes_its_singular_positions_on_the_exact_motion(
     path.write_text(rigid_n_four_bar(2))
     system = mb.load(path)
     statuses = set()
-    # motion(): (status, residual); a stage's ẏ: status; a compiled step: ACCEPTED where the kernel served
-    # every stage, else the step is taken again on the Python path, whose stages are counted
-    originals = kernel.motion, staged.rates, staged.step
+    # motion() (Engine._solved): (status, residual); a stage's ẏ: status; a compiled step: ACCEPTED where the kernel
+    # served every stage, else the step is taken again on the Python path, whose stages are counted
+    originals = Engine._solved, staged.rates, staged.step
 
-    def counted(*args):
-        found = originals[0](*args)
+    def counted(self, *args):
+        found = originals[0](self, *args)
         statuses.add(int(found[0]))
         return found
 
@@ -159,11 +160,11 @@ def test_the_rigid_n_four_bar_passes_its_singular_positions_on_the_exact_motion(
         if found[0] == staged.ACCEPTED:
             statuses.add(kernel.OK)
         return found
-    kernel.motion, staged.rates, staged.step = counted, counted_stage, counted_step
+    Engine._solved, staged.rates, staged.step = counted, counted_stage, counted_step
     try:
         trajectory = mb.simulate(system, 8.0, dt=0.05)
     finally:
-        kernel.motion, staged.rates, staged.step = originals
+        Engine._solved, staged.rates, staged.step = originals
     assert trajectory.status == "completed" and not trajectory.stats["relaxed_spans"]
     assert len(ref.n_four_bar_singular_times(2, 8.0)) == 8
     assert kernel.OK in statuses and statuses <= {kernel.OK, kernel.NEAR_SINGULAR}

@@ -10,6 +10,7 @@ import pytest
 
 import mbsynth as mb
 from mbsynth.compiled import kernel, row_fit
+from mbsynth.compiled.engine import EMPTY, NO_BODIES
 
 ROOT = Path(__file__).resolve().parents[2]
 BRICARD = ROOT / "models" / "mechanisms" / "bricard.yaml"
@@ -153,7 +154,7 @@ def test_a_reusing_call_at_rest_solves_loop_rows_as_a_full_call(model):
     shift[[r for r in rest.L.quat_row if r >= 0]] = 0.0
 
     def call(right, mode):
-        status = kernel.motion(q, qd, gen, right, *rest.buffers, mode, 1e-12, rest.general)[0]
+        status = kernel.motion_rates(q, qd, gen, right, *rest.buffers, mode, 1e-12, rest.general, NO_BODIES, EMPTY)[0]
         assert status == kernel.OK
         return rest.W.qdd.copy()
 

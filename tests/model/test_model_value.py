@@ -129,7 +129,7 @@ def test_a_read_only_state_is_copied_and_compiles_nothing_more():
     q_batch = np.array([q])
     q_batch.flags.writeable = False
     np.testing.assert_array_equal(model.motion_batch(0.0, q_batch, np.array([qd]))[0][0], expected)
-    for dispatcher in (kernel.motion, kernel.motion_rows):
+    for dispatcher in (kernel.motion_rates, kernel.motion_rows):
         assert all(argument.mutable for signature in dispatcher.signatures for argument in signature
                    if isinstance(argument, numba.types.Array))
 

@@ -20,7 +20,6 @@ import zlib
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 import scipy.sparse
 
 from ...core.errors import ModelError
@@ -62,10 +61,11 @@ def write_fe(fe, path):
             arrays |= {f"{name}_rows": coo.row, f"{name}_cols": coo.col, f"{name}_values": coo.data}
         np.savez(path, **arrays)
         return path
+    from scipy.io import mmwrite  # Matrix Market only: a model of beam elements or .npz files never loads it
     path.mkdir(parents=True, exist_ok=True)
     for name in ("mass", "stiffness"):
-        scipy.io.mmwrite(path / f"{name}.mtx", scipy.sparse.coo_matrix(getattr(fe, name)), precision=17, symmetry="symmetric")
-    scipy.io.mmwrite(path / "nodes.mtx", fe.nodes, precision=17)
+        mmwrite(path / f"{name}.mtx", scipy.sparse.coo_matrix(getattr(fe, name)), precision=17, symmetry="symmetric")
+    mmwrite(path / "nodes.mtx", fe.nodes, precision=17)
     return path
 
 
@@ -112,8 +112,9 @@ def _read_one(path, what):
     _check_file(path, f"the {what}")
     suffix = path.suffix.lower()
     if suffix == ".mtx":
+        from scipy.io import mmread  # as in ``write_fe``
         try:
-            return scipy.io.mmread(path)
+            return mmread(path)
         except MTX_ERRORS as err:
             raise ModelError(f"{path}: not a readable Matrix Market file ({type(err).__name__}: {err})") from err
     if suffix == ".npz":
