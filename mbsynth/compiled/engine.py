@@ -157,12 +157,14 @@ class Engine:
         ahead.finish()
         self.motion(0.0, q, qd)
 
-    def motion(self, t, q, qd, bshift=None, drift=False):
+    def motion(self, t, q, qd, bshift=None, drift=False, kept=None):
         """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
         bshift: added to b per row of the System (Baumgarte's −2αφ̇ − β²φ); ``drift``: the
         state may lie off the constraint manifold (an integrator's stage: the drift rule,
         kernel.motion). Its q̈ and Qc are new arrays; its residual is computed when first
-        read where the kernel's mode does not check it per call (module docstring)."""
+        read where the kernel's mode does not check it per call (module docstring), at
+        ``kept``: copies of (q, q̇) its caller holds (Data.motion's, shared with λ), else
+        made here."""
         bshift = EMPTY if bshift is None else bshift
         with self.lock:
             status, residual = self._solved(t, q, qd, bshift, drift, self.mode)
@@ -170,8 +172,9 @@ class Engine:
                 return None
             qdd, Qc = self.W.qdd.copy(), self.W.Qc.copy()
         if self.mode != kernel.CHECKED:  # the state as it is now, for the residual when read
-            residual = functools.partial(self.checked_residual, t, q.copy(), qd.copy(),
-                                         bshift.copy() if bshift.size else EMPTY, drift)
+            q, qd = (q.copy(), qd.copy()) if kept is None else kept
+            residual = functools.partial(self.checked_residual, t, q, qd, bshift.copy() if bshift.size else EMPTY,
+                                         drift)
         return Motion.made(qdd, True, self.no_freedom, Qc, residual, "tree (Baraff)")
 
     def checked_residual(self, t, q, qd, bshift, drift):

@@ -228,20 +228,21 @@ class Data:
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
         q, qd = self._state(q, qd)
-        motion = self._solved(t, q, qd, method, baumgarte, drift)
-        return motion.with_multipliers(functools.partial(self._lam, t, q, qd))
+        kept = q.copy(), qd.copy()  # the state its λ and residual are read at, whatever the caller does to q, q̇
+        motion = self._solved(t, q, qd, method, baumgarte, drift, kept)
+        return motion.with_multipliers(functools.partial(self._lam, t, *kept))
 
     def _lam(self, t, q, qd, motion):
         """λ of ``motion`` at (t, q, q̇): ``Motion.lam``'s source (it holds no Motion: no cycle)."""
         return self._multipliers(t, q, qd, motion)[0]
 
-    def _solved(self, t, q, qd, method, baumgarte, drift):
-        """The Motion of ``motion``, without its multipliers."""
+    def _solved(self, t, q, qd, method, baumgarte, drift, kept=None):
+        """The Motion of ``motion``, without its multipliers (``kept``: Engine.motion's)."""
         if method == "kkt":
             engine = self.engine
             if engine is not None:
                 shift = None if baumgarte is None else self._stabilized(t, q, qd, 0.0, *baumgarte)
-                found = engine.motion(t, q, qd, shift, drift)
+                found = engine.motion(t, q, qd, shift, drift, kept)
                 if found is not None:
                     return found
         return self._kkt_motion(t, q, qd, method, baumgarte, drift)

@@ -133,6 +133,23 @@ def test_a_read_only_state_is_copied_and_compiles_nothing_more():
         assert all(argument.mutable for signature in dispatcher.signatures for argument in signature
                    if isinstance(argument, numba.types.Array))
 
+@pytest.mark.parametrize("path", ["compiled", "kkt"])
+def test_a_motion_is_of_the_state_it_was_asked_at_whatever_its_arrays_become(path):
+    """A Motion's λ and residual are read when first asked for: at the state of the call, not
+    at what the caller's arrays hold by then (an integrator's or a controller's own arrays,
+    written again at every step). Checked by Qc − C = Aᵀλ at the state of the call."""
+    model = mb.from_robot("ur5")
+    data = model.data(path)
+    q, qd = model.initial_q.copy(), np.linspace(-0.1, 0.1, model.n)
+    arrays = data.evaluate(0.0, q.copy(), qd.copy())
+    motion = data.motion(0.0, q, qd)
+    q += 0.3
+    qd *= 2.0
+    force = arrays.M @ motion.qdd - arrays.Q - arrays.C
+    assert np.abs(arrays.A.T @ motion.lam - force).max() <= 1e-12 * np.abs(force).max()
+    assert motion.residual <= 1e-14
+
+
 def test_the_one_cache_can_be_emptied_without_changing_an_answer():
     model = mb.load(FOUR_BAR)
     q, qd = model.initial_state()
