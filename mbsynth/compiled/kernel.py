@@ -48,7 +48,7 @@ from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
-from .tree import factor, solve, spd_inverse
+from .tree import cholesky, factor, solve
 from ..core.tolerances import (DIVISION_GUARD, DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL,
                                KERNEL_NULL_RTOL, KERNEL_RESIDUAL_MAX, NEAR_SINGULAR as NEAR_SINGULAR_RTOL,
                                SCHUR_CONDITION_MAX, SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
@@ -124,18 +124,21 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
     NEAR_SINGULAR (its solve's rounding, ε κ)."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     if nx > 0:
-        inverse, work = Mx.copy(), np.zeros((nx, nx))
+        L, scale, forces = S[mx:mx + nx, :nx], values[:nx], rhs[mx:mx + nx]  # free until _close_reduced uses them
         largest = 0.0
         for x in range(nx):
             largest = max(largest, Mx[x, x])
-        if spd_inverse(inverse, nx, np.full(nx, largest), work):
-            return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S,
-                                  vectors, rhs, lam, multipliers, drift)
+        scale[:] = largest
+        if cholesky(Mx, nx, scale, L):
+            _copy(Fx, forces)
+            return _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y, w, z, S,
+                                  vectors, values, rhs, lam, multipliers, drift)
         if drift >= 0.0:
-            Fa = _augmented(Mx, Ax, xb, Fx, segs, inverse)
-            if spd_inverse(inverse, nx, np.full(nx, largest + 1.0), work):
-                return _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fa, ry, z0, y, w, z, S,
-                                      vectors, rhs, lam, multipliers, drift)
+            _augmented(Mx, Ax, xb, Fx, segs, L, forces)
+            scale[:] = largest + 1.0
+            if cholesky(L, nx, scale, L):
+                return _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y, w, z, S,
+                                      vectors, values, rhs, lam, multipliers, drift)
     S[:, :] = 0.0
     for x in range(nx):
         for c in range(nx):
@@ -158,15 +161,15 @@ def _close(topology, segs, seg6, factored, Mx, Ax, xb, Fx, ry, z0, y, w, z, S, v
 
 
 @njit(**OPTIONS)
-def _augmented(Mx, Ax, xb, Fx, segs, out):
-    """out ← Mx + Σ A_xᵀA_x over the extra rows on no tree unknown; returns F_x + Σ A_xᵀ b_x over
+def _augmented(Mx, Ax, xb, Fx, segs, out, Fa):
+    """out ← Mx + Σ A_xᵀA_x over the extra rows on no tree unknown, Fa ← F_x + Σ A_xᵀ b_x over
     them. Where those rows hold (A_x q̈_x = b_x, every row kept: ``_close`` off the manifold,
     rows certified) the added terms cancel, so the motion and the multipliers are Mx's, and a
     mass indefinite only along directions the rows hold (a flexible part's stiffening term
     along its torsion) becomes positive definite (weight 1: the rows have unit norm, the
     masses are over the largest)."""
     nx = Mx.shape[0]
-    Fa = Fx.copy()
+    _copy(Fx, Fa)
     for c in range(nx):
         for d in range(nx):
             out[c, d] = Mx[c, d]
@@ -181,7 +184,6 @@ def _augmented(Mx, Ax, xb, Fx, segs, out):
             Fa[c] += a * xb[x]
             for d in range(nx):
                 out[c, d] += a * Ax[x, d]
-    return Fa
 
 
 @njit(**OPTIONS)
@@ -237,25 +239,32 @@ def _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multiplie
 
 
 @njit(**OPTIONS)
-def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, y, w, z, S, vectors, rhs, lam,
-                   multipliers, drift):
-    """``_close`` where the extra coordinates' mass Mx is positive definite (``inverse``: Mx⁻¹,
-    tree.spd_inverse): their accelerations q̈_x = Mx⁻¹ (F_x − A_xᵀ λ) are eliminated,
-    leaving the rows' Schur matrix A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ (positive semi-definite,
+def _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y, w, z, S, vectors, values, rhs,
+                   lam, multipliers, drift):
+    """``_close`` where the extra coordinates' mass Mx is positive definite (``L``: its Cholesky
+    factor, Mx = L Lᵀ, tree.cholesky; ``forces``: F_x, rhs[m_x:] itself): their accelerations
+    q̈_x = Mx⁻¹ (F_x − A_xᵀ λ) are eliminated, leaving the rows' Schur matrix
+    A_x Mx⁻¹ A_xᵀ + G K⁻¹ Gᵀ = WᵀW + G K⁻¹ Gᵀ with W = L⁻¹ A_xᵀ (positive semi-definite,
     m_x × m_x) for λ. The motion is unique (the masses are), so dropped directions are
     dependent rows, judged for consistency. Off the manifold (``drift`` ≥ 0) ``motion`` comes
     here only with rows certified (certify.py): the drift rule keeps every direction and its
     answer is this plain one, which this solve gives to about ε κ of the Schur matrix; a
     stage whose κ exceeds SCHUR_CONDITION_MAX (a singular position near: κ grows as σ_min⁻²),
-    or with a direction dropped here, is left to the exact treatment (NEAR_SINGULAR)."""
+    or with a direction dropped here, is left to the exact treatment (NEAR_SINGULAR). Work:
+    W in vectors[m_x:, :m_x], L⁻¹ F_x over ``forces``, the Schur eigenvalues in values[:m_x]."""
     mx, nx = Ax.shape[0], Ax.shape[1]
-    Sc, Vc = S[:mx, :mx], vectors[:mx, :mx]
-    qx, W = np.zeros(nx), np.zeros((mx, nx))  # Mx⁻¹ F_x; Mx⁻¹ A_xᵀ, a row per extra row
-    for c in range(nx):
-        for d in range(nx):
-            qx[c] += inverse[c, d] * Fx[d]
-            for x in range(mx):
-                W[x, c] += inverse[c, d] * Ax[x, d]
+    Sc, Vc, W = S[:mx, :mx], vectors[:mx, :mx], vectors[mx:mx + nx, :mx]
+    for c in range(nx):  # forces ← L⁻¹ F_x, W ← L⁻¹ A_xᵀ (forward substitution)
+        inv = 1.0 / L[c, c]
+        total = forces[c]
+        for d in range(c):
+            total -= L[c, d] * forces[d]
+        forces[c] = total * inv
+        for x in range(mx):
+            total = Ax[x, c]
+            for d in range(c):
+                total -= L[c, d] * W[d, x]
+            W[c, x] = total * inv
     for x in range(mx):
         y[:] = 0.0
         _scatter(x, 1.0, segs, seg6, y)
@@ -263,13 +272,13 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
         for r in range(mx):
             total = _row_dot(r, segs, seg6, w)
             for c in range(nx):
-                total += Ax[r, c] * W[x, c]
+                total += W[c, r] * W[c, x]
             Sc[r, x] = total
         total = -xb[x] + _row_dot(x, segs, seg6, z0)
         for c in range(nx):
-            total += Ax[x, c] * qx[c]
+            total += W[c, x] * forces[c]
         rhs[x] = total
-    values = np.zeros(mx)
+    values = values[:mx]
     symmetric_eigen(Sc, Vc, values)
     if drift >= 0.0 and mx and not values.min() * SCHUR_CONDITION_MAX >= values.max():
         return NEAR_SINGULAR  # its solve's rounding, ε κ, is the exact rule's to avoid
@@ -291,11 +300,16 @@ def _close_reduced(topology, segs, seg6, factored, inverse, Ax, xb, Fx, ry, z0, 
             dropped += coef * coef
     if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + DIVISION_GUARD):
         return INCONSISTENT
-    for c in range(nx):  # q̈_x = Mx⁻¹ F_x − (Mx⁻¹ A_xᵀ) λ
-        total = qx[c]
+    for c in range(nx):  # q̈_x = L⁻ᵀ (L⁻¹ F_x − W λ) (back substitution)
+        total = forces[c]
         for x in range(mx):
-            total -= W[x, c] * lam[nx + x]
+            total -= W[c, x] * lam[nx + x]
         lam[c] = total
+    for c in range(nx - 1, -1, -1):
+        total = lam[c]
+        for d in range(c + 1, nx):
+            total -= L[d, c] * lam[d]
+        lam[c] = total / L[c, c]
     _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
     return OK
 

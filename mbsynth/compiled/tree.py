@@ -214,10 +214,11 @@ def _components_closed(J, r0, k, S, Jr):
     return True
 
 
-@njit(**OPTIONS)
-def spd_inverse(A, m, scale, L):
-    """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
-    PIVOT_RTOL · scale[j] (scale: per column)."""
+@njit(**INLINE)
+def cholesky(A, m, scale, L):
+    """L[:m, :m]'s lower triangle ← the Cholesky factor of A[:m, :m] (from its lower
+    triangle; L may be A itself). False when a pivot is not above PIVOT_RTOL · scale[j]
+    (scale: per column)."""
     for j in range(m):
         d = A[j, j]
         for c in range(j):
@@ -230,6 +231,15 @@ def spd_inverse(A, m, scale, L):
             for c in range(j):
                 t -= L[r, c] * L[j, c]
             L[r, j] = t / L[j, j]
+    return True
+
+
+@njit(**OPTIONS)
+def spd_inverse(A, m, scale, L):
+    """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
+    PIVOT_RTOL · scale[j] (scale: per column)."""
+    if not cholesky(A, m, scale, L):
+        return False
     for j in range(m):  # L ← L⁻¹ (lower triangular)
         L[j, j] = 1.0 / L[j, j]
         for r in range(j + 1, m):

@@ -29,8 +29,8 @@ def test_a_mass_indefinite_along_held_rows_keeps_its_motion_and_multipliers():
     assert held @ M @ held < 0.0
     empty = np.zeros(0, dtype=np.int64)
     segments = (np.array([0, 0, 0, 1], dtype=np.int64), empty, empty, empty)  # the last row also acts on a tree node
-    out = np.zeros((COORDINATES, COORDINATES))
-    Fa = _augmented(M, A, b, F, segments, out)
+    out, Fa = np.zeros((COORDINATES, COORDINATES)), np.zeros(COORDINATES)
+    _augmented(M, A, b, F, segments, out, Fa)
     np.testing.assert_allclose(out, M + A[:2].T @ A[:2], atol=1e-15)  # the tree's row is left out
     assert np.linalg.eigvalsh(out).min() > 0.0
     qdd, lam = _kkt(M, A, F, b)
