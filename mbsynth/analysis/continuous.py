@@ -241,10 +241,12 @@ class ContinuousIntegration(CutIntegration):
         self._look(t, q, qd)
 
     def _look(self, t, q, qd, A=None):
-        """The state (t, q, q̇) reached on the constraints (``A``: its rows, if at hand) shown
-        to the watch, which may list a singular position passed, and its measure to the step
-        plan."""
+        """The state (t, q, q̇) reached on the constraints (``A``: its rows, if at hand; else
+        the kernel's projection's where it has them, extra_projection.py) shown to the watch,
+        which may list a singular position passed, and its measure to the step plan."""
         if self.watch is not None:
+            if A is None and self.projection is not None:  # the rows from the kernel's projection (compiled)
+                A = self.projection.rows_at(t, q, qd)
             found = self.watch.passed(t, q, qd, A)
             if found is not None:
                 self.f.add_singular(*found)

@@ -134,6 +134,18 @@ class ExtraProjection:
         weights = self._least(t, q, qd)[1]
         return tuple(int(r) for r in self.xrow_row[weights > share * weights.max(initial=0.0)])
 
+    def rows_at(self, t, q, qd):
+        """The System's A at (t, q, q̇), dense (m × n), from the rows' entries of the generated
+        function (compiled), or None where the extra rows are not all of the System's."""
+        if self.xrow_row.size != self.m:
+            return None
+        with self.lock:
+            self._evaluate(t, q, qd)
+            values = self.gen[self.entries].copy()
+        A = np.zeros((self.m, self.n))
+        np.add.at(A, (self.xrow_row[self.rows], self.columns), values)
+        return A
+
     def _least(self, t, q, qd):
         """(σ_min/σ₁, the rows' weights in the least direction) at (t, q, q̇)."""
         with self.lock:

@@ -231,6 +231,11 @@ class Projection:
         (``Engine.at``): itself, its numbers being the Layout's, which the copy shares."""
         return self
 
+    def rows_at(self, t, q, qd):
+        """None: the run's singular watch does not look at its states (``watched``), and reads
+        no rows from it (extra_projection.py's ``rows_at``)."""
+        return None
+
     @classmethod
     def build(cls, engine):
         """The Projection on ``engine``'s Layout, or None where its kernel does not cover the System."""

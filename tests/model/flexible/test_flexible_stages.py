@@ -47,6 +47,20 @@ def test_stages_off_the_manifold_are_the_kernels_with_the_drift_rules_motion(mod
         assert np.abs(compiled.qdd - exact.qdd).max() <= 1e-9 * np.abs(exact.qdd).max()
 
 
+def test_the_extra_projections_rows_are_the_systems(models):
+    """The rows the kernel's projection hands a run's singular watch (ExtraProjection.rows_at,
+    from the generated function's entries) are the System's A (its own evaluator) at states
+    of a run of the strip, to rounding."""
+    system = models["strip"]
+    data = system.data()
+    projection = data.engine.projection()
+    assert isinstance(projection, extra_projection.ExtraProjection)
+    run = mb.simulate(system, 0.01, dt=0.005)
+    for t, q, qd in zip(run.t, run.q, run.qd):
+        A = data.constraint_arrays(t, q, qd, sparse=False).A
+        assert np.abs(projection.rows_at(t, q, qd) - A).max() <= 1e-14 * np.abs(A).max()
+
+
 @pytest.mark.parametrize("name", ["strip", "slider_crank"])
 def test_a_run_takes_every_stage_on_the_compiled_path(models, name, monkeypatch):
     """0.05 s of the model: every step is taken in compiled code (staged.py: no stage
