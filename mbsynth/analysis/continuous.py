@@ -1,5 +1,5 @@
 """The continuous strategy of the run loop: every run with ``stabilization="projection"``
-and an explicit Runge–Kutta pair (RK23, RK45, DOP853) or Radau IIA (stepper.MOVABLE).
+and an explicit Runge–Kutta pair (RK23, RK45, DOP853) or Radau IIA (stepper.movable).
 
 The steps are chosen by the error control alone, up to the next control sample or the end;
 each accepted step is put back on the constraints and the integrator goes on from there,
@@ -68,7 +68,7 @@ class ContinuousIntegration(CutIntegration):
     def fits(method, stabilization):
         """Whether a run with the OdeSolver class ``method`` and ``stabilization`` can be
         integrated continuously."""
-        return issubclass(method, stepper.MOVABLE) and stabilization == "projection"
+        return stepper.movable(method) and stabilization == "projection"
 
     def __init__(self, *args):
         self.passed = None  # the states at the times the last step passed (Passed)

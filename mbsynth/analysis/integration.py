@@ -17,7 +17,7 @@ control sample): the integrator's f is computed afresh there.
 
 ``simulate`` chooses (ContinuousIntegration.fits). Both count the same (``stats``) and share
 how an integrator goes on from a state: the same explicit pair or Radau where it can
-(stepper.MOVABLE), else a new one; an implicit one (stepper.IMPLICIT) is given the Jacobian
+(stepper.movable), else a new one; an implicit one (stepper.implicit) is given the Jacobian
 of the motion (derivative.StateDerivative.jacobian). Both integrate y = (q, v), each rigid body's quaternion
 rates replaced by its angular velocity (velocity_form.py), and hand back (q, q̇).
 """
@@ -47,7 +47,7 @@ class Integration:
         self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None, self.form)
         self.steps = 0
         # the largest relative drift between projections (drift.py)
-        self.drift_target = max(DRIFT_TARGET, IMPLICIT_DRIFT * rtol) if issubclass(method, stepper.IMPLICIT) \
+        self.drift_target = max(DRIFT_TARGET, IMPLICIT_DRIFT * rtol) if stepper.implicit(method) \
             else DRIFT_TARGET
         self.solver = None  # the integrator, kept from interval to interval (``resumed``)
         self.solver_tolerances = None  # its (rtol, atol)
@@ -82,18 +82,18 @@ class Integration:
     def resumed(self, t, q, qd, t_bound, rtol, atol):
         """The integrator at the state (t, q, q̇), bound for t_bound, its first step the one
         it last proposed: the same explicit pair where it stands at t with these tolerances
-        (stepper.MOVABLE), moved to the state — given f there — where a projection moved it
+        (stepper.movable), moved to the state — given f there — where a projection moved it
         or the forces jumped; else a new one, as ``solve_ivp`` would start it."""
         first = None if self.next_step is None else min(self.next_step, t_bound - t)
         solver = self.solver
-        if isinstance(solver, stepper.MOVABLE) and solver.t == t and self.solver_tolerances == (rtol, atol):
+        if solver is not None and stepper.movable(type(solver)) and solver.t == t and self.solver_tolerances == (rtol, atol):
             y = solver.y if self.form.represents(solver.y, q, qd) else self.form.to_integrator(q, qd)
             if self.forces_jumped or not stepper.stands_at(solver, y):
                 stepper.move(solver, y, self.f(t, y))
             stepper.resume(solver, t_bound, first)
         else:
             y = self.form.to_integrator(q, qd)
-            jacobian = dict(jac=self.f.jacobian) if issubclass(self.method, stepper.IMPLICIT) else {}
+            jacobian = dict(jac=self.f.jacobian) if stepper.implicit(self.method) else {}
             solver = self.solver = stepper.start(self.method, self.f, t, y, t_bound, rtol=rtol, atol=atol,
                                                  first_step=first, **jacobian)
             self.solver_tolerances = (rtol, atol)

@@ -35,7 +35,6 @@ import math
 import time
 
 import numpy as np
-import scipy.integrate
 
 from .control import SampledControl
 from ..core.errors import ControlError, ModelError, SimulationError, SolveError
@@ -83,7 +82,7 @@ def simulate(model, t_end, *, t0=0.0, q0=None, qd0=None, dt=None, method="DOP853
     """
     if stabilization not in STABILIZATIONS:
         raise ValueError(f"stabilization must be one of {STABILIZATIONS}, got {stabilization!r}")
-    method = _integrator(method)
+    method = stepper.integrator(method)
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end > t0):
         raise ValueError(f"t_end ({t_end}) must be after t0 ({t0}), both finite")
     data = _run_data(model, path)
@@ -167,9 +166,9 @@ def _strategy(system, method, stabilization):
     contacts (impacts.py), else continuous where it can be, else cut."""
     continuous = ContinuousIntegration.fits(method, stabilization)
     if system.unilaterals:
-        if not (continuous and issubclass(method, stepper.RESUMABLE)):
+        if not (continuous and stepper.resumable(method)):
             raise ValueError(f"model '{system.name}' has limits or contacts: its run needs an explicit "
-                             f"Runge–Kutta method ({', '.join(k.__name__ for k in stepper.RESUMABLE)}) and "
+                             f"Runge–Kutta method ({', '.join(stepper.RESUMABLE)}) and "
                              f"stabilization='projection'")
         from .impacts import EventIntegration  # loaded only by a model with limits or contacts (start-up)
         return EventIntegration
@@ -177,12 +176,12 @@ def _strategy(system, method, stabilization):
 
 
 def _check_implicit(system, method, controller):
-    """Raise ModelError where an implicit method (stepper.IMPLICIT) cannot serve the run: its
+    """Raise ModelError where an implicit method (stepper.implicit) cannot serve the run: its
     Newton iteration needs the Jacobian of the motion, which Coulomb friction at a joint has
     not (C jumps with the sign of the sliding rate, friction.py); a sampled controller's
     forces jump at every sample, where it would start afresh (Jacobian, factors, a small
     first step) each time."""
-    if not issubclass(method, stepper.IMPLICIT):
+    if not stepper.implicit(method):
         return
     rubbing = [con.name for con in system.constraints if getattr(con, "coulomb", None)]
     if rubbing:
@@ -217,16 +216,6 @@ def _trajectory(recorder, run, status):
     traj = recorder.trajectory(status)
     traj.stats.update(run.stats())
     return traj
-
-
-def _integrator(method):
-    """The OdeSolver class of ``method``: a ``solve_ivp`` method name or such a class."""
-    if isinstance(method, type) and issubclass(method, scipy.integrate.OdeSolver):
-        return method
-    if method not in stepper.METHODS:
-        raise ValueError(f"method must be one of {', '.join(stepper.METHODS)} (or a scipy OdeSolver class), "
-                         f"got {method!r}")
-    return stepper.METHODS[method]
 
 
 def _output_count(t0, t_end, dt):

@@ -1,61 +1,80 @@
-"""scipy's integrators driven one step at a time, moved where the run loop puts them.
+"""The run loop's integrators driven one step at a time, moved where the run loop puts them.
 
-``simulate`` steps an OdeSolver (``solve_ivp``'s classes) itself: it moves the state onto
-the constraints between steps, stops at control samples and takes a step again when it
-drifted too far. An explicit Runge–Kutta pair (RESUMABLE) carries nothing from one step to
-the next but its state (t, y), y's derivative f and its next step's size h_abs, so it goes
-on from a moved state exactly as a new one started there with that first step would (the
-test of this module checks it bit for bit against scipy's own constructor). Radau IIA
-(MOVABLE, for stiff models) carries besides its Newton matrix — the Jacobian J and its LU
-factors at the step size — and its last step's collocation polynomial, the Newton
-iteration's first guess: a move by a projection (the drift, within the tolerance) leaves
-both good enough, so it goes on from the moved state too; where its step size is set here
-its factors are made afresh. This is the only module that writes an OdeSolver's attributes
-or reads its internals (DOP853's extra stages and interpolant, ``interpolate``); ``simulate``
-calls these functions and ``step()``.
+``simulate`` steps an OdeSolver (``solve_ivp``'s classes; DOP853 its own, dop853.py, which
+steps as scipy's) itself: it moves the state onto the constraints between steps, stops at
+control samples and takes a step again when it drifted too far. An explicit Runge–Kutta
+pair (``resumable``) carries nothing from one step to the next but its state (t, y), y's
+derivative f and its next step's size h_abs, so it goes on from a moved state exactly as a
+new one started there with that first step would (the test of this module checks it bit
+for bit against scipy's own constructor). Radau IIA (``movable``, for stiff models) carries
+besides its Newton matrix — the Jacobian J and its LU factors at the step size — and its
+last step's collocation polynomial, the Newton iteration's first guess: a move by a
+projection (the drift, within the tolerance) leaves both good enough, so it goes on from
+the moved state too; where its step size is set here its factors are made afresh. This is
+the only module that writes an OdeSolver's attributes or reads its internals (DOP853's
+extra stages and interpolant, ``interpolate``); ``simulate`` calls these functions and
+``step()``. scipy.integrate is imported only for a method other than DOP853 (its import
+costs a tenth of a warm run's process: dop853.py).
 """
 
+import importlib
+import sys
+
 import numpy as np
-import scipy.integrate
 from numba import njit
 
-# what ``interpolate`` reads of DOP853 (scipy's, not public): its extra stages' tableau (A_EXTRA,
-# C_EXTRA), its interpolant's matrix D and, per step, K_extended; where a scipy lacks them,
-# every interpolant goes through scipy's own call
-DOP853_INTERNALS = all(hasattr(scipy.integrate.DOP853, name) for name in ("A_EXTRA", "C_EXTRA", "D", "n_stages"))
+from .dop853 import DOP853
 
-METHODS = {kind.__name__: kind for kind in (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853,
-                                            scipy.integrate.Radau, scipy.integrate.BDF, scipy.integrate.LSODA)}
-# integrators that go on from a moved state given its derivative: an explicit Runge–Kutta
-# pair carries nothing else from one step to the next
-RESUMABLE = (scipy.integrate.RK23, scipy.integrate.RK45, scipy.integrate.DOP853)
-# integrators that go on from a moved state given its derivative (module docstring): the
-# continuous run loop's (continuous.py)
-MOVABLE = RESUMABLE + (scipy.integrate.Radau,)
-# integrators given the Jacobian of the motion (derivative.StateDerivative.jacobian)
-IMPLICIT = (scipy.integrate.Radau, scipy.integrate.BDF, scipy.integrate.LSODA)
+METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")  # solve_ivp's method names
+RESUMABLE = ("RK23", "RK45", "DOP853")  # explicit pairs: nothing carried from step to step but (t, y, f, h_abs)
+IMPLICIT = ("Radau", "BDF", "LSODA")  # given the Jacobian of the motion (derivative.StateDerivative.jacobian)
 
 
-class CompiledDOP853(scipy.integrate.DOP853):
-    """scipy's DOP853 whose steps and extra stages are taken in compiled code where the run's
-    right-hand side can (compiled/staged.py, through ``derivative``'s ``step`` and ``extra``),
-    else by scipy's own Python (a stage the kernel declines, a run outside the compiled
-    engine): the same method, tableau and step-size control either way."""
+def integrator(method):
+    """The OdeSolver class of ``method``: a solve_ivp method name (one of METHODS) or such a
+    class. DOP853 is the run loop's own (dop853.py; scipy's class too is taken as it), the
+    others scipy's."""
+    if isinstance(method, type):
+        integrate = sys.modules.get("scipy.integrate")  # an OdeSolver subclass exists only where it was imported
+        if issubclass(method, DOP853):
+            return method
+        if integrate is not None and issubclass(method, integrate.OdeSolver):
+            return DOP853 if method is integrate.DOP853 else method
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)} (or a scipy OdeSolver class), got {method!r}")
+    return DOP853 if method == "DOP853" else getattr(importlib.import_module("scipy.integrate"), method)
 
-    derivative = None  # the run's StateDerivative (analysis/derivative.py)
 
-    def _step_impl(self):
-        taken = None if self.derivative is None else self.derivative.step(self)
-        return super()._step_impl() if taken is None else taken
+def _among(method, names):
+    """Whether the integrator class ``method`` is one of the methods ``names`` or derives from one."""
+    if issubclass(method, DOP853):
+        return "DOP853" in names
+    integrate = sys.modules["scipy.integrate"]  # a class not ours is scipy's: imported already
+    return issubclass(method, tuple(getattr(integrate, name) for name in names))
+
+
+def resumable(method):
+    """Whether ``method`` goes on from a moved state given its derivative: an explicit pair."""
+    return _among(method, RESUMABLE)
+
+
+def movable(method):
+    """Whether ``method`` goes on from a moved state given its derivative (module docstring):
+    the continuous run loop's (continuous.py)."""
+    return _among(method, RESUMABLE + ("Radau",))
+
+
+def implicit(method):
+    """Whether ``method`` takes the Jacobian of the motion."""
+    return _among(method, IMPLICIT)
 
 
 def start(method, f, t, y, t_bound, **options):
     """A new integrator of the OdeSolver class ``method`` on the right-hand side f (a
     StateDerivative) from (t, y): DOP853's steps compiled where f can take them."""
-    if method is not scipy.integrate.DOP853 or not DOP853_INTERNALS:
-        return method(f, t, y, t_bound, **options)
-    solver = CompiledDOP853(f, t, y, t_bound, **options)
-    solver.derivative = f
+    solver = method(f, t, y, t_bound, **options)
+    if method is DOP853:
+        solver.derivative = f
     return solver
 
 
@@ -113,9 +132,9 @@ def step_to(solver, t_to):
 
 
 def _set_step(solver, h_abs):
-    """The solver's next step size h_abs; Radau's Newton factors, made for another step
-    size, made afresh."""
-    if h_abs != solver.h_abs and isinstance(solver, scipy.integrate.Radau):
+    """The solver's next step size h_abs; Radau's Newton factors (LU_real, LU_complex), made
+    for another step size, made afresh."""
+    if h_abs != solver.h_abs and hasattr(solver, "LU_real"):
         solver.LU_real = solver.LU_complex = None
     solver.h_abs = h_abs
 
@@ -128,15 +147,15 @@ def cap(solver, max_step):
 def interpolate(solver, times, out):
     """The states (a row per time) at ``times`` within the solver's last step, from its
     interpolant, into ``out``. DOP853's as scipy's ``dense_output`` makes it — three extra
-    stages (compiled, as the steps, where CompiledDOP853's derivative can), then
+    stages (compiled, as the steps, where the solver's ``derivative`` can), then
     y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…)))) with x the step's fraction — with the
     arithmetic compiled (scipy's costs more than the stages' motion on a small model). Other
-    interpolants through scipy."""
-    if not (DOP853_INTERNALS and isinstance(solver, scipy.integrate.DOP853) and solver.t != solver.t_old):
+    interpolants (another method's, a step of no length) through the solver's ``dense_output``."""
+    if not (isinstance(solver, DOP853) and solver.t != solver.t_old):
         out[:] = solver.dense_output()(times).T
         return
     K, h, t_old, y_old = solver.K_extended, solver.h_previous, solver.t_old, solver.y_old
-    done = solver.derivative.extra(solver) if getattr(solver, "derivative", None) is not None else 0
+    done = solver.derivative.extra(solver) if solver.derivative is not None else 0
     for s, (a, c) in enumerate(zip(solver.A_EXTRA[done:], solver.C_EXTRA[done:]), start=solver.n_stages + 1 + done):
         K[s] = solver.fun(t_old + c * h, _stage_state(K, a, s, h, y_old))
     F = np.empty((solver.D.shape[0] + 3, y_old.size))

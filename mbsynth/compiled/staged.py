@@ -24,14 +24,13 @@ import numpy as np
 from numba import njit, typeof, types
 
 from . import flexible, kernel
+from ..core.dop853_tableau import MAX_FACTOR, MIN_FACTOR, SAFETY
 from .bodies import OPTIONS, state_of
 from .packing import pack, view1, view2, view4
 from .pointers import address, caster
 from .rows import relative_drift, residuals_energy
 
 ACCEPTED, TOO_SMALL, DECLINED = range(3)  # ``step``'s outcome
-# scipy's step-size control, the constants of scipy.integrate._ivp.rk (the test of this module compares them)
-SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 PART_ARRAYS = 6  # a flexible part's kernel arrays (axes, W, s0, K, D, S: flexible_body.PartArrays)
 
 F1, F2, F4 = types.float64[::1], types.float64[:, ::1], types.float64[:, :, :, ::1]

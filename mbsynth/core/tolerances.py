@@ -116,6 +116,10 @@ INTEGRATION_RTOL = 1e-10  # simulate's (and the CLI's) default relative toleranc
 INTEGRATION_ATOL = 1e-10  # simulate's (and the CLI's) default absolute tolerance of the integrator
 LAST_INTERVAL_MERGE = 1e-12  # simulate.py: a last output interval shorter than this times dt joins the one before
 SAMPLE_ROUNDING = 1e-9  # schedule.py: a span within this many sample intervals of a whole number of them has that many
+FIRST_STEP_ZERO_NORM = 1e-5  # dop853.py: a state or rate of scaled RMS norm below this counts as zero when the
+# first step is chosen (Hairer, Nørsett & Wanner II.4, as scipy's select_initial_step); the trial step is then
+FIRST_STEP_GUESS = 1e-6  # dop853.py: that trial step, and the least first step where the rate does not change
+FIRST_STEP_FLAT = 1e-15  # dop853.py: scaled norms of the rate and of its change below this count as no change
 JACOBIAN_STEP = 1.5e-8  # derivative.py: √ε, a forward difference's truncation and rounding errors balance (per unit of y)
 DIP_FLOOR = 1e-12  # singular_watch.py: σ_r/σ₁ below its neighbours by less than this is the SVD's rounding (~n ε), not a dip
 MAX_STATE = 1e12  # derivative.py: a coordinate or velocity beyond this (SI units) counts as an exploding state
