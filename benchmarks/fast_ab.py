@@ -4,8 +4,8 @@ On a shared machine the time of one evaluation moves by 10–20 % between proces
 minutes, more than most changes to the kernel; two builds timed in separate runs cannot be
 compared. This script puts the revision's package beside the working tree's (``git archive``
 into ``<cache>/ab/<commit>/mbsynth_<commit>``, compiled once into its own numba cache),
-calls both kernels from Python on the same state with the same buffers, as System.motion
-does, in interleaved rounds, and prints both times and their ratio (new / old: below 1 is
+calls both kernels from Python on the same state with the same buffers and mode, as
+System.motion does, in interleaved rounds, and prints both times and their ratio (new / old: below 1 is
 faster), with the largest difference of the two q̈. Not from a numba loop: a loop compiled
 in the process that compiled the kernel can inline it and hoist its views out of the loop,
 which made one build look 15 % faster than it runs when loaded from the cache.
@@ -62,11 +62,12 @@ def same_packing(old):
         [list(f.__members__) for f in (kernel.LAYOUT, kernel.WORK)]
 
 
-def _checked(module, engine):
-    """The mode argument of a kernel whose ``motion`` takes one (its checked call), its
-    ``drift`` where it takes that (−1: on the manifold), then its ``general`` where it takes
-    that, else none."""
-    mode = (module.CHECKED,) if hasattr(module, "CHECKED") else ()
+def _call_tail(module, engine):
+    """The arguments after the Work of a kernel's ``motion``: the mode motion() calls it in
+    (engine.py: a rigid tree's residual is checked when read, not per call) where it takes
+    one, its ``drift`` where it takes that (−1: on the manifold), then its ``general`` where
+    it takes that."""
+    mode = (engine.mode,) if hasattr(module, "CHECKED") else ()
     drift = (-1.0,) if hasattr(module, "NEAR_SINGULAR") else ()
     return mode + drift + ((engine.general,) if hasattr(module, "GENERAL") else ())
 
@@ -76,7 +77,7 @@ def compare(label, old, new):
     engine = engine_for(case.system)
     q, v = case.draw(np.random.default_rng(0))
     qm, qdm = case.to_maximal(q, v)
-    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_checked(module, engine))
+    args = {module: (qm, qdm, engine.gen, np.zeros(0), *engine.buffers, *_call_tail(module, engine))
             for module in (old, new)}
     results = []
     for module in (old, new):

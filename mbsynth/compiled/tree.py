@@ -306,11 +306,12 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
     elif not _null_space(J, rows[i], np.int64(ki), np.int64(vi), S[i], Jr[i], G, pivot):
         return False
     Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
-    top = 0.0
     for a in range(vi):
         for c in range(vi):
             Ha[a, c] += H[i, a, c]
-            top = max(top, abs(Ha[a, c]))
+    top = 0.0  # max |H^A| (H^A is positive semidefinite: its largest entry is on the diagonal)
+    for a in range(vi):
+        top = max(top, Ha[a, a])
     for a in range(vi):
         for e in range(m):
             t = 0.0
