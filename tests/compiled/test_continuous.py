@@ -59,6 +59,23 @@ def test_compiled_rows_equal_the_systems_residuals_and_energies(model):
         np.testing.assert_allclose((kinetic, potential), system.energy(0.0, q, qd), rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("size", [0, 1, 3, 4, 7, 420])
+def test_the_rows_largest_entry_is_numpys_and_a_nan_shows(size):
+    """rows.largest (four interleaved maxima) against numpy's max |x|, each entry in turn the
+    largest (every place of the four); a NaN or an infinity anywhere shows."""
+    from mbsynth.compiled.rows import largest
+    x = np.random.default_rng(size).uniform(-1.0, 1.0, size)
+    assert largest(x) == (np.abs(x).max() if size else 0.0)
+    for i in range(size):
+        y = x.copy()
+        y[i] = -5.0
+        assert largest(y) == 5.0
+        y[i] = np.nan
+        assert np.isnan(largest(y))
+        y[i] = -np.inf
+        assert largest(y) == np.inf
+
+
 @pytest.mark.parametrize("drift", [(1e-6, 1.0), (1e-10, 1e-10)], ids=["large", "integrator's"])
 @pytest.mark.parametrize("model", MODELS + EXTRA)
 def test_a_projection_is_the_least_mass_norm_step_onto_the_constraints(model, drift):
