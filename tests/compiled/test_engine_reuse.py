@@ -242,6 +242,20 @@ def test_equal_systems_behave_the_same(model):
     assert heavier.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
 
 
+def test_the_runs_of_a_system_share_one_projection():
+    """Each run's Data has its own Engine, a copy (``Engine.at``) of the first one made at the
+    Layout's parameter values: the projection a run asks for is made once, on that first
+    Engine, and every run's is the same (a rigid tree's projection holds no parameter
+    values), whichever run asked first and whenever the others' Data were made."""
+    system = mb.loads(MODEL, "reuse")
+    first, second = system.data().engine, system.data().engine
+    origin = first.origin
+    assert len({id(first), id(second), id(origin)}) == 3 and second.origin is origin
+    made = second.projection()
+    assert made is not None and origin.projection() is made and first.projection() is made
+    assert system.data().engine.projection() is made
+
+
 def test_a_parameter_only_the_rows_read_moves_the_projection_too():
     """Two four-bars of one structure, bars of 1 m and 2 m: the Layout has no numbers (the
     rows are all generated), so the second model's Engine is the first's at other parameter
