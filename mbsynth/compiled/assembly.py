@@ -161,16 +161,20 @@ def nodes(q, qd, bshift, kind, start, mass, mg, inertia, quat_row, Qf, Cf, H, F,
             for b in range(3):
                 Rb[a, b] = 2 * Rb[a, b] + 2 * s[i] / length * R[a, b]
                 B[a, b] = R[a, b] / (2 * length)
+        Ji, RJ = inertia[i], H[i, 0:3, 3:6]  # R J into H's upper right block (work, zeroed after)
         for a in range(3):
             F[i, a] = Qf[c + a] + Cf[c + a]
             F[i, 3 + a] = (B[a, 0] * e[0] + B[a, 1] * e[1] + B[a, 2] * e[2]) / length
-            for b in range(3):  # (R J Rᵀ)[a, b]
-                t = 0.0
-                for x in range(3):
-                    t += R[a, x] * (inertia[i, x, 0] * R[b, 0] + inertia[i, x, 1] * R[b, 1]
-                                    + inertia[i, x, 2] * R[b, 2])
-                H[i, 3 + a, 3 + b] = t
+            for b in range(3):
+                RJ[a, b] = R[a, 0] * Ji[0, b] + R[a, 1] * Ji[1, b] + R[a, 2] * Ji[2, b]
+        for a in range(3):  # (R J Rᵀ)[a, b], symmetric
+            for b in range(a + 1):
+                t = RJ[a, 0] * R[b, 0] + RJ[a, 1] * R[b, 1] + RJ[a, 2] * R[b, 2]
+                H[i, 3 + a, 3 + b] = H[i, 3 + b, 3 + a] = t
                 mu = max(mu, abs(t))
+        for a in range(3):
+            for b in range(3):
+                RJ[a, b] = 0.0
     return mu
 
 

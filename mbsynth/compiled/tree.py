@@ -266,11 +266,12 @@ def _cross_into(x, z, out, o):
 
 
 @njit(**OPTIONS)
-def _add_rigid_transport(Ia, z, Hp):
+def _add_rigid_transport(Ia, z, Hp, W):
     """Hp += Xᵀ Ia X for X = [[I, [ζ]×], [0, I]]: with Ia = [[A, B], [Bᵀ, D]] and
     M = A [ζ]× + B, Xᵀ Ia X = [[A, M], [Mᵀ, [ζ]×ᵀ M + Bᵀ [ζ]× + D]] (rows of A [ζ]× and
-    Bᵀ[ζ]×: a row × ζ; columns of [ζ]×ᵀ M: a column × ζ)."""
-    M = Ia[6:9, 0:3]
+    Bᵀ[ζ]×: a row × ζ; columns of [ζ]×ᵀ M: a column × ζ). W: work, its rows 6 to 9 (Ia may
+    be W's first six)."""
+    M = W[6:9, 0:3]
     for a in range(3):
         for c in range(3):
             M[a, c] = Ia[a, 3 + c]
@@ -282,7 +283,7 @@ def _add_rigid_transport(Ia, z, Hp):
             Hp[3 + c, a] += M[a, c]
             Hp[3 + a, 3 + c] += Ia[3 + a, 3 + c]
         _cross_into(Ia[0:3, 3 + a], z, Hp[3 + a], 3)  # row a of Bᵀ[ζ]×
-    col = Ia[9, 0:3]
+    col = W[9, 0:3]
     for c in range(3):  # column c of [ζ]×ᵀ M
         col[0], col[1], col[2] = M[1, c] * z[2] - M[2, c] * z[1], M[2, c] * z[0] - M[0, c] * z[2], \
             M[0, c] * z[1] - M[1, c] * z[0]
@@ -306,9 +307,15 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
     elif not _null_space(J, rows[i], np.int64(ki), np.int64(vi), S[i], Jr[i], G, pivot):
         return False
     Ha, Si, Ui, Ni = HA[i], S[i], U[i], N[i]
-    for a in range(vi):
-        for c in range(vi):
-            Ha[a, c] += H[i, a, c]
+    if vi == 6:  # a rigid body's H is blockdiag(m I₃, R J Rᵀ) (assembly.nodes): its nonzero entries alone
+        for a in range(3):
+            Ha[a, a] += H[i, a, a]
+            for c in range(3):
+                Ha[3 + a, 3 + c] += H[i, 3 + a, 3 + c]
+    else:
+        for a in range(vi):
+            for c in range(vi):
+                Ha[a, c] += H[i, a, c]
     top = 0.0  # max |H^A| (H^A is positive semidefinite: its largest entry is on the diagonal)
     for a in range(vi):
         top = max(top, Ha[a, a])
@@ -335,6 +342,9 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
     p = parent[i]
     if p < 0:  # a root passes nothing on
         return True
+    if m == 0 and transport[i] != GENERAL:  # held by its rows alone (welded): I^a = H^A
+        _add_rigid_transport(Ha, zeta[i], HA[p], G)
+        return True
     for a in range(vi):  # G ← I^a = H^A − U N Uᵀ
         for c in range(a + 1):
             t = Ha[a, c]
@@ -346,7 +356,7 @@ def _factor_node(i, vi, ki, topology, H, J, P, factored, G, pivot):
             G[a, c] = t
             G[c, a] = t
     if transport[i] != GENERAL:
-        _add_rigid_transport(G, zeta[i], HA[p])
+        _add_rigid_transport(G, zeta[i], HA[p], G)
         return True
     vp, r0, Xi = v[p], rows[i], X[i]
     for a in range(vi):
