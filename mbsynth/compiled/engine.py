@@ -191,18 +191,13 @@ class Engine:
 
     def _solved(self, t, q, qd, bshift, drift, mode):
         """kernel.motion's (status, residual) at (t, q, q̇) in ``mode``, its q̈ and Qc left
-        in this Engine's Work (the caller holds the lock), through the kernel's one entry
-        (kernel.motion_rates, no rates)."""
-        delta = self._generated(t, q, qd, drift)
-        return kernel.motion_rates(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general, NO_BODIES, EMPTY)
-
-    def _generated(self, t, q, qd, drift):
-        """The generated function's outputs at (t, q, q̇) into ``gen`` (the caller holds the
-        lock); returns kernel.motion's ``drift``: the state's relative drift where ``drift``
-        and the model closes loops, else −1."""
+        in this Engine's Work (the caller holds the lock): the generated function's outputs
+        into ``gen``, then the kernel's one entry (kernel.motion_rates, no rates) with its
+        ``drift``: the state's relative drift where ``drift`` and the model closes loops, else −1."""
         if self.module is not None:
             self.module.evaluate(float(t), q, qd, self.p, self.gen)
-        return self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
+        delta = self.relative_drift(q, qd) if drift and self.closes_loops else -1.0
+        return kernel.motion_rates(q, qd, self.gen, bshift, *self.buffers, mode, delta, self.general, NO_BODIES, EMPTY)
 
     def relative_drift(self, q, qd):
         """The state's relative drift (rows.relative_drift), the extra rows' φ read from ``gen``

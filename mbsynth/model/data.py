@@ -227,10 +227,10 @@ class Data:
             method = OLD_METHODS[method]
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
-        q, qd = self._state(q, qd)
-        kept = q.copy(), qd.copy()  # the state its λ and residual are read at, whatever the caller does to q, q̇
-        motion = self._solved(t, q, qd, method, baumgarte, drift, kept)
-        return motion.with_multipliers(functools.partial(self._lam, t, *kept))
+        # copies: the state its λ and residual are read at, whatever the caller does to q, q̇
+        q, qd = self.system._state_copies(q, qd)
+        motion = self._solved(t, q, qd, method, baumgarte, drift, (q, qd))
+        return motion.with_multipliers(functools.partial(self._lam, t, q, qd))
 
     def _lam(self, t, q, qd, motion):
         """λ of ``motion`` at (t, q, q̇): ``Motion.lam``'s source (it holds no Motion: no cycle)."""
