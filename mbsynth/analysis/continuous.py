@@ -35,6 +35,7 @@ from .derivative import Crawl
 from .drift import next_cap
 from .projection import project, relative_drift
 from .singular_watch import SingularWatch
+from ..compiled.rows import largest
 from ..core.tolerances import MAX_STATE, RELAXED_MAX
 
 
@@ -279,12 +280,9 @@ class ContinuousIntegration(CutIntegration):
 
 @njit(cache=True)
 def _bounded(states):
-    """Per row of ``states``, whether each entry is within MAX_STATE (False where one is NaN)."""
+    """Per row of ``states``, whether each entry is within MAX_STATE (False where one is NaN:
+    rows.largest gives NaN then)."""
     within = np.empty(states.shape[0], dtype=np.bool_)
     for r in range(states.shape[0]):
-        within[r] = True
-        for c in range(states.shape[1]):
-            if not abs(states[r, c]) <= MAX_STATE:
-                within[r] = False
-                break
+        within[r] = largest(states[r]) <= MAX_STATE
     return within

@@ -185,3 +185,15 @@ def test_the_command_line_refuses_output_that_cannot_fit_with_exit_2(tmp_path):
                            "--t-end", "1e6", "--dt", "1e-6", "--out", str(out)], capture_output=True, text=True,
                           timeout=300, cwd=Path(__file__).parents[2])
     assert done.returncode == 2 and "output rows would take" in done.stderr and not out.exists()
+
+
+def test_a_row_is_bounded_when_every_entry_is_within_max_state():
+    """continuous._bounded per row, against the entries themselves: a row with one entry
+    beyond MAX_STATE (either sign), a NaN or an infinity anywhere is not bounded."""
+    from mbsynth.analysis.continuous import _bounded
+    states = np.random.default_rng(2).uniform(-1.0, 1.0, (4, 11)) * MAX_STATE
+    states[1, 7] = -1.5 * MAX_STATE
+    states[2, 0] = np.nan
+    states[3, 10] = np.inf
+    assert _bounded(states).tolist() == [True, False, False, False]
+    assert _bounded(np.full((1, 5), MAX_STATE)).tolist() == [True]
