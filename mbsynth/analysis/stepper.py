@@ -21,7 +21,6 @@ import importlib
 import sys
 
 import numpy as np
-from numba import njit
 
 from .dop853 import DOP853
 
@@ -146,57 +145,9 @@ def cap(solver, max_step):
 
 def interpolate(solver, times, out):
     """The states (a row per time) at ``times`` within the solver's last step, from its
-    interpolant, into ``out``. DOP853's as scipy's ``dense_output`` makes it — three extra
-    stages (compiled, as the steps, where the solver's ``derivative`` can), then
-    y_old + x (F₀ + (1 − x)(F₁ + x (F₂ + (1 − x)(…)))) with x the step's fraction — with the
-    arithmetic compiled (scipy's costs more than the stages' motion on a small model). Other
-    interpolants (another method's, a step of no length) through the solver's ``dense_output``."""
-    if not (isinstance(solver, DOP853) and solver.t != solver.t_old):
+    interpolant, into ``out``: DOP853's compiled (dop853.Interpolant), another method's
+    through its ``dense_output``."""
+    if isinstance(solver, DOP853):
+        solver.dense_output().into(np.asarray(times, dtype=float), out)
+    else:
         out[:] = solver.dense_output()(times).T
-        return
-    K, h, t_old, y_old = solver.K_extended, solver.h_previous, solver.t_old, solver.y_old
-    done = solver.derivative.extra(solver) if solver.derivative is not None else 0
-    for s, (a, c) in enumerate(zip(solver.A_EXTRA[done:], solver.C_EXTRA[done:]), start=solver.n_stages + 1 + done):
-        K[s] = solver.fun(t_old + c * h, _stage_state(K, a, s, h, y_old))
-    F = np.empty((solver.D.shape[0] + 3, y_old.size))
-    _coefficients(K, solver.D, h, solver.y, y_old, solver.f, F)
-    _rows(np.asarray(times, dtype=float), t_old, h, F, y_old, out)
-
-
-@njit(cache=True)
-def _stage_state(K, a, s, h, y_old):
-    """y_old + h Σ_{i<s} a_i K_i: the state of an extra stage."""
-    y = np.empty(y_old.shape[0])
-    for c in range(y.shape[0]):
-        acc = 0.0
-        for i in range(s):
-            acc += K[i, c] * a[i]
-        y[c] = y_old[c] + acc * h
-    return y
-
-
-@njit(cache=True)
-def _coefficients(K, D, h, y, y_old, f, F):
-    """DOP853's interpolant coefficients F: Δy, h f_old − Δy, 2Δy − h (f + f_old), then h D K."""
-    for c in range(y.shape[0]):
-        dy = y[c] - y_old[c]
-        F[0, c], F[1, c], F[2, c] = dy, h * K[0, c] - dy, 2 * dy - h * (f[c] + K[0, c])
-        for r in range(D.shape[0]):
-            acc = 0.0
-            for s in range(K.shape[0]):
-                acc += D[r, s] * K[s, c]
-            F[3 + r, c] = h * acc
-
-
-@njit(cache=True)
-def _rows(times, t_old, h, F, y_old, out):
-    """The interpolant's rows: out[j] = y_old + Σ_k P[j, k] F[k], P[j, k] = x (1 − x) x … (k + 1
-    factors, alternating) at x = (t_j − t_old)/h."""
-    for j in range(times.shape[0]):
-        x = (times[j] - t_old) / h
-        out[j] = y_old
-        p = 1.0
-        for k in range(F.shape[0]):
-            p *= x if k % 2 == 0 else 1.0 - x
-            for c in range(y_old.shape[0]):
-                out[j, c] += p * F[k, c]

@@ -26,7 +26,7 @@ WARM_RUN = 0.01  # [s] of each warm-up model's run: a few steps, every function 
 
 def warm(texts):
     """Build each model's Engine and run every kernel entry point on it; then a short run of it,
-    so that the run loop's own numba functions (analysis/stepper.py's dense output,
+    so that the run loop's own numba functions (analysis/dop853.py's dense output,
     velocity_form.py) are in the cache too, not compiled by a user's first run."""
     from ..analysis.simulate import simulate
     from ..compiled import background

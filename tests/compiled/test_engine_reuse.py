@@ -242,6 +242,7 @@ def test_equal_systems_behave_the_same(model):
     assert heavier.L.node_mass[0] == 5.0 and engine.L.node_mass[0] == 1.3
 
 
+@pytest.mark.implementation
 def test_the_runs_of_a_system_share_one_projection():
     """Each run's Data has its own Engine, a copy (``Engine.at``) of the first one made at the
     Layout's parameter values: the projection a run asks for is made once, on that first
