@@ -3,9 +3,9 @@
 Dormand and Prince's explicit Runge–Kutta pair of order 8(5,3) with its 7th-order dense
 output (Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*, II.4 and II.10;
 the tableau in core/dop853_tableau.py), taken step by step as scipy's ``scipy.integrate.DOP853``
-takes it: the same initial step, error norm, step-size control and interpolant, operation
-for operation, so that a run is the same bit for bit (tests/analysis/test_dop853.py checks it
-against scipy's). It has the part of scipy's OdeSolver interface that the run loop reads and
+takes it: the same initial step, error norm and step-size control, operation for operation,
+so that its steps are the same bit for bit (tests/analysis/test_dop853.py checks them against
+scipy's). It has the part of scipy's OdeSolver interface that the run loop reads and
 writes (stepper.py): ``step()``, ``status``, ``t``, ``y``, ``f``, ``h_abs``, ``max_step``,
 ``t_bound``, the last step's ``t_old``, ``y_old``, ``h_previous`` and stages ``K_extended``,
 and ``dense_output()``, whose arithmetic is compiled (scipy's costs more than the stages'
