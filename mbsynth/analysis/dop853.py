@@ -58,6 +58,7 @@ class DOP853:
         self.direction = np.sign(t_bound - t0) if t_bound != t0 else 1
         self.n, self.status = y0.size, "running"
         self.rtol, self.atol = _tolerances(rtol, atol, self.n)
+        self.atol_entries = np.broadcast_to(np.asarray(self.atol, dtype=float), (self.n,)).copy()  # compiled steps
         self.f = self.fun(self.t, self.y)
         if first_step is None:
             self.h_abs = _initial_step(self.fun, self.t, self.y, t_bound, max_step, self.f, self.direction,

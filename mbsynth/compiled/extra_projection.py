@@ -139,11 +139,10 @@ class ExtraProjection:
         function (compiled), or None where the extra rows are not all of the System's."""
         if self.xrow_row.size != self.m:
             return None
+        A = np.zeros((self.m, self.n))
         with self.lock:
             self._evaluate(t, q, qd)
-            values = self.gen[self.entries].copy()
-        A = np.zeros((self.m, self.n))
-        np.add.at(A, (self.xrow_row[self.rows], self.columns), values)
+            _dense_rows(self.gen, self.layout, A)
         return A
 
     def _least(self, t, q, qd):
@@ -176,6 +175,15 @@ class ExtraProjection:
         with self.lock:
             return drift(float(t), np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(qd, dtype=float),
                          self.evaluation, self.layout, self.work)
+
+
+@njit(**OPTIONS)
+def _dense_rows(gen, layout, A):
+    """The System's A (m × n, zeros) from the rows' entries as evaluated last, each added at
+    its System row and coordinate (entries at one place summed)."""
+    rows, columns, entries, xrow_row = layout[0], layout[1], layout[2], layout[8]
+    for e in range(rows.shape[0]):
+        A[xrow_row[rows[e]], columns[e]] += gen[entries + e]
 
 
 @njit(**OPTIONS)

@@ -202,17 +202,16 @@ class Stages:
         return out if status == kernel.OK else None
 
     def step(self, solver):
-        """One step of scipy's DOP853 ``solver`` in compiled code, its state written as its
-        ``_step_impl`` writes it: (True, None) for a step taken, (False, message) where the
+        """One step of the DOP853 ``solver`` (analysis/dop853.py) in compiled code, its state
+        written as its ``_step_impl`` writes it: (True, None) for a step taken, (False, message) where the
         step size fell too small, None where a stage was declined (the solver untouched: its
         step is the Python path's). Also returns the evaluations made: (result, evaluations)."""
         y_new, f_new = np.empty(self.size), np.empty(self.size)
-        atol = np.broadcast_to(np.asarray(solver.atol, dtype=float), (self.size,)).copy()
         with self.engine.lock:
             outcome, t_new, h, h_abs, evaluations = step(
-                solver.t, solver.y, solver.f, solver.h_abs, solver.t_bound, solver.max_step, solver.rtol, atol,
-                float(solver.direction), solver.A, solver.B, solver.C, solver.E3, solver.E5, solver.error_exponent,
-                solver.K, y_new, f_new, self.stage, self.bundle, self.general)
+                solver.t, solver.y, solver.f, solver.h_abs, solver.t_bound, solver.max_step, solver.rtol,
+                solver.atol_entries, float(solver.direction), solver.A, solver.B, solver.C, solver.E3, solver.E5,
+                solver.error_exponent, solver.K, y_new, f_new, self.stage, self.bundle, self.general)
         if outcome == DECLINED:
             return None, evaluations
         if outcome == TOO_SMALL:

@@ -1,16 +1,17 @@
 """The run loop's stages in compiled code (mbsynth.compiled.staged) against independent
-results: ẏ at a stage against (2.14) on the KKT path, a whole DOP853 step against scipy's own
-``_step_impl`` on the same right-hand side (its trials, error norm and next step size), and a
+results: ẏ at a stage against (2.14) on the KKT path, a whole DOP853 step against the
+solver's Python step on the same right-hand side (analysis/dop853.py: scipy's ``_step_impl``
+bit for bit, tests/analysis/test_dop853.py; its trials, error norm and next step size), and a
 stage the kernel declines left to the Python path with the integrator untouched."""
 
 import copy
 
 import numpy as np
 import pytest
-import scipy.integrate
 from scipy.integrate._ivp import rk
 
 import mbsynth as mb
+from mbsynth.analysis.dop853 import DOP853
 from mbsynth.analysis.velocity_form import VelocityForm
 from mbsynth.compiled import engine_for, staged
 from tests.helpers.compare import rel
@@ -43,19 +44,19 @@ def test_a_stage_is_the_motion_of_2_14(model):
 
 
 def test_a_step_is_scipys(model):
-    """Eight DOP853 steps taken by ``Stages.step`` and by scipy's ``_step_impl`` from the same
+    """Eight DOP853 steps taken by ``Stages.step`` and by the solver's Python step from the same
     solver state on the same right-hand side: the same outcome, t, y, ẏ and next step size
     to rounding, rejected trials and their shorter retries among them. The error estimate is
     a sum of the stages that cancels to about rtol of them, so the rounding of its two
     summation orders (a loop here, BLAS there) moves a retried step's size by about 1e-11 of
     itself, and the state with it."""
     system, stages, form, y = model
-    solver = scipy.integrate.DOP853(lambda t, y: stages.rates(t, y), 0.0, y, 1.0, rtol=1e-7, atol=1e-7)
+    solver = DOP853(lambda t, y: stages.rates(t, y), 0.0, y, 1.0, rtol=1e-7, atol=1e-7)
     rejected = 0
     for _ in range(8):
         mine, theirs = copy.deepcopy(solver), copy.deepcopy(solver)
         taken, evaluations = stages.step(mine)
-        assert taken == scipy.integrate.DOP853._step_impl(theirs) == (True, None)
+        assert taken == theirs._step_impl() == (True, None)
         rejected += evaluations > 12
         assert evaluations % 12 == 0
         assert mine.t == pytest.approx(theirs.t, rel=1e-10)
@@ -68,12 +69,13 @@ def test_a_step_is_scipys(model):
 
 
 def test_a_step_below_the_smallest_fails_as_scipys(model):
-    """A step size capped below ten units of t's rounding: scipy's failure and message."""
+    """A step size capped below ten units of t's rounding: the Python step's failure and message
+    (scipy's)."""
     system, stages, form, y = model
-    solver = scipy.integrate.DOP853(lambda t, y: stages.rates(t, y), 1.0, y, 2.0, rtol=1e-7, atol=1e-7)
+    solver = DOP853(lambda t, y: stages.rates(t, y), 1.0, y, 2.0, rtol=1e-7, atol=1e-7)
     solver.max_step = 1e-300
     taken, evaluations = stages.step(solver)
-    assert taken == scipy.integrate.DOP853._step_impl(copy.deepcopy(solver)) and taken[0] is False
+    assert taken == copy.deepcopy(solver)._step_impl() and taken[0] is False
     assert evaluations == 0 and solver.t == 1.0
 
 
@@ -82,7 +84,7 @@ def test_a_declined_stage_leaves_the_step_to_the_python_path(model):
     None with the solver's state as it was, for the Python path to take the step."""
     system, stages, form, y = model
     assert stages.rates(0.0, np.full_like(y, np.nan)) is None
-    solver = scipy.integrate.DOP853(lambda t, y: stages.rates(t, y), 0.0, y, 1.0, rtol=1e-7, atol=1e-7)
+    solver = DOP853(lambda t, y: stages.rates(t, y), 0.0, y, 1.0, rtol=1e-7, atol=1e-7)
     solver.f = np.full_like(solver.f, np.nan)  # the first stage moves the state by NaN
     before = (solver.t, solver.y, solver.h_abs)
     taken, evaluations = stages.step(solver)
