@@ -38,8 +38,9 @@ engine built from numba's cache), then with the derivation cache off
 ``mbsynth check models/robots/ur5_payload.yaml`` end to end (the whole process); once,
 ``from_robot("talos")`` and its first motion with no caches at all, waiting while numba
 compiles the kernels (``MBSYNTH_COMPILED=wait``; by default the KKT path answers meanwhile);
-Pinocchio's ``buildModelFromUrdf`` for scale. Writes benchmarks/end_to_end_results.md (or
-``--out``).
+Pinocchio's ``buildModelFromUrdf`` for scale. A third table splits talos's run into its steps
+and its rows: both codes with FEW_OUTPUTS + 1 output rows and with OUTPUTS + 1. Writes
+benchmarks/end_to_end_results.md (or ``--out``).
 
 Beside Pinocchio, on the robots and the chain: MuJoCo's ``mj_forward`` on the same model
 (benchmarks/mujoco_twin.py: Pinocchio's model written as MJCF, its qacc equal to aba's to
@@ -76,6 +77,7 @@ from mujoco_twin import MujocoTwin  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 T_END, OUTPUTS, TOL = 2.0, 500, 1e-10
+FEW_OUTPUTS = 10  # the rows table's short run: one row per 0.2 s
 CHAIN_T_END = 1.0  # the 100-link chain's run (its motion costs ~0.4 ms an evaluation)
 ANDREWS_T_END = 0.03  # the test set's interval
 ANDREWS = HERE.parent / "models" / "mechanisms" / "andrews.yaml"
@@ -123,6 +125,30 @@ def pinocchio_case(name, system, model, q, v, twin=None, t_end=T_END, exudyn=Fal
     others = [("MuJoCo", None, mujoco_run)] + ([("Exudyn", 1, exudyn_run)] if exudyn else [])
     return Case(name, system, "Pinocchio", pinocchio_rhs(model), np.concatenate([q, v]), model.nq, twin, t_end,
                 gap=None if twin is None else lambda reached, ours: body_distance(twin, reached, ours), others=others)
+
+
+def rows_lines(case, rounds):
+    """The table of what output rows cost on ``case``: its run with FEW_OUTPUTS + 1 rows and
+    with OUTPUTS + 1, each code's best of ``rounds`` (the runs alternating), and the cost of
+    each row more."""
+    best = {}
+    for _ in range(rounds):
+        for outputs in (FEW_OUTPUTS, OUTPUTS):
+            for code, run in (("Pinocchio", lambda: _seconds(integrate, case.rhs, case.y0, case.t_end, outputs)),
+                              ("mbsynth, one thread", lambda: mbsynth_run(case, 1, outputs)[0])):
+                best[code, outputs] = min(best.get((code, outputs), np.inf), run())
+    lines = ["| code | %d rows (s) | %d rows (s) | each row more (µs) |" % (FEW_OUTPUTS + 1, OUTPUTS + 1),
+             "|---|---:|---:|---:|"]
+    for code in ("Pinocchio", "mbsynth, one thread"):
+        few, many = best[code, FEW_OUTPUTS], best[code, OUTPUTS]
+        lines.append(f"| {code} | {few:.4f} | {many:.4f} | {1e6 * (many - few) / (OUTPUTS - FEW_OUTPUTS):.1f} |")
+    return lines
+
+
+def _seconds(function, *args):
+    started = time.perf_counter()
+    function(*args)
+    return time.perf_counter() - started
 
 
 def frame_distance(model, q, other):
@@ -233,10 +259,10 @@ def pinocchio_rhs(model):
     return f
 
 
-def integrate(rhs, y0, t_end):
-    """solve_ivp as every reference code is run: DOP853, TOL, OUTPUTS + 1 rows."""
+def integrate(rhs, y0, t_end, outputs=OUTPUTS):
+    """solve_ivp as every reference code is run: DOP853, TOL, ``outputs`` + 1 rows."""
     return solve_ivp(rhs, (0.0, t_end), y0, method="DOP853", rtol=TOL, atol=TOL,
-                     t_eval=np.linspace(0.0, t_end, OUTPUTS + 1))
+                     t_eval=np.linspace(0.0, t_end, outputs + 1))
 
 
 def reference_run(case):
@@ -246,13 +272,15 @@ def reference_run(case):
     return time.perf_counter() - started, sol.nfev, sol.y[:case.nq, -1]
 
 
-def mbsynth_run(case, cores=None):
+def mbsynth_run(case, cores=None, outputs=OUTPUTS):
     """(seconds, evaluations, largest position residual, energy spread, final q) of
-    mb.simulate; ``cores``: the threads its projections may take (default: one per core)."""
+    mb.simulate with ``outputs`` + 1 rows; ``cores``: the threads its projections may take
+    (default: one per core)."""
     default, threads.THREADS = threads.THREADS, cores or threads.THREADS
     try:
         started = time.perf_counter()
-        traj = mb.simulate(case.system, case.t_end, method="DOP853", rtol=TOL, atol=TOL, **case.start)
+        traj = mb.simulate(case.system, case.t_end, dt=case.t_end / outputs, method="DOP853", rtol=TOL, atol=TOL,
+                           **case.start)
         seconds = time.perf_counter() - started
     finally:
         threads.THREADS = default
@@ -378,6 +406,13 @@ def main():
             lines.append(f"| | | {code} | {seconds:.3f} | {seconds / reference[0]:.1f} | {count} | – | – | "
                          f"{distance:.1e} |")
         print(*lines[-3 - len(case.others):], sep="\n", flush=True)
+    talos = cases[1]
+    lines += ["", f"What the output rows cost: {talos.name}, {talos.t_end:g} s, with {FEW_OUTPUTS + 1} rows and "
+              f"with {OUTPUTS + 1} (best of {args.rounds} rounds, the runs alternating). mbsynth puts every row "
+              f"back on the constraints (row_fit.py: a few projected exactly per step, the others through them, "
+              f"each judged) and records its {talos.system.n} coordinates and rates; Pinocchio's rows are "
+              f"solve_ivp's interpolant at {talos.y0.size} numbers (q, v).", ""] + rows_lines(talos, args.rounds)
+    print(*lines[-4:], sep="\n", flush=True)
     if not args.simulations_only:
         lines += ["", "Building the model (numba's cache warm, but in the row that says otherwise):", ""] + build_lines(args.rounds)
     text = "\n".join(lines) + "\n"
