@@ -182,9 +182,9 @@ def _components_closed(J, r0, k, S, Jr):
     if not (g00 > PIVOT_RTOL * g00 and t2 > PIVOT_RTOL * g11 * g00):
         return False
     if k == 5:
-        g01 = dot3(N0, N1)
-        j0 = ((g11 * N0[0] - g01 * N1[0]) / t2, (g11 * N0[1] - g01 * N1[1]) / t2, (g11 * N0[2] - g01 * N1[2]) / t2)
-        j1 = ((g00 * N1[0] - g01 * N0[0]) / t2, (g00 * N1[1] - g01 * N0[1]) / t2, (g00 * N1[2] - g01 * N0[2]) / t2)
+        g01, r2 = dot3(N0, N1), 1.0 / t2
+        j0 = ((g11 * N0[0] - g01 * N1[0]) * r2, (g11 * N0[1] - g01 * N1[1]) * r2, (g11 * N0[2] - g01 * N1[2]) * r2)
+        j1 = ((g00 * N1[0] - g01 * N0[0]) * r2, (g00 * N1[1] - g01 * N0[1]) * r2, (g00 * N1[2] - g01 * N0[2]) * r2)
         for e in range(3):
             S[3 + e, 0] = T[e]
             Jr[3 + e, 0] = Jr[3 + e, 1] = Jr[3 + e, 2] = 0.0
@@ -201,17 +201,24 @@ def _components_closed(J, r0, k, S, Jr):
     det = dot3(N2, T)
     if not det * det > PIVOT_RTOL * dot3(N2, N2) * t2:
         return False
-    c0, c1 = cross3(N1, N2), cross3(N2, N0)  # N⁻¹'s columns: (N1×N2, N2×N0, N0×N1)/det
+    r = 1.0 / det  # N⁻¹'s columns: (N1×N2, N2×N0, N0×N1)/det
+    c0, c1, c2 = _scaled3(r, cross3(N1, N2)), _scaled3(r, cross3(N2, N0)), _scaled3(r, T)
     for e in range(3):
         Jr[3 + e, 0] = Jr[3 + e, 1] = Jr[3 + e, 2] = 0.0
-        Jr[3 + e, 3], Jr[3 + e, 4], Jr[3 + e, 5] = c0[e] / det, c1[e] / det, T[e] / det
+        Jr[3 + e, 3], Jr[3 + e, 4], Jr[3 + e, 5] = c0[e], c1[e], c2[e]
     for a in range(3):
         C = _row3(J, r0 + a, 3)
         inv = 1.0 / D[a]
         for c in range(3):
             Jr[a, c] = inv if c == a else 0.0
-        Jr[a, 3], Jr[a, 4], Jr[a, 5] = -inv * dot3(C, c0) / det, -inv * dot3(C, c1) / det, -inv * dot3(C, T) / det
+        Jr[a, 3], Jr[a, 4], Jr[a, 5] = -inv * dot3(C, c0), -inv * dot3(C, c1), -inv * dot3(C, c2)
     return True
+
+
+@njit(**INLINE)
+def _scaled3(f, x):
+    """f x for a 3-tuple x."""
+    return (f * x[0], f * x[1], f * x[2])
 
 
 @njit(**INLINE)
@@ -238,6 +245,11 @@ def cholesky(A, m, scale, L):
 def spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""
+    if m == 1:  # one free unknown (a revolute, a slider): the pivot's reciprocal
+        if not A[0, 0] > PIVOT_RTOL * scale[0]:
+            return False
+        A[0, 0] = 1.0 / A[0, 0]
+        return True
     if not cholesky(A, m, scale, L):
         return False
     for j in range(m):  # L ← L⁻¹ (lower triangular)
