@@ -34,7 +34,7 @@ from .cut import CutIntegration
 from .derivative import Crawl
 from .drift import next_cap
 from .projection import project, relative_drift
-from .singular_watch import SingularWatch
+from .singular_watch import SingularWatch, rows_keep_rank
 from ..compiled.rows import largest
 from ..core.tolerances import MAX_STATE, RELAXED_MAX
 
@@ -77,6 +77,7 @@ class ContinuousIntegration(CutIntegration):
         self.has_rows = len(self.data.system.constraint_names) > 0
         self.watch = None  # the singular positions passed between stages (singular_watch.py), on projected runs
         self.crossing = None  # the step plan near singular positions (crossing.py)
+        self.keeps_rank = rows_keep_rank(self.data.system)  # no singular position to watch for
 
     def advance(self, t_next, q, qd, t_stop):
         try:
@@ -167,11 +168,15 @@ class ContinuousIntegration(CutIntegration):
         names = self.data.system.constraint_names
         self.f.add_singular(t_star, tuple(names[r] for r in rows), solver.t - t_start)
 
-    @contextlib.contextmanager
     def _stages_on_manifold(self, across):
-        """Within: where ``across`` (a step across a singular position), each stage is put on
-        the constraints by the kernel's projection before its motion is evaluated."""
-        self.f.on_manifold = self.projection if across else None  # called with (t, q, q̇)
+        """A context within which, where ``across`` (a step across a singular position), each
+        stage is put on the constraints by the kernel's projection before its motion is
+        evaluated (elsewhere nothing changes)."""
+        return self._projected_stages() if across else contextlib.nullcontext()
+
+    @contextlib.contextmanager
+    def _projected_stages(self):
+        self.f.on_manifold = self.projection  # called with (t, q, q̇)
         try:
             yield
         finally:
@@ -229,7 +234,10 @@ class ContinuousIntegration(CutIntegration):
         on (singular_watch.py): on runs projected by analysis/projection.py or by compiled/extra_projection.py
         (``watched``) of models whose A is small enough. Plan the steps across them
         (crossing.py) where the kernel projects the states and the watch or the projection
-        (extra_projection.py's ``measure``) measures them."""
+        (extra_projection.py's ``measure``) measures them; none where the rows keep their
+        rank (singular_watch.rows_keep_rank)."""
+        if self.keeps_rank:
+            return
         if self.watch is None and (self.projection is None or self.projection.watched) and \
                 SingularWatch.fits(self.data):
             self.watch = SingularWatch(self.data, t, q, qd)

@@ -18,9 +18,50 @@ to decompose at every step (WATCH_ENTRIES).
 import numpy as np
 from numba import njit
 
+from ..compiled.nodes import PARTICLE_NODE
 from ..core.tolerances import DIP_FLOOR, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
+from ..model.parts.part_type import QUATERNION
 
 WATCH_ENTRIES = 4096  # the largest A (rows × coordinates) watched: an SVD per step costs little beside the step
+# joint kinds whose rows are independent wherever they hold (``rows_keep_rank``)
+RANK_KEEPING_KINDS = ("fixed", "revolute", "prismatic", "cylindrical", "spherical", "universal")
+
+
+def rows_keep_rank(system):
+    """Whether the System's rows keep their rank along every motion, so that a run passes no
+    singular position and its watch has nothing to find: parts turned by a unit quaternion
+    (rigid or flexible) or particles, no limits or contacts, and rows that are the parts'
+    own unit-quaternion rows and the joints of RANK_KEEPING_KINDS, no joint closing a loop
+    (the world counted as one part).
+
+    Why: hung from the world part by part, A is block-triangular, each block a joint's rows
+    on the coordinates of the part it brings in, with that part's quaternion row. On a part's
+    (r̈, α) a joint's rows are: component rows e_k on r̈; rows d·a (a joint axis) a on r̈; rows
+    a·b of two axes a × b on α alone, of unit length where they hold (a ⟂ b), and
+    independent there (z_B = ±z_A for the aligned axis: ±y_A, ∓x_A; the orientation lock's
+    three are the frame's axes on each of its branches) — on the quaternion's rates through
+    2E(u)ᵀ, orthogonal to its own row's u. A flexible part's modes only add columns. So
+    every block has full row rank wherever the rows hold: σ_r never dips."""
+    own = {f"{part.name}.unit_quaternion" for part in system.parts if part.part_type.orientation == QUATERNION}
+    if system.unilaterals or not all(part.part_type.orientation == QUATERNION or
+                                     part.part_type.node == PARTICLE_NODE for part in system.parts):
+        return False
+    joined = {}  # union-find over the parts' names and the world (None)
+
+    def root(name):
+        while name in joined:
+            name = joined[name]
+        return name
+    for con in system.constraints:
+        if con.name in own and con.size == 1:
+            continue
+        if getattr(con, "joint_kind", None) not in RANK_KEEPING_KINDS:
+            return False
+        a, b = (root(None if part is None else part.name) for part in con.parts)
+        if a == b:  # the joint closes a loop
+            return False
+        joined[a] = b
+    return True
 SEARCH_STEPS = 60  # golden-section steps: the bracket shrinks to 0.618^60 ≈ 3e-13 of its width
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
