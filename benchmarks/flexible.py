@@ -12,7 +12,8 @@ plane of the swing), that node held at the floating frame (``Reduction.hold``); 
 mbsynth: ``type: flexible_body`` (the test's ``pendulum_yaml``: the beam generator,
 ``reduction: craig_bampton``),
 ``simulate`` with DOP853 and with Radau (the implicit method for stiff models) at rtol = atol
-as stated, one output interval, the compiled kernels built before anything is timed. The
+as stated (DOP853 from 1e-2: below about 1e-4 the step is held by the stability of the
+866 rad/s mode, not by the error control, and the error stays near 4e-7 m), one output interval, the compiled kernels built before anything is timed. The
 spin-up beam (models/flexible/spin_up_beam.yaml, 15 s, 500 output rows) is timed beside it
 with both methods, warm (its second run in the process), its tip against DOP853 at the
 default tolerance.
@@ -87,7 +88,7 @@ except ImportError as missing:
     exu, WHY_NO_EXUDYN = None, f"exudyn is not importable ({missing}); `pip install exudyn` for its rows"
 
 MODES = 8
-RTOLS = (1e-5, 1e-7, 1e-9)
+RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-7, 1e-9)  # loose ones too: there the highest mode's stability holds the step
 RADAU_RTOLS = (1e-4, 3e-5, 1e-5)
 SPIN_UP = HERE.parent / "models" / "flexible" / "spin_up_beam.yaml"
 SPIN_UP_RUNS = (("DOP853", 1e-10), ("DOP853", 1e-6), ("Radau", 1e-6), ("Radau", 1e-4))
