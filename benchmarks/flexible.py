@@ -353,7 +353,7 @@ def matched(rows):
             walls[code] = r["wall"]
             lines.append(f"{code} {seconds(r['wall'])} s ({r['settings']})")
     if "mbsynth" in walls and "Exudyn" in walls:
-        lines.append(f"mbsynth / Exudyn {walls['mbsynth'] / walls['Exudyn']:.1f}×")
+        lines.append(f"mbsynth / Exudyn {walls['mbsynth'] / walls['Exudyn']:.2f}×")
     return lines
 
 
