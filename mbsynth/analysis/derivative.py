@@ -31,6 +31,7 @@ import logging
 
 import numpy as np
 
+from ..compiled.rows import largest
 from ..core.errors import SolveError
 from ..model.angle_singularity import AngleParts, explain
 from ..core.tolerances import ANGLES_NEAR, COLLAPSE_SPAN, JACOBIAN_STEP, MAX_STATE, STEP_RESOLUTION
@@ -258,7 +259,7 @@ class StateDerivative:
     def check(self, t, q, qd):
         """Raise SolveError naming the coordinates where the state (q, q̇) is not finite or
         beyond MAX_STATE."""
-        if np.abs(q).max(initial=0.0) <= MAX_STATE and np.abs(qd).max(initial=0.0) <= MAX_STATE:  # not if NaN
+        if largest(q) <= MAX_STATE and largest(qd) <= MAX_STATE:  # not if NaN (largest gives NaN then)
             return
         self.t_failed = t
         y = np.concatenate([q, qd])

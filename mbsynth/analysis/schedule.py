@@ -66,7 +66,7 @@ class Schedule:
 
     def between(self, a, b):
         """The output times and samples in [a, b), in order."""
-        outputs = self.outputs[np.searchsorted(self.outputs, a):np.searchsorted(self.outputs, b)].tolist()
+        outputs = self.outputs[self.outputs.searchsorted(a):self.outputs.searchsorted(b)].tolist()
         if self.h is None:
             return outputs
         j, samples = self._first_sample_from(a), []
