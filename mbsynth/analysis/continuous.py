@@ -176,6 +176,7 @@ class ContinuousIntegration(CutIntegration):
 
     @contextlib.contextmanager
     def _projected_stages(self):
+        """Within: each stage put on the constraints by the kernel's projection."""
         self.f.on_manifold = self.projection  # called with (t, q, q̇)
         try:
             yield

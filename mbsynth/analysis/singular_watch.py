@@ -12,7 +12,8 @@ that do not change, as a clamped part's, give ratios equal but for it), the dip 
 them: a golden-section search on the positions' cubic Hermite interpolant between the ends
 (q and q̇ at each) finds its bottom, listed as a singular position where the ratio falls below NEAR_SINGULAR
 there, with the rows of its nearly dependent direction. For models whose A is small enough
-to decompose at every step (WATCH_ENTRIES).
+to decompose at every step (WATCH_ENTRIES), and whose rows can lose rank at all
+(``rows_keep_rank``: not a tree of joints that keep it).
 """
 
 import numpy as np
@@ -23,6 +24,8 @@ from ..core.tolerances import DIP_FLOOR, NAME_RTOL, NEAR_SINGULAR, RANK_RTOL
 from ..model.parts.part_type import QUATERNION
 
 WATCH_ENTRIES = 4096  # the largest A (rows × coordinates) watched: an SVD per step costs little beside the step
+SEARCH_STEPS = 60  # golden-section steps: the bracket shrinks to 0.618^60 ≈ 3e-13 of its width
+GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 # joint kinds whose rows are independent wherever they hold (``rows_keep_rank``)
 RANK_KEEPING_KINDS = ("fixed", "revolute", "prismatic", "cylindrical", "spherical", "universal")
 
@@ -62,8 +65,6 @@ def rows_keep_rank(system):
             return False
         joined[a] = b
     return True
-SEARCH_STEPS = 60  # golden-section steps: the bracket shrinks to 0.618^60 ≈ 3e-13 of its width
-GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
 
 class SingularWatch:

@@ -203,9 +203,10 @@ class Stages:
 
     def step(self, solver):
         """One step of the DOP853 ``solver`` (analysis/dop853.py) in compiled code, its state
-        written as its ``_step_impl`` writes it: (True, None) for a step taken, (False, message) where the
-        step size fell too small, None where a stage was declined (the solver untouched: its
-        step is the Python path's). Also returns the evaluations made: (result, evaluations)."""
+        written as its ``_step_impl`` writes it: (True, None) for a step taken, (False,
+        message) where the step size fell too small, None where a stage was declined (the
+        solver untouched: its step is the Python path's). Also returns the evaluations made:
+        (result, evaluations)."""
         y_new, f_new = np.empty(self.size), np.empty(self.size)
         with self.engine.lock:
             outcome, t_new, h, h_abs, evaluations = step(
