@@ -22,8 +22,9 @@ Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
 - the same robot with each welded link (a fixed joint to its parent) merged into its nearest
   link on a movable joint (``from_robot(..., merge_fixed=True)``: fewer bodies and
   coordinates, the dynamics of the movable joints unchanged, as Pinocchio merges them):
-  ``Data.motion`` and kernel.motion in a numba loop. Its q̈, mapped to Pinocchio's v̇, is
-  compared with ``aba`` on the robot as it is.
+  ``Data.motion``, kernel.motion in a numba loop and each of its stages, whose difference
+  from the robot as it is, over the welded links, is what a welded link costs each stage.
+  Its q̈, mapped to Pinocchio's v̇, is compared with ``aba`` on the robot as it is.
 
 The machine is shared by several processes: every figure is the minimum over ROUNDS rounds
 in which all callables of a robot take turns (a round times COUNT calls of each), so load
@@ -220,14 +221,19 @@ def robot(name, floating, loops, empty, args_rounds):
     layers = {k: f for k, f in layers.items() if f is not None}
     data_m, state_m, args_m, merged_error, merged_bodies, merged_n = merged_robot(name, floating, list(twin.model.names), q, v, a)
     layers["Data.motion, welded links merged (merge_fixed=True)"] = lambda: data_m.motion(0.0, *state_m)
+    checked_m = (*args_m[:-3], kernel.CHECKED, *args_m[-2:])
     kernel_loops = {label: (lambda f=f, a=(args if label == "whole" else checked): f(REPEAT, *a))
                     for label, f in loops.items()}
     kernel_zero = {label: (lambda f=f: f(0, *checked)) for label, f in loops.items() if label != "whole"}
+    merged_loops = {label: (lambda f=f: f(REPEAT, *checked_m)) for label, f in loops.items() if label != "whole"}
+    merged_zero = {label: (lambda f=f: f(0, *checked_m)) for label, f in loops.items() if label != "whole"}
     callables = {**layers, **{("K", k): f for k, f in kernel_loops.items()},
-                 **{("0", k): f for k, f in kernel_zero.items()}, "merged": lambda: loops["whole"](REPEAT, *args_m)}
+                 **{("0", k): f for k, f in kernel_zero.items()}, "merged": lambda: loops["whole"](REPEAT, *args_m),
+                 **{("Km", k): f for k, f in merged_loops.items()}, **{("0m", k): f for k, f in merged_zero.items()}}
     best = rounds(callables, args_rounds, SAMPLE_S)
     whole = best[("K", "whole")] / REPEAT
     stages = {label: max(0.0, (best[("K", label)] - best[("0", label)]) / REPEAT) for label in STAGES}
+    merged_stages = {label: max(0.0, (best[("Km", label)] - best[("0m", label)]) / REPEAT) for label in STAGES}
     per_call = [label for label in STAGES if engine.mode == kernel.CHECKED or STAGES[label] != "_residual"]
     states = [twin.to_maximal(*sample_pinocchio_state(twin, rng)) for _ in range(BATCH)]
     Q, QD = np.array([s[0] for s in states]), np.array([s[1] for s in states])
@@ -240,7 +246,7 @@ def robot(name, floating, loops, empty, args_rounds):
                 nv=twin.model.nv, layers={k: best[k] for k in layers}, whole=whole, stages=stages, per_call=per_call,
                 batch=batch["batch"] / BATCH, batch_aba=batch["aba"], error=error, a=a,
                 merged=best["merged"] / REPEAT, merged_error=merged_error, merged_bodies=merged_bodies,
-                merged_n=merged_n)
+                merged_n=merged_n, merged_stages=merged_stages)
 
 
 def table(results, rounds_used):
@@ -273,6 +279,18 @@ def table(results, rounds_used):
         for r in results) + " |")
     lines.append("| **kernel.motion in a numba loop, welded links merged (merge_fixed=True)** | " + " | ".join(
         f"**{r['merged'] * 1e6:.2f}** ({r['merged'] / r['layers']['pinocchio.aba']:.2f}×)" for r in results) + " |")
+    lines += ["", "Each stage on the robot as it is and with its welded links merged (the same loops), and what "
+              "each welded link adds to it (the difference over the welded links):", "",
+              "| stage | " + " | ".join(f"{r['label']}: as it is | merged | per welded link (ns)" for r in results)
+              + " |", "|---|" + "---:|---:|---:|" * len(results)]
+    for label in [*STAGES, "whole"]:
+        cells = []
+        for r in results:
+            alone = r["whole"] if label == "whole" else r["stages"][label]
+            merged = r["merged"] if label == "whole" else r["merged_stages"][label]
+            cells.append(f"{alone * 1e6:.2f} | {merged * 1e6:.2f} | {(alone - merged) / r['welded'] * 1e9:.0f}")
+        lines.append(f"| {'the whole kernel (a numba loop)' if label == 'whole' else label} | " + " | ".join(cells)
+                     + " |")
     lines += ["", "Per body: " + "; ".join(
         f"{r['label']}: the kernel {r['whole'] / r['bodies'] * 1e9:.0f} ns on each of its {r['bodies']} bodies "
         f"({r['welded']} of them welded to their parent by a fixed joint, which Pinocchio merges into the parent's "
