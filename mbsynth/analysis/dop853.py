@@ -58,7 +58,6 @@ class DOP853:
         self.direction = np.sign(t_bound - t0) if t_bound != t0 else 1
         self.n, self.status = y0.size, "running"
         self.rtol, self.atol = _tolerances(rtol, atol, self.n)
-        self.atol_entries = np.broadcast_to(np.asarray(self.atol, dtype=float), (self.n,)).copy()  # compiled steps
         self.f = self.fun(self.t, self.y)
         if first_step is None:
             self.h_abs = _initial_step(self.fun, self.t, self.y, t_bound, max_step, self.f, self.direction,
@@ -226,7 +225,8 @@ def _rows(times, t_old, h, F, y_old, out):
 
 
 def _tolerances(rtol, atol, n):
-    """(rtol, atol) as scipy's validate_tol leaves them: rtol raised to 100 ε with a warning."""
+    """(rtol, atol) as scipy's validate_tol checks them, rtol raised to 100 ε with a warning;
+    atol one per entry (the compiled steps read it so; the sums are scipy's all the same)."""
     if np.any(rtol < 100 * EPS):
         warnings.warn(f"At least one element of `rtol` is too small. Setting `rtol = np.maximum(rtol, {100 * EPS})`.",
                       stacklevel=4)
@@ -236,7 +236,7 @@ def _tolerances(rtol, atol, n):
         raise ValueError("`atol` has wrong shape.")
     if np.any(atol < 0):
         raise ValueError("`atol` must be positive.")
-    return rtol, atol
+    return rtol, np.broadcast_to(atol, (n,)).astype(float)
 
 
 def _rms(x):

@@ -86,7 +86,8 @@ class Integration:
         or the forces jumped; else a new one, as ``solve_ivp`` would start it."""
         first = None if self.next_step is None else min(self.next_step, t_bound - t)
         solver = self.solver
-        if solver is not None and stepper.movable(type(solver)) and solver.t == t and self.solver_tolerances == (rtol, atol):
+        if solver is not None and stepper.movable(type(solver)) and solver.t == t and \
+                self.solver_tolerances == (rtol, atol):
             y = solver.y if self.form.represents(solver.y, q, qd) else self.form.to_integrator(q, qd)
             if self.forces_jumped or not stepper.stands_at(solver, y):
                 stepper.move(solver, y, self.f(t, y))

@@ -211,7 +211,7 @@ class Stages:
         with self.engine.lock:
             outcome, t_new, h, h_abs, evaluations = step(
                 solver.t, solver.y, solver.f, solver.h_abs, solver.t_bound, solver.max_step, solver.rtol,
-                solver.atol_entries, float(solver.direction), solver.A, solver.B, solver.C, solver.E3, solver.E5,
+                solver.atol, float(solver.direction), solver.A, solver.B, solver.C, solver.E3, solver.E5,
                 solver.error_exponent, solver.K, y_new, f_new, self.stage, self.bundle, self.general)
         if outcome == DECLINED:
             return None, evaluations
