@@ -375,12 +375,10 @@ class System:
     def _state_copies(self, q, qd):
         """(q, q̇) as new 1-d float arrays of n entries, copies of what was given (whatever
         the caller does to its arrays later), or ValueError naming the shapes."""
-        q, qd = np.array(q, dtype=float), np.array(qd, dtype=float)
+        q, qd = np.array(q, dtype=float).ravel(), np.array(qd, dtype=float).ravel()
         if q.shape != (self.n,) or qd.shape != (self.n,):
-            q, qd = q.ravel(), qd.ravel()
-            if q.shape != (self.n,) or qd.shape != (self.n,):
-                raise ValueError(f"model '{self.name}' has {self.n} coordinates; got q of shape "
-                                 f"{q.shape} and qd of shape {qd.shape}")
+            raise ValueError(f"model '{self.name}' has {self.n} coordinates; got q of shape "
+                             f"{q.shape} and qd of shape {qd.shape}")
         return q, qd
 
     def evaluate(self, t, q, qd):
