@@ -6,8 +6,10 @@ For talos (floating base) and the UR5 of example-robot-data, at one state drawn 
 Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
 
 - the layers from Python: ``System.motion`` (finds the model's default Data), ``Data.motion``
-  (checks the state, picks the path), ``Engine.motion`` (compiled/engine.py: the generated
-  function, the kernel, the ``Motion``), the Engine's lean entry for an integrator's stage
+  (picks the path), ``Engine.motion_copied`` (compiled/engine.py: one compiled call, single.py,
+  that copies the state, evaluates the generated function and the kernel; the ``Motion``),
+  ``Engine.motion`` (the generated function and the kernel in two calls, on copies made
+  before: Baumgarte's shifts, a drifted model with loops), the Engine's lean entry for an integrator's stage
   (``Stages.rates`` of compiled/staged.py as ``simulate``'s stages call it: ẏ in the
   integrator's form, analysis/velocity_form.py), and ``kernel.motion`` called alone from Python;
 - the Python → numba call alone: an empty njit function with kernel.motion's argument count,
@@ -209,7 +211,8 @@ def robot(name, floating, loops, empty, args_rounds):
         "pinocchio.aba": lambda: pin.aba(twin.model, twin.data, q, v, tau),
         "System.motion": lambda: system.motion(0.0, qm, qdm),
         "Data.motion": lambda: data.motion(0.0, qm, qdm),
-        "Engine.motion": lambda: engine.motion(0.0, qm, qdm),
+        "Engine.motion_copied (Data.motion's one call: single.py)": lambda: engine.motion_copied(0.0, qm, qdm),
+        "Engine.motion (two calls: with Baumgarte's shifts, a drifted loop)": lambda: engine.motion(0.0, qm, qdm),
         "Stages.rates (the integrator's stage)": lambda: stages.rates(0.0, y),
         "kernel.motion from Python": lambda: kernel.motion(*args),
         f"empty njit call, {len(args)} arguments": lambda: empty(*args),

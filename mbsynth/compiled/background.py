@@ -32,6 +32,7 @@ VARIABLE = "MBSYNTH_COMPILED"  # the environment's choice of the default path
 OLD_VARIABLE = "MBSYNTH_FAST"  # its old name, read where VARIABLE is not set
 MODES = ("on", "off")  # VARIABLE: the compiled path where it covers a model, or never
 LEGACY_MODES = {"wait": "on", "background": "on"}  # earlier names of "on", still accepted
+_ENVIRON_KEYS = tuple((name, os.environ.encodekey(name)) for name in (VARIABLE, OLD_VARIABLE))  # ``given``
 
 
 class TemplateSlot:
@@ -58,10 +59,14 @@ def default_path_as(path):
 
 def given():
     """(name, text) of the environment's choice: MBSYNTH_COMPILED, else OLD_VARIABLE (its
-    old name); (MBSYNTH_COMPILED, None) where neither is set."""
-    for name in (VARIABLE, OLD_VARIABLE):
-        if os.environ.get(name) is not None:
-            return name, os.environ[name]
+    old name); (MBSYNTH_COMPILED, None) where neither is set. Read from the dict behind
+    ``os.environ`` (what its ``get`` reads): ``get`` of a name not set raises and catches a
+    KeyError inside, a microsecond each, and every ``System.motion`` asks."""
+    environ = os.environ._data
+    for name, key in _ENVIRON_KEYS:
+        value = environ.get(key)
+        if value is not None:
+            return name, os.environ.decodevalue(value)
     return VARIABLE, None
 
 

@@ -11,7 +11,10 @@ Engines share one set of buffers, ``Engine.at``). ``Template.engine(p)`` makes t
 at parameter values p: its numbers and work buffers. An Engine holds no reference to a System.
 
 ``Engine.motion`` returns a ``Motion`` equal to (2.14)'s, or None when the kernel's checks
-send the problem to the exact treatment (kernel.py's status); ``stages`` gives the same
+send the problem to the exact treatment (kernel.py's status); ``motion_copied`` (Data.motion's,
+where no shift or drift rule applies) the same in one compiled call (single.py) that copies
+the state, evaluates the generated function and the kernel, and writes q̈ and Qc into a new
+block beside the copies, which the Motion holds; ``stages`` gives the same
 evaluation for an integrator's stages and steps, without the Motion (staged.py);
 ``motion_batch`` evaluates many states in parallel. Each is one call into the kernel, which
 leaves q̈ and Qc in the Engine's own buffers (its Work); a Motion holds copies of them, so
@@ -39,11 +42,19 @@ from .projection import Projection
 from .extra_projection import ExtraProjection
 from .rows import Rows, relative_drift
 from .packing import pack, views
+from .single import ACCELERATION, FORCE, RATE, STATE, Single
 from .threads import THREADS, pool
 
 EMPTY = np.zeros(0)
 NO_BODIES = np.zeros(0, dtype=np.int64)  # ``stages``' ``starts`` of a state in (q, q̇) itself
 CHUNK = 16  # fewest rows a thread takes at a time
+FLOAT = np.dtype(float)
+
+
+def _plain(x):
+    """Whether x is a writeable C-contiguous 1-d float64 array (the type single.motion_into is
+    compiled for: numba would compile it anew for another)."""
+    return type(x) is np.ndarray and x.dtype is FLOAT and x.ndim == 1 and x.strides[0] == 8 and x.flags.writeable
 
 
 class Template:
@@ -110,6 +121,7 @@ class Engine:
         self.projections = []  # the Projection, once made (``at``'s copies get it on their parameter values)
         self.origin = self  # the Engine whose buffers this one shares (``at``'s copies: the one they were made of)
         self.staged = {}  # the compiled stages (staged.Stages) per integrator form, once made
+        self.single = None  # ``motion_copied``'s compiled call (single.Single), once made
         # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with extra rows
         self.rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
         self.generated_phi = slice(self.outputs - template.phi_outputs, self.outputs)  # φ of the extra rows in gen
@@ -120,7 +132,7 @@ class Engine:
         allocates nothing."""
         other = copy.copy(self)
         other.p = p
-        other.staged = {}
+        other.staged, other.single = {}, None
         other.projections = [made and made.at(other) for made in self.projections]
         return other
 
@@ -158,11 +170,12 @@ class Engine:
     def warm(self, q, qd):
         """Compile (or load from the cache) everything ``motion`` calls, at the state (q, q̇):
         the generated function first, then, once the helpers this process started (ahead.py)
-        have put their parts of the kernel into the cache, the kernel."""
+        have put their parts of the kernel into the cache, the kernel, and ``motion_copied``'s call."""
         if self.module is not None:
             self.module.evaluate(0.0, q, qd, self.p, self.gen)
         ahead.finish()
         self.motion(0.0, q, qd)
+        self.motion_copied(0.0, np.array(q, dtype=float), np.array(qd, dtype=float))
 
     def motion(self, t, q, qd, bshift=None, drift=False, kept=None):
         """A Motion at (t, q, q̇) (validated 1-d float arrays), or None for the exact path.
@@ -183,6 +196,26 @@ class Engine:
             residual = functools.partial(self.checked_residual, t, q, qd, bshift.copy() if bshift.size else EMPTY,
                                          drift)
         return Motion.made(qdd, True, self.no_freedom, Qc, residual, "tree (Baraff)")
+
+    def motion_copied(self, t, q, qd, drift=False):
+        """``motion(t, q, q̇, drift=drift)`` for a model whose kernel needs no drift (no extra
+        rows) or a state on the manifold, in one compiled call that copies the state too
+        (single.py): (the Motion, the copies of q and q̇ it was evaluated at). None where q or
+        q̇ is not a writeable 1-d float64 array of n contiguous entries (the caller's checks
+        then say what it is) or where the kernel declines."""
+        if not (_plain(q) and _plain(qd)):
+            return None
+        block = np.empty((4, self.n))
+        with self.lock:
+            if self.single is None:
+                self.single = Single(self)
+            status, residual = self.single(float(t), q, qd, block)
+        if status != kernel.OK:
+            return None
+        q, qd = block[STATE], block[RATE]
+        if self.mode != kernel.CHECKED:
+            residual = functools.partial(self.checked_residual, t, q, qd, EMPTY, drift)
+        return Motion.made(block[ACCELERATION], True, self.no_freedom, block[FORCE], residual, "tree (Baraff)"), q, qd
 
     def checked_residual(self, t, q, qd, bshift, drift):
         """The kernel's relative residual (kernel.motion, CHECKED) of the motion at (t, q, q̇)."""

@@ -227,9 +227,13 @@ class Data:
             method = OLD_METHODS[method]
         if method not in METHODS:
             raise ValueError(f"method must be one of {sorted(METHODS)}, got {method!r}")
-        # copies: the state its λ and residual are read at, whatever the caller does to q, q̇
-        q, qd = self.system._state_copies(q, qd)
-        motion = self._solved(t, q, qd, method, baumgarte, drift, (q, qd))
+        engine = self.engine if method == "kkt" and baumgarte is None else None
+        found = None if engine is None or (drift and engine.closes_loops) else engine.motion_copied(t, q, qd, drift)
+        if found is not None:  # one compiled call, which copies the state too
+            motion, q, qd = found
+        else:  # copies: the state its λ and residual are read at, whatever the caller does to q, q̇
+            q, qd = self.system._state_copies(q, qd)
+            motion = self._solved(t, q, qd, method, baumgarte, drift, (q, qd))
         return motion.with_multipliers(functools.partial(self._lam, t, q, qd))
 
     def _lam(self, t, q, qd, motion):

@@ -118,7 +118,7 @@ def test_a_read_only_state_is_copied_and_compiles_nothing_more():
     compiles no second, read-only specialization of them (a minute on a new machine), and
     the motion equals that of a writeable copy."""
     import numba
-    from mbsynth.compiled import kernel
+    from mbsynth.compiled import kernel, single
     model = mb.from_robot("ur5")
     q, qd = model.initial_q, np.zeros(model.n)
     qd.flags.writeable = False
@@ -129,7 +129,7 @@ def test_a_read_only_state_is_copied_and_compiles_nothing_more():
     q_batch = np.array([q])
     q_batch.flags.writeable = False
     np.testing.assert_array_equal(model.motion_batch(0.0, q_batch, np.array([qd]))[0][0], expected)
-    for dispatcher in (kernel.motion_rates, kernel.motion_rows):
+    for dispatcher in (kernel.motion_rates, kernel.motion_rows, single.motion_into):
         assert all(argument.mutable for signature in dispatcher.signatures for argument in signature
                    if isinstance(argument, numba.types.Array))
 
