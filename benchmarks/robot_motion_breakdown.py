@@ -6,7 +6,8 @@ For talos (floating base) and the UR5 of example-robot-data, at one state drawn 
 Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
 
 - the layers from Python: ``System.motion`` (finds the model's default Data), ``Data.motion``
-  (picks the path), ``Engine.motion_copied`` (compiled/engine.py: one compiled call, single.py,
+  (picks the path), ``Data.acceleration`` (q̈ alone into the Data's own array, as ``aba``
+  writes ``data.ddq``: no Motion, nothing allocated), ``Engine.motion_copied`` (compiled/engine.py: one compiled call, single.py,
   that copies the state, evaluates the generated function and the kernel; the ``Motion``),
   ``Engine.motion`` (the generated function and the kernel in two calls, on copies made
   before: Baumgarte's shifts, a drifted model with loops), the Engine's lean entry for an integrator's stage
@@ -151,7 +152,11 @@ def rounds(callables, rounds, seconds):
     """{label: the minimum over ``rounds`` of one call's mean time in a sample of about
     ``seconds``}, the callables taking turns within each round. Every sample lasts about
     as long (each callable's count of calls per sample is set from its first calls), so
-    that each has the same chance of a quiet moment of the machine."""
+    that each has the same chance of a quiet moment of the machine. Each sample follows one
+    untimed call: the first calls after the other callables' samples are slower, their
+    arrays and code pushed out of the caches (talos's ``System.motion``, the first Python
+    layer after ``aba`` and the numba loops, read 73 µs without that call, 64 with it, 54
+    in a loop of its own): the turns' cost, not the call's."""
     counts = {}
     for label, fn in callables.items():
         fn()
@@ -165,6 +170,7 @@ def rounds(callables, rounds, seconds):
     for _ in range(rounds):
         for label, fn in callables.items():
             count = counts[label]
+            fn()  # untimed: the first call after the others' samples pays for what they pushed out of the caches
             started = time.perf_counter()
             for _ in range(count):
                 fn()
@@ -211,6 +217,7 @@ def robot(name, floating, loops, empty, args_rounds):
         "pinocchio.aba": lambda: pin.aba(twin.model, twin.data, q, v, tau),
         "System.motion": lambda: system.motion(0.0, qm, qdm),
         "Data.motion": lambda: data.motion(0.0, qm, qdm),
+        "Data.acceleration (q̈ alone, into data.qdd)": lambda: data.acceleration(0.0, qm, qdm),
         "Engine.motion_copied (Data.motion's one call: single.py)": lambda: engine.motion_copied(0.0, qm, qdm),
         "Engine.motion (two calls: with Baumgarte's shifts, a drifted loop)": lambda: engine.motion(0.0, qm, qdm),
         "Stages.rates (the integrator's stage)": lambda: stages.rates(0.0, y),

@@ -42,7 +42,7 @@ from .projection import Projection
 from .extra_projection import ExtraProjection
 from .rows import Rows, relative_drift
 from .packing import pack, views
-from .single import ACCELERATION, FORCE, RATE, STATE, Single
+from .single import ACCELERATION, FORCE, RATE, STATE, single
 from .threads import THREADS, pool
 
 EMPTY = np.zeros(0)
@@ -51,10 +51,12 @@ CHUNK = 16  # fewest rows a thread takes at a time
 FLOAT = np.dtype(float)
 
 
-def _plain(x):
-    """Whether x is a writeable C-contiguous 1-d float64 array (the type single.motion_into is
-    compiled for: numba would compile it anew for another)."""
-    return type(x) is np.ndarray and x.dtype is FLOAT and x.ndim == 1 and x.strides[0] == 8 and x.flags.writeable
+def _plain(q, qd):
+    """Whether q and q̇ are writeable C-contiguous 1-d float64 arrays (the type single.motion_into
+    is compiled for: numba would compile it anew for another)."""
+    return type(q) is np.ndarray and q.dtype is FLOAT and q.ndim == 1 and q.strides[0] == 8 and q.flags.writeable \
+        and type(qd) is np.ndarray and qd.dtype is FLOAT and qd.ndim == 1 and qd.strides[0] == 8 \
+        and qd.flags.writeable
 
 
 class Template:
@@ -121,7 +123,7 @@ class Engine:
         self.projections = []  # the Projection, once made (``at``'s copies get it on their parameter values)
         self.origin = self  # the Engine whose buffers this one shares (``at``'s copies: the one they were made of)
         self.staged = {}  # the compiled stages (staged.Stages) per integrator form, once made
-        self.single = None  # ``motion_copied``'s compiled call (single.Single), once made
+        self.single = None  # ``motion_into``'s compiled call (single.single), once made
         # φ of the kernel's rows, for the relative drift of a state off the manifold of a model with extra rows
         self.rows = Rows(L, self.packed, int(L.sizes[1])) if self.closes_loops else None
         self.generated_phi = slice(self.outputs - template.phi_outputs, self.outputs)  # φ of the extra rows in gen
@@ -203,19 +205,27 @@ class Engine:
         (single.py): (the Motion, the copies of q and q̇ it was evaluated at). None where q or
         q̇ is not a writeable 1-d float64 array of n contiguous entries (the caller's checks
         then say what it is) or where the kernel declines."""
-        if not (_plain(q) and _plain(qd)):
-            return None
         block = np.empty((4, self.n))
-        with self.lock:
-            if self.single is None:
-                self.single = Single(self)
-            status, residual = self.single(float(t), q, qd, block)
-        if status != kernel.OK:
+        residual = self.motion_into(t, q, qd, block)
+        if residual is None:
             return None
         q, qd = block[STATE], block[RATE]
         if self.mode != kernel.CHECKED:
             residual = functools.partial(self.checked_residual, t, q, qd, EMPTY, drift)
         return Motion.made(block[ACCELERATION], True, self.no_freedom, block[FORCE], residual, "tree (Baraff)"), q, qd
+
+    def motion_into(self, t, q, qd, block):
+        """single.motion_into at (t, q, q̇), its rows (copies of q, q̇; q̈, Qc) into ``block``
+        (4 × n): the kernel's residual where it checks it per call (else 0), or None where q
+        or q̇ is not a writeable 1-d float64 array of n contiguous entries or the kernel
+        declines (``block`` then holds nothing to read)."""
+        if not _plain(q, qd):
+            return None
+        with self.lock:
+            if self.single is None:
+                self.single = single(self)
+            status, residual = self.single(float(t), q, qd, block)
+        return residual if status == kernel.OK else None
 
     def checked_residual(self, t, q, qd, bshift, drift):
         """The kernel's relative residual (kernel.motion, CHECKED) of the motion at (t, q, q̇)."""

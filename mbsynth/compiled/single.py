@@ -4,10 +4,11 @@
 function and flexible parts there (staged.evaluate) and the kernel (kernel.motion_rates,
 through its function pointer, so that this small function compiles once for every model and
 holds no copy of the kernel), and writes q̈ and Qc into the block's other rows. Its arguments
-are arrays and numbers alone: numba checks each array's type on entry in compiled code, but a
-tuple's in Python, a microsecond per call for the bundles of staged.py. ``Single`` holds the
-arrays of one Engine.
+are arrays and numbers alone, the Engine's first: ``single`` binds them (functools.partial,
+no Python frame per call).
 """
+
+import functools
 
 import numpy as np
 from numba import njit, typeof
@@ -20,13 +21,14 @@ from .staged import _kernel_rates, evaluate, evaluation_of, rates_signature
 from .assembly import Work
 
 WORK = fields(Work)
-STATE, RATE, ACCELERATION, FORCE = range(4)  # the rows of ``motion_into``'s block: q, q̇, q̈, Qc
+STATE, RATE, ACCELERATION, FORCE = range(4)  # the rows of ``motion_into``'s block: q, q̇, q̈, Qc (model/data.py
+# reads row 2 as q̈ without importing this module, which would load scipy with numba's function types)
 WRONG_SIZE = -1  # ``motion_into``'s status for a state that is not of n entries
 
 
 @njit(**OPTIONS)
-def motion_into(t, q, qd, block, calls, p, gen, own_meta, own_ints, own_floats, own_index, LI, LF, LX, WI, WF, WX,
-                mode, general):
+def motion_into(calls, p, gen, own_meta, own_ints, own_floats, own_index, LI, LF, LX, WI, WF, WX, mode, general, t,
+                q, qd, block):
     """kernel.motion's (status, residual) at (t, q, q̇) with block's rows ← (q, q̇, q̈, Qc):
     the state copied first and evaluated there (the copy is what a Motion's λ and residual
     are read at), q̈ and Qc written only on OK. calls: the addresses of the generated
@@ -52,18 +54,14 @@ def motion_into(t, q, qd, block, calls, p, gen, own_meta, own_ints, own_floats, 
     return status, residual
 
 
-class Single:
-    """``motion_into``'s arguments for one Engine, but the state and the block (made on
-    the Engine's first ``motion``; its copies make their own: they differ in p)."""
-
-    def __init__(self, engine):
-        evaluation, self.keep = evaluation_of(engine, engine.gen)
-        generated_c, generated_jit, fill_c, fill_jit, p, gen, own_meta, own_ints, own_floats, own_index = evaluation
-        kernel_c, kernel_jit = address(kernel.motion_rates, rates_signature(typeof(engine.general)))
-        calls = np.array([generated_c, generated_jit, fill_c, fill_jit, kernel_c, kernel_jit], dtype=np.int64)
-        self.arguments = (calls, p, gen, own_meta, own_ints, own_floats, own_index, *engine.buffers, engine.mode,
-                          engine.general)
-
-    def __call__(self, t, q, qd, block):
-        """``motion_into`` (the caller holds the Engine's lock)."""
-        return motion_into(t, q, qd, block, *self.arguments)
+def single(engine):
+    """``motion_into`` with one Engine's arguments bound, a callable of (t, q, q̇, block)
+    (the caller holds the Engine's lock); it keeps the code its addresses point into."""
+    evaluation, keep = evaluation_of(engine, engine.gen)
+    generated_c, generated_jit, fill_c, fill_jit, p, gen, own_meta, own_ints, own_floats, own_index = evaluation
+    kernel_c, kernel_jit = address(kernel.motion_rates, rates_signature(typeof(engine.general)))
+    calls = np.array([generated_c, generated_jit, fill_c, fill_jit, kernel_c, kernel_jit], dtype=np.int64)
+    bound = functools.partial(motion_into, calls, p, gen, own_meta, own_ints, own_floats, own_index, *engine.buffers,
+                              engine.mode, engine.general)
+    bound.keep = keep
+    return bound

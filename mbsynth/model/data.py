@@ -117,6 +117,11 @@ class Data:
         self._evaluator = None  # made on first use: a compiled run may never need it
         self._joint_values = None  # joint_values.JointValuesBatch, made on first use
         self._engine = UNSET  # the compiled Engine, made on first use on the compiled path
+        # ``acceleration``'s block, rows as compiled/single.py's motion_into writes them (q, q̇, q̈, Qc: its
+        # constants, not imported here: single.py loads numba's function types, and with them scipy), and
+        # its q̈ row, the array ``acceleration`` returns
+        self._block = np.zeros((4, system.n))
+        self.qdd = self._block[2]
 
     def __repr__(self):
         return f"Data({self.system.name!r}, path={self.path!r})"
@@ -235,6 +240,17 @@ class Data:
             q, qd = self.system._state_copies(q, qd)
             motion = self._solved(t, q, qd, method, baumgarte, drift, (q, qd))
         return motion.with_multipliers(functools.partial(self._lam, t, q, qd))
+
+    def acceleration(self, t, q, qd):
+        """q̈ at (t, q, q̇) alone, ``motion(t, q, qd).qdd`` written into this Data's own array
+        ``qdd`` and returned, as Pinocchio's ``aba`` writes ``data.ddq``: the next call
+        overwrites it. On the compiled path (a state of float arrays) one compiled call that
+        allocates nothing; no λ, residual or uniqueness, and errors as ``motion``'s. Like
+        Pinocchio's Data, a Data serves one thread."""
+        engine = self.engine
+        if engine is None or engine.motion_into(t, q, qd, self._block) is None:
+            self.qdd[:] = self.motion(t, q, qd).qdd
+        return self.qdd
 
     def _lam(self, t, q, qd, motion):
         """λ of ``motion`` at (t, q, q̇): ``Motion.lam``'s source (it holds no Motion: no cycle)."""

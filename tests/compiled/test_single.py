@@ -2,11 +2,15 @@
 (the generated function, then kernel.motion_rates), which the rest of the compiled path
 makes: the same kernel on the same state gives the same q̈ and Qc, bit for bit, and λ."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import mbsynth as mb
 from mbsynth.compiled.single import WRONG_SIZE, motion_into
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _state(model, seed):
@@ -77,3 +81,32 @@ def test_the_motion_keeps_the_state_it_was_asked_at():
     force = arrays.M @ motion.qdd - arrays.Q - arrays.C
     assert np.abs(arrays.A.T @ motion.lam - force).max() <= 1e-12 * np.abs(force).max()
     assert motion.residual <= 1e-13
+
+
+@pytest.mark.parametrize("path", ["compiled", "kkt"])
+def test_acceleration_is_the_motions_qdd_in_the_datas_own_array(path):
+    """Data.acceleration writes motion()'s q̈ (bit for bit) into data.qdd and returns it;
+    the next call overwrites it; a state the one call does not take (a list) and a model
+    closing loops give the motion's q̈ too."""
+    model = mb.from_robot("ur5")
+    data = model.data(path)
+    q, qd = _state(model, 5)
+    expected = data.motion(0.0, q, qd).qdd
+    found = data.acceleration(0.0, q, qd)
+    assert found is data.qdd
+    np.testing.assert_array_equal(found, expected)
+    q2, qd2 = _state(model, 6)
+    data.acceleration(0.0, list(q2), qd2)
+    np.testing.assert_array_equal(found, data.motion(0.0, q2, qd2).qdd)
+    loop = mb.load(ROOT / "models" / "mechanisms" / "bricard.yaml")
+    looped = loop.data(path)
+    q, qd = loop.initial_state()
+    np.testing.assert_array_equal(looped.acceleration(0.0, q, qd), looped.motion(0.0, q, qd).qdd)
+
+
+def test_acceleration_raises_as_motion_does():
+    model = mb.from_robot("ur5")
+    data = model.data("compiled")
+    q, qd = _state(model, 7)
+    with pytest.raises(ValueError, match=f"has {model.n} coordinates"):
+        data.acceleration(0.0, q[:-1].copy(), qd)
