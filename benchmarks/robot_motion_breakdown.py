@@ -30,8 +30,11 @@ Pinocchio's coordinates and mapped to mbsynth's (robots/twin.py), caches warm:
   Its q̈, mapped to Pinocchio's v̇, is compared with ``aba`` on the robot as it is.
 
 The machine is shared by several processes: every figure is the minimum over ROUNDS rounds
-in which all callables of a robot take turns (a round times COUNT calls of each), so load
-hits all of them alike; ratios are to ``aba``'s minimum in the same rounds. Writes
+in which the callables of a robot take turns (a round times a sample of SAMPLE_S of each), so
+load hits all of them alike; ratios are to ``aba``'s minimum in the same rounds. The layers
+from Python take their turns apart from the numba loops (each group with ``aba``): taking
+turns with those loops, whose arrays push theirs out of the caches, the first layer after
+them read up to a third slower than in a loop of its own. Writes
 benchmarks/robot_motion_breakdown_results.md.
 """
 
@@ -59,7 +62,7 @@ from mbsynth.robots.validate import sample_pinocchio_state
 
 HERE = Path(__file__).resolve().parent
 ROBOTS = [("talos", True), ("ur5", False)]
-ROUNDS, SAMPLE_S, REPEAT, BATCH = 300, 1e-3, 20, 1024  # rounds, seconds a sample lasts, stage runs per loop
+ROUNDS, SAMPLE_S, REPEAT, BATCH = 100, 1e-2, 20, 1024  # rounds, seconds a sample lasts, stage runs per loop
 FIXED_ROWS = 6  # a node hung by six rows: welded to its parent
 BATCH_SAMPLE_S = 1e-2  # a batch's sample: one batch, or as many aba calls as last as long
 # stage label → the function kernel.motion's statement calls (the first such statement on the
@@ -154,9 +157,7 @@ def rounds(callables, rounds, seconds):
     as long (each callable's count of calls per sample is set from its first calls), so
     that each has the same chance of a quiet moment of the machine. Each sample follows one
     untimed call: the first calls after the other callables' samples are slower, their
-    arrays and code pushed out of the caches (talos's ``System.motion``, the first Python
-    layer after ``aba`` and the numba loops, read 73 µs without that call, 64 with it, 54
-    in a loop of its own): the turns' cost, not the call's."""
+    arrays and code pushed out of the caches (the turns' cost, not the call's)."""
     counts = {}
     for label, fn in callables.items():
         fn()
@@ -237,10 +238,12 @@ def robot(name, floating, loops, empty, args_rounds):
     kernel_zero = {label: (lambda f=f: f(0, *checked)) for label, f in loops.items() if label != "whole"}
     merged_loops = {label: (lambda f=f: f(REPEAT, *checked_m)) for label, f in loops.items() if label != "whole"}
     merged_zero = {label: (lambda f=f: f(0, *checked_m)) for label, f in loops.items() if label != "whole"}
-    callables = {**layers, **{("K", k): f for k, f in kernel_loops.items()},
+    callables = {"aba": layers["pinocchio.aba"], **{("K", k): f for k, f in kernel_loops.items()},
                  **{("0", k): f for k, f in kernel_zero.items()}, "merged": lambda: loops["whole"](REPEAT, *args_m),
                  **{("Km", k): f for k, f in merged_loops.items()}, **{("0m", k): f for k, f in merged_zero.items()}}
-    best = rounds(callables, args_rounds, SAMPLE_S)
+    # the layers from Python in rounds of their own: the numba loops' arrays, taking turns with them, pushed
+    # theirs out of the caches (talos's System.motion read 73 µs there against 54 in a loop of its own)
+    best = {**rounds(layers, args_rounds, SAMPLE_S), **rounds(callables, args_rounds, SAMPLE_S)}
     whole = best[("K", "whole")] / REPEAT
     stages = {label: max(0.0, (best[("K", label)] - best[("0", label)]) / REPEAT) for label in STAGES}
     merged_stages = {label: max(0.0, (best[("Km", label)] - best[("0m", label)]) / REPEAT) for label in STAGES}
@@ -251,7 +254,8 @@ def robot(name, floating, loops, empty, args_rounds):
                    max(5, args_rounds // 20), BATCH_SAMPLE_S)
     qdd, _ = data.motion_batch(0.0, Q, QD)
     error = float(np.abs(qdd[0] - data.motion(0.0, Q[0], QD[0], method="reference").qdd).max())
-    return dict(label=f"{name}{' (floating)' if floating else ''}", bodies=len(engine.L.node_kind), n=system.n,
+    return dict(label=f"{name}{' (floating)' if floating else ''}", aba_kernel=best["aba"],
+                bodies=len(engine.L.node_kind), n=system.n,
                 welded=int(np.sum(engine.L.node_k == FIXED_ROWS)), joints=twin.model.njoints - 1,
                 nv=twin.model.nv, layers={k: best[k] for k in layers}, whole=whole, stages=stages, per_call=per_call,
                 batch=batch["batch"] / BATCH, batch_aba=batch["aba"], error=error, a=a,
@@ -279,7 +283,8 @@ def table(results, rounds_used):
     for label in results[0]["layers"]:
         row(label, [r["layers"].get(label, np.nan) for r in results], label != "pinocchio.aba")
     lines.append("| **kernel.motion in a numba loop** | " + " | ".join(
-        f"**{r['whole'] * 1e6:.2f}** ({r['whole'] / r['layers']['pinocchio.aba']:.2f}×)" for r in results) + " |")
+        f"**{r['whole'] * 1e6:.2f}** ({r['whole'] / r['aba_kernel']:.2f}× aba {r['aba_kernel'] * 1e6:.2f})"
+        for r in results) + " |")
     for label in STAGES:
         row(f"&nbsp;&nbsp;{label}", [r["stages"][label] for r in results], False)
     row("&nbsp;&nbsp;the rest (views, branches)", [r["whole"] - sum(r["stages"][k] for k in r["per_call"])
@@ -288,7 +293,8 @@ def table(results, rounds_used):
         f"{r['batch'] * 1e6:.2f} ({r['batch'] / r['batch_aba']:.2f}× aba {r['batch_aba'] * 1e6:.2f})"
         for r in results) + " |")
     lines.append("| **kernel.motion in a numba loop, welded links merged (merge_fixed=True)** | " + " | ".join(
-        f"**{r['merged'] * 1e6:.2f}** ({r['merged'] / r['layers']['pinocchio.aba']:.2f}×)" for r in results) + " |")
+        f"**{r['merged'] * 1e6:.2f}** ({r['merged'] / r['aba_kernel']:.2f}× aba {r['aba_kernel'] * 1e6:.2f})"
+        for r in results) + " |")
     lines += ["", "Each stage on the robot as it is and with its welded links merged (the same loops), and what "
               "each welded link adds to it (the difference over the welded links):", "",
               "| stage | " + " | ".join(f"{r['label']}: as it is | merged | per welded link (ns)" for r in results)
