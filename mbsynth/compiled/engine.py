@@ -42,7 +42,7 @@ from .projection import Projection
 from .extra_projection import ExtraProjection
 from .rows import Rows, relative_drift
 from .packing import pack, views
-from .single import ACCELERATION, FORCE, RATE, STATE, single
+from .single import ACCELERATION, FORCE, RATE, STATE, WRONG_SIZE, single
 from .threads import THREADS, pool
 
 EMPTY = np.zeros(0)
@@ -202,30 +202,34 @@ class Engine:
     def motion_copied(self, t, q, qd, drift=False):
         """``motion(t, q, q̇, drift=drift)`` for a model whose kernel needs no drift (no extra
         rows) or a state on the manifold, in one compiled call that copies the state too
-        (single.py): (the Motion, the copies of q and q̇ it was evaluated at). None where q or
-        q̇ is not a writeable 1-d float64 array of n contiguous entries (the caller's checks
-        then say what it is) or where the kernel declines."""
+        (single.py): (the Motion, or None where the kernel declines; the copies of q and q̇).
+        None where q or q̇ is not a writeable 1-d float64 array of n contiguous entries (the
+        caller's checks then say what it is)."""
         block = np.empty((4, self.n))
-        residual = self.motion_into(t, q, qd, block)
-        if residual is None:
+        found = self.motion_into(t, q, qd, block)
+        if found is None:
             return None
         q, qd = block[STATE], block[RATE]
+        ok, residual = found
+        if not ok:
+            return None, q, qd
         if self.mode != kernel.CHECKED:
             residual = functools.partial(self.checked_residual, t, q, qd, EMPTY, drift)
         return Motion.made(block[ACCELERATION], True, self.no_freedom, block[FORCE], residual, "tree (Baraff)"), q, qd
 
     def motion_into(self, t, q, qd, block):
         """single.motion_into at (t, q, q̇), its rows (copies of q, q̇; q̈, Qc) into ``block``
-        (4 × n): the kernel's residual where it checks it per call (else 0), or None where q
-        or q̇ is not a writeable 1-d float64 array of n contiguous entries or the kernel
-        declines (``block`` then holds nothing to read)."""
+        (4 × n): (whether the kernel took the state — else q̈ and Qc are not written —, its
+        residual where it checks it per call, else 0), or None where q or q̇ is not a writeable
+        1-d float64 array of n contiguous entries (nothing written; the caller's checks then say
+        what it is)."""
         if not _plain(q, qd):
             return None
         with self.lock:
             if self.single is None:
                 self.single = single(self)
             status, residual = self.single(float(t), q, qd, block)
-        return residual if status == kernel.OK else None
+        return None if status == WRONG_SIZE else (status == kernel.OK, residual)
 
     def checked_residual(self, t, q, qd, bshift, drift):
         """The kernel's relative residual (kernel.motion, CHECKED) of the motion at (t, q, q̇)."""

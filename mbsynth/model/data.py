@@ -236,6 +236,8 @@ class Data:
         found = None if engine is None or (drift and engine.closes_loops) else engine.motion_copied(t, q, qd, drift)
         if found is not None:  # one compiled call, which copies the state too
             motion, q, qd = found
+            if motion is None:  # the kernel declined: the exact treatment's
+                motion = self._kkt_motion(t, q, qd, method, baumgarte, drift)
         else:  # copies: the state its λ and residual are read at, whatever the caller does to q, q̇
             q, qd = self.system._state_copies(q, qd)
             motion = self._solved(t, q, qd, method, baumgarte, drift, (q, qd))
@@ -248,8 +250,11 @@ class Data:
         allocates nothing; no λ, residual or uniqueness, and errors as ``motion``'s. Like
         Pinocchio's Data, a Data serves one thread."""
         engine = self.engine
-        if engine is None or engine.motion_into(t, q, qd, self._block) is None:
+        found = None if engine is None else engine.motion_into(t, q, qd, self._block)
+        if found is None:  # not a state of float arrays (or no engine): checked and copied
             self.qdd[:] = self.motion(t, q, qd).qdd
+        elif not found[0]:  # the kernel declined: the exact treatment's, at the copies the call made
+            self.qdd[:] = self._kkt_motion(t, self._block[0], self._block[1], "kkt", None, False).qdd
         return self.qdd
 
     def _lam(self, t, q, qd, motion):
