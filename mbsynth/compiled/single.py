@@ -1,4 +1,5 @@
-"""One ``motion()`` from Python in one compiled call (Engine.motion).
+"""One ``motion()`` from Python in one compiled call (Engine.motion_into: Data.motion,
+Data.acceleration).
 
 ``motion_into`` copies the state into the rows of a new block, evaluates the model's generated
 function and flexible parts there (staged.evaluate) and the kernel (kernel.motion_rates,
