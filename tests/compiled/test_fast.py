@@ -37,6 +37,7 @@ from mbsynth.core.kinematics import body_rate_matrix
 
 from mbsynth.analysis.velocity_form import VelocityForm
 from tests.helpers.compare import rel
+from tests.helpers.free_spin import free_spin
 from tests.helpers.rotations import E
 from tests.helpers.literal import literal_2_14
 from tests.helpers.states import random_state
@@ -452,26 +453,9 @@ def test_indeterminate_and_inconsistent_cases_fall_back():
     r = (0, 0, −0.5), has ω × (ω × r); its own spin is free, η = 0 gives it none. The
     errors carry their numbers: z̈ = 1 against the weld's z̈ = 0, rows (1, 0) of b out of
     the range of two equal unit rows by 1/√2; the force 1 on the massless dot."""
-    free = loads("""
-        name: free_spin
-        parts:
-          heavy: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.1, 0.1], frames: {tip: {position: [0, 0, -0.5]}}}
-          ghost: {type: rigid_body, mass: 0.0, inertia: [0, 0, 0]}
-        gravity: [0, 0, -9.81]
-        joints:
-          - {name: hang, type: spherical, parent: world, child: heavy}
-          - {name: tip, type: spherical, parent: heavy.tip, child: ghost}
-        """)
-    omega, tip = np.array([0.3, -0.5, 0.8]), np.array([0.0, 0.0, -0.5])
-    q, qd = free.initial_state()
-    q[7:10] = tip
-    qd[3:7] = np.concatenate([[0.0], omega / 2])  # at u = (1, 0, 0, 0)
-    qd[7:10] = np.cross(omega, tip)
+    free, q, qd, expected = free_spin()
     assert engine_for(free).motion(0.0, q, qd) is None
     motion = free.motion(0.0, q, qd)
-    expected = np.zeros(14)
-    expected[3:7] = -omega @ omega / 4 * q[3:7]
-    expected[7:10] = np.cross(omega, np.cross(omega, tip))
     assert not motion.unique and motion.nullspace.shape == (14, 3)
     assert np.abs(motion.nullspace[:10]).max() < 1e-12  # the ghost's spin alone
     assert rel(motion.qdd, expected) < 1e-10

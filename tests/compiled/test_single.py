@@ -9,6 +9,7 @@ import pytest
 
 import mbsynth as mb
 from mbsynth.compiled.single import WRONG_SIZE, motion_into
+from tests.helpers.free_spin import free_spin
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -113,31 +114,13 @@ def test_acceleration_raises_as_motion_does():
 
 
 def test_a_state_the_kernel_declines_is_the_exact_treatments():
-    """A massless body free to spin on a spherical joint: the motion is not unique, the kernel
-    hands it back, and motion() and acceleration() give the exact treatment's q̈ (η = 0: no
-    spin of the ghost) from the one call's copies of the state."""
-    model = mb.loads("""
-        name: free_spin
-        parts:
-          heavy: {type: rigid_body, mass: 1.0, inertia: [0.1, 0.2, 0.3], frames: {tip: {position: [0, 0, -0.5]}}}
-          ghost: {type: rigid_body, mass: 0.0, inertia: [0, 0, 0]}
-        gravity: [0, 0, -9.81]
-        joints:
-          - {name: hang, type: spherical, parent: world, child: heavy}
-          - {name: tip, type: spherical, parent: heavy.tip, child: ghost}
-        """)
+    """A massless body free to spin (helpers/free_spin.py): the kernel hands the state back,
+    and motion() and acceleration() give the exact treatment's q̈ from the one call's copies
+    of the state — the closed form of a body turning at constant ω, the ghost not spinning."""
+    model, q, qd, expected = free_spin()
     data = model.data("compiled")
-    q, qd = model.initial_state()
-    q[7:10] = (0.0, 0.0, -0.5)
-    qd[4:7] = (0.15, -0.25, 0.4)  # ω/2 at u = (1, 0, 0, 0)
-    qd[7:10] = np.cross([0.3, -0.5, 0.8], [0.0, 0.0, -0.5])
+    assert data.engine.motion_into(0.0, q, qd, np.zeros((4, model.n))) == (False, 0.0)  # declined
     motion = data.motion(0.0, q, qd)
-    assert not motion.unique and engine_declines(data, q, qd)
-    expected = model.data("kkt").motion(0.0, q, qd).qdd
-    np.testing.assert_array_equal(motion.qdd, expected)
-    np.testing.assert_array_equal(data.acceleration(0.0, q, qd), expected)
-
-
-def engine_declines(data, q, qd):
-    """Whether the compiled call hands the state back (the kernel declines it)."""
-    return data.engine.motion_into(0.0, q, qd, np.zeros((4, q.size))) == (False, 0.0)
+    assert not motion.unique
+    assert np.abs(motion.qdd - expected).max() <= 1e-10 * np.abs(expected).max()
+    np.testing.assert_array_equal(data.acceleration(0.0, q, qd), motion.qdd)
