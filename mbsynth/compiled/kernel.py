@@ -250,8 +250,11 @@ def _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y,
     here only with rows certified (certify.py): the drift rule keeps every direction and its
     answer is this plain one, which this solve gives to about ε κ of the Schur matrix; a
     stage whose κ exceeds SCHUR_CONDITION_MAX (a singular position near: κ grows as σ_min⁻²),
-    or with a direction dropped here, is left to the exact treatment (NEAR_SINGULAR). Work:
-    W in vectors[m_x:, :m_x], L⁻¹ F_x over ``forces``, the Schur eigenvalues in values[:m_x]."""
+    or with a direction dropped here, is left to the exact treatment (NEAR_SINGULAR). Where a
+    Cholesky factor of the Schur matrix shows that none of this can happen (``_plain_schur``)
+    λ comes from that factor, with no eigendecomposition. Work: W in vectors[m_x:, :m_x],
+    L⁻¹ F_x over ``forces``, the Schur eigenvalues in values[:m_x] (or the Schur factor in
+    vectors[:m_x, :m_x])."""
     mx, nx = Ax.shape[0], Ax.shape[1]
     Sc, Vc, W = S[:mx, :mx], vectors[:mx, :mx], vectors[mx:mx + nx, :mx]
     for c in range(nx):  # forces ← L⁻¹ F_x, W ← L⁻¹ A_xᵀ (forward substitution)
@@ -279,6 +282,11 @@ def _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y,
             total += W[c, x] * forces[c]
         rhs[x] = total
     values = values[:mx]
+    if _plain_schur(Sc, Vc, values, drift):  # every direction kept: λ by the Cholesky factor in Vc
+        _cholesky_solve(Vc, rhs, lam[nx:nx + mx])
+        _reduced_accelerations(L, W, forces, lam, nx, mx)
+        _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
+        return OK
     symmetric_eigen(Sc, Vc, values)
     if drift >= 0.0 and mx and not values.min() * SCHUR_CONDITION_MAX >= values.max():
         return NEAR_SINGULAR  # its solve's rounding, ε κ, is the exact rule's to avoid
@@ -300,7 +308,16 @@ def _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y,
             dropped += coef * coef
     if math.sqrt(dropped) > KERNEL_CONSISTENCY_RTOL * (math.sqrt(size) + DIVISION_GUARD):
         return INCONSISTENT
-    for c in range(nx):  # q̈_x = L⁻ᵀ (L⁻¹ F_x − W λ) (back substitution)
+    _reduced_accelerations(L, W, forces, lam, nx, mx)
+    _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
+    return OK
+
+
+@njit(**OPTIONS)
+def _reduced_accelerations(L, W, forces, lam, nx, mx):
+    """lam[:nx] ← q̈_x = L⁻ᵀ (L⁻¹ F_x − W λ) (back substitution; ``_close_reduced``'s L, W,
+    forces = L⁻¹ F_x and λ in lam[nx:])."""
+    for c in range(nx):
         total = forces[c]
         for x in range(mx):
             total -= W[c, x] * lam[nx + x]
@@ -310,8 +327,52 @@ def _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y,
         for d in range(c + 1, nx):
             total -= L[d, c] * lam[d]
         lam[c] = total / L[c, c]
-    _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
-    return OK
+
+
+@njit(**OPTIONS)
+def _plain_schur(Sc, Lc, column, drift):
+    """Whether the rows' Schur matrix Sc (symmetric positive semi-definite, m × m) certainly
+    keeps every eigen-direction under ``_close_reduced``'s rules, so that its solve is the
+    plain one: Lc's lower triangle ← the Cholesky factor of Sc (Sc untouched; ``column``: m
+    of work). Its eigenvalues lie in [1/‖L⁻¹‖_F², trace Sc] (‖Sc⁻¹‖₂ = ‖L⁻¹‖₂² ≤ ‖L⁻¹‖_F²),
+    so where 1/‖L⁻¹‖_F² is above SCHUR_ZERO_RTOL · max(trace, 1) no direction is dropped,
+    and off the manifold (drift ≥ 0) where trace · ‖L⁻¹‖_F² ≤ SCHUR_CONDITION_MAX the
+    condition is within bounds. False where either bound fails or a pivot is not positive:
+    the eigendecomposition judges then."""
+    m = Sc.shape[0]
+    column[:] = 0.0  # the pivots' floor (tree.cholesky): positive
+    if not cholesky(Sc, m, column, Lc):
+        return False
+    trace = 0.0
+    for j in range(m):
+        trace += Sc[j, j]
+    inverse = 0.0  # ‖L⁻¹‖_F², a column of L⁻¹ at a time (forward substitution of e_j)
+    for j in range(m):
+        for r in range(j, m):
+            t = 1.0 if r == j else 0.0
+            for c in range(j, r):
+                t -= Lc[r, c] * column[c]
+            column[r] = t / Lc[r, r]
+            inverse += column[r] * column[r]
+    if not inverse * SCHUR_ZERO_RTOL * max(trace, 1.0) < 1.0:
+        return False
+    return drift < 0.0 or trace * inverse <= SCHUR_CONDITION_MAX
+
+
+@njit(**OPTIONS)
+def _cholesky_solve(Lc, rhs, out):
+    """out ← (Lc Lcᵀ)⁻¹ rhs (Lc lower triangular, m × m; rhs[:m])."""
+    m = out.shape[0]
+    for r in range(m):
+        t = rhs[r]
+        for c in range(r):
+            t -= Lc[r, c] * out[c]
+        out[r] = t / Lc[r, r]
+    for r in range(m - 1, -1, -1):
+        t = out[r]
+        for c in range(r + 1, m):
+            t -= Lc[c, r] * out[c]
+        out[r] = t / Lc[r, r]
 
 
 @njit(**OPTIONS)
