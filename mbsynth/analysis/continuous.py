@@ -34,7 +34,7 @@ from .cut import CutIntegration
 from .derivative import Crawl
 from .drift import next_cap
 from .projection import project, relative_drift
-from .singular_watch import SingularWatch, rows_keep_rank
+from .singular_watch import SingularWatch
 from ..compiled.rows import largest
 from ..core.tolerances import MAX_STATE, RELAXED_MAX
 
@@ -77,7 +77,6 @@ class ContinuousIntegration(CutIntegration):
         self.has_rows = len(self.data.system.constraint_names) > 0
         self.watch = None  # the singular positions passed between stages (singular_watch.py), on projected runs
         self.crossing = None  # the step plan near singular positions (crossing.py)
-        self.keeps_rank = rows_keep_rank(self.data.system)  # no singular position to watch for
 
     def advance(self, t_next, q, qd, t_stop):
         try:

@@ -6,8 +6,8 @@ The accelerations (2.14) satisfy the constraints at the acceleration level only,
 and velocities drift off them by the integration error. The stages of a span are only as good
 as that drift (their motion is the drift rule's least-squares one where it explains an
 inconsistency), so a span is kept short enough that the relative drift (projection.py's
-``relative_drift``, or the kernel's) stays below DRIFT_TARGET (an implicit method's: its rtol,
-integration.IMPLICIT_DRIFT).
+``relative_drift``, or the kernel's) stays below DRIFT_TARGET (an implicit method's, or where
+the rows keep their rank: the rtol where larger, integration.drift_target).
 """
 
 import numpy as np

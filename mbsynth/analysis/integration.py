@@ -26,13 +26,26 @@ import logging
 
 from . import stepper
 from .derivative import StateDerivative
+from .singular_watch import rows_keep_rank
 from .velocity_form import VelocityForm
 from ..core.tolerances import DRIFT_TARGET
 
 log = logging.getLogger(__name__)
 
-IMPLICIT_DRIFT = 1.0  # an implicit method's drift target per unit of its rtol: its steps, long where the stiff
-# parts are quasi-static, drift by about their local error; DRIFT_TARGET would cut them to an explicit pair's length
+
+def drift_target(method, rtol, keeps_rank):
+    """The largest relative drift between projections (drift.py) of a run with the OdeSolver
+    class ``method`` at ``rtol``: DRIFT_TARGET, or rtol where larger, for an implicit method
+    or rows that keep their rank (singular_watch.rows_keep_rank). The tight
+    target keeps the stages near the manifold, where the drift rule judges nearly dependent
+    rows by the drift (kernel.py, core/equations.py); rows that keep their rank have none to
+    judge, and an implicit method's long steps, where the stiff parts are quasi-static, drift
+    by about their local error. There a step may drift as far as its error control lets it:
+    DRIFT_TARGET would cut a loose run's steps to a tight one's length (a stiff model's
+    explicit steps included, whose stability then holds them)."""
+    if stepper.implicit(method) or keeps_rank:
+        return max(DRIFT_TARGET, rtol)
+    return DRIFT_TARGET
 
 
 class Integration:
@@ -46,9 +59,8 @@ class Integration:
         self.form = VelocityForm(data.model)  # the integrator's y = (q, v) and (q, q̇)
         self.f = StateDerivative(data, baumgarte if stabilization == "baumgarte" else None, self.form)
         self.steps = 0
-        # the largest relative drift between projections (drift.py)
-        self.drift_target = max(DRIFT_TARGET, IMPLICIT_DRIFT * rtol) if stepper.implicit(method) \
-            else DRIFT_TARGET
+        self.keeps_rank = rows_keep_rank(data.system)  # no singular position to pass (singular_watch.py)
+        self.drift_target = drift_target(method, rtol, self.keeps_rank)
         self.solver = None  # the integrator, kept from interval to interval (``resumed``)
         self.solver_tolerances = None  # its (rtol, atol)
         self.next_step = None  # the step it proposed after its last step not cut short at an interval's end

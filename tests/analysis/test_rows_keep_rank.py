@@ -95,7 +95,12 @@ def test_a_run_that_keeps_rank_ends_where_the_watched_run_ends(monkeypatch):
     monkeypatch.setattr(SingularWatch, "__init__", counted)
     alone = mb.simulate(system, 0.3, rtol=1e-8, atol=1e-8)
     assert not made
-    monkeypatch.setattr(continuous, "rows_keep_rank", lambda system: False)
+    keeping = continuous.ContinuousIntegration.__init__
+
+    def watching(self, *args):  # the watch forced on, the drift target (integration.drift_target) kept
+        keeping(self, *args)
+        self.keeps_rank = False
+    monkeypatch.setattr(continuous.ContinuousIntegration, "__init__", watching)
     watched = mb.simulate(system, 0.3, rtol=1e-8, atol=1e-8)
     assert made
     assert alone.q[-1].tobytes() == watched.q[-1].tobytes() and alone.qd[-1].tobytes() == watched.qd[-1].tobytes()
