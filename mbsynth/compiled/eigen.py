@@ -17,11 +17,14 @@ SWEEPS = 60
 
 @njit(**OPTIONS)
 def symmetric_eigen(S, V, values):
-    """S = V diag(values) Vᵀ for a symmetric S (overwritten; p × p)."""
+    """S = V diag(values) Vᵀ for a symmetric S (overwritten; p × p). Returns the sweeps
+    of rotations taken: they stop once the off-diagonal is at rounding (JACOBI_OFF_RTOL), at
+    most SWEEPS."""
     p = S.shape[0]
     for i in range(p):
         for j in range(p):
             V[i, j] = 1.0 if i == j else 0.0
+    sweeps = 0
     for _ in range(SWEEPS):
         off = total = 0.0
         for i in range(p):
@@ -30,6 +33,7 @@ def symmetric_eigen(S, V, values):
                 off += S[i, j] ** 2
         if off <= JACOBI_OFF_RTOL * (total + 2 * off) or off == 0.0:
             break
+        sweeps += 1
         for i in range(p - 1):
             for j in range(i + 1, p):
                 if S[i, j] == 0.0:
@@ -50,3 +54,4 @@ def symmetric_eigen(S, V, values):
                     V[k, i], V[k, j] = c * a - s * b, s * a + c * b
     for i in range(p):
         values[i] = S[i, i]
+    return sweeps

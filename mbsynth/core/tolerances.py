@@ -56,8 +56,8 @@ MASS_PROJECTION_REUSE = 1e-8  # compiled/projection.py: the largest position ste
 MASS_PROJECTION_SHRINK = 1e-3  # compiled/projection.py, extra_projection.py: a velocity step must cut φ̇ by this
 # much at least (or leave it below MASS_PROJECTION_RATE_RTOL of its terms)
 KERNEL_RESIDUAL_MAX = 1e-9  # kernel.py: a solution whose relative residual exceeds this goes to the exact path
-JACOBI_OFF_RTOL = 1e-36  # eigen.py: Jacobi sweeps stop when the off-diagonal's squared norm is below this share of
-# the whole (off-diagonal entries ~1e-18 of the matrix: below rounding)
+JACOBI_OFF_RTOL = EPS ** 2  # eigen.py: Jacobi sweeps stop when the off-diagonal's squared norm is below this share
+# of the whole (its entries at rounding, ε of the matrix: where eigenvalues repeat, sweeps cannot push them lower)
 STACKED_CHECK_RTOL = 1e-12  # grouped.py: a stacked call must agree with the single calls to this,
 # relative to the group's largest value (checked once, at the first state)
 
