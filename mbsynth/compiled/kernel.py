@@ -48,7 +48,7 @@ from .eigen import symmetric_eigen
 from .joints import RIGID
 from .layout import Layout
 from .packing import borrowed, fields, view1, view2, view3, view4
-from .tree import cholesky, factor, solve
+from .tree import cholesky, cholesky_solve, factor, solve
 from ..core.tolerances import (DIVISION_GUARD, DRIFT_MASS_SPREAD, DRIFT_RANK, KERNEL_CONSISTENCY_RTOL,
                                KERNEL_NULL_RTOL, KERNEL_RESIDUAL_MAX, NEAR_SINGULAR as NEAR_SINGULAR_RTOL,
                                SCHUR_CONDITION_MAX, SCHUR_DEPENDENT_RTOL, SCHUR_ZERO_RTOL, SPLIT_MOVES)
@@ -283,7 +283,7 @@ def _close_reduced(topology, segs, seg6, factored, L, Ax, xb, forces, ry, z0, y,
         rhs[x] = total
     values = values[:mx]
     if _plain_schur(Sc, Vc, values, drift):  # every direction kept: λ by the Cholesky factor in Vc
-        _cholesky_solve(Vc, rhs, lam[nx:nx + mx])
+        cholesky_solve(Vc, rhs, lam[nx:nx + mx])
         _reduced_accelerations(L, W, forces, lam, nx, mx)
         _tree_solve(topology, segs, seg6, factored, ry, y, z, lam, nx, mx, multipliers)
         return OK
@@ -357,22 +357,6 @@ def _plain_schur(Sc, Lc, column, drift):
     if not inverse * SCHUR_ZERO_RTOL * max(trace, 1.0) < 1.0:
         return False
     return drift < 0.0 or trace * inverse <= SCHUR_CONDITION_MAX
-
-
-@njit(**OPTIONS)
-def _cholesky_solve(Lc, rhs, out):
-    """out ← (Lc Lcᵀ)⁻¹ rhs (Lc lower triangular, m × m; rhs[:m])."""
-    m = out.shape[0]
-    for r in range(m):
-        t = rhs[r]
-        for c in range(r):
-            t -= Lc[r, c] * out[c]
-        out[r] = t / Lc[r, r]
-    for r in range(m - 1, -1, -1):
-        t = out[r]
-        for c in range(r + 1, m):
-            t -= Lc[c, r] * out[c]
-        out[r] = t / Lc[r, r]
 
 
 @njit(**OPTIONS)

@@ -242,6 +242,22 @@ def cholesky(A, m, scale, L):
 
 
 @njit(**OPTIONS)
+def cholesky_solve(L, rhs, out):
+    """out ← (L Lᵀ)⁻¹ rhs for ``cholesky``'s factor L (m × m, m = out's size; rhs[:m])."""
+    m = out.shape[0]
+    for r in range(m):
+        t = rhs[r]
+        for c in range(r):
+            t -= L[r, c] * out[c]
+        out[r] = t / L[r, r]
+    for r in range(m - 1, -1, -1):
+        t = out[r]
+        for c in range(r + 1, m):
+            t -= L[c, r] * out[c]
+        out[r] = t / L[r, r]
+
+
+@njit(**OPTIONS)
 def spd_inverse(A, m, scale, L):
     """A[:m, :m] ← its inverse by Cholesky (L: work). False when a pivot is not above
     PIVOT_RTOL · scale[j] (scale: per column)."""

@@ -1,4 +1,4 @@
-"""kernel._plain_schur and _cholesky_solve: the rows' Schur matrix solved by its Cholesky
+"""kernel._plain_schur and tree.cholesky_solve: the rows' Schur matrix solved by its Cholesky
 factor only where the factor proves that the eigendecomposition would keep every direction.
 Checked against numpy's eigenvalues and solve: the bound 1/‖L⁻¹‖_F² ≤ λ_min, the solution,
 and a refusal wherever an eigenvalue lies below SCHUR_ZERO_RTOL · max(λ_max, 1), or off the
@@ -7,7 +7,8 @@ manifold the condition exceeds SCHUR_CONDITION_MAX."""
 import numpy as np
 import pytest
 
-from mbsynth.compiled.kernel import _cholesky_solve, _plain_schur
+from mbsynth.compiled.kernel import _plain_schur
+from mbsynth.compiled.tree import cholesky_solve
 from mbsynth.core.tolerances import SCHUR_CONDITION_MAX, SCHUR_ZERO_RTOL
 
 ROWS = 6
@@ -38,7 +39,7 @@ def test_a_well_conditioned_schur_matrix_is_solved_by_its_factor(seed):
     assert 1.0 / np.sum(np.linalg.inv(L) ** 2) <= np.linalg.eigvalsh(S).min() * (1 + 1e-12)
     rhs = np.random.default_rng(seed).standard_normal(ROWS)
     out = np.zeros(ROWS)
-    _cholesky_solve(factor, rhs, out)
+    cholesky_solve(factor, rhs, out)
     np.testing.assert_allclose(out, np.linalg.solve(S, rhs), rtol=1e-12)
 
 
