@@ -41,7 +41,14 @@ MODEL = ROOT / "models" / "flexible" / "cantilever.yaml"
 CLI = ["simulate", str(MODEL), "--t-end", "1"]  # the bundled 4-mode strip, 1 s, as a user types it
 RIGID = ROOT / "models" / "rigid" / "solid_pendulum.yaml"  # the floor: a rigid pendulum's whole process
 CHILD = """\
-import sys, time
+import gc, sys, time
+collecting = [0.0, 0.0]  # the start of the collection under way, the time in collections so far
+def timed(phase, info):
+    if phase == "start":
+        collecting[0] = time.perf_counter()
+    else:
+        collecting[1] += time.perf_counter() - collecting[0]
+gc.callbacks.append(timed)
 started = time.perf_counter()
 import mbsynth as mb
 model = mb.load(sys.argv[1])
@@ -49,7 +56,7 @@ loaded = time.perf_counter()
 run = mb.simulate(model, 0.1)
 done = time.perf_counter()
 assert run.status == "completed", run.status
-print(f"{loaded - started:.3f} {done - loaded:.3f} {len(run.t)}")
+print(f"{loaded - started:.3f} {done - loaded:.3f} {collecting[1]:.3f} {len(run.t)}")
 """
 
 # µs per call on benchmarks/flexible.py's pinned pendulum (8 modes), best of 7 rounds, warm caches
@@ -127,8 +134,8 @@ def command(arguments, cache, numba):
 
 
 def timed(path, cache, numba):
-    """(process wall, its CPU time (user + system, its helpers included), load, simulate [s],
-    output rows) of one new process."""
+    """(process wall, its CPU time (user + system, its helpers included), load, simulate, the
+    cycle collector's share of load and simulate [s], output rows) of one new process."""
     env = child_environment(MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
@@ -137,8 +144,8 @@ def timed(path, cache, numba):
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
-    load, simulate, rows = out.stdout.split()
-    return wall, cpu, float(load), float(simulate), int(rows)
+    load, simulate, collections, rows = out.stdout.split()
+    return wall, cpu, float(load), float(simulate), float(collections), int(rows)
 
 
 def main():
@@ -174,13 +181,18 @@ def main():
              f"Python {platform.python_version()}. Median of {args.runs} runs; the model is "
              "models/flexible/cantilever.yaml with its modes raised (40 elements, clamped at node 0, four node frames, "
              "an output at the tip); `mb.load` then `mb.simulate(model, 0.1)` on the default path. Load and simulate: "
-             "wall time inside the process (interpreter start and imports of mbsynth's floors included in load).",
+             "wall time inside the process (interpreter start and imports of mbsynth's floors included in load); "
+             "of which in the cycle collector's collections (gc.callbacks; core/collection.py freezes the model "
+             "layer's objects after its import).",
              "",
-             "| caches | process wall [s] | process CPU [s] | load [s] | simulate 0.1 s [s] | output rows |",
-             "|---|---|---|---|---|---|"]
+             "| caches | process wall [s] | process CPU [s] | load [s] | simulate 0.1 s [s] | of which collections [s] "
+             "| output rows |",
+             "|---|---|---|---|---|---|---|"]
     for name, found in rows:
         medians = [statistics.median(x[i] for x in found) for i in range(4)]
-        lines.append(f"| {name} | " + " | ".join(f"{m:.2f}" for m in medians) + f" | {found[0][4]} |")
+        collections = statistics.median(x[4] for x in found)
+        lines.append(f"| {name} | " + " | ".join(f"{m:.2f}" for m in medians) + f" | {collections:.3f} | "
+                     f"{found[0][5]} |")
     lines += ["", f"`mbsynth simulate models/flexible/cantilever.yaml --t-end 1` (4 modes), a new process with warm "
               f"caches, median of {args.runs}: {statistics.median(x[0] for x in cli):.2f} s wall, "
               f"{statistics.median(x[1] for x in cli):.2f} s CPU."]

@@ -10,11 +10,9 @@ imported on first use (PEP 562), so sympy, scipy, pandas, dask, matplotlib, mesh
 pinocchio and numba load when their feature is used.
 """
 
-import importlib
-
 from .core.equations import Motion, RankReport, constrained_acceleration, rank_report, udwadia_kalaba
 from .core.errors import ControlError, ModelError, NoEquilibrium, SimulationError, SolveError
-from .core import leaving as _leaving
+from .core import collection as _collection, leaving as _leaving
 
 _leaving.skip_final_collections()
 
@@ -41,9 +39,9 @@ __all__ = [
 
 def __getattr__(name):
     if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+        value = getattr(_collection.imported(f"{__name__}.{_LAZY[name]}"), name)
     elif name in _SUBMODULES:
-        value = importlib.import_module(f"{__name__}.{_SUBMODULES[name]}")
+        value = _collection.imported(f"{__name__}.{_SUBMODULES[name]}")
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value  # later look-ups do not come back here

@@ -5,6 +5,12 @@ import ...``: pyproject's ``pythonpath`` puts the repository root on the path)."
 
 import pytest
 
+from mbsynth.core import collection
+
+# the model layer imported first, as ``mb.load`` imports it (its objects frozen: core/collection.py), before any
+# test makes objects of its own: those are then collected as in a user's process
+collection.imported("mbsynth.io")
+
 
 @pytest.fixture(scope="module")
 def scheduler():

@@ -25,12 +25,12 @@ pandas, dask, matplotlib, meshcat or pinocchio.
 """
 
 import argparse
-import importlib
 import json
 import os
 import select
 import sys
 
+from ..core import collection
 from ..core.errors import ModelError, NoEquilibrium, SolveError
 from .outputs import Outputs
 from .parsers import BAD_INPUT, BUG, CLOSED_OUTPUT, INTERRUPTED, VERDICT, UsageError, parser
@@ -50,7 +50,7 @@ def main(argv=None):
         return BAD_INPUT
     outputs = None
     try:
-        command = importlib.import_module(f"{__name__}.{args.command}")
+        command = collection.imported(f"{__name__}.{args.command}")
         outputs = Outputs(args, getattr(command, "OUTPUTS", ()))
         outputs.check()
         code = command.run(args)

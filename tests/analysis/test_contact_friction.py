@@ -92,7 +92,9 @@ def test_contacts_that_switch_between_stick_and_slip_without_end_stop_the_run_na
     rows do not determine (their split chosen in their cones, cones.py); where they break
     away, their slide (its acceleration zero at the onset) turns back within the first step
     and their cones hold again, over and over at that instant: the run stops naming them
-    (no hang)."""
+    (no hang). Which of the two stops comes first — the cap on events at one instant, or the
+    integrator's step collapsing in the modes of the last switch — rests on the last bits of
+    the slide's onset, which differ between BLAS builds (OPENBLAS_CORETYPE)."""
     system = mb.loads("""name: tipping_box
 parameters: {m: 1.0, a: 0.1, g: 9.81, mu: 0.5, w: 3.0}
 gravity: [0, 0, -g]
@@ -114,7 +116,11 @@ contacts:
 """)
     with pytest.raises(mb.SimulationError) as err:
         mb.simulate(system, 1.0, rtol=1e-10, atol=1e-10)
-    assert "k2, k3: 100 events at this instant: held contacts switch between stick and slip without end" in \
-        str(err.value)
-    assert [(ev.name, ev.kind) for ev in err.value.trajectory.events[:4]] == \
+    message, events = str(err.value), err.value.trajectory.events
+    assert "k2, k3: 100 events at this instant: held contacts switch between stick and slip without end" in message \
+        or "k2, k3: the run cannot go on with these contacts held in their friction modes" in message
+    assert [(ev.name, ev.kind) for ev in events[:4]] == \
         [("k2", "contact"), ("k3", "contact"), ("k2", "stick"), ("k3", "stick")]
+    last = [ev for ev in events if ev.t == events[-1].t]
+    assert events[-1].t > 0 and len(last) >= 90  # switching without end at one instant
+    assert {ev.name for ev in last} == {"k2", "k3"} and {ev.kind for ev in last} == {"stick", "slip"}
