@@ -22,7 +22,8 @@ event found by root finding on it.
 
 The forces reported where they are not determined: the minimum-norm λ₀ where it lies in
 the cones (then nothing changes where it already did), otherwise the program's force at
-s* (deterministic: HiGHS's simplex on the same data gives the same vertex).
+s* (deterministic: HiGHS's simplex on the same data gives the same vertex; where it gives
+none, its interior point method's crossover: ``program``).
 """
 
 from typing import NamedTuple
@@ -30,10 +31,12 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import linprog
 
+from ..core.errors import SolveError
 from ..core.tolerances import CONE_DEPTH, CONE_TOL, DEPENDENT_RTOL, LP_FEASIBILITY_TOL
 
 CONE_CUTS = 8  # the first polygon circumscribing each friction cone has this many sides
 CONE_ROUNDS = 100  # cutting-plane programs at most (each halves the angle of the polygon's worst corner)
+LP_METHODS = ("highs-ds", "highs-ipm")  # ``program``: HiGHS's dual simplex, its interior point where it fails
 
 
 class Cone(NamedTuple):
@@ -89,10 +92,7 @@ class Shared:
                 for u in cuts[i]:
                     rows.append(np.append(u @ W[t] - c.mu * W[c.normal], -1.0))
                     rhs.append(-(u @ lam0[t] - c.mu * lam0[c.normal]))
-            found = linprog(np.append(np.zeros(k), 1.0), A_ub=np.array(rows), b_ub=np.array(rhs),
-                            bounds=[(None, None)] * k + [(-1.0, None)], method="highs-ds",
-                            options={"primal_feasibility_tolerance": LP_FEASIBILITY_TOL,
-                                     "dual_feasibility_tolerance": LP_FEASIBILITY_TOL})
+            found = program(np.array(rows), np.array(rhs))
             lam = lam0 + W @ found.x[:k]
             true = self.violation(lam * self.scale, with_cones) / self.scale
             if true < best[0]:
@@ -105,6 +105,23 @@ class Shared:
                 if size - c.mu * lam[c.normal] > found.fun + CONE_TOL and size > 0:
                     cuts[i].append(tangential / size)
         return best[0] * self.scale, best[1]
+
+
+def program(rows, rhs):
+    """linprog's result for min s over (z, s) subject to rows · (z, s) ≤ rhs, s ≥ −1: by
+    HiGHS's dual simplex, or where it ends without a solution (it may stop "Not Set" on a
+    program it solves at other tolerances), by HiGHS's interior point method (its crossover
+    ends at a vertex too). SolveError where neither gives one: the program always has one
+    (s large enough is feasible, s ≥ −1 bounds it)."""
+    k = rows.shape[1] - 1
+    for method in LP_METHODS:
+        found = linprog(np.append(np.zeros(k), 1.0), A_ub=rows, b_ub=rhs, bounds=[(None, None)] * k + [(-1.0, None)],
+                        method=method, options={"primal_feasibility_tolerance": LP_FEASIBILITY_TOL,
+                                                "dual_feasibility_tolerance": LP_FEASIBILITY_TOL})
+        if found.x is not None:
+            return found
+    raise SolveError(f"the friction cones' linear program ({rows.shape[0]} rows over {k} free forces) got no "
+                     f"solution from HiGHS: {found.message}")
 
 
 def shared_rows(W, rows):

@@ -6,9 +6,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import OptimizeResult, linprog
 
 import mbsynth as mb
-from mbsynth.analysis.cones import Cone, Shared
+from mbsynth.analysis import cones
+from mbsynth.analysis.cones import Cone, Shared, program
 from mbsynth.model.reactions import indeterminate, multipliers
 
 MODEL = Path(__file__).resolve().parents[2] / "models" / "contact" / "box_on_four_corners.yaml"
@@ -110,3 +112,66 @@ def test_a_pushed_table_sticks_up_to_mu_m_g_and_its_friction_equals_the_push():
     assert _table(1.01 * mu * m * G, mu)[0].margin()[0] > 0
     assert abs(_table(mu * m * G, mu)[0].margin()[0]) < 1e-8 * m * G
 
+
+# A program of the pushed box's cutting planes (test below) on which HiGHS's dual simplex at
+# LP_FEASIBILITY_TOL ended "Not Set" without a solution (scipy 1.17.1): rows (z; the last column, s's, is −1)
+NOT_SET_ROWS = np.array([
+    [0.25678122268373216, 0.08366977695356423, 0.6668656768869002],
+    [-0.2219640731642863, -0.04201039846913657, 0.7643698019656956],
+    [-0.5706858251893873, -0.14308145219681873, 0.4141164637072444],
+    [-0.5851075605497739, -0.16033733171914574, -0.17872068260310384],
+    [-0.2567812222642873, -0.08366977684261466, -0.6668656769353102],
+    [0.2219640735837312, 0.04201039858008616, -0.7643698020141056],
+    [0.5706858256088322, 0.14308145230776828, -0.41411646375565453],
+    [0.5851075609692188, 0.16033733183009535, 0.17872068255469373],
+    [0.02421155362378954, -0.011201587247559978, -0.7815054774175373],
+    [0.05879187017469085, -0.6968422874666679, -0.35861037553827324],
+    [0.535893818933444, -0.36198630846997143, -0.3106277669189341],
+    [0.6990764364352108, 0.18491634054133707, -0.08068362530548333],
+    [0.45274955849099713, 0.6234975050742056, 0.19652388973315926],
+    [-0.05879187057649848, 0.6968422871466659, 0.3586103754791006],
+    [-0.5358938193352517, 0.36198630814996957, 0.31062776685976146],
+    [-0.6990764368370185, -0.18491634086133896, 0.08068362524631068],
+    [-0.4527495588928049, -0.6234975053942077, -0.19652388979233193],
+    [-0.31557309285842305, 0.6131725105131035, -0.3082553013486267],
+    [-0.3139297457691579, 0.40399670693910783, -0.4537420350467615],
+    [-0.12839061124582368, -0.041834888344518546, -0.33343283840176136],
+    [0.13235800205877665, -0.46316017335506005, -0.017803207130055756],
+    [0.31557309284078583, -0.6131725103040512, 0.3082553014562094],
+    [0.3139297457515207, -0.40399670673005555, 0.45374203515434425],
+    [0.12839061122818643, 0.0418348885535708, 0.33343283850934413],
+    [-0.13235800207641385, 0.4631601735641123, 0.01780320723763854],
+    [-0.3396177858165004, 0.5290568408483023, -0.42517193138248816],
+])
+NOT_SET_RHS = np.array([
+    0.14465944725149016, 0.1420202438803712, 0.1440554733762609,
+    0.1495729259030088, 0.1553405526001957, 0.15797975597131464,
+    0.15594452647542495, 0.15042707394867705, 0.15742894010605218,
+    -0.005359426451988523, -0.001724779279995616, 0.0029533889975852257,
+    0.005934670850810728, 0.0054726718033181855, 0.0018380246313252793,
+    -0.0028401436462555632, -0.005821425499481065, 0.16220991476355776,
+    0.16077222107559658, 0.1529911376263495, 0.1434247175704286,
+    0.1376768400332344, 0.1391145337211956, 0.14689561717044267,
+    0.15646203722636357, 0.162271931307723,
+])
+
+
+def test_a_program_the_dual_simplex_leaves_without_a_solution_gets_the_one_other_solvers_agree_on():
+    """cones.program on NOT_SET_ROWS: the value HiGHS's dual simplex gives at its default
+    tolerances (1e-7, not LP_FEASIBILITY_TOL), every row met, s above its bound."""
+    rows = np.hstack([NOT_SET_ROWS, -np.ones((len(NOT_SET_ROWS), 1))])
+    found = program(rows, NOT_SET_RHS)
+    k = NOT_SET_ROWS.shape[1]
+    reference = linprog(np.append(np.zeros(k), 1.0), A_ub=rows, b_ub=NOT_SET_RHS,
+                        bounds=[(None, None)] * k + [(-1.0, None)], method="highs-ds")
+    assert reference.status == 0 and found.status == 0
+    assert abs(found.fun - reference.fun) < 1e-12 * abs(reference.fun) + 1e-15
+    assert (rows @ found.x - NOT_SET_RHS).max() < 1e-12 and found.x[-1] >= -1.0
+
+
+def test_a_program_no_method_solves_is_a_solve_error_naming_it(monkeypatch):
+    monkeypatch.setattr(cones, "linprog", lambda *args, **kwargs: OptimizeResult(x=None, message="(Not Set)"))
+    rows = np.hstack([NOT_SET_ROWS, -np.ones((len(NOT_SET_ROWS), 1))])
+    with pytest.raises(mb.SolveError, match=r"friction cones' linear program \(26 rows over 3 free forces\) got no "
+                                            r"solution from HiGHS: \(Not Set\)"):
+        program(rows, NOT_SET_RHS)

@@ -161,9 +161,12 @@ def test_the_one_cache_can_be_emptied_without_changing_an_answer():
 
 
 # Module-level state outside MEMO that the package keeps on purpose: the thread pools and
-# helper processes (compiled/threads.py, worker.py, ahead.py) and the locks that guard them.
+# helper processes (compiled/threads.py, worker.py, ahead.py) and the locks that guard them;
+# whether the process froze the model layer's objects (core/collection.py: a fact of the process,
+# which MEMO.clear() must not undo).
 POOLS = {("compiled/threads.py", "_threads"), ("compiled/threads.py", "_owner"),
-         ("compiled/worker.py", "_workers"), ("compiled/ahead.py", "_started"), ("compiled/ahead.py", "_running")}
+         ("compiled/worker.py", "_workers"), ("compiled/ahead.py", "_started"), ("compiled/ahead.py", "_running"),
+         ("core/collection.py", "_done")}
 MUTATORS = {"append", "extend", "update", "setdefault", "pop", "popitem", "clear", "add", "insert", "remove",
             "discard", "__setitem__"}
 
