@@ -86,7 +86,7 @@ def test_a_loose_explicit_run_of_the_flexible_pendulum_is_held_by_its_stability_
     """The pendulum's rows keep their rank, so its steps may drift by the rtol between
     projections (integration.drift_target): at rtol 1e-3 DOP853 takes fewer than three times
     the steps its stability needs on the 866 rad/s mode (ω t / DOP853_REACH; held to a drift
-    of 1e-9 it took five), its tip within 1e-7 m of the converged answer, every output row on
+    of 1e-9 it would take about five), its tip within 1e-7 m of the converged answer, every output row on
     the constraints."""
     system = mb.loads(pendulum_yaml(8), name="flexible_pendulum")
     t_end = 0.2

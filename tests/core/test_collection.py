@@ -1,6 +1,6 @@
 """The model layer's import (core/collection.py): the first public name imported on use
-pauses the cycle collector and freezes what the import made; the collector then runs as
-before, and what is made later is collected as before."""
+pauses the cycle collector and freezes what the import made; the collector then runs again,
+and what is made later is collected as usual."""
 
 import os
 import subprocess
