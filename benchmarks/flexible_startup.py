@@ -1,6 +1,6 @@
 """Load plus the first 0.1 s of a 20-mode Craig–Bampton beam, each in a new process (issue 62).
 
-    .venv/bin/python benchmarks/flexible_startup.py [--runs 3] [--modes 20] [--out FILE]
+    .venv/bin/python benchmarks/flexible_startup.py [--runs 3] [--modes 20] [--baseline REV] [--out FILE]
 
 The model: models/flexible/cantilever.yaml (a steel strip of 40 beam elements clamped at
 node 0, four node frames, an output at the tip) with MODES fixed-interface modes instead of
@@ -16,6 +16,13 @@ outside (the whole process, interpreter start included).
 - beside them, models/rigid/solid_pendulum.yaml the same way with warm caches: the floor of
   any run (interpreter, imports, the kernels' loading); and ``mbsynth simulate
   models/flexible/cantilever.yaml --t-end 1`` with warm caches.
+
+--baseline REV (a commit of this repository or a checkout's folder) adds, in every run beside
+the warm beam, models/mechanisms/simple_pendulum.yaml (a rigid pendulum both codes have) the
+same way with warm caches on that code and on this one: a reference measured in the same
+run, so that a figure stated against another code's process (issue 62 states its 1.5 s beside
+a rigid pendulum's 1.7 s of its day) is read as a ratio rather than across machines. The
+baseline's kernels and its model's caches are built first, in folders of their own.
 
 Figures are medians of --runs (each cold run on new folders); on a shared machine the CPU time
 (user + system) is the steadier figure. Writes
@@ -40,6 +47,7 @@ ROOT = HERE.parent
 MODEL = ROOT / "models" / "flexible" / "cantilever.yaml"
 CLI = ["simulate", str(MODEL), "--t-end", "1"]  # the bundled 4-mode strip, 1 s, as a user types it
 RIGID = ROOT / "models" / "rigid" / "solid_pendulum.yaml"  # the floor: a rigid pendulum's whole process
+SHARED = Path("models") / "mechanisms" / "simple_pendulum.yaml"  # a rigid pendulum every baseline has
 CHILD = """\
 import gc, sys, time
 collecting = [0.0, 0.0]  # the start of the collection under way, the time in collections so far
@@ -100,12 +108,12 @@ def model_text(modes):
     return text.replace("amplitude_rates: [0.05, 0, 0, 0]", f"amplitude_rates: [{rates}]")
 
 
-def child_environment(**variables):
-    """The environment of a timed process: this one's with ``variables``, without
-    PYTHONDONTWRITEBYTECODE (set in some sandboxes: every process would compile the sources
-    whose bytecode is stale, where a user's installation keeps it)."""
+def child_environment(root=ROOT, **variables):
+    """The environment of a timed process of the code in ``root``: this one's with
+    ``variables``, without PYTHONDONTWRITEBYTECODE (set in some sandboxes: every process would
+    compile the sources whose bytecode is stale, where a user's installation keeps it)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    return dict(env, PYTHONPATH=str(ROOT), **variables)
+    return dict(env, PYTHONPATH=str(root), **variables)
 
 
 def installed_kernels():
@@ -121,6 +129,17 @@ def installed_kernels():
     return Path(found.stdout.strip())
 
 
+def compile_ahead(root, cache, numba):
+    """Compile the kernels of the code in ``root`` into these folders, as its ``make install``
+    does (its compile-ahead command: ``mbsynth.cli.compile_ahead``, or ``mbsynth.compiled``
+    in older code)."""
+    module = "mbsynth.cli.compile_ahead" if (root / "mbsynth" / "cli" / "compile_ahead.py").exists() else \
+        "mbsynth.compiled"
+    env = child_environment(root, MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
+    subprocess.run([sys.executable, "-m", module], env=env, cwd=root, check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+
+
 def command(arguments, cache, numba):
     """(process wall, its CPU time [s]) of ``python -m mbsynth <arguments>`` in a new process."""
     env = child_environment(MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
@@ -133,13 +152,14 @@ def command(arguments, cache, numba):
     return wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
 
 
-def timed(path, cache, numba):
+def timed(path, cache, numba, root=ROOT, **variables):
     """(process wall, its CPU time (user + system, its helpers included), load, simulate, the
-    cycle collector's share of load and simulate [s], output rows) of one new process."""
-    env = child_environment(MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba))
+    cycle collector's share of load and simulate [s], output rows) of one new process of the
+    code in ``root`` (``variables`` added to its environment)."""
+    env = child_environment(root, MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba), **variables)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", CHILD, str(path)], env=env, cwd=ROOT, check=True,
+    out = subprocess.run([sys.executable, "-c", CHILD, str(path)], env=env, cwd=root, check=True,
                          capture_output=True, text=True)
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -153,29 +173,49 @@ def main():
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--modes", type=int, default=20)
     parser.add_argument("--out", default=str(HERE / "flexible_startup_results.md"))
+    parser.add_argument("--baseline", help="a commit or a checkout's folder: its rigid pendulum in the same runs")
     args = parser.parse_args()
     kernels = installed_kernels()
-    cold, warm = [], []
+    cold, warm, shared, base = [], [], [], []
     with tempfile.TemporaryDirectory() as scratch:
-        path = Path(scratch) / f"beam_{args.modes}_modes.yaml"
+        scratch = Path(scratch)
+        path = scratch / f"beam_{args.modes}_modes.yaml"
         path.write_text(model_text(args.modes))
+        if args.baseline:
+            sys.path.insert(0, str(HERE))
+            from startup import baseline_folder
+
+            base_root = baseline_folder(args.baseline, scratch / "baseline")
+            base_caches = scratch / "baseline_cache", scratch / "baseline_numba"
+            compile_ahead(base_root, *base_caches)
+            for variables in ({"MBSYNTH_FAST": "wait"}, {}, {}):  # its model's kernels, then its default path's
+                timed(base_root / SHARED, *base_caches, base_root, **variables)
         for k in range(args.runs):
-            cache, numba = Path(scratch) / f"cache{k}", Path(scratch) / f"numba{k}"
+            cache, numba = scratch / f"cache{k}", scratch / f"numba{k}"
             cache.mkdir()
             shutil.copytree(kernels, numba)
             cold.append(timed(path, cache, numba))
             warm.append(timed(path, cache, numba))
             print(f"run {k + 1}: cold {cold[-1][0]:.2f} s ({cold[-1][1]:.2f} s CPU), warm {warm[-1][0]:.2f} s "
                   f"({warm[-1][1]:.2f} s CPU)", flush=True)
+            if args.baseline:
+                timed(ROOT / SHARED, cache, numba)  # its model's caches filled
+                shared.append(timed(ROOT / SHARED, cache, numba))
+                base.append(timed(base_root / SHARED, *base_caches, base_root))
+                print(f"  {SHARED}: {shared[-1][0]:.2f} s here, {base[-1][0]:.2f} s on {args.baseline}", flush=True)
         timed(RIGID, cache, numba)  # its model's caches filled
         rigid = [timed(RIGID, cache, numba) for _ in range(args.runs)]
         command(CLI, cache, numba)
         cli = [command(CLI, cache, numba) for _ in range(args.runs)]
     rows = [("cold (model caches empty, kernels as installed)", cold), ("warm (the same caches again)", warm),
             ("rigid pendulum (models/rigid/solid_pendulum.yaml), warm", rigid)]
+    if args.baseline:
+        rows += [(f"rigid pendulum ({SHARED}), warm, each run beside the warm beam", shared),
+                 (f"the same pendulum on {args.baseline}, warm, each run beside the warm beam", base)]
     lines = [f"# Load + first 0.1 s of a {args.modes}-mode Craig–Bampton beam, new process",
              "",
-             f"`benchmarks/flexible_startup.py --runs {args.runs} --modes {args.modes}`, "
+             f"`benchmarks/flexible_startup.py --runs {args.runs} --modes {args.modes}"
+             f"{f' --baseline {args.baseline}' if args.baseline else ''}`, "
              f"{datetime.date.today()}, {platform.machine()}, {os.cpu_count()} cores (shared: compare within one "
              "table), "
              f"Python {platform.python_version()}. Median of {args.runs} runs; the model is "
@@ -193,6 +233,11 @@ def main():
         collections = statistics.median(x[4] for x in found)
         lines.append(f"| {name} | " + " | ".join(f"{m:.2f}" for m in medians) + f" | {collections:.3f} | "
                      f"{found[0][5]} |")
+    if args.baseline:
+        ratio = statistics.median(w[0] / b[0] for w, b in zip(warm, base))
+        lines += ["", f"The warm beam's process over {args.baseline}'s rigid pendulum process, each pair from one run, "
+                  f"median of {args.runs}: **{ratio:.2f}** (issue 62's target, 1.5 s where a rigid pendulum's process "
+                  "took 1.7 s: 0.88)."]
     lines += ["", f"`mbsynth simulate models/flexible/cantilever.yaml --t-end 1` (4 modes), a new process with warm "
               f"caches, median of {args.runs}: {statistics.median(x[0] for x in cli):.2f} s wall, "
               f"{statistics.median(x[1] for x in cli):.2f} s CPU."]

@@ -107,7 +107,7 @@ def main():
     parser.add_argument("--out", type=Path, default=HERE / "startup_results.md", help="the results table")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
-        repos = [HERE.parent] + ([_baseline(args.baseline, Path(folder))] if args.baseline else [])
+        repos = [HERE.parent] + ([baseline_folder(args.baseline, Path(folder))] if args.baseline else [])
         rows = [measure(repos, *command, args.runs) for command in COMMANDS]
     lines = ["# Start-up", "",
              f"`benchmarks/startup.py --runs {args.runs}{f' --baseline {args.baseline}' if args.baseline else ''}` "
@@ -120,7 +120,7 @@ def main():
     print("\n".join(lines))
 
 
-def _baseline(baseline, folder):
+def baseline_folder(baseline, folder):
     """The folder of the baseline's code: ``baseline`` itself if it is a folder, else that
     commit of this repository extracted into ``folder``."""
     if Path(baseline).is_dir():
