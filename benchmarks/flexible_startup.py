@@ -159,8 +159,10 @@ def timed(path, cache, numba, root=ROOT, **variables):
     env = child_environment(root, MBSYNTH_CACHE_DIR=str(cache), NUMBA_CACHE_DIR=str(numba), **variables)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", CHILD, str(path)], env=env, cwd=root, check=True,
-                         capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-c", CHILD, str(path)], env=env, cwd=root, capture_output=True, text=True,
+                         check=False)
+    if out.returncode:
+        raise RuntimeError(f"{path} on {root} failed ({out.returncode}): {out.stderr[-3000:]}")
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
